@@ -1,0 +1,762 @@
+//! The C edge. Each `fmi2…` function of [`export_fmi2!`](crate::export_fmi2)
+//! calls one function here, which checks the instance pointer against the
+//! live set, the state table, null pointers and lengths, then delegates to
+//! [`Instance`] inside `catch_unwind`.
+
+use crate::ffi::*;
+use crate::instance::Instance;
+use crate::logger::Logger;
+use crate::model::ModelFactory;
+use crate::serialize::Snapshot;
+use crate::state_machine::{is_allowed, State};
+use crate::variables::VarType;
+use std::collections::BTreeSet;
+use std::ffi::CStr;
+use std::os::raw::c_char;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Mutex;
+
+/// Addresses of the instances this library created and has not freed.
+static LIVE: Mutex<BTreeSet<usize>> = Mutex::new(BTreeSet::new());
+/// Larger array lengths are refused outright: no model has that many
+/// variables, and reading that far would only run past the caller's arrays.
+const MAX_ARRAY_LENGTH: usize = 1 << 20;
+
+fn live() -> std::sync::MutexGuard<'static, BTreeSet<usize>> {
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".to_string()
+    }
+}
+
+/// Run `body` on the instance behind `c` if `c` is live and `function` is
+/// allowed in its state. Errors are logged as `function: message`.
+///
+/// # Safety
+/// `c` is only dereferenced if it is in the live set, i.e. was returned by
+/// `fmi2Instantiate` of this library and not yet freed.
+pub unsafe fn call(
+    c: fmi2Component,
+    function: &'static str,
+    body: impl FnOnce(&mut Instance) -> Result<fmi2Status, String>,
+) -> fmi2Status {
+    if c.is_null() || !live().contains(&(c as usize)) {
+        // No instance, so no logger to report to: the status says it.
+        return fmi2Status::fmi2Error;
+    }
+    // SAFETY: c is a live instance created by Box::into_raw in `instantiate`.
+    let instance = unsafe { &mut *(c as *mut Instance) };
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        if !is_allowed(function, instance.state) {
+            instance.logger.error(&format!(
+                "{function}: illegal call sequence: not allowed in state {}",
+                instance.state.name()
+            ));
+            return fmi2Status::fmi2Error;
+        }
+        instance.logger.call(|| format!("{function} (state {}, t = {})", instance.state.name(), instance.time));
+        match body(instance) {
+            Ok(status) => status,
+            Err(message) => {
+                instance.logger.error(&format!("{function}: {message}"));
+                fmi2Status::fmi2Error
+            }
+        }
+    }));
+    outcome.unwrap_or_else(|payload| {
+        let message = panic_message(&*payload);
+        let _ = catch_unwind(AssertUnwindSafe(|| {
+            instance.state = State::Fatal;
+            instance.logger.fatal(&format!("{function}: internal error (panic): {message}"));
+        }));
+        fmi2Status::fmi2Fatal
+    })
+}
+
+/// A read-only C array as a slice; `n == 0` accepts NULL.
+///
+/// # Safety
+/// When non-null, `ptr` must point to `n` readable elements (the FMI
+/// contract); we check null, alignment and a plausible length.
+pub unsafe fn in_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a [T], String> {
+    if n == 0 {
+        return Ok(&[]);
+    }
+    if ptr.is_null() {
+        return Err(format!("argument {what} is NULL but its length is {n}"));
+    }
+    if n > MAX_ARRAY_LENGTH {
+        return Err(format!("length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"));
+    }
+    if !ptr.is_aligned() {
+        return Err(format!("argument {what} = {ptr:p} is not aligned"));
+    }
+    // SAFETY: non-null, aligned, length bounded; validity is the caller's contract.
+    Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
+}
+
+/// A writable C array as a slice; `n == 0` accepts NULL.
+///
+/// # Safety
+/// As [`in_slice`], for `n` writable elements.
+pub unsafe fn out_slice<'a, T>(ptr: *mut T, n: usize, what: &str) -> Result<&'a mut [T], String> {
+    if n == 0 {
+        return Ok(&mut []);
+    }
+    if ptr.is_null() {
+        return Err(format!("argument {what} is NULL but its length is {n}"));
+    }
+    if n > MAX_ARRAY_LENGTH {
+        return Err(format!("length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"));
+    }
+    if !ptr.is_aligned() {
+        return Err(format!("argument {what} = {ptr:p} is not aligned"));
+    }
+    // SAFETY: as above.
+    Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
+}
+
+/// # Safety
+/// `s` is NULL or a NUL-terminated string.
+unsafe fn c_str(s: fmi2String, what: &str) -> Result<String, String> {
+    if s.is_null() {
+        return Err(format!("argument {what} is NULL"));
+    }
+    // SAFETY: non-null and NUL-terminated by the FMI contract.
+    Ok(unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned())
+}
+
+pub fn types_platform() -> *const c_char {
+    TYPES_PLATFORM.as_ptr() as *const c_char
+}
+
+pub fn version() -> *const c_char {
+    VERSION.as_ptr() as *const c_char
+}
+
+/// `fmi2Instantiate`: the GUID picks the model from `registry`.
+///
+/// # Safety
+/// Pointer arguments are NULL or valid per the FMI contract.
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn instantiate(
+    registry: &'static [ModelFactory],
+    instance_name: fmi2String,
+    fmu_type: fmi2Type,
+    guid: fmi2String,
+    _resource_location: fmi2String,
+    functions: *const fmi2CallbackFunctions,
+    _visible: fmi2Boolean,
+    logging_on: fmi2Boolean,
+) -> fmi2Component {
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        if functions.is_null() || !(functions as usize).is_multiple_of(std::mem::align_of::<fmi2CallbackFunctions>()) {
+            return std::ptr::null_mut();
+        }
+        // SAFETY: non-null and aligned; the importer owns it for the call.
+        let functions = unsafe { &*functions };
+        let name = unsafe { c_str(instance_name, "instanceName") };
+        let mut logger = Logger::new(
+            functions.logger,
+            functions.componentEnvironment,
+            name.as_deref().unwrap_or("?"),
+            logging_on != fmi2False,
+        );
+        let name = match name {
+            Ok(n) => n,
+            Err(e) => {
+                logger.error(&format!("fmi2Instantiate: {e}"));
+                return std::ptr::null_mut();
+            }
+        };
+        if fmu_type != fmi2CoSimulation {
+            logger.error(&format!(
+                "fmi2Instantiate: fmuType = {fmu_type} is not supported: this FMU implements Co-Simulation (1) only"
+            ));
+            return std::ptr::null_mut();
+        }
+        let guid = match unsafe { c_str(guid, "fmuGUID") } {
+            Ok(g) => g,
+            Err(e) => {
+                logger.error(&format!("fmi2Instantiate: {e}"));
+                return std::ptr::null_mut();
+            }
+        };
+        let Some(factory) = registry.iter().find(|f| f.info.guid == guid) else {
+            let known: Vec<String> = registry.iter().map(|f| format!("{} {}", f.info.model_name, f.info.guid)).collect();
+            logger.error(&format!(
+                "fmi2Instantiate: unknown fmuGUID {guid}; this binary holds {}",
+                known.join(", ")
+            ));
+            return std::ptr::null_mut();
+        };
+        let instance = Box::new(Instance::new(factory.info, (factory.create)(), &name, logger));
+        let address = Box::into_raw(instance);
+        live().insert(address as usize);
+        address as fmi2Component
+    }));
+    outcome.unwrap_or(std::ptr::null_mut())
+}
+
+/// # Safety
+/// `c` is checked against the live set before use.
+pub unsafe fn free_instance(c: fmi2Component) {
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        if c.is_null() {
+            return;
+        }
+        let removed = live().remove(&(c as usize));
+        if removed {
+            // SAFETY: was live, so it came from Box::into_raw and is freed once.
+            let instance = unsafe { Box::from_raw(c as *mut Instance) };
+            if !is_allowed("fmi2FreeInstance", instance.state) && instance.state != State::Fatal {
+                // Freed anyway: keeping it would leak; nothing else is possible.
+            }
+            drop(instance);
+        }
+    }));
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn set_debug_logging(c: fmi2Component, on: fmi2Boolean, n: usize, categories: *const fmi2String) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SetDebugLogging", |inst| {
+            let cats = in_slice(categories, n, "categories[]")?;
+            if cats.is_empty() {
+                inst.logger.set_all(on != fmi2False);
+                return Ok(fmi2Status::fmi2OK);
+            }
+            let names = cats
+                .iter()
+                .enumerate()
+                .map(|(i, s)| c_str(*s, &format!("categories[{i}]")))
+                .collect::<Result<Vec<_>, _>>()?;
+            inst.logger.set_categories(on != fmi2False, &names)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`].
+pub unsafe fn setup_experiment(
+    c: fmi2Component,
+    _tolerance_defined: fmi2Boolean,
+    _tolerance: f64,
+    start: f64,
+    stop_defined: fmi2Boolean,
+    stop: f64,
+) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SetupExperiment", |inst| {
+            inst.setup_experiment(start, (stop_defined != fmi2False).then_some(stop))?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+macro_rules! simple_call {
+    ($fn_name:ident, $fmi:literal, $method:ident) => {
+        /// # Safety
+        /// See [`call`].
+        pub unsafe fn $fn_name(c: fmi2Component) -> fmi2Status {
+            unsafe { call(c, $fmi, |inst| inst.$method().map(|_| fmi2Status::fmi2OK)) }
+        }
+    };
+}
+simple_call!(enter_initialization_mode, "fmi2EnterInitializationMode", enter_initialization_mode);
+simple_call!(exit_initialization_mode, "fmi2ExitInitializationMode", exit_initialization_mode);
+simple_call!(terminate, "fmi2Terminate", terminate);
+simple_call!(reset, "fmi2Reset", reset);
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn get_real(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *mut f64) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2GetReal", |inst| {
+            let vrs = in_slice(vr, n, "vr[]")?;
+            let out = out_slice(value, n, "value[]")?;
+            inst.get(VarType::Real, vrs, out)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn get_integer(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *mut fmi2Integer) -> fmi2Status {
+    unsafe { get_converted(c, "fmi2GetInteger", VarType::Integer, vr, n, value, |x| x as fmi2Integer) }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn get_boolean(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *mut fmi2Boolean) -> fmi2Status {
+    unsafe { get_converted(c, "fmi2GetBoolean", VarType::Boolean, vr, n, value, |x| (x != 0.0) as fmi2Boolean) }
+}
+
+unsafe fn get_converted<T>(
+    c: fmi2Component,
+    function: &'static str,
+    t: VarType,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *mut T,
+    convert: fn(f64) -> T,
+) -> fmi2Status {
+    unsafe {
+        call(c, function, |inst| {
+            let vrs = in_slice(vr, n, "vr[]")?;
+            let out = out_slice(value, n, "value[]")?;
+            let mut tmp = vec![0.0; n];
+            inst.get(t, vrs, &mut tmp)?;
+            for (o, x) in out.iter_mut().zip(tmp) {
+                *o = convert(x);
+            }
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// These models have no String variables: any value reference is refused.
+///
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn get_or_set_string(c: fmi2Component, function: &'static str, vr: *const fmi2ValueReference, n: usize, value: *const fmi2String) -> fmi2Status {
+    unsafe {
+        call(c, function, |inst| {
+            let vrs = in_slice(vr, n, "vr[]")?;
+            in_slice(value, n, "value[]")?;
+            if let Some(first) = vrs.first() {
+                let what = match inst.info.variable(*first) {
+                    Some(v) => format!("value reference {first} ({}) is not a String variable", v.name),
+                    None => format!("unknown value reference {first}"),
+                };
+                return Err(format!("{what}: {} has no String variables", inst.info.model_name));
+            }
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn set_real(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *const f64) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SetReal", |inst| {
+            let vrs = in_slice(vr, n, "vr[]")?;
+            let values = in_slice(value, n, "value[]")?;
+            inst.set(VarType::Real, vrs, values)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn set_integer(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *const fmi2Integer) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SetInteger", |inst| {
+            let vrs = in_slice(vr, n, "vr[]")?;
+            let values: Vec<f64> = in_slice(value, n, "value[]")?.iter().map(|x| *x as f64).collect();
+            inst.set(VarType::Integer, vrs, &values)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn set_boolean(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *const fmi2Boolean) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SetBoolean", |inst| {
+            let vrs = in_slice(vr, n, "vr[]")?;
+            let values: Vec<f64> =
+                in_slice(value, n, "value[]")?.iter().map(|x| if *x != 0 { 1.0 } else { 0.0 }).collect();
+            inst.set(VarType::Boolean, vrs, &values)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`]; `state` is NULL or points to an `fmi2FMUstate`.
+pub unsafe fn get_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2GetFMUstate", |inst| {
+            let slot = out_slice(state, 1, "FMUstate")?;
+            let reuse = slot[0] as usize;
+            if reuse != 0 {
+                inst.saved_snapshot(reuse)?;
+            }
+            let snap = inst.snapshot()?;
+            slot[0] = inst.store_snapshot(snap, reuse) as fmi2FMUstate;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`]; `state` is checked against this instance's saved states.
+pub unsafe fn set_fmu_state(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SetFMUstate", |inst| {
+            if state.is_null() {
+                return Err("argument FMUstate is NULL".into());
+            }
+            let snap = inst.saved_snapshot(state as usize)?.clone();
+            inst.restore(&snap)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`]; `state` is NULL or points to an `fmi2FMUstate`.
+pub unsafe fn free_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2FreeFMUstate", |inst| {
+            let slot = out_slice(state, 1, "FMUstate")?;
+            if slot[0].is_null() {
+                return Ok(fmi2Status::fmi2OK);
+            }
+            inst.free_snapshot(slot[0] as usize)?;
+            slot[0] = std::ptr::null_mut();
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`].
+pub unsafe fn serialized_fmu_state_size(c: fmi2Component, state: fmi2FMUstate, size: *mut usize) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SerializedFMUstateSize", |inst| {
+            let out = out_slice(size, 1, "size")?;
+            out[0] = inst.saved_snapshot(state as usize)?.to_bytes().len();
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`out_slice`].
+pub unsafe fn serialize_fmu_state(c: fmi2Component, state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SerializeFMUstate", |inst| {
+            let data = inst.saved_snapshot(state as usize)?.to_bytes();
+            if size != data.len() {
+                return Err(format!(
+                    "size = {size} but the serialized state is {} bytes (ask fmi2SerializedFMUstateSize)",
+                    data.len()
+                ));
+            }
+            let out = out_slice(bytes as *mut u8, size, "serializedState[]")?;
+            out.copy_from_slice(&data);
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn deserialize_fmu_state(c: fmi2Component, bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2DeSerializeFMUstate", |inst| {
+            let slot = out_slice(state, 1, "FMUstate")?;
+            let reuse = slot[0] as usize;
+            if reuse != 0 {
+                inst.saved_snapshot(reuse)?;
+            }
+            let data = in_slice(bytes as *const u8, size, "serializedState[]")?;
+            let snap = Snapshot::from_bytes(data, inst.info.guid, inst.n_values())?;
+            slot[0] = inst.store_snapshot(snap, reuse) as fmi2FMUstate;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn get_directional_derivative(
+    c: fmi2Component,
+    unknown: *const fmi2ValueReference,
+    n_unknown: usize,
+    known: *const fmi2ValueReference,
+    n_known: usize,
+    dv_known: *const f64,
+    dv_unknown: *mut f64,
+) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2GetDirectionalDerivative", |inst| {
+            let unknowns = in_slice(unknown, n_unknown, "vUnknown_ref[]")?;
+            let knowns = in_slice(known, n_known, "vKnown_ref[]")?;
+            let seeds = in_slice(dv_known, n_known, "dvKnown[]")?;
+            let out = out_slice(dv_unknown, n_unknown, "dvUnknown[]")?;
+            inst.directional_derivative(unknowns, knowns, seeds, out)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn set_real_input_derivatives(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    order: *const fmi2Integer,
+    value: *const f64,
+) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2SetRealInputDerivatives", |inst| {
+            let vrs = in_slice(vr, n, "vr[]")?;
+            let orders = in_slice(order, n, "order[]")?;
+            let values = in_slice(value, n, "value[]")?;
+            inst.set_input_derivatives(vrs, orders, values)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn get_real_output_derivatives(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    order: *const fmi2Integer,
+    value: *mut f64,
+) -> fmi2Status {
+    unsafe {
+        call(c, "fmi2GetRealOutputDerivatives", |inst| {
+            let vrs = in_slice(vr, n, "vr[]")?;
+            let orders = in_slice(order, n, "order[]")?;
+            let out = out_slice(value, n, "value[]")?;
+            inst.get_output_derivatives(vrs, orders, out)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call`].
+pub unsafe fn do_step(c: fmi2Component, t: f64, h: f64, _no_set_prior: fmi2Boolean) -> fmi2Status {
+    unsafe { call(c, "fmi2DoStep", |inst| inst.do_step(t, h)) }
+}
+
+/// # Safety
+/// See [`call`].
+pub unsafe fn cancel_step(c: fmi2Component) -> fmi2Status {
+    // Allowed only in StepInProgress, which this FMU never enters (it never
+    // returns fmi2Pending); `call` reports the illegal call.
+    unsafe { call(c, "fmi2CancelStep", |_| Ok(fmi2Status::fmi2OK)) }
+}
+
+/// `fmi2Get*Status`. Only `fmi2LastSuccessfulTime` (Real) and
+/// `fmi2Terminated` (Boolean) are meaningful for an FMU that never returns
+/// `fmi2Pending` or `fmi2Discard`; other kinds give `fmi2Discard`.
+///
+/// # Safety
+/// See [`call`] and [`out_slice`].
+pub unsafe fn get_status<T: Copy>(
+    c: fmi2Component,
+    function: &'static str,
+    kind: fmi2StatusKind,
+    value: *mut T,
+    answer: impl FnOnce(&Instance, fmi2StatusKind) -> Option<T>,
+) -> fmi2Status {
+    unsafe {
+        call(c, function, |inst| {
+            let out = out_slice(value, 1, "value")?;
+            match answer(inst, kind) {
+                Some(v) => {
+                    out[0] = v;
+                    Ok(fmi2Status::fmi2OK)
+                }
+                None => {
+                    inst.logger.warning(&format!(
+                        "{function}: status kind {kind} is not available: this FMU completes every step synchronously"
+                    ));
+                    Ok(fmi2Status::fmi2Discard)
+                }
+            }
+        })
+    }
+}
+
+
+/// Emit every FMI 2.0 Co-Simulation function for the models in `registry`
+/// (an expression of type `&'static [ModelFactory]`). Invoke once in a cdylib.
+#[macro_export]
+macro_rules! export_fmi2 {
+    ($registry:expr) => {
+        mod fmi2_exports {
+            #![allow(non_snake_case, clippy::missing_safety_doc)]
+            use super::*;
+            use std::os::raw::c_char;
+            use $crate::exports as x;
+            use $crate::ffi::*;
+
+            #[no_mangle]
+            pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
+                x::types_platform()
+            }
+            #[no_mangle]
+            pub extern "C" fn fmi2GetVersion() -> *const c_char {
+                x::version()
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetDebugLogging(c: fmi2Component, on: fmi2Boolean, n: usize, cats: *const fmi2String) -> fmi2Status {
+                unsafe { x::set_debug_logging(c, on, n, cats) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2Instantiate(
+                name: fmi2String,
+                fmu_type: fmi2Type,
+                guid: fmi2String,
+                resources: fmi2String,
+                functions: *const fmi2CallbackFunctions,
+                visible: fmi2Boolean,
+                logging_on: fmi2Boolean,
+            ) -> fmi2Component {
+                unsafe { x::instantiate($registry, name, fmu_type, guid, resources, functions, visible, logging_on) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
+                unsafe { x::free_instance(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetupExperiment(c: fmi2Component, tol_defined: fmi2Boolean, tol: f64, start: f64, stop_defined: fmi2Boolean, stop: f64) -> fmi2Status {
+                unsafe { x::setup_experiment(c, tol_defined, tol, start, stop_defined, stop) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
+                unsafe { x::enter_initialization_mode(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
+                unsafe { x::exit_initialization_mode(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
+                unsafe { x::terminate(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
+                unsafe { x::reset(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetReal(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Real) -> fmi2Status {
+                unsafe { x::get_real(c, vr, n, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetInteger(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Integer) -> fmi2Status {
+                unsafe { x::get_integer(c, vr, n, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetBoolean(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Boolean) -> fmi2Status {
+                unsafe { x::get_boolean(c, vr, n, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetString(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2String) -> fmi2Status {
+                unsafe { x::get_or_set_string(c, "fmi2GetString", vr, n, v as *const fmi2String) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetReal(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Real) -> fmi2Status {
+                unsafe { x::set_real(c, vr, n, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetInteger(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Integer) -> fmi2Status {
+                unsafe { x::set_integer(c, vr, n, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetBoolean(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Boolean) -> fmi2Status {
+                unsafe { x::set_boolean(c, vr, n, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetString(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2String) -> fmi2Status {
+                unsafe { x::get_or_set_string(c, "fmi2SetString", vr, n, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
+                unsafe { x::get_fmu_state(c, s) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, s: fmi2FMUstate) -> fmi2Status {
+                unsafe { x::set_fmu_state(c, s) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2FreeFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
+                unsafe { x::free_fmu_state(c, s) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: fmi2Component, s: fmi2FMUstate, size: *mut usize) -> fmi2Status {
+                unsafe { x::serialized_fmu_state_size(c, s, size) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SerializeFMUstate(c: fmi2Component, s: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) -> fmi2Status {
+                unsafe { x::serialize_fmu_state(c, s, bytes, size) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2DeSerializeFMUstate(c: fmi2Component, bytes: *const fmi2Byte, size: usize, s: *mut fmi2FMUstate) -> fmi2Status {
+                unsafe { x::deserialize_fmu_state(c, bytes, size, s) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
+                c: fmi2Component,
+                unknown: *const fmi2ValueReference,
+                n_unknown: usize,
+                known: *const fmi2ValueReference,
+                n_known: usize,
+                dv_known: *const fmi2Real,
+                dv_unknown: *mut fmi2Real,
+            ) -> fmi2Status {
+                unsafe { x::get_directional_derivative(c, unknown, n_unknown, known, n_known, dv_known, dv_unknown) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetRealInputDerivatives(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, order: *const fmi2Integer, v: *const fmi2Real) -> fmi2Status {
+                unsafe { x::set_real_input_derivatives(c, vr, n, order, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, order: *const fmi2Integer, v: *mut fmi2Real) -> fmi2Status {
+                unsafe { x::get_real_output_derivatives(c, vr, n, order, v) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2DoStep(c: fmi2Component, t: fmi2Real, h: fmi2Real, no_set_prior: fmi2Boolean) -> fmi2Status {
+                unsafe { x::do_step(c, t, h, no_set_prior) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
+                unsafe { x::cancel_step(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2Status) -> fmi2Status {
+                unsafe { x::get_status(c, "fmi2GetStatus", kind, v, |_, k| (k == fmi2DoStepStatus).then_some(fmi2Status::fmi2OK)) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetRealStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2Real) -> fmi2Status {
+                unsafe { x::get_status(c, "fmi2GetRealStatus", kind, v, |i, k| (k == fmi2LastSuccessfulTime).then_some(i.time)) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetIntegerStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2Integer) -> fmi2Status {
+                unsafe { x::get_status(c, "fmi2GetIntegerStatus", kind, v, |_, _| None) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetBooleanStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2Boolean) -> fmi2Status {
+                unsafe { x::get_status(c, "fmi2GetBooleanStatus", kind, v, |_, k| (k == fmi2Terminated).then_some(fmi2False)) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetStringStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2String) -> fmi2Status {
+                unsafe { x::get_status(c, "fmi2GetStringStatus", kind, v, |_, _| None) }
+            }
+        }
+    };
+}

@@ -1,0 +1,504 @@
+//! One FMU instance: the FMI 2.0 CS semantics in safe Rust. Every method
+//! returns `Result`; the message names the problem and the value, and the C
+//! edge (`exports`) prefixes the function name and logs it.
+//!
+//! Errors caused by the caller's arguments (an unknown value reference, NaN,
+//! a wrong communication point, …) change nothing: the instance stays in its
+//! state and can be used further. Only a failure inside a model step moves it
+//! to `Error`, and a panic to `Fatal`.
+
+use crate::ffi::fmi2Status;
+use crate::logger::Logger;
+use crate::model::Model;
+use crate::serialize::Snapshot;
+use crate::state_machine::State;
+use crate::variables::{Causality, ModelInfo, VarType, Variable};
+use crate::Values;
+use std::collections::HashMap;
+
+/// Relative tolerance on communication points (time is taken from the
+/// master at every step, never summed inside the FMU).
+const TIME_TOLERANCE: f64 = 1e-9;
+/// Relative size of finite-difference perturbations, times the larger of
+/// |u| and the input's nominal value.
+const FD_RELATIVE_STEP: f64 = 1e-6;
+
+pub struct Instance {
+    pub info: &'static ModelInfo,
+    pub name: String,
+    pub logger: Logger,
+    pub state: State,
+    model: Box<dyn Model>,
+    values: Values,
+    /// `du/dt` per value reference (non-zero for inputs only).
+    slopes: Vec<f64>,
+    outputs_dirty: bool,
+    initialized: bool,
+    pub time: f64,
+    start_time: f64,
+    stop_time: Option<f64>,
+    /// The last step, kept for directional derivatives: the state, inputs
+    /// and slopes before it, and its length. Valid until an input changes.
+    replay: Replay,
+    /// FMU states handed out by `fmi2GetFMUstate` / `fmi2DeSerializeFMUstate`,
+    /// by address, so that a pointer we did not create is refused.
+    saved_states: HashMap<usize, Box<Snapshot>>,
+}
+
+struct Replay {
+    valid: bool,
+    model_state: Vec<f64>,
+    values: Vec<f64>,
+    slopes: Vec<f64>,
+    h: f64,
+}
+
+fn type_name(t: VarType) -> &'static str {
+    match t {
+        VarType::Real => "Real",
+        VarType::Integer => "Integer",
+        VarType::Boolean => "Boolean",
+    }
+}
+
+impl Instance {
+    pub fn new(info: &'static ModelInfo, model: Box<dyn Model>, name: &str, logger: Logger) -> Self {
+        let values = Values::from_start(info.variables);
+        let n = values.len();
+        Instance {
+            info,
+            name: name.to_string(),
+            logger,
+            state: State::Instantiated,
+            model,
+            values,
+            slopes: vec![0.0; n],
+            outputs_dirty: true,
+            initialized: false,
+            time: 0.0,
+            start_time: 0.0,
+            stop_time: None,
+            replay: Replay {
+                valid: false,
+                model_state: Vec::new(),
+                values: vec![0.0; n],
+                slopes: vec![0.0; n],
+                h: 0.0,
+            },
+            saved_states: HashMap::new(),
+        }
+    }
+
+    fn variable(&self, vr: u32) -> Result<&'static Variable, String> {
+        self.info.variable(vr).ok_or_else(|| {
+            format!(
+                "unknown value reference {vr} ({} has value references 0..={})",
+                self.info.model_name,
+                self.info.variables.len().saturating_sub(1)
+            )
+        })
+    }
+
+    fn variable_of_type(&self, vr: u32, t: VarType) -> Result<&'static Variable, String> {
+        let v = self.variable(vr)?;
+        if v.var_type != t {
+            return Err(format!(
+                "value reference {vr} ({}) is a {} variable, not {}",
+                v.name,
+                type_name(v.var_type),
+                type_name(t)
+            ));
+        }
+        Ok(v)
+    }
+
+    // ---- set-up ---------------------------------------------------------
+
+    pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), String> {
+        if !start.is_finite() {
+            return Err(format!("startTime must be finite but was {start}"));
+        }
+        if let Some(stop) = stop {
+            if !(stop.is_finite() && stop >= start) {
+                return Err(format!("stopTime must be finite and >= startTime = {start} but was {stop}"));
+            }
+        }
+        self.start_time = start;
+        self.time = start;
+        self.stop_time = stop;
+        Ok(())
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> Result<(), String> {
+        self.state = State::InitializationMode;
+        self.time = self.start_time;
+        self.outputs_dirty = true;
+        Ok(())
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> Result<(), String> {
+        self.model.initialize(&self.values)?;
+        self.model.compute_outputs(&mut self.values);
+        self.outputs_dirty = false;
+        self.initialized = true;
+        self.replay.valid = false;
+        self.state = State::StepComplete;
+        Ok(())
+    }
+
+    pub fn terminate(&mut self) -> Result<(), String> {
+        self.state = State::Terminated;
+        Ok(())
+    }
+
+    pub fn reset(&mut self) -> Result<(), String> {
+        self.values = Values::from_start(self.info.variables);
+        self.slopes.iter_mut().for_each(|s| *s = 0.0);
+        self.outputs_dirty = true;
+        self.initialized = false;
+        self.replay.valid = false;
+        self.time = 0.0;
+        self.start_time = 0.0;
+        self.stop_time = None;
+        self.state = State::Instantiated;
+        Ok(())
+    }
+
+    /// Recompute the outputs if an input or parameter changed since the last
+    /// computation. In initialization mode this validates the parameters.
+    fn ensure_outputs(&mut self) -> Result<(), String> {
+        if self.outputs_dirty {
+            if !self.initialized {
+                self.model.initialize(&self.values)?;
+            }
+            self.model.compute_outputs(&mut self.values);
+            self.outputs_dirty = false;
+        }
+        Ok(())
+    }
+
+    // ---- get / set ------------------------------------------------------
+
+    /// Read values of type `t` into `out` (already checked: same length).
+    pub fn get(&mut self, t: VarType, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
+        for vr in vrs {
+            self.variable_of_type(*vr, t)?;
+        }
+        let wants_outputs = vrs.iter().any(|vr| self.info.variables[*vr as usize].causality == Causality::Output);
+        if wants_outputs {
+            self.ensure_outputs()?;
+        }
+        for (o, vr) in out.iter_mut().zip(vrs) {
+            *o = self.values.real(*vr);
+        }
+        Ok(())
+    }
+
+    /// Check, then set, values of type `t`: all or nothing.
+    pub fn set(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
+        let in_step_mode = self.state == State::StepComplete;
+        for (vr, value) in vrs.iter().zip(values) {
+            let v = self.variable_of_type(*vr, t)?;
+            let allowed = if in_step_mode { v.settable_in_step_mode() } else { v.settable_before_init() };
+            if !allowed {
+                let what = match v.causality {
+                    Causality::Output => "an output".to_string(),
+                    Causality::Parameter => "a fixed parameter, which cannot change after initialization".to_string(),
+                    _ => format!("{:?}", v.causality).to_lowercase(),
+                };
+                return Err(format!(
+                    "cannot set {} (value reference {vr}) in state {}: it is {what}",
+                    v.name,
+                    self.state.name()
+                ));
+            }
+            if !value.is_finite() {
+                return Err(format!("{} (value reference {vr}) must be finite but was {value}", v.name));
+            }
+            if v.causality == Causality::Input {
+                self.model
+                    .check_input(*vr, *value)
+                    .map_err(|e| format!("{} (value reference {vr}) = {value}: {e}", v.name))?;
+            }
+        }
+        for (vr, value) in vrs.iter().zip(values) {
+            if self.values.real(*vr) != *value || self.info.variables[*vr as usize].causality != Causality::Input {
+                self.replay.valid = false;
+            }
+            self.values.set(*vr, *value);
+        }
+        if !vrs.is_empty() {
+            self.outputs_dirty = true;
+        }
+        Ok(())
+    }
+
+    pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], slopes: &[f64]) -> Result<(), String> {
+        for ((vr, order), slope) in vrs.iter().zip(orders).zip(slopes) {
+            let v = self.variable_of_type(*vr, VarType::Real)?;
+            if v.causality != Causality::Input {
+                return Err(format!("{} (value reference {vr}) is not an input", v.name));
+            }
+            if *order != 1 {
+                return Err(format!(
+                    "derivative order {order} for {} is not supported (only order 1: inputs are interpolated linearly)",
+                    v.name
+                ));
+            }
+            if !slope.is_finite() {
+                return Err(format!("derivative of {} must be finite but was {slope}", v.name));
+            }
+        }
+        for (vr, slope) in vrs.iter().zip(slopes) {
+            self.slopes[*vr as usize] = *slope;
+        }
+        if !vrs.is_empty() {
+            self.replay.valid = false;
+        }
+        Ok(())
+    }
+
+    pub fn get_output_derivatives(&mut self, vrs: &[u32], orders: &[i32], out: &mut [f64]) -> Result<(), String> {
+        let max_order = self.info.capabilities.max_output_derivative_order as i32;
+        for (vr, order) in vrs.iter().zip(orders) {
+            let v = self.variable_of_type(*vr, VarType::Real)?;
+            if v.causality != Causality::Output {
+                return Err(format!("{} (value reference {vr}) is not an output", v.name));
+            }
+            if *order < 1 || *order > max_order {
+                return Err(format!("derivative order {order} for {} is outside 1..={max_order}", v.name));
+            }
+        }
+        self.ensure_outputs()?;
+        for (o, vr) in out.iter_mut().zip(vrs) {
+            *o = self.model.output_derivative(&self.values, &self.slopes, *vr).ok_or_else(|| {
+                format!("{} has no time derivative in this model", self.info.variables[*vr as usize].name)
+            })?;
+        }
+        Ok(())
+    }
+
+    // ---- stepping -------------------------------------------------------
+
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<fmi2Status, String> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(format!("communicationStepSize must be finite and > 0 but was {h}"));
+        }
+        let tolerance = TIME_TOLERANCE * self.time.abs().max(1.0);
+        if !t.is_finite() || (t - self.time).abs() > tolerance {
+            return Err(format!(
+                "expected currentCommunicationPoint = {} but was {t} (difference {:e})",
+                self.time,
+                t - self.time
+            ));
+        }
+        if self.model.needs_step_replay() {
+            self.replay.model_state.clear();
+            self.model.save_state(&mut self.replay.model_state);
+            self.replay.values.copy_from_slice(self.values.as_slice());
+            self.replay.slopes.copy_from_slice(&self.slopes);
+            self.replay.h = h;
+        }
+        if let Err(e) = self.model.do_step(&self.values, &self.slopes, h) {
+            self.state = State::Error;
+            return Err(format!("step from t = {t} over h = {h} failed: {e}"));
+        }
+        // Inputs as the FMU saw them at the end of the step (u + du·h); the
+        // slopes apply to one step only.
+        advance_inputs(self.info, &mut self.values, &mut self.slopes, h);
+        self.replay.valid = self.model.needs_step_replay();
+        self.time = t + h;
+        self.outputs_dirty = true;
+        Ok(fmi2Status::fmi2OK)
+    }
+
+    // ---- directional derivatives ----------------------------------------
+
+    /// `dv_unknown = J · dv_known` with J = ∂outputs/∂inputs.
+    ///
+    /// Right after `fmi2DoStep` (no input changed since) J is the
+    /// sensitivity of the outputs at the new communication point to the
+    /// inputs held over that step, state change included: what a strongly
+    /// coupled master needs. Otherwise (before the first step, or after new
+    /// inputs were set) it is the direct-feedthrough derivative at the
+    /// current state. A model may supply J itself; else it is obtained by
+    /// central differences along `dv_known`, replaying the step from the
+    /// saved pre-step state.
+    pub fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        for vr in unknowns {
+            let v = self.variable_of_type(*vr, VarType::Real)?;
+            if v.causality != Causality::Output {
+                return Err(format!("unknown {} (value reference {vr}) is not an output", v.name));
+            }
+        }
+        for (vr, dv) in knowns.iter().zip(dv_known) {
+            let v = self.variable_of_type(*vr, VarType::Real)?;
+            if v.causality != Causality::Input {
+                return Err(format!("known {} (value reference {vr}) is not an input", v.name));
+            }
+            if !dv.is_finite() {
+                return Err(format!("seed dvKnown for {} must be finite but was {dv}", v.name));
+            }
+        }
+        self.ensure_outputs()?;
+
+        // Analytic where the model provides every entry.
+        let analytic: Option<Vec<f64>> = unknowns
+            .iter()
+            .map(|u| {
+                knowns.iter().zip(dv_known).try_fold(0.0, |acc, (k, dv)| {
+                    self.model.partial_derivative(&self.values, *u, *k).map(|d| acc + d * dv)
+                })
+            })
+            .collect();
+        if let Some(j) = analytic {
+            dv_unknown.copy_from_slice(&j);
+            return Ok(());
+        }
+
+        // Perturbation ε along dv_known, sized so that no input moves by more
+        // than FD_RELATIVE_STEP of its scale.
+        let mut eps = f64::INFINITY;
+        for (k, dv) in knowns.iter().zip(dv_known) {
+            if *dv != 0.0 {
+                let v = &self.info.variables[*k as usize];
+                let scale = self.values.real(*k).abs().max(v.nominal.unwrap_or(1.0));
+                eps = eps.min(FD_RELATIVE_STEP * scale / dv.abs());
+            }
+        }
+        if !eps.is_finite() {
+            dv_unknown.iter_mut().for_each(|d| *d = 0.0);
+            return Ok(());
+        }
+        let plus = self.perturbed_outputs(knowns, dv_known, eps, unknowns)?;
+        let minus = self.perturbed_outputs(knowns, dv_known, -eps, unknowns)?;
+        for ((d, p), m) in dv_unknown.iter_mut().zip(&plus).zip(&minus) {
+            *d = (p - m) / (2.0 * eps);
+        }
+        Ok(())
+    }
+
+    fn perturbed_outputs(&self, knowns: &[u32], dv: &[f64], eps: f64, unknowns: &[u32]) -> Result<Vec<f64>, String> {
+        let mut values = self.values.clone();
+        if self.replay.valid {
+            let mut model = self.model.clone_model();
+            model.restore_state(&self.replay.model_state)?;
+            values.copy_from_slice(&self.replay.values);
+            for (k, d) in knowns.iter().zip(dv) {
+                values.set(*k, values.real(*k) + eps * d);
+            }
+            let mut slopes = self.replay.slopes.clone();
+            model.do_step(&values, &slopes, self.replay.h)?;
+            advance_inputs(self.info, &mut values, &mut slopes, self.replay.h);
+            model.compute_outputs(&mut values);
+        } else {
+            for (k, d) in knowns.iter().zip(dv) {
+                values.set(*k, values.real(*k) + eps * d);
+            }
+            self.model.compute_outputs(&mut values);
+        }
+        Ok(unknowns.iter().map(|u| values.real(*u)).collect())
+    }
+
+    // ---- FMU states -----------------------------------------------------
+
+    pub fn snapshot(&mut self) -> Result<Snapshot, String> {
+        self.ensure_outputs()?;
+        let mut model_state = Vec::new();
+        if self.initialized {
+            self.model.save_state(&mut model_state);
+        }
+        Ok(Snapshot {
+            guid: self.info.guid.to_string(),
+            state: self.state,
+            initialized: self.initialized,
+            time: self.time,
+            values: self.values.as_slice().to_vec(),
+            slopes: self.slopes.clone(),
+            model_state,
+        })
+    }
+
+    pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
+        if snap.guid != self.info.guid || snap.values.len() != self.values.len() {
+            return Err(format!("the FMU state belongs to GUID {}, not this FMU ({})", snap.guid, self.info.guid));
+        }
+        let previous = self.values.clone();
+        self.values.copy_from_slice(&snap.values);
+        if snap.initialized {
+            let same_parameters = self.initialized
+                && self.info.variables.iter().all(|v| {
+                    v.causality != Causality::Parameter || previous.real(v.vr) == snap.values[v.vr as usize]
+                });
+            let result = if same_parameters { Ok(()) } else { self.model.initialize(&self.values) }
+                .and_then(|_| self.model.restore_state(&snap.model_state));
+            if let Err(e) = result {
+                // Lose nothing: put the previous values and model back.
+                self.values = previous;
+                if self.initialized {
+                    let _ = self.model.initialize(&self.values);
+                }
+                return Err(format!("cannot restore the FMU state: {e}"));
+            }
+        }
+        self.slopes.copy_from_slice(&snap.slopes);
+        self.initialized = snap.initialized;
+        self.time = snap.time;
+        self.state = snap.state;
+        self.replay.valid = false;
+        self.outputs_dirty = true;
+        Ok(())
+    }
+
+    /// Keep a snapshot and return its address (the `fmi2FMUstate`).
+    pub fn store_snapshot(&mut self, snap: Snapshot, reuse: usize) -> usize {
+        if let Some(existing) = self.saved_states.get_mut(&reuse) {
+            **existing = snap;
+            return reuse;
+        }
+        let mut boxed = Box::new(snap);
+        let address = &mut *boxed as *mut Snapshot as usize;
+        self.saved_states.insert(address, boxed);
+        address
+    }
+
+    pub fn saved_snapshot(&self, address: usize) -> Result<&Snapshot, String> {
+        self.saved_states.get(&address).map(|b| &**b).ok_or_else(|| {
+            format!("FMUstate {address:#x} was not created by this instance (or was already freed)")
+        })
+    }
+
+    pub fn free_snapshot(&mut self, address: usize) -> Result<(), String> {
+        self.saved_states
+            .remove(&address)
+            .map(|_| ())
+            .ok_or_else(|| format!("FMUstate {address:#x} was not created by this instance (or was already freed)"))
+    }
+
+    pub fn n_values(&self) -> usize {
+        self.values.len()
+    }
+
+    pub fn values(&self) -> &Values {
+        &self.values
+    }
+}
+
+/// After a step of length `h`, inputs stand at `u + du·h`; slopes reset.
+fn advance_inputs(info: &ModelInfo, values: &mut Values, slopes: &mut [f64], h: f64) {
+    for v in info.variables {
+        if v.causality == Causality::Input {
+            let s = &mut slopes[v.vr as usize];
+            if *s != 0.0 {
+                values.set(v.vr, values.real(v.vr) + *s * h);
+                *s = 0.0;
+            }
+        }
+    }
+}

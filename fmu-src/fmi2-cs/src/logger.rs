@@ -1,0 +1,128 @@
+//! Messages to the importer's logger, by category, honouring `loggingOn`
+//! and `fmi2SetDebugLogging`.
+
+use crate::ffi::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
+use crate::variables::LOG_CATEGORIES;
+use std::ffi::CString;
+
+pub struct Logger {
+    callback: fmi2CallbackLogger,
+    environment: fmi2ComponentEnvironment,
+    instance_name: CString,
+    /// One flag per entry of [`LOG_CATEGORIES`].
+    enabled: [bool; 4],
+    /// The last message of status Error or Fatal (for tests and for the
+    /// host's reports; the importer receives it through the callback).
+    pub last_error: Option<String>,
+}
+
+// The environment pointer belongs to the importer, which guarantees that it
+// may be used from the thread that calls into the instance.
+unsafe impl Send for Logger {}
+
+pub const CATEGORY_ERROR: usize = 0;
+pub const CATEGORY_FATAL: usize = 1;
+pub const CATEGORY_WARNING: usize = 2;
+pub const CATEGORY_CALLS: usize = 3;
+
+impl Logger {
+    pub fn new(
+        callback: fmi2CallbackLogger,
+        environment: fmi2ComponentEnvironment,
+        instance_name: &str,
+        logging_on: bool,
+    ) -> Self {
+        let mut logger = Logger {
+            callback,
+            environment,
+            instance_name: to_cstring(instance_name),
+            enabled: [true, true, false, false],
+            last_error: None,
+        };
+        logger.set_all(logging_on);
+        logger
+    }
+
+    /// `loggingOn` with no categories: errors always stay on (they are not
+    /// debug logging), the debug categories follow the flag.
+    pub fn set_all(&mut self, on: bool) {
+        self.enabled[CATEGORY_WARNING] = on;
+        self.enabled[CATEGORY_CALLS] = on;
+    }
+
+    /// `fmi2SetDebugLogging` with explicit categories: each named category
+    /// (including the error ones) is switched to `on`.
+    pub fn set_categories(&mut self, on: bool, categories: &[String]) -> Result<(), String> {
+        let mut indices = Vec::with_capacity(categories.len());
+        for c in categories {
+            match LOG_CATEGORIES.iter().position(|(name, _)| name == c) {
+                Some(i) => indices.push(i),
+                None => {
+                    let known: Vec<&str> = LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
+                    return Err(format!("unknown log category \"{c}\" (known: {})", known.join(", ")));
+                }
+            }
+        }
+        for i in indices {
+            self.enabled[i] = on;
+        }
+        Ok(())
+    }
+
+    pub fn is_enabled(&self, category: usize) -> bool {
+        self.enabled[category]
+    }
+
+    pub fn log(&mut self, status: fmi2Status, category: usize, message: &str) {
+        if matches!(status, fmi2Status::fmi2Error | fmi2Status::fmi2Fatal) {
+            self.last_error = Some(message.to_string());
+        }
+        if !self.enabled[category] {
+            return;
+        }
+        if let Some(callback) = self.callback {
+            let category_c = to_cstring(LOG_CATEGORIES[category].0);
+            // The message is the format string, with every '%' doubled: C
+            // importers that run it through vsnprintf print it unchanged, and
+            // importers that print it as is (FMPy's ctypes logger is not
+            // variadic) show it readable. No argument is ever consumed.
+            let message_c = to_cstring(&message.replace('%', "%%"));
+            // SAFETY: the importer supplied this callback for exactly this
+            // use; every string is NUL-terminated and outlives the call, and
+            // the format contains no conversion that would read an argument.
+            unsafe {
+                callback(
+                    self.environment,
+                    self.instance_name.as_ptr(),
+                    status as i32,
+                    category_c.as_ptr(),
+                    message_c.as_ptr(),
+                );
+            }
+        }
+    }
+
+    pub fn error(&mut self, message: &str) {
+        self.log(fmi2Status::fmi2Error, CATEGORY_ERROR, message);
+    }
+
+    pub fn fatal(&mut self, message: &str) {
+        self.log(fmi2Status::fmi2Fatal, CATEGORY_FATAL, message);
+    }
+
+    pub fn warning(&mut self, message: &str) {
+        self.log(fmi2Status::fmi2Warning, CATEGORY_WARNING, message);
+    }
+
+    pub fn call(&mut self, message: impl FnOnce() -> String) {
+        if self.enabled[CATEGORY_CALLS] {
+            let m = message();
+            self.log(fmi2Status::fmi2OK, CATEGORY_CALLS, &m);
+        }
+    }
+}
+
+/// A C string from any Rust string: interior NULs become spaces.
+pub fn to_cstring(s: &str) -> CString {
+    CString::new(s.replace('\0', " ")).expect("NULs were replaced")
+}

@@ -1,0 +1,68 @@
+//! What a model provides to the FMI layer. Models are plain Rust: they never
+//! see a pointer, a C string or an FMI status.
+
+use crate::{ModelInfo, Values};
+
+/// A co-simulation model: parameters and inputs come in through [`Values`],
+/// outputs go out through it, the state lives in the implementor.
+///
+/// Communication-step semantics: at a communication point the importer sets
+/// the inputs `u(t)` (and optionally their slopes `du/dt`), then
+/// `do_step(h)` advances the state to `t + h` with `u(t + τ) = u(t) + du·τ`.
+/// Outputs are a function of the state and the *current* inputs, so an
+/// output with direct feedthrough changes as soon as an input is set.
+pub trait Model: Send {
+    fn info(&self) -> &'static ModelInfo;
+
+    /// Read and validate the parameters, and reset the state to its initial
+    /// value. Called when outputs are first needed in initialization mode
+    /// and again at `fmi2ExitInitializationMode`. The error names the
+    /// parameter and its value.
+    fn initialize(&mut self, values: &Values) -> Result<(), String>;
+
+    /// Physical checks of an input value beyond finiteness (e.g. a normal
+    /// force must not be negative).
+    fn check_input(&self, _vr: u32, _value: f64) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// Write every output into `values` from the state and the current inputs.
+    fn compute_outputs(&self, values: &mut Values);
+
+    /// Advance the state over `h` seconds. `slopes[vr]` is `du/dt` of input
+    /// `vr` (zero when not set).
+    fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String>;
+
+    /// Append the complete state to `out` (cleared by the caller).
+    fn save_state(&self, out: &mut Vec<f64>);
+
+    /// Restore a state written by `save_state` of the same model.
+    fn restore_state(&mut self, state: &[f64]) -> Result<(), String>;
+
+    fn clone_model(&self) -> Box<dyn Model>;
+
+    /// `∂ output / ∂ input` computed by the model itself. `None` lets the
+    /// layer differentiate the last step numerically by replaying it.
+    fn partial_derivative(&self, _values: &Values, _output: u32, _input: u32) -> Option<f64> {
+        None
+    }
+
+    /// Whether the layer must keep a copy of the pre-step state so that it can
+    /// replay the step for directional derivatives. Models whose
+    /// `partial_derivative` covers every output/input pair return `false`.
+    fn needs_step_replay(&self) -> bool {
+        true
+    }
+
+    /// First time derivative of an output at the current point, with the
+    /// inputs moving at `slopes`. `None` when this output has none.
+    fn output_derivative(&self, _values: &Values, _slopes: &[f64], _output: u32) -> Option<f64> {
+        None
+    }
+}
+
+/// An entry of the binary's model registry: the GUID picks the model.
+pub struct ModelFactory {
+    pub info: &'static ModelInfo,
+    pub create: fn() -> Box<dyn Model>,
+}

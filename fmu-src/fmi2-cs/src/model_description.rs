@@ -1,0 +1,184 @@
+//! `modelDescription.xml` rendered from a [`ModelInfo`]: the variable table
+//! is the only place a variable is written down.
+
+use crate::variables::{Causality, Initial, ModelInfo, VarType, Variability, LOG_CATEGORIES};
+use std::fmt::Write;
+
+/// SI base-unit exponents (kg, m, s) of the units our models use.
+const UNITS: &[(&str, [i32; 3])] = &[
+    ("kg", [1, 0, 0]),
+    ("1/N", [-1, -1, 2]),
+    ("m", [0, 1, 0]),
+    ("s", [0, 0, 1]),
+    ("1/m", [0, -1, 0]),
+    ("m/s", [0, 1, -1]),
+    ("m/s2", [0, 1, -2]),
+    ("s/m", [0, -1, 1]),
+    ("N", [1, 1, -2]),
+    ("N/m", [1, 0, -2]),
+    ("N.s/m", [1, 0, -1]),
+];
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// Shortest representation that parses back to the same `f64`.
+fn number(x: f64) -> String {
+    format!("{x:?}")
+}
+
+fn causality(c: Causality) -> &'static str {
+    match c {
+        Causality::Parameter => "parameter",
+        Causality::Input => "input",
+        Causality::Output => "output",
+        Causality::Local => "local",
+    }
+}
+
+fn variability(v: Variability) -> &'static str {
+    match v {
+        Variability::Fixed => "fixed",
+        Variability::Tunable => "tunable",
+        Variability::Discrete => "discrete",
+        Variability::Continuous => "continuous",
+    }
+}
+
+/// Render the FMI 2.0 model description. `generation_tool` names the crate
+/// and version that built the binary.
+pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String> {
+    info.check()?;
+    let mut x = String::new();
+    let caps = &info.capabilities;
+    let w = &mut x;
+    let _ = writeln!(w, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+    let _ = writeln!(w, "<!-- Generated from the variable table in the source code; do not edit by hand. -->");
+    let _ = writeln!(
+        w,
+        r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="{}" description="{}" author="friction-fmu project" generationTool="{}" variableNamingConvention="structured" numberOfEventIndicators="0">"#,
+        escape(info.model_name),
+        escape(info.guid),
+        escape(&format!("{} Source: {}", info.description, info.source)),
+        escape(generation_tool)
+    );
+    let _ = writeln!(
+        w,
+        r#"  <CoSimulation modelIdentifier="{}" needsExecutionTool="false" canHandleVariableCommunicationStepSize="{}" canInterpolateInputs="{}" maxOutputDerivativeOrder="{}" canRunAsynchronuously="false" canBeInstantiatedOnlyOncePerProcess="false" canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="{}" canSerializeFMUstate="{}" providesDirectionalDerivative="{}"/>"#,
+        escape(info.model_identifier),
+        caps.can_handle_variable_step,
+        caps.can_interpolate_inputs,
+        caps.max_output_derivative_order,
+        caps.can_get_and_set_state,
+        caps.can_serialize_state,
+        caps.provides_directional_derivative
+    );
+
+    let mut used: Vec<&str> = info.variables.iter().filter_map(|v| v.unit).collect();
+    used.sort();
+    used.dedup();
+    if !used.is_empty() {
+        let _ = writeln!(w, "  <UnitDefinitions>");
+        for unit in used {
+            let (_, [kg, m, s]) = UNITS
+                .iter()
+                .find(|(name, _)| *name == unit)
+                .ok_or_else(|| format!("{}: unit {unit} has no base-unit definition", info.model_name))?;
+            let mut base = String::new();
+            for (name, e) in [("kg", kg), ("m", m), ("s", s)] {
+                if *e != 0 {
+                    let _ = write!(base, r#" {name}="{e}""#);
+                }
+            }
+            let _ = writeln!(w, r#"    <Unit name="{}"><BaseUnit{base}/></Unit>"#, escape(unit));
+        }
+        let _ = writeln!(w, "  </UnitDefinitions>");
+    }
+
+    let _ = writeln!(w, "  <LogCategories>");
+    for (name, description) in LOG_CATEGORIES {
+        let _ = writeln!(w, r#"    <Category name="{name}" description="{}"/>"#, escape(description));
+    }
+    let _ = writeln!(w, "  </LogCategories>");
+
+    let e = &info.default_experiment;
+    let _ = writeln!(
+        w,
+        r#"  <DefaultExperiment startTime="{}" stopTime="{}" stepSize="{}"/>"#,
+        number(e.start_time),
+        number(e.stop_time),
+        number(e.step_size)
+    );
+
+    let _ = writeln!(w, "  <ModelVariables>");
+    for (i, v) in info.variables.iter().enumerate() {
+        let _ = writeln!(w, "    <!-- index {} -->", i + 1);
+        let initial = match (v.initial(), v.causality) {
+            (Some(Initial::Exact), _) => r#" initial="exact""#,
+            (Some(Initial::Approx), _) => r#" initial="approx""#,
+            (Some(Initial::Calculated), Causality::Output) => r#" initial="calculated""#,
+            _ => "",
+        };
+        let _ = writeln!(
+            w,
+            r#"    <ScalarVariable name="{}" valueReference="{}" description="{}" causality="{}" variability="{}"{initial}>"#,
+            escape(v.name),
+            v.vr,
+            escape(v.description),
+            causality(v.causality),
+            variability(v.variability)
+        );
+        let mut attrs = String::new();
+        if let Some(u) = v.unit {
+            let _ = write!(attrs, r#" unit="{}""#, escape(u));
+        }
+        if let Some(n) = v.nominal {
+            let _ = write!(attrs, r#" nominal="{}""#, number(n));
+        }
+        if let Some(m) = v.min {
+            let _ = write!(attrs, r#" min="{}""#, number(m));
+        }
+        if let Some(m) = v.max {
+            let _ = write!(attrs, r#" max="{}""#, number(m));
+        }
+        let (tag, start) = match v.var_type {
+            VarType::Real => ("Real", v.start.map(number)),
+            VarType::Integer => ("Integer", v.start.map(|s| format!("{}", s as i64))),
+            VarType::Boolean => ("Boolean", v.start.map(|s| (s != 0.0).to_string())),
+        };
+        if let Some(s) = start {
+            let _ = write!(attrs, r#" start="{s}""#);
+        }
+        let _ = writeln!(w, "      <{tag}{attrs}/>");
+        let _ = writeln!(w, "    </ScalarVariable>");
+    }
+    let _ = writeln!(w, "  </ModelVariables>");
+
+    let _ = writeln!(w, "  <ModelStructure>");
+    let outputs: Vec<_> = info.variables.iter().enumerate().filter(|(_, v)| v.causality == Causality::Output).collect();
+    let _ = writeln!(w, "    <Outputs>");
+    for (i, v) in &outputs {
+        let deps: Vec<String> = v.depends_on.iter().map(|d| (d + 1).to_string()).collect();
+        if deps.is_empty() {
+            let _ = writeln!(w, r#"      <Unknown index="{}" dependencies=""/>"#, i + 1);
+        } else {
+            let kinds = vec!["dependent"; deps.len()].join(" ");
+            let _ = writeln!(
+                w,
+                r#"      <Unknown index="{}" dependencies="{}" dependenciesKind="{kinds}"/>"#,
+                i + 1,
+                deps.join(" ")
+            );
+        }
+    }
+    let _ = writeln!(w, "    </Outputs>");
+    let _ = writeln!(w, "    <InitialUnknowns>");
+    for (i, _) in &outputs {
+        let _ = writeln!(w, r#"      <Unknown index="{}"/>"#, i + 1);
+    }
+    let _ = writeln!(w, "    </InitialUnknowns>");
+    let _ = writeln!(w, "  </ModelStructure>");
+    let _ = writeln!(w, "</fmiModelDescription>");
+    Ok(x)
+}

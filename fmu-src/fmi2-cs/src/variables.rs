@@ -1,0 +1,298 @@
+//! The variable table: one source of truth for the C layer and the XML.
+
+/// FMI 2.0 base type of a scalar variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VarType {
+    Real,
+    Integer,
+    Boolean,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    Input,
+    Output,
+    Local,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variability {
+    Fixed,
+    Tunable,
+    Discrete,
+    Continuous,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Initial {
+    Exact,
+    Approx,
+    Calculated,
+}
+
+/// One scalar variable. Its value reference is its index in the table
+/// (checked by [`ModelInfo::check`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Variable {
+    pub vr: u32,
+    pub name: &'static str,
+    pub var_type: VarType,
+    pub causality: Causality,
+    pub variability: Variability,
+    /// Start value (integers and booleans as exact `f64`); `None` for
+    /// calculated outputs.
+    pub start: Option<f64>,
+    pub unit: Option<&'static str>,
+    pub description: &'static str,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    /// Scale used for finite-difference perturbations and declared as `nominal`.
+    pub nominal: Option<f64>,
+    /// Outputs only: the inputs this output depends on directly (direct
+    /// feedthrough), by value reference.
+    pub depends_on: &'static [u32],
+}
+
+impl Variable {
+    const fn base(vr: u32, name: &'static str, var_type: VarType, causality: Causality) -> Self {
+        Variable {
+            vr,
+            name,
+            var_type,
+            causality,
+            variability: Variability::Continuous,
+            start: None,
+            unit: None,
+            description: "",
+            min: None,
+            max: None,
+            nominal: None,
+            depends_on: &[],
+        }
+    }
+
+    /// A fixed real parameter (set before initialisation, `initial="exact"`).
+    pub const fn parameter(
+        vr: u32,
+        name: &'static str,
+        start: f64,
+        unit: &'static str,
+        description: &'static str,
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Real, Causality::Parameter);
+        v.variability = Variability::Fixed;
+        v.start = Some(start);
+        v.unit = if unit.is_empty() { None } else { Some(unit) };
+        v.description = description;
+        v
+    }
+
+    /// A fixed integer parameter.
+    pub const fn integer_parameter(
+        vr: u32,
+        name: &'static str,
+        start: i32,
+        description: &'static str,
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Integer, Causality::Parameter);
+        v.variability = Variability::Fixed;
+        v.start = Some(start as f64);
+        v.description = description;
+        v
+    }
+
+    /// A fixed boolean parameter (a switch).
+    pub const fn boolean_parameter(
+        vr: u32,
+        name: &'static str,
+        start: bool,
+        description: &'static str,
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Boolean, Causality::Parameter);
+        v.variability = Variability::Fixed;
+        v.start = Some(if start { 1.0 } else { 0.0 });
+        v.description = description;
+        v
+    }
+
+    /// A continuous real input with a start value.
+    pub const fn input(
+        vr: u32,
+        name: &'static str,
+        start: f64,
+        unit: &'static str,
+        nominal: f64,
+        description: &'static str,
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Real, Causality::Input);
+        v.start = Some(start);
+        v.unit = if unit.is_empty() { None } else { Some(unit) };
+        v.nominal = Some(nominal);
+        v.description = description;
+        v
+    }
+
+    /// A continuous real output, computed by the model.
+    pub const fn output(
+        vr: u32,
+        name: &'static str,
+        unit: &'static str,
+        description: &'static str,
+        depends_on: &'static [u32],
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Real, Causality::Output);
+        v.unit = if unit.is_empty() { None } else { Some(unit) };
+        v.description = description;
+        v.depends_on = depends_on;
+        v
+    }
+
+    /// A discrete integer output (a count).
+    pub const fn integer_output(
+        vr: u32,
+        name: &'static str,
+        description: &'static str,
+        depends_on: &'static [u32],
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Integer, Causality::Output);
+        v.variability = Variability::Discrete;
+        v.description = description;
+        v.depends_on = depends_on;
+        v
+    }
+
+    /// A discrete boolean output (an indicator).
+    pub const fn boolean_output(
+        vr: u32,
+        name: &'static str,
+        description: &'static str,
+        depends_on: &'static [u32],
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Boolean, Causality::Output);
+        v.variability = Variability::Discrete;
+        v.description = description;
+        v.depends_on = depends_on;
+        v
+    }
+
+    pub const fn with_min(mut self, min: f64) -> Self {
+        self.min = Some(min);
+        self
+    }
+
+    pub const fn with_max(mut self, max: f64) -> Self {
+        self.max = Some(max);
+        self
+    }
+
+    /// The FMI 2.0 `initial` attribute implied by causality and variability.
+    pub fn initial(&self) -> Option<Initial> {
+        match self.causality {
+            Causality::Parameter => Some(Initial::Exact),
+            Causality::Output => Some(Initial::Calculated),
+            Causality::Input => None,
+            Causality::Local => Some(Initial::Calculated),
+        }
+    }
+
+    /// May this variable be set in the instantiated / initialization mode?
+    pub fn settable_before_init(&self) -> bool {
+        matches!(self.causality, Causality::Parameter | Causality::Input)
+    }
+
+    /// May this variable be set after initialization (step mode)?
+    pub fn settable_in_step_mode(&self) -> bool {
+        self.causality == Causality::Input
+            || (self.causality == Causality::Parameter && self.variability == Variability::Tunable)
+    }
+}
+
+/// Co-simulation capability flags, rendered into `<CoSimulation …/>`.
+#[derive(Clone, Copy, Debug)]
+pub struct Capabilities {
+    pub can_handle_variable_step: bool,
+    pub can_interpolate_inputs: bool,
+    pub max_output_derivative_order: u32,
+    pub can_get_and_set_state: bool,
+    pub can_serialize_state: bool,
+    pub provides_directional_derivative: bool,
+}
+
+impl Capabilities {
+    /// Everything this layer implements.
+    pub const FULL: Capabilities = Capabilities {
+        can_handle_variable_step: true,
+        can_interpolate_inputs: true,
+        max_output_derivative_order: 1,
+        can_get_and_set_state: true,
+        can_serialize_state: true,
+        provides_directional_derivative: true,
+    };
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct DefaultExperiment {
+    pub start_time: f64,
+    pub stop_time: f64,
+    pub step_size: f64,
+}
+
+/// Everything the C layer and the XML renderer need to know about one model.
+#[derive(Debug)]
+pub struct ModelInfo {
+    /// `modelName` and the `.fmu` file name, e.g. `LuGre`.
+    pub model_name: &'static str,
+    /// `modelIdentifier`: the name of the shared library inside the FMU.
+    pub model_identifier: &'static str,
+    pub guid: &'static str,
+    pub description: &'static str,
+    /// Which seed paper or reference the equations come from.
+    pub source: &'static str,
+    pub variables: &'static [Variable],
+    pub default_experiment: DefaultExperiment,
+    pub capabilities: Capabilities,
+}
+
+/// Log categories every FMU of this layer declares, in this order.
+pub const LOG_CATEGORIES: &[(&str, &str)] = &[
+    ("logStatusError", "Errors: invalid calls, arguments and parameters (on by default)"),
+    ("logStatusFatal", "Fatal errors: internal failures (on by default)"),
+    ("logStatusWarning", "Warnings"),
+    ("logCalls", "Every FMI function call with its arguments"),
+];
+
+impl ModelInfo {
+    pub fn variable(&self, vr: u32) -> Option<&'static Variable> {
+        self.variables.get(vr as usize)
+    }
+
+    pub fn by_name(&self, name: &str) -> Option<&'static Variable> {
+        self.variables.iter().find(|v| v.name == name)
+    }
+
+    /// Consistency of the table: value reference = index, unique names,
+    /// start values where required, dependencies pointing at inputs.
+    pub fn check(&self) -> Result<(), String> {
+        let mut names = std::collections::HashSet::new();
+        for (i, v) in self.variables.iter().enumerate() {
+            if v.vr as usize != i {
+                return Err(format!("{}: variable {} has vr {} at index {}", self.model_name, v.name, v.vr, i));
+            }
+            if !names.insert(v.name) {
+                return Err(format!("{}: duplicate variable name {}", self.model_name, v.name));
+            }
+            let needs_start = matches!(v.causality, Causality::Parameter | Causality::Input);
+            if needs_start != v.start.is_some() {
+                return Err(format!("{}: variable {} start value presence is wrong", self.model_name, v.name));
+            }
+            for d in v.depends_on {
+                match self.variable(*d) {
+                    Some(dep) if dep.causality == Causality::Input => {}
+                    _ => return Err(format!("{}: {} depends on vr {} which is not an input", self.model_name, v.name, d)),
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,431 @@
+//! The C edge of the FMI layer, exercised through the exported functions
+//! with a toy model: the state table, null pointers, unknown pointers,
+//! panics, NaN, serialized-state corruption and logging.
+
+use fmi2_cs::ffi::*;
+use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelFactory, ModelInfo, Values, Variable};
+use std::ffi::{c_void, CStr, CString};
+use std::os::raw::{c_char, c_int};
+use std::ptr::{null, null_mut};
+use std::cell::RefCell;
+
+// ---- a toy model: y = k*u + s, ds/dt = u; panics in a step when u = 13 ----
+
+const U: u32 = 0;
+const Y: u32 = 1;
+const K: u32 = 2;
+static VARIABLES: [Variable; 3] = [
+    Variable::input(U, "u", 0.0, "", 1.0, "input"),
+    Variable::output(Y, "y", "", "k*u + integral of u", &[U]),
+    Variable::parameter(K, "k", 2.0, "", "gain, > 0"),
+];
+static INFO: ModelInfo = ModelInfo {
+    model_name: "Toy",
+    model_identifier: "Toy",
+    guid: "{toy}",
+    description: "test model",
+    source: "test",
+    variables: &VARIABLES,
+    default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 0.1 },
+    capabilities: Capabilities::FULL,
+};
+
+#[derive(Clone)]
+struct Toy {
+    k: f64,
+    s: f64,
+}
+
+impl Model for Toy {
+    fn info(&self) -> &'static ModelInfo {
+        &INFO
+    }
+    fn initialize(&mut self, v: &Values) -> Result<(), String> {
+        let k = v.real(K);
+        if k <= 0.0 {
+            return Err(format!("invalid parameter k = {k}: must be > 0"));
+        }
+        self.k = k;
+        self.s = 0.0;
+        Ok(())
+    }
+    fn compute_outputs(&self, v: &mut Values) {
+        v.set(Y, self.k * v.real(U) + self.s);
+    }
+    fn do_step(&mut self, v: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
+        if v.real(U) == 13.0 {
+            panic!("unlucky input");
+        }
+        self.s += v.real(U) * h + 0.5 * slopes[U as usize] * h * h;
+        Ok(())
+    }
+    fn save_state(&self, out: &mut Vec<f64>) {
+        out.push(self.s);
+    }
+    fn restore_state(&mut self, s: &[f64]) -> Result<(), String> {
+        match s {
+            [x] => {
+                self.s = *x;
+                Ok(())
+            }
+            _ => Err(format!("expected 1 number, got {}", s.len())),
+        }
+    }
+    fn clone_model(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
+}
+
+static REGISTRY: [ModelFactory; 1] = [ModelFactory { info: &INFO, create: || Box::new(Toy { k: 1.0, s: 0.0 }) }];
+fmi2_cs::export_fmi2!(&REGISTRY[..]);
+use fmi2_exports::*;
+
+// ---- a logger that records messages ----------------------------------------
+
+// The FMU calls the logger synchronously on the calling thread, and each
+// test runs on its own thread: a thread-local log keeps tests apart.
+thread_local! {
+    static LOG: RefCell<Vec<(i32, String, String)>> = const { RefCell::new(Vec::new()) };
+}
+
+fn log_snapshot() -> Vec<(i32, String, String)> {
+    LOG.with(|l| l.borrow().clone())
+}
+
+fn log_clear() {
+    LOG.with(|l| l.borrow_mut().clear());
+}
+
+extern "C" fn record(_env: *mut c_void, _name: *const c_char, status: c_int, category: *const c_char, message: *const c_char) {
+    // SAFETY: the FMU passes NUL-terminated strings.
+    let (c, m) = unsafe { (CStr::from_ptr(category), CStr::from_ptr(message)) };
+    LOG.with(|l| l.borrow_mut().push((status, c.to_string_lossy().into(), m.to_string_lossy().into())));
+}
+
+fn callbacks() -> fmi2CallbackFunctions {
+    // SAFETY: on x86-64 and aarch64 a non-variadic function with these five
+    // arguments can be called through the variadic pointer type (the FMU
+    // passes no variadic arguments); this is what ctypes importers do.
+    let logger = unsafe { std::mem::transmute::<*const (), unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...)>(record as *const ()) };
+    fmi2CallbackFunctions {
+        logger: Some(logger),
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: null_mut(),
+    }
+}
+
+fn last_error_containing(needle: &str) -> String {
+    let log = log_snapshot();
+    let found = log.iter().rev().find(|(s, _, m)| *s >= 3 && m.contains(needle));
+    found.map(|(_, _, m)| m.clone()).unwrap_or_else(|| panic!("no error message containing {needle:?} in {log:?}"))
+}
+
+fn new_instance(name: &str) -> fmi2Component {
+    let cb = Box::leak(Box::new(callbacks()));
+    let name = CString::new(name).unwrap();
+    let c = unsafe { fmi2Instantiate(name.as_ptr(), fmi2CoSimulation, c"{toy}".as_ptr(), null(), cb, 0, 0) };
+    assert!(!c.is_null());
+    c
+}
+
+fn initialized(name: &str) -> fmi2Component {
+    let c = new_instance(name);
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2Status::fmi2OK);
+        assert_eq!(fmi2EnterInitializationMode(c), fmi2Status::fmi2OK);
+        assert_eq!(fmi2ExitInitializationMode(c), fmi2Status::fmi2OK);
+    }
+    c
+}
+
+fn get(c: fmi2Component, vr: u32) -> f64 {
+    let mut x = f64::NAN;
+    assert_eq!(unsafe { fmi2GetReal(c, &vr, 1, &mut x) }, fmi2Status::fmi2OK);
+    x
+}
+
+fn set(c: fmi2Component, vr: u32, x: f64) -> fmi2Status {
+    unsafe { fmi2SetReal(c, &vr, 1, &x) }
+}
+
+const OK: fmi2Status = fmi2Status::fmi2OK;
+const ERR: fmi2Status = fmi2Status::fmi2Error;
+
+#[test]
+fn lifecycle_and_feedthrough() {
+    let c = initialized("life");
+    assert_eq!(set(c, U, 1.5), OK);
+    assert_eq!(get(c, Y), 3.0); // direct feedthrough before any step
+    unsafe {
+        assert_eq!(fmi2DoStep(c, 0.0, 0.5, 1), OK);
+        assert_eq!(get(c, Y), 3.0 + 0.75);
+        assert_eq!(fmi2Terminate(c), OK);
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
+fn instantiate_refuses_bad_arguments_with_a_message() {
+    let cb = Box::leak(Box::new(callbacks()));
+    unsafe {
+        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2ModelExchange, c"{toy}".as_ptr(), null(), cb, 0, 0).is_null());
+        last_error_containing("fmuType = 0");
+        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, c"{nope}".as_ptr(), null(), cb, 0, 0).is_null());
+        last_error_containing("unknown fmuGUID {nope}");
+        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, null(), null(), cb, 0, 0).is_null());
+        last_error_containing("fmuGUID is NULL");
+        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, c"{toy}".as_ptr(), null(), null(), 0, 0).is_null());
+    }
+}
+
+#[test]
+fn null_and_foreign_component_pointers_are_refused() {
+    let mut x = 0.0;
+    let vr = Y;
+    let mut bogus = [0u64; 64];
+    let foreign = bogus.as_mut_ptr() as fmi2Component;
+    unsafe {
+        assert_eq!(fmi2GetReal(null_mut(), &vr, 1, &mut x), ERR);
+        assert_eq!(fmi2GetReal(foreign, &vr, 1, &mut x), ERR);
+        assert_eq!(fmi2DoStep(foreign, 0.0, 0.1, 0), ERR);
+        fmi2FreeInstance(foreign); // ignored, no crash
+        fmi2FreeInstance(null_mut());
+    }
+    // a freed instance is no longer accepted (no use after free)
+    let c = initialized("freed");
+    unsafe {
+        fmi2FreeInstance(c);
+        assert_eq!(fmi2GetReal(c, &vr, 1, &mut x), ERR);
+        fmi2FreeInstance(c); // double free is ignored
+    }
+}
+
+#[test]
+fn null_arrays_and_unknown_references() {
+    let c = initialized("arrays");
+    let vr = Y;
+    let mut x = 0.0;
+    unsafe {
+        assert_eq!(fmi2GetReal(c, null(), 1, &mut x), ERR);
+        last_error_containing("fmi2GetReal: argument vr[] is NULL");
+        assert_eq!(fmi2GetReal(c, &vr, 1, null_mut()), ERR);
+        last_error_containing("value[] is NULL");
+        assert_eq!(fmi2GetReal(c, null(), 0, null_mut()), OK);
+        assert_eq!(fmi2GetReal(c, &vr, usize::MAX, &mut x), ERR);
+        let bad = 77u32;
+        assert_eq!(fmi2GetReal(c, &bad, 1, &mut x), ERR);
+        last_error_containing("unknown value reference 77");
+        let mut i = 0;
+        assert_eq!(fmi2GetInteger(c, &vr, 1, &mut i), ERR);
+        last_error_containing("is a Real variable, not Integer");
+        assert_eq!(set(c, Y, 1.0), ERR);
+        last_error_containing("cannot set y");
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
+fn non_finite_values_are_refused_and_nothing_is_lost() {
+    let c = initialized("nan");
+    assert_eq!(set(c, U, 0.25), OK);
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        assert_eq!(set(c, U, bad), ERR);
+        let m = last_error_containing("fmi2SetReal: u (value reference 0) must be finite");
+        assert!(m.to_lowercase().contains(&bad.to_string().to_lowercase()), "{m}");
+        assert_eq!(get(c, U), 0.25);
+    }
+    // a batch with one bad value sets nothing
+    let vrs = [U, U];
+    let vals = [0.5, f64::NAN];
+    assert_eq!(unsafe { fmi2SetReal(c, vrs.as_ptr(), 2, vals.as_ptr()) }, ERR);
+    assert_eq!(get(c, U), 0.25);
+    unsafe { fmi2FreeInstance(c) };
+}
+
+#[test]
+fn invalid_parameter_is_refused_at_exit_initialization() {
+    let c = new_instance("param");
+    unsafe {
+        assert_eq!(fmi2EnterInitializationMode(c), OK);
+        assert_eq!(set(c, K, -1.0), OK);
+        assert_eq!(fmi2ExitInitializationMode(c), ERR);
+        last_error_containing("fmi2ExitInitializationMode: invalid parameter k = -1");
+        // still in initialization mode: fix it and go on
+        assert_eq!(set(c, K, 3.0), OK);
+        assert_eq!(fmi2ExitInitializationMode(c), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        // a fixed parameter cannot change now
+        assert_eq!(set(c, K, 4.0), ERR);
+        last_error_containing("fixed parameter");
+        fmi2FreeInstance(c);
+    }
+}
+
+/// Every instance-taking function in every reachable state agrees with the
+/// state table: allowed calls do not fail for state reasons, others return
+/// fmi2Error with "illegal call sequence".
+#[test]
+fn state_table_is_enforced() {
+    use fmi2_cs::state_machine::{is_allowed, State};
+    let reach = |state: State| -> fmi2Component {
+        let c = new_instance("states");
+        unsafe {
+            match state {
+                State::Instantiated => {}
+                State::InitializationMode => {
+                    fmi2EnterInitializationMode(c);
+                }
+                State::StepComplete => {
+                    fmi2EnterInitializationMode(c);
+                    fmi2ExitInitializationMode(c);
+                }
+                State::Terminated => {
+                    fmi2EnterInitializationMode(c);
+                    fmi2ExitInitializationMode(c);
+                    fmi2Terminate(c);
+                }
+                _ => unreachable!(),
+            }
+        }
+        c
+    };
+    type Probe = (&'static str, fn(fmi2Component) -> fmi2Status);
+    let probes: &[Probe] = &[
+        ("fmi2SetupExperiment", |c| unsafe { fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0) }),
+        ("fmi2EnterInitializationMode", |c| unsafe { fmi2EnterInitializationMode(c) }),
+        ("fmi2ExitInitializationMode", |c| unsafe { fmi2ExitInitializationMode(c) }),
+        ("fmi2Terminate", |c| unsafe { fmi2Terminate(c) }),
+        ("fmi2DoStep", |c| unsafe { fmi2DoStep(c, 0.0, 0.1, 0) }),
+        ("fmi2CancelStep", |c| unsafe { fmi2CancelStep(c) }),
+        ("fmi2GetReal", |c| {
+            let (vr, mut x) = (U, 0.0);
+            unsafe { fmi2GetReal(c, &vr, 1, &mut x) }
+        }),
+        ("fmi2SetReal", |c| set(c, U, 1.0)),
+        ("fmi2SetRealInputDerivatives", |c| {
+            let (vr, o, d) = (U, 1, 1.0);
+            unsafe { fmi2SetRealInputDerivatives(c, &vr, 1, &o, &d) }
+        }),
+        ("fmi2GetRealOutputDerivatives", |c| {
+            let (vr, o, mut d) = (Y, 1, 0.0);
+            unsafe { fmi2GetRealOutputDerivatives(c, &vr, 1, &o, &mut d) }
+        }),
+        ("fmi2GetRealStatus", |c| {
+            let mut t = 0.0;
+            unsafe { fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &mut t) }
+        }),
+    ];
+    for state in [State::Instantiated, State::InitializationMode, State::StepComplete, State::Terminated] {
+        for (name, probe) in probes {
+            let c = reach(state);
+            log_clear();
+            let status = probe(c);
+            let illegal = log_snapshot().iter().any(|(_, _, m)| m.contains("illegal call sequence"));
+            if is_allowed(name, state) {
+                assert!(!illegal, "{name} in {state:?} was refused as illegal");
+            } else {
+                assert_eq!(status, ERR, "{name} in {state:?}");
+                assert!(illegal, "{name} in {state:?}: no 'illegal call sequence' message");
+            }
+            unsafe { fmi2FreeInstance(c) };
+        }
+    }
+}
+
+#[test]
+fn panic_becomes_fatal_and_never_unwinds() {
+    let c = initialized("panic");
+    assert_eq!(set(c, U, 13.0), OK);
+    let status = unsafe { fmi2DoStep(c, 0.0, 0.1, 0) };
+    assert_eq!(status, fmi2Status::fmi2Fatal);
+    let log = log_snapshot();
+    assert!(log.iter().any(|(s, _, m)| *s == 4 && m.contains("fmi2DoStep: internal error (panic): unlucky input")));
+    // after fatal, nothing but free is possible
+    assert_eq!(unsafe { fmi2DoStep(c, 0.0, 0.1, 0) }, ERR);
+    unsafe { fmi2FreeInstance(c) };
+}
+
+#[test]
+fn state_round_trip_and_corruption() {
+    let c = initialized("state");
+    set(c, U, 1.0);
+    unsafe {
+        fmi2DoStep(c, 0.0, 0.1, 0);
+        let mut s: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        let mut size = 0;
+        assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
+        let mut bytes = vec![0 as c_char; size];
+        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
+        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size - 1), ERR);
+        fmi2DoStep(c, 0.1, 0.1, 0);
+        let y_after = get(c, Y);
+        // restore the in-memory state and the deserialized one: same continuation
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        fmi2DoStep(c, 0.1, 0.1, 0);
+        assert_eq!(get(c, Y).to_bits(), y_after.to_bits());
+        let mut d: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut d), OK);
+        assert_eq!(fmi2SetFMUstate(c, d), OK);
+        fmi2DoStep(c, 0.1, 0.1, 0);
+        assert_eq!(get(c, Y).to_bits(), y_after.to_bits());
+        // truncated and corrupted bytes are refused with a reason
+        let mut e: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size / 2, &mut e), ERR);
+        last_error_containing("fmi2DeSerializeFMUstate");
+        bytes[size / 2] ^= 0x55;
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut e), ERR);
+        last_error_containing("checksum");
+        assert!(e.is_null());
+        // a pointer that is not one of ours
+        let mut junk = [0u64; 8];
+        assert_eq!(fmi2SetFMUstate(c, junk.as_mut_ptr() as fmi2FMUstate), ERR);
+        last_error_containing("was not created by this instance");
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), OK);
+        assert!(s.is_null());
+        assert_eq!(fmi2FreeFMUstate(c, &mut d), OK);
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
+fn directional_derivative_of_the_last_step() {
+    // y(t+h) = k*u + s + u*h  ⇒  ∂y/∂u over the step = k + h
+    let c = initialized("jac");
+    set(c, U, 0.7);
+    unsafe {
+        let (unknown, known, seed) = (Y, U, 1.0);
+        let mut d = 0.0;
+        assert_eq!(fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, &mut d), OK);
+        assert!((d - 2.0).abs() < 1e-8, "feedthrough {d}");
+        fmi2DoStep(c, 0.0, 0.25, 0);
+        assert_eq!(fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, &mut d), OK);
+        assert!((d - 2.25).abs() < 1e-8, "step sensitivity {d}");
+        // unknown must be an output, known an input
+        assert_eq!(fmi2GetDirectionalDerivative(c, &known, 1, &known, 1, &seed, &mut d), ERR);
+        last_error_containing("is not an output");
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
+fn logging_categories() {
+    let cb = Box::leak(Box::new(callbacks()));
+    let c = unsafe { fmi2Instantiate(c"logged".as_ptr(), fmi2CoSimulation, c"{toy}".as_ptr(), null(), cb, 0, 1) };
+    log_clear();
+    unsafe {
+        fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0);
+        assert!(log_snapshot().iter().any(|(_, cat, m)| cat == "logCalls" && m.contains("fmi2SetupExperiment")));
+        let cats = [c"logCalls".as_ptr()];
+        assert_eq!(fmi2SetDebugLogging(c, 0, 1, cats.as_ptr()), OK);
+        log_clear();
+        fmi2EnterInitializationMode(c);
+        assert!(log_snapshot().is_empty());
+        let bad = [c"logNothing".as_ptr()];
+        assert_eq!(fmi2SetDebugLogging(c, 1, 1, bad.as_ptr()), ERR);
+        last_error_containing("unknown log category \"logNothing\"");
+        fmi2FreeInstance(c);
+    }
+}

@@ -1,0 +1,43 @@
+//! Packaging: every model of every FMU library of this project, rendered and
+//! zipped. The model descriptions come from the variable tables only.
+
+use fmi2_cs::ModelInfo;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Every model we ship, in a stable order.
+pub fn all_models() -> Vec<&'static ModelInfo> {
+    friction_fmu::models()
+}
+
+/// The model description of `info`, as shipped.
+pub fn render(info: &ModelInfo) -> Result<String, String> {
+    fmi2_cs::model_description::render(info, friction_fmu::GENERATION_TOOL)
+}
+
+/// Path of the checked-in description of `info` under `dir`.
+pub fn description_path(dir: &Path, info: &ModelInfo) -> PathBuf {
+    dir.join(format!("{}.xml", info.model_name))
+}
+
+/// Write `dist/<Name>.fmu`: `modelDescription.xml` and
+/// `binaries/linux64/<modelIdentifier>.so`.
+pub fn package(info: &ModelInfo, library: &Path, out_dir: &Path) -> Result<PathBuf, String> {
+    let binary = std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+    let xml = render(info)?;
+    std::fs::create_dir_all(out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
+    let path = out_dir.join(format!("{}.fmu", info.model_name));
+    let file = std::fs::File::create(&path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+    let mut zip = zip::ZipWriter::new(file);
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .unix_permissions(0o644);
+    let mut add = |name: &str, data: &[u8]| -> Result<(), String> {
+        zip.start_file(name, options).map_err(|e| format!("{}: {e}", path.display()))?;
+        zip.write_all(data).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    add("modelDescription.xml", xml.as_bytes())?;
+    add(&format!("binaries/linux64/{}.so", info.model_identifier), &binary)?;
+    zip.finish().map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(path)
+}

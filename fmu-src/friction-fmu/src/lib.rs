@@ -1,0 +1,61 @@
+//! The friction FMUs. Each module binds one law of `friction-laws` to the FMI
+//! layer: its variable table (the single source of the model description)
+//! and a [`fmi2_cs::Model`] implementation. The same binary is packaged as
+//! `Dahl.fmu`, `LuGre.fmu`, `ResetIntegrator.fmu`, `Bristle.fmu` and
+//! `Bristle2D.fmu`; `fmi2Instantiate` picks the law by GUID.
+#![forbid(unsafe_code)]
+
+pub mod bristle;
+pub mod bristle2d;
+pub mod dahl;
+pub mod in_process;
+pub mod lugre;
+pub mod reset_integrator;
+
+use fmi2_cs::{Model, ModelFactory, ModelInfo};
+use std::sync::LazyLock;
+
+/// Every model this binary holds.
+pub static REGISTRY: LazyLock<[ModelFactory; 5]> = LazyLock::new(|| {
+    [
+        ModelFactory { info: &dahl::INFO, create: || Box::new(dahl::DahlFmu::default()) },
+        ModelFactory { info: &lugre::INFO, create: || Box::new(lugre::LuGreFmu::default()) },
+        ModelFactory { info: &reset_integrator::INFO, create: || Box::new(reset_integrator::ResetFmu::default()) },
+        ModelFactory { info: &bristle::INFO, create: || Box::new(bristle::BristleFmu::default()) },
+        ModelFactory { info: &bristle2d::INFO, create: || Box::new(bristle2d::Bristle2DFmu::default()) },
+    ]
+});
+
+/// The model infos, in registry order.
+pub fn models() -> Vec<&'static ModelInfo> {
+    REGISTRY.iter().map(|f| f.info).collect()
+}
+
+/// A fresh model by name (for in-process runs that bypass the C ABI).
+pub fn create(model_name: &str) -> Option<Box<dyn Model>> {
+    REGISTRY.iter().find(|f| f.info.model_name == model_name).map(|f| (f.create)())
+}
+
+/// Name and version written into `generationTool`.
+pub const GENERATION_TOOL: &str = concat!("friction-fmu ", env!("CARGO_PKG_VERSION"));
+
+#[allow(unsafe_code)]
+mod exported {
+    use super::REGISTRY;
+    fmi2_cs::export_fmi2!(&REGISTRY[..]);
+}
+
+/// Convert a law's parameter error into the message the FMI layer logs.
+fn param_err(e: friction_laws::ParamError) -> String {
+    e.to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_variable_table_is_consistent() {
+        for info in super::models() {
+            info.check().unwrap();
+        }
+    }
+}

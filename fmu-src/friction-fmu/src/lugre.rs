@@ -1,0 +1,207 @@
+//! `LuGre.fmu`: the LuGre law (seed 001 eq. 9–12; MODELS.md "LuGre") with
+//! the extensions the slider of seed 003 and the tribometer of seed 002
+//! need: velocity-dependent micro-damping, direction-dependent levels,
+//! position-dependent levels (a table of scale factors over `x`), and the
+//! normal-force form.
+
+use crate::param_err;
+use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use friction_laws::lugre::{LuGre, LuGreInputs, LuGreParams, TABLE_POINTS};
+use friction_laws::Ramp;
+use std::sync::LazyLock;
+
+pub mod vr {
+    pub const V: u32 = 0;
+    pub const X: u32 = 1;
+    pub const FN: u32 = 2;
+    pub const F: u32 = 3;
+    pub const Z: u32 = 4;
+    pub const SLIDING: u32 = 5;
+    pub const SIGMA0: u32 = 6;
+    pub const SIGMA1: u32 = 7;
+    pub const SIGMA2: u32 = 8;
+    pub const FC: u32 = 9;
+    pub const FS: u32 = 10;
+    pub const VS: u32 = 11;
+    pub const STRIBECK_EXPONENT: u32 = 12;
+    pub const VD: u32 = 13;
+    pub const DIRECTION_DEPENDENT: u32 = 14;
+    pub const FC_NEG: u32 = 15;
+    pub const FS_NEG: u32 = 16;
+    pub const NORMAL_FORCE_FORM: u32 = 17;
+    pub const POSITION_DEPENDENT: u32 = 18;
+    pub const N_TABLE: u32 = 19;
+    /// `x_table[i]`, i = 1..=32, at `X_TABLE + i - 1`.
+    pub const X_TABLE: u32 = 20;
+    pub const SCALE_POS: u32 = X_TABLE + super::TABLE_POINTS as u32;
+    pub const SCALE_NEG: u32 = SCALE_POS + super::TABLE_POINTS as u32;
+}
+
+const INPUTS: &[u32] = &[vr::V, vr::X, vr::FN];
+
+fn variables() -> Vec<Variable> {
+    let d = LuGreParams::default();
+    let mut v = vec![
+        Variable::input(vr::V, "v", 0.0, "m/s", 1e-3, "Sliding velocity of the body relative to the surface"),
+        Variable::input(vr::X, "x", 0.0, "m", 0.1, "Position along the travel (used when position_dependent)"),
+        Variable::input(vr::FN, "Fn", 1.0, "N", 1.0, "Normal force (used when normal_force_form), >= 0"),
+        Variable::output(vr::F, "F", "N", "Friction force F = sigma0*z + sigma1(v)*dz/dt + sigma2*v", INPUTS),
+        Variable::output(vr::Z, "z", "m", "Mean bristle deflection", &[]),
+        Variable::boolean_output(vr::SLIDING, "sliding", "True when moving and sigma0*|z| has reached 99 % of g(v)", INPUTS),
+        Variable::parameter(vr::SIGMA0, "sigma0", d.sigma0, "N/m", "Bristle stiffness (per unit Fn, 1/m, in the normal-force form)").with_min(0.0),
+        Variable::parameter(vr::SIGMA1, "sigma1", d.sigma1, "N.s/m", "Bristle damping (per unit Fn, s/m, in the normal-force form)").with_min(0.0),
+        Variable::parameter(vr::SIGMA2, "sigma2", d.sigma2, "N.s/m", "Viscous friction (per unit Fn, s/m, in the normal-force form)").with_min(0.0),
+        Variable::parameter(vr::FC, "Fc", d.fc, "N", "Coulomb level for v >= 0 (friction coefficient mu_d in the normal-force form)").with_min(0.0),
+        Variable::parameter(vr::FS, "Fs", d.fs, "N", "Static (break-away) level for v >= 0, >= Fc (mu_s in the normal-force form)").with_min(0.0),
+        Variable::parameter(vr::VS, "vs", d.vs, "m/s", "Stribeck velocity").with_min(0.0),
+        Variable::parameter(vr::STRIBECK_EXPONENT, "stribeck_exponent", d.stribeck_exponent, "", "Stribeck exponent delta in exp(-|v/vs|^delta)").with_min(0.0),
+        Variable::parameter(vr::VD, "vd", d.vd, "m/s", "Micro-damping decay velocity: sigma1(v) = sigma1*exp(-(v/vd)^2); 0 = constant sigma1").with_min(0.0),
+        Variable::boolean_parameter(vr::DIRECTION_DEPENDENT, "direction_dependent", false, "Use Fc_neg, Fs_neg and scale_neg for v < 0"),
+        Variable::parameter(vr::FC_NEG, "Fc_neg", d.fc_neg, "N", "Coulomb level for v < 0 (when direction_dependent)").with_min(0.0),
+        Variable::parameter(vr::FS_NEG, "Fs_neg", d.fs_neg, "N", "Static level for v < 0, >= Fc_neg (when direction_dependent)").with_min(0.0),
+        Variable::boolean_parameter(vr::NORMAL_FORCE_FORM, "normal_force_form", false, "Seed 002 form: stiffness, damping and levels are per unit normal force Fn"),
+        Variable::boolean_parameter(vr::POSITION_DEPENDENT, "position_dependent", false, "Scale Fc and Fs by a piecewise-linear table over the input x"),
+        Variable::integer_parameter(vr::N_TABLE, "n_table", d.n_table as i32, "Number of table points used (2..32)"),
+    ];
+    let names = |base: &str| -> Vec<&'static str> {
+        (1..=TABLE_POINTS).map(|i| &*Box::leak(format!("{base}[{i}]").into_boxed_str())).collect()
+    };
+    for (i, name) in names("x_table").into_iter().enumerate() {
+        v.push(Variable::parameter(vr::X_TABLE + i as u32, name, d.x_table[i], "m", "Table position (strictly increasing over the points used)"));
+    }
+    for (i, name) in names("scale_pos").into_iter().enumerate() {
+        v.push(Variable::parameter(vr::SCALE_POS + i as u32, name, d.scale_pos[i], "", "Scale factor on Fc and Fs at x_table[i], v >= 0").with_min(0.0));
+    }
+    for (i, name) in names("scale_neg").into_iter().enumerate() {
+        v.push(Variable::parameter(vr::SCALE_NEG + i as u32, name, d.scale_neg[i], "", "Scale factor on Fc_neg and Fs_neg at x_table[i], v < 0 (when direction_dependent)").with_min(0.0));
+    }
+    v
+}
+
+pub static INFO: LazyLock<ModelInfo> = LazyLock::new(|| ModelInfo {
+    model_name: "LuGre",
+    model_identifier: "LuGre",
+    guid: "{cc09ec7b-20f5-4798-9c84-4aa863242977}",
+    description: "LuGre friction: dz/dt = v - sigma0*|v|*z/g(v), g(v) = Fc + (Fs - Fc)*exp(-|v/vs|^delta), F = sigma0*z + sigma1(v)*dz/dt + sigma2*v; exact exponential update for piecewise-constant inputs. Defaults: Canudas de Wit et al. 1995.",
+    source: "seed 001 (Sun et al. 2016) eq. 9-12; seed 002 eq. 1-3 (normal-force form); seed 003 eq. 2.8-2.9 (position and direction dependence).",
+    variables: Box::leak(variables().into_boxed_slice()),
+    default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
+    capabilities: Capabilities::FULL,
+});
+
+#[derive(Clone, Debug)]
+pub struct LuGreFmu {
+    law: LuGre,
+}
+
+impl Default for LuGreFmu {
+    fn default() -> Self {
+        LuGreFmu { law: LuGre::new(LuGreParams::default()).expect("default parameters are valid") }
+    }
+}
+
+impl LuGreFmu {
+    pub fn params(values: &Values) -> LuGreParams {
+        let table = |base: u32| -> [f64; TABLE_POINTS] { std::array::from_fn(|i| values.real(base + i as u32)) };
+        LuGreParams {
+            sigma0: values.real(vr::SIGMA0),
+            sigma1: values.real(vr::SIGMA1),
+            sigma2: values.real(vr::SIGMA2),
+            fc: values.real(vr::FC),
+            fs: values.real(vr::FS),
+            vs: values.real(vr::VS),
+            stribeck_exponent: values.real(vr::STRIBECK_EXPONENT),
+            vd: values.real(vr::VD),
+            direction_dependent: values.boolean(vr::DIRECTION_DEPENDENT),
+            fc_neg: values.real(vr::FC_NEG),
+            fs_neg: values.real(vr::FS_NEG),
+            normal_force_form: values.boolean(vr::NORMAL_FORCE_FORM),
+            position_dependent: values.boolean(vr::POSITION_DEPENDENT),
+            n_table: values.integer(vr::N_TABLE).max(0) as usize,
+            x_table: table(vr::X_TABLE),
+            scale_pos: table(vr::SCALE_POS),
+            scale_neg: table(vr::SCALE_NEG),
+        }
+    }
+
+    fn inputs(values: &Values) -> (f64, f64, f64) {
+        (values.real(vr::V), values.real(vr::X), values.real(vr::FN))
+    }
+}
+
+impl Model for LuGreFmu {
+    fn info(&self) -> &'static ModelInfo {
+        &INFO
+    }
+
+    fn initialize(&mut self, values: &Values) -> Result<(), String> {
+        if values.integer(vr::N_TABLE) < 2 || values.integer(vr::N_TABLE) > TABLE_POINTS as i32 {
+            return Err(format!(
+                "invalid parameter n_table = {}: must be in 2..={TABLE_POINTS}",
+                values.integer(vr::N_TABLE)
+            ));
+        }
+        self.law = LuGre::new(Self::params(values)).map_err(param_err)?;
+        Ok(())
+    }
+
+    fn check_input(&self, input: u32, value: f64) -> Result<(), String> {
+        if input == vr::FN && value < 0.0 {
+            return Err("the normal force must be >= 0".into());
+        }
+        Ok(())
+    }
+
+    fn compute_outputs(&self, values: &mut Values) {
+        let (v, x, fn_) = Self::inputs(values);
+        values.set(vr::F, self.law.force(v, x, fn_));
+        values.set(vr::Z, self.law.z());
+        values.set_boolean(vr::SLIDING, self.law.sliding(v, x, fn_));
+    }
+
+    fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
+        let ramp = |i: u32| Ramp::new(values.real(i), slopes[i as usize]);
+        let inputs = LuGreInputs { v: ramp(vr::V), x: ramp(vr::X), fn_: ramp(vr::FN) };
+        self.law.step(&inputs, h);
+        Ok(())
+    }
+
+    fn save_state(&self, out: &mut Vec<f64>) {
+        out.extend(self.law.state_to_vec());
+    }
+
+    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+        self.law.state_from_slice(state)
+    }
+
+    fn clone_model(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
+
+    /// dz/dt from the state equation; dF/dt = σ0·ż + σ1·z̈ + σ2·v̇ with
+    /// z̈ = v̇ − σ0·d(|v|·z/g)/dt, for constant σ1 and x, Fn at rest (the
+    /// general case is not offered: `None`).
+    fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {
+        let (v, x, fn_) = Self::inputs(values);
+        let z_dot = self.law.z_dot(v, x, fn_);
+        match output {
+            vr::Z => Some(z_dot),
+            vr::F => {
+                let p = Self::params(values);
+                let moving_levels = slopes[vr::X as usize] != 0.0 || slopes[vr::FN as usize] != 0.0;
+                if p.vd != 0.0 || p.normal_force_form || moving_levels {
+                    return None;
+                }
+                let a = slopes[vr::V as usize];
+                let g = self.law.g(v, x, fn_);
+                let dv = 1e-7 * v.abs().max(p.vs);
+                let g_prime = (self.law.g(v + dv, x, fn_) - self.law.g(v - dv, x, fn_)) / (2.0 * dv);
+                let z = self.law.z();
+                let d_abs_v = v.signum() * a;
+                let z_ddot = a - p.sigma0 * (d_abs_v * z / g + v.abs() * z_dot / g - v.abs() * z * g_prime * a / (g * g));
+                Some(p.sigma0 * z_dot + p.sigma1 * z_ddot + p.sigma2 * a)
+            }
+            _ => None,
+        }
+    }
+}

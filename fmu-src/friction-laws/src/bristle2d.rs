@@ -1,0 +1,593 @@
+//! Two-dimensional bristle (reset-integrator) friction after seed 004
+//! (Wijata, Awrejcewicz, Matej, Makowski 2016); the equations are derived in
+//! MODELS.md "Two-dimensional bristle" because the seed lost them.
+//!
+//! State: bristle deflection `z = (z1, z2)`, stiction range the disc
+//! `|z| < z0`.
+//! `ż = v − [|z| ≥ z0 and z·v > 0]·(z·v)·z/|z|²`;
+//! `Fi = (1 + ai(|z|))·σ0i·zi + σ1i(|v|)·żi`, `ai(|z|) = ai` inside the disc,
+//! 0 on its boundary, `σ1i(|v|) = σ1i·exp(−(|v|/av)²)` (av = 0: constant).
+//!
+//! In sliding (`|z| = z0`, `z·v > 0`) `z` stays on the circle and its angle
+//! `φ` turns toward the slip direction `θ`: `dφ/dt = (|v|/z0)·sin(θ − φ)`,
+//! solved in closed form by `tan((θ − φ)/2) = tan((θ − φ0)/2)·e^(−|v|t/z0)`.
+
+use crate::error::{require_non_negative, require_positive};
+use crate::{ParamError, Ramp};
+
+/// Relative tolerance on `|z|²` for "on the boundary": a state projected onto
+/// the circle counts as on it despite round-off.
+const BOUNDARY_TOL: f64 = 1e-12;
+/// Most sub-steps per step for ramped velocities.
+const MAX_SUBSTEPS: usize = 10_000;
+/// Largest relative change of the velocity vector per sub-step.
+const KAPPA: f64 = 1e-3;
+
+/// Parameters of the 2-D bristle model (SI units): stiffnesses σ01, σ02
+/// (N/m), dampings σ11, σ12 (N·s/m), stiction gradients a1, a2 (–),
+/// stiction radius z0 (m), damping decay speed av (m/s; 0 = constant).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bristle2DParams {
+    pub sigma01: f64,
+    pub sigma02: f64,
+    pub sigma11: f64,
+    pub sigma12: f64,
+    pub a1: f64,
+    pub a2: f64,
+    pub z0: f64,
+    pub av: f64,
+}
+
+impl Default for Bristle2DParams {
+    /// Seed 004 numerical set: σ01 = σ02 = 1e4 N/m, σ11 = σ12 = 74.15 N·s/m,
+    /// a1 = a2 = 0.1, z0 = 1e-4 m, av = 1e-2 m/s.
+    fn default() -> Self {
+        Bristle2DParams {
+            sigma01: 1e4,
+            sigma02: 1e4,
+            sigma11: 74.15,
+            sigma12: 74.15,
+            a1: 0.1,
+            a2: 0.1,
+            z0: 1e-4,
+            av: 1e-2,
+        }
+    }
+}
+
+impl Bristle2DParams {
+    /// Seed 004 experimental fit: σ01 = 7293.7, σ02 = 5572.08 N/m,
+    /// σ11 = 209.2, σ12 = 182.8 N·s/m, a1 = a2 = 0.2, z0 = 1e-4 m,
+    /// av = 1e-2 m/s.
+    pub fn experimental() -> Self {
+        Bristle2DParams {
+            sigma01: 7293.7,
+            sigma02: 5572.08,
+            sigma11: 209.2,
+            sigma12: 182.8,
+            a1: 0.2,
+            a2: 0.2,
+            z0: 1e-4,
+            av: 1e-2,
+        }
+    }
+
+    /// σ0i > 0, σ1i ≥ 0, ai ≥ 0, z0 > 0, av ≥ 0, all finite.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        require_positive("sigma01", self.sigma01)?;
+        require_positive("sigma02", self.sigma02)?;
+        require_non_negative("sigma11", self.sigma11)?;
+        require_non_negative("sigma12", self.sigma12)?;
+        require_non_negative("a1", self.a1)?;
+        require_non_negative("a2", self.a2)?;
+        require_positive("z0", self.z0)?;
+        require_non_negative("av", self.av)?;
+        Ok(())
+    }
+}
+
+fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+/// 2-D bristle state: deflection `z` (m), kept in the closed disc `|z| ≤ z0`.
+#[derive(Clone, Debug)]
+pub struct Bristle2D {
+    p: Bristle2DParams,
+    z: [f64; 2],
+}
+
+impl Bristle2D {
+    /// Relaxed state `z = 0` with validated parameters.
+    pub fn new(p: Bristle2DParams) -> Result<Self, ParamError> {
+        p.validate()?;
+        Ok(Bristle2D { p, z: [0.0; 2] })
+    }
+
+    pub fn params(&self) -> &Bristle2DParams {
+        &self.p
+    }
+
+    pub fn z(&self) -> [f64; 2] {
+        self.z
+    }
+
+    /// Sets the deflection; a value outside the stiction disc is projected
+    /// radially onto its boundary (the model never leaves the closed disc).
+    pub fn set_z(&mut self, z: [f64; 2]) {
+        self.z = z;
+        self.clamp_to_disc();
+    }
+
+    fn clamp_to_disc(&mut self) {
+        let r = self.z[0].hypot(self.z[1]);
+        if r > self.p.z0 {
+            self.project(r);
+        }
+    }
+
+    /// Puts `z` (of length `r > 0`) exactly on the circle `|z| = z0`.
+    fn project(&mut self, r: f64) {
+        let f = self.p.z0 / r;
+        self.z = [self.z[0] * f, self.z[1] * f];
+    }
+
+    fn on_boundary(&self) -> bool {
+        let z0 = self.p.z0;
+        dot(self.z, self.z) >= z0 * z0 * (1.0 - BOUNDARY_TOL)
+    }
+
+    /// `ż = v − [|z| ≥ z0 and z·v > 0]·(z·v)·z/|z|²` (MODELS.md, derived).
+    pub fn z_dot(&self, v: [f64; 2]) -> [f64; 2] {
+        let zv = dot(self.z, v);
+        if self.on_boundary() && zv > 0.0 {
+            let c = zv / dot(self.z, self.z);
+            [v[0] - c * self.z[0], v[1] - c * self.z[1]]
+        } else {
+            v
+        }
+    }
+
+    /// `Fi = (1 + ai(|z|))·σ0i·zi + σ1i(|v|)·żi` with `ai` only inside the
+    /// disc and `σ1i(|v|) = σ1i·exp(−(|v|/av)²)`.
+    pub fn force(&self, v: [f64; 2]) -> [f64; 2] {
+        let p = &self.p;
+        let zd = self.z_dot(v);
+        let (g1, g2) = if self.on_boundary() {
+            (1.0, 1.0)
+        } else {
+            (1.0 + p.a1, 1.0 + p.a2)
+        };
+        let damp = if p.av > 0.0 {
+            let r = dot(v, v) / (p.av * p.av);
+            (-r).exp()
+        } else {
+            1.0
+        };
+        [
+            g1 * p.sigma01 * self.z[0] + p.sigma11 * damp * zd[0],
+            g2 * p.sigma02 * self.z[1] + p.sigma12 * damp * zd[1],
+        ]
+    }
+
+    /// Sliding: on the boundary of the stiction disc and slipping outward
+    /// (`z·v > 0`).
+    pub fn sliding(&self, v: [f64; 2]) -> bool {
+        self.on_boundary() && dot(self.z, v) > 0.0
+    }
+
+    /// Advances over `[0, h]` with `v = (v1(τ), v2(τ))`.
+    ///
+    /// Constant `v`: exact (see [`Bristle2D::advance_constant`]).
+    /// Ramped `v`: sub-steps on which the velocity vector changes by at most
+    /// 0.1 % of `|v| + v_floor` (`v_floor = √(0.001·|dv/dt|·z0)`, so the
+    /// path travelled while `|v|` is below it is small against `z0`), at most
+    /// 10 000 per step, each advanced exactly with a frozen velocity: the
+    /// midpoint velocity, except that in sliding its direction is taken at
+    /// `τ* = hs·(1 − φ1(khs))/(1 − e^(−khs))`, `k = |v|/z0`,
+    /// `φ1(x) = (1 − e^(−x))/x` (the time at which a frozen target gives the
+    /// exact response of the linearised relaxation to a uniformly turning
+    /// target: `hs/2` when `khs ≪ 1`, `hs − 1/k` when `khs ≫ 1`), which keeps
+    /// the deflection's lag behind a turning slip direction second-order
+    /// accurate also when a sub-step slides over many `z0`.
+    pub fn step(&mut self, v1: Ramp, v2: Ramp, h: f64) {
+        if !(h > 0.0) {
+            return;
+        }
+        let acc = v1.slope.hypot(v2.slope);
+        if acc == 0.0 {
+            self.advance_constant([v1.value, v2.value], h);
+            return;
+        }
+        let v_floor = (KAPPA * acc * self.p.z0).sqrt();
+        let min_len = h / MAX_SUBSTEPS as f64;
+        let mut t = 0.0;
+        let mut count = 0;
+        while t < h {
+            count += 1;
+            let rest = h - t;
+            let mut len = rest;
+            if count < MAX_SUBSTEPS {
+                let speed = v1.at(t).hypot(v2.at(t));
+                let l = KAPPA * (speed + v_floor) / acc;
+                if l < rest {
+                    len = l.max(min_len);
+                }
+            }
+            let t1 = if len >= rest { h } else { t + len };
+            self.substep(v1, v2, t, t1);
+            t = t1;
+        }
+    }
+
+    fn substep(&mut self, v1: Ramp, v2: Ramp, t: f64, t1: f64) {
+        let hs = t1 - t;
+        let tm = 0.5 * (t + t1);
+        let vm = [v1.at(tm), v2.at(tm)];
+        let speed = vm[0].hypot(vm[1]);
+        if speed > 0.0 && self.on_boundary() && dot(self.z, vm) >= 0.0 {
+            let x = speed / self.p.z0 * hs;
+            let frac = if x < 1e-4 {
+                0.5 + x / 12.0
+            } else {
+                let one_minus_e = -(-x).exp_m1();
+                (1.0 - one_minus_e / x) / one_minus_e
+            };
+            let ts = t + frac * hs;
+            let vd = [v1.at(ts), v2.at(ts)];
+            let sd = vd[0].hypot(vd[1]);
+            if sd > 0.0 {
+                let f = speed / sd;
+                self.advance_constant([vd[0] * f, vd[1] * f], hs);
+                return;
+            }
+        }
+        self.advance_constant(vm, hs);
+    }
+
+    /// Exact advance over `h` at constant `v`: inside the disc `ż = v` up to
+    /// the exact boundary hit (`|z + vτ| = z0`); on the boundary with
+    /// `z·v ≥ 0` the closed-form rotation (tangential slip, `z·v = 0`
+    /// included, turns outward at once); on the boundary with `z·v < 0` the
+    /// straight path back into the disc.
+    pub fn advance_constant(&mut self, v: [f64; 2], h: f64) {
+        let speed2 = dot(v, v);
+        if !(h > 0.0) || speed2 == 0.0 {
+            return;
+        }
+        let z0 = self.p.z0;
+        let mut rest = h;
+        for _ in 0..4 {
+            let b = dot(self.z, v);
+            if self.on_boundary() && b >= 0.0 {
+                self.rotate(v, rest);
+                return;
+            }
+            // Straight path z + vτ: time to reach |z| = z0.
+            let c = dot(self.z, self.z) - z0 * z0;
+            let disc = (b * b - speed2 * c).max(0.0);
+            let tau = if b <= 0.0 {
+                (-b + disc.sqrt()) / speed2
+            } else {
+                (-c / (b + disc.sqrt())).max(0.0)
+            };
+            if tau >= rest {
+                self.z = [self.z[0] + v[0] * rest, self.z[1] + v[1] * rest];
+                self.clamp_to_disc();
+                return;
+            }
+            self.z = [self.z[0] + v[0] * tau, self.z[1] + v[1] * tau];
+            let r = self.z[0].hypot(self.z[1]);
+            if r > 0.0 {
+                self.project(r);
+            }
+            rest -= tau;
+        }
+        // Round-off kept bouncing at a tangential exit: slide for the rest.
+        self.rotate(v, rest);
+    }
+
+    /// Sliding on the circle for time `t` at constant `v`:
+    /// `ψ = θ − φ`, `tan(ψ/2) ← tan(ψ0/2)·e^(−|v|t/z0)`, evaluated without
+    /// angles (`tan(ψ0/2) = sin ψ0/(1 + cos ψ0)` with `cos ψ0 = ẑ·v̂ ≥ 0`).
+    fn rotate(&mut self, v: [f64; 2], t: f64) {
+        let z0 = self.p.z0;
+        let speed = v[0].hypot(v[1]);
+        let r = self.z[0].hypot(self.z[1]);
+        if speed == 0.0 || r == 0.0 {
+            return;
+        }
+        let vh = [v[0] / speed, v[1] / speed];
+        let zh = [self.z[0] / r, self.z[1] / r];
+        let cos0 = dot(zh, vh);
+        let sin0 = zh[0] * vh[1] - zh[1] * vh[0];
+        let q0 = sin0 / (1.0 + cos0.max(0.0));
+        let q = q0 * (-speed * t / z0).exp();
+        let d = 1.0 + q * q;
+        let (cos_psi, sin_psi) = ((1.0 - q * q) / d, 2.0 * q / d);
+        let u = [
+            cos_psi * vh[0] + sin_psi * vh[1],
+            cos_psi * vh[1] - sin_psi * vh[0],
+        ];
+        let n = u[0].hypot(u[1]);
+        self.z = [z0 * u[0] / n, z0 * u[1] / n];
+    }
+
+    /// State `[z1, z2]`.
+    pub fn state_to_vec(&self) -> Vec<f64> {
+        vec![self.z[0], self.z[1]]
+    }
+
+    /// Restores `[z1, z2]` (finite; projected into the disc like
+    /// [`Bristle2D::set_z`]).
+    pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
+        match s {
+            [a, b] if a.is_finite() && b.is_finite() => {
+                self.set_z([*a, *b]);
+                Ok(())
+            }
+            [_, _] => Err(format!("2-D bristle state {s:?} is not finite")),
+            _ => Err(format!("2-D bristle state has 2 values, got {}", s.len())),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn norm(a: [f64; 2]) -> f64 {
+        a[0].hypot(a[1])
+    }
+
+    #[test]
+    fn isotropic_sliding_level_in_sixteen_directions() {
+        let p = Bristle2DParams::default();
+        for k in 0..16 {
+            let th = 2.0 * PI * k as f64 / 16.0 + 0.1;
+            let v = [0.05 * th.cos(), 0.05 * th.sin()];
+            let mut b = Bristle2D::new(p).unwrap();
+            b.step(Ramp::constant(v[0]), Ramp::constant(v[1]), 0.1);
+            assert!(b.sliding(v));
+            let f = b.force(v);
+            assert!((norm(f) / (p.sigma01 * p.z0) - 1.0).abs() < 1e-9, "k {k}: {f:?}");
+            // Force along the slip direction.
+            assert!((f[0] * v[1] - f[1] * v[0]).abs() < 1e-9 * norm(f) * norm(v));
+            // Turn by 90° while sliding: stays on the circle.
+            let w = [-v[1], v[0]];
+            b.step(Ramp::constant(w[0]), Ramp::constant(w[1]), 1e-3);
+            assert!((norm(b.z()) / p.z0 - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn anisotropic_sliding_force_lies_on_the_ellipse() {
+        let p = Bristle2DParams::experimental();
+        for k in 0..24 {
+            let th = 2.0 * PI * k as f64 / 24.0;
+            let v = [0.02 * th.cos(), 0.02 * th.sin()];
+            let mut b = Bristle2D::new(p).unwrap();
+            b.step(Ramp::constant(v[0]), Ramp::constant(v[1]), 1.0);
+            let f = b.force(v);
+            let e = (f[0] / (p.sigma01 * p.z0)).powi(2) + (f[1] / (p.sigma02 * p.z0)).powi(2);
+            assert!((e - 1.0).abs() < 1e-9, "k {k}: {e}");
+        }
+    }
+
+    #[test]
+    fn stiction_peak_inside_the_disc() {
+        let p = Bristle2DParams::default();
+        let mut b = Bristle2D::new(p).unwrap();
+        let v = [3e-5, 4e-5];
+        // |v|·t = 0.999·z0: still sticking, F = (1 + a)σ0 z + σ1 v.
+        b.step(Ramp::constant(v[0]), Ramp::constant(v[1]), 0.999 * p.z0 / 5e-5);
+        assert!(!b.sliding(v));
+        let damp = (-(5e-5f64 / p.av).powi(2)).exp();
+        let f = b.force(v);
+        let expect = (1.0 + p.a1) * p.sigma01 * 0.999 * p.z0 * 0.6 + p.sigma11 * damp * v[0];
+        assert!((f[0] / expect - 1.0).abs() < 1e-12);
+        b.step(Ramp::constant(v[0]), Ramp::constant(v[1]), 1.0);
+        assert!(b.sliding(v));
+        assert!((norm(b.force(v)) / (p.sigma01 * p.z0) - 1.0).abs() < 1e-9);
+        // Reversal: leaves the boundary straight inward (ż = v).
+        let w = [-v[0], -v[1]];
+        assert!(!b.sliding(w));
+        assert_eq!(b.z_dot(w), w);
+        b.step(Ramp::constant(w[0]), Ramp::constant(w[1]), 2.0 * p.z0 / 5e-5 * 0.5);
+        assert!(norm(b.z()) < 1e-12 * p.z0);
+        // Crosses the disc and slides on the far side.
+        b.step(Ramp::constant(w[0]), Ramp::constant(w[1]), 10.0);
+        assert!(b.sliding(w));
+    }
+
+    #[test]
+    fn turning_slip_direction_keeps_sliding() {
+        let p = Bristle2DParams::default();
+        for &(h, omega, speed) in &[(1e-3, 2.0 * PI, 0.1), (1e-2, 4.0 * PI, 0.05), (0.05, 6.0, 0.2)] {
+            let mut b = Bristle2D::new(p).unwrap();
+            let vel = |t: f64| [speed * (omega * t).cos(), speed * (omega * t).sin()];
+            let n = (2.0 / h) as usize;
+            let transient = (5.0 * p.z0 / speed / h).ceil() as usize + 1;
+            for k in 0..n {
+                let t = k as f64 * h;
+                let (a, c) = (vel(t), vel(t + h));
+                b.step(
+                    Ramp::new(a[0], (c[0] - a[0]) / h),
+                    Ramp::new(a[1], (c[1] - a[1]) / h),
+                    h,
+                );
+                if k >= transient {
+                    assert!(b.sliding(c), "h {h} step {k}: stuck at z {:?}", b.z());
+                    let f = b.force(c);
+                    assert!((norm(f) / (p.sigma01 * p.z0) - 1.0).abs() < 0.05);
+                }
+            }
+        }
+    }
+
+    /// Reference: exact straight motion inside the disc (the path is
+    /// quadratic in time), the sliding angle by RK4 on
+    /// `φ̇ = (v2 cos φ − v1 sin φ)/z0`, events located by bisection.
+    struct Reference {
+        z0: f64,
+        inside: bool,
+        z: [f64; 2],
+        phi: f64,
+    }
+
+    impl Reference {
+        fn z(&self) -> [f64; 2] {
+            if self.inside {
+                self.z
+            } else {
+                [self.z0 * self.phi.cos(), self.z0 * self.phi.sin()]
+            }
+        }
+
+        fn phi_after(&self, phi: f64, v1: Ramp, v2: Ramp, t: f64, dt: f64) -> f64 {
+            let f = |s: f64, ph: f64| (v2.at(s) * ph.cos() - v1.at(s) * ph.sin()) / self.z0;
+            let k1 = f(t, phi);
+            let k2 = f(t + 0.5 * dt, phi + 0.5 * dt * k1);
+            let k3 = f(t + 0.5 * dt, phi + 0.5 * dt * k2);
+            let k4 = f(t + dt, phi + dt * k3);
+            phi + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        }
+
+        fn advance(&mut self, v1: Ramp, v2: Ramp, t: f64, dt: f64) {
+            if !self.inside {
+                let c = |s: f64, ph: f64| v1.at(s) * ph.cos() + v2.at(s) * ph.sin();
+                if c(t, self.phi) < 0.0 {
+                    self.inside = true;
+                    self.z = self.z();
+                } else {
+                    let ph = self.phi_after(self.phi, v1, v2, t, dt);
+                    if c(t + dt, ph) >= 0.0 {
+                        self.phi = ph;
+                        return;
+                    }
+                    // Leaves the boundary inside this step.
+                    let (mut lo, mut hi) = (0.0, dt);
+                    for _ in 0..60 {
+                        let m = 0.5 * (lo + hi);
+                        if c(t + m, self.phi_after(self.phi, v1, v2, t, m)) >= 0.0 {
+                            lo = m;
+                        } else {
+                            hi = m;
+                        }
+                    }
+                    self.phi = self.phi_after(self.phi, v1, v2, t, lo);
+                    self.inside = true;
+                    self.z = self.z();
+                    return self.advance(v1, v2, t + lo, dt - lo);
+                }
+            }
+            let path = |s: f64| {
+                let (a, b) = (v1.at(t), v2.at(t));
+                [
+                    self.z[0] + a * s + 0.5 * v1.slope * s * s,
+                    self.z[1] + b * s + 0.5 * v2.slope * s * s,
+                ]
+            };
+            let end = path(dt);
+            if norm(end) < self.z0 {
+                self.z = end;
+                return;
+            }
+            let (mut lo, mut hi) = (0.0, dt);
+            for _ in 0..60 {
+                let m = 0.5 * (lo + hi);
+                if norm(path(m)) < self.z0 {
+                    lo = m;
+                } else {
+                    hi = m;
+                }
+            }
+            let zb = path(hi);
+            self.inside = false;
+            self.phi = zb[1].atan2(zb[0]);
+            self.phi = self.phi_after(self.phi, v1, v2, t + hi, dt - hi);
+        }
+    }
+
+    /// Worst deflection error (relative to z0) at the step ends over `n`
+    /// steps of `h` with the velocity ramping from `vel(k).0` to `vel(k).1`.
+    fn compare_with_reference(
+        p: Bristle2DParams,
+        h: f64,
+        n: usize,
+        vel: impl Fn(usize) -> ([f64; 2], [f64; 2]),
+    ) -> f64 {
+        let mut b = Bristle2D::new(p).unwrap();
+        let mut r = Reference {
+            z0: p.z0,
+            inside: true,
+            z: [0.0; 2],
+            phi: 0.0,
+        };
+        let m = ((h / 2e-6).ceil() as usize).max(10);
+        let dt = h / m as f64;
+        let mut worst: f64 = 0.0;
+        for k in 0..n {
+            let (a, c) = vel(k);
+            let (v1, v2) = (Ramp::new(a[0], (c[0] - a[0]) / h), Ramp::new(a[1], (c[1] - a[1]) / h));
+            b.step(v1, v2, h);
+            for j in 0..m {
+                r.advance(v1, v2, j as f64 * dt, dt);
+            }
+            let mut q = Bristle2D::new(p).unwrap();
+            q.set_z(r.z());
+            let e = norm([b.z()[0] - q.z()[0], b.z()[1] - q.z()[1]]) / p.z0;
+            worst = worst.max(e);
+        }
+        worst
+    }
+
+    #[test]
+    fn exact_step_matches_a_fine_reference() {
+        let p = Bristle2DParams::default();
+        // Piecewise-constant velocities: sticking, boundary hits, sliding,
+        // reversals through the disc.
+        let pattern = [[3e-3, 1e-3], [-2e-3, 2e-3], [-1e-3, -3e-3], [4e-3, 0.0], [0.0, 5e-3], [-4e-3, -4e-3]];
+        let e = compare_with_reference(p, 0.03, 6, |k| (pattern[k], pattern[k]));
+        assert!(e < 1e-8, "constant velocities: {e:e}");
+        // Ramped: a smooth planar slip path, sliding and sticking.
+        let vel = |t: f64| [4e-3 * (3.0 * t).sin(), 3e-3 * (5.0 * t).cos()];
+        let sampled = |h: f64| move |k: usize| (vel(k as f64 * h), vel((k + 1) as f64 * h));
+        let e = compare_with_reference(p, 0.01, 120, sampled(0.01));
+        assert!(e < 1e-6, "ramped h 0.01: {e:e}");
+        let e = compare_with_reference(p, 0.1, 12, sampled(0.1));
+        assert!(e < 1e-6, "ramped h 0.1: {e:e}");
+        // Fast sliding with a turning direction (many z0 per sub-step).
+        let vel = |t: f64| [0.5 * (0.7 * t).cos(), 0.5 * (0.7 * t).sin()];
+        let e = compare_with_reference(p, 0.05, 10, |k| (vel(k as f64 * 0.05), vel((k + 1) as f64 * 0.05)));
+        assert!(e < 1e-6, "fast turning: {e:e}");
+    }
+
+    #[test]
+    fn validation_state_round_trip_and_finite_for_all_steps() {
+        let p = Bristle2DParams::default();
+        assert_eq!(Bristle2D::new(Bristle2DParams { z0: 0.0, ..p }).unwrap_err().name, "z0");
+        assert_eq!(Bristle2D::new(Bristle2DParams { a2: -0.1, ..p }).unwrap_err().name, "a2");
+        assert_eq!(Bristle2D::new(Bristle2DParams { sigma02: -1.0, ..p }).unwrap_err().name, "sigma02");
+        let mut a = Bristle2D::new(p).unwrap();
+        a.step(Ramp::new(1e-3, -0.1), Ramp::new(-2e-3, 0.05), 0.03);
+        let mut b = Bristle2D::new(p).unwrap();
+        b.state_from_slice(&a.state_to_vec()).unwrap();
+        for &h in &[1e-7, 1e-4, 1e-1, 1.0] {
+            for &(v, s) in &[(1.0, -3.0), (-1e3, 5e3), (0.0, 0.0), (1e-12, 1e6), (0.0, -1e-9)] {
+                a.step(Ramp::new(v, s), Ramp::new(-0.5 * v, s), h);
+                b.step(Ramp::new(v, s), Ramp::new(-0.5 * v, s), h);
+                assert!(norm(a.z()) <= p.z0 * (1.0 + 4.0 * f64::EPSILON));
+                let f = a.force([v, 0.3]);
+                assert!(f[0].is_finite() && f[1].is_finite());
+                assert_eq!(a.z()[0].to_bits(), b.z()[0].to_bits());
+                assert_eq!(a.z()[1].to_bits(), b.z()[1].to_bits());
+            }
+        }
+        assert!(b.state_from_slice(&[0.0]).is_err());
+        assert!(b.state_from_slice(&[0.0, f64::NAN]).is_err());
+        b.set_z([1.0, 0.0]);
+        assert_eq!(b.z(), [p.z0, 0.0]);
+    }
+}

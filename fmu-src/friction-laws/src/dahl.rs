@@ -1,0 +1,328 @@
+//! Dahl friction (seed 001 eq. 2–3 and 16–17; seed 003 eq. 2.4–2.5;
+//! MODELS.md "Dahl").
+//!
+//! `dF/dx = σ·|1 − (F/Fc)·sgn v|^α · sgn(1 − (F/Fc)·sgn v)`, `dF/dt = (dF/dx)·v`.
+//!
+//! The law is rate-independent, so it is integrated in the displacement
+//! domain: over an interval on which `v` keeps one sign `s`, the increment
+//! `Δx = ∫ v dt` is exact for a ramped `v`, and with `y = 1 − F·s/Fc`,
+//! `u = |Δx|`, the ODE `d|y|/du = −(σ/Fc)·|y|^α` (sign of `y` preserved) has
+//! the closed-form solution used by [`Dahl::step`] for every `α > 0`.
+
+use crate::interval::{displacement, one_sign_pieces, sign_on};
+use crate::error::require_positive;
+use crate::{ParamError, Ramp};
+
+/// Dahl parameters: rest stiffness `sigma` (N/m), Coulomb level `fc` (N),
+/// shape exponent `alpha` (–).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DahlParams {
+    pub sigma: f64,
+    pub fc: f64,
+    pub alpha: f64,
+}
+
+impl Default for DahlParams {
+    /// Seed 001, Table 7 (nominal): σ = 87 750 N/m, Fc = 2.0 N, α = 1.
+    fn default() -> Self {
+        DahlParams {
+            sigma: 87_750.0,
+            fc: 2.0,
+            alpha: 1.0,
+        }
+    }
+}
+
+impl DahlParams {
+    /// All three parameters must be finite and > 0.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        require_positive("sigma", self.sigma)?;
+        require_positive("Fc", self.fc)?;
+        require_positive("alpha", self.alpha)?;
+        Ok(())
+    }
+}
+
+/// Dahl friction state: the force `F` itself (N).
+#[derive(Clone, Debug)]
+pub struct Dahl {
+    p: DahlParams,
+    f: f64,
+}
+
+impl Dahl {
+    /// A relaxed contact (`F = 0`) with validated parameters.
+    pub fn new(p: DahlParams) -> Result<Self, ParamError> {
+        p.validate()?;
+        Ok(Dahl { p, f: 0.0 })
+    }
+
+    pub fn params(&self) -> &DahlParams {
+        &self.p
+    }
+
+    /// The friction force `F` (the state; Dahl has no direct feedthrough).
+    pub fn force(&self) -> f64 {
+        self.f
+    }
+
+    /// Equivalent bristle deflection `z = F/σ` (m).
+    pub fn z(&self) -> f64 {
+        self.f / self.p.sigma
+    }
+
+    /// `true` when moving (`v ≠ 0`) with `sgn(v)·F ≥ 0.99·Fc`.
+    pub fn sliding(&self, v: f64) -> bool {
+        v != 0.0 && v.signum() * self.f >= 0.99 * self.p.fc
+    }
+
+    /// Advances over `[0, h]` with velocity `v(τ) = v.value + v.slope·τ`.
+    /// The step is split at the zero crossing of `v`; on each one-sign piece
+    /// the displacement `Δx` is exact and the update
+    /// (`y = 1 − F·s/Fc`, `u = |Δx|`, `k = σu/Fc`):
+    /// - α = 1: `|y| ← |y|·e^(−k)`,
+    /// - α < 1: `|y| ← (|y|^(1−α) − (1−α)k)^(1/(1−α))`, clamped at 0,
+    /// - α > 1: `|y| ← (|y|^(1−α) + (α−1)k)^(−1/(α−1))`,
+    ///
+    /// is the exact solution of `d|y|/du = −(σ/Fc)|y|^α`, evaluated in
+    /// increment form (`expm1`/`ln_1p`) so small steps lose no digits.
+    pub fn step(&mut self, v: Ramp, h: f64) {
+        if h <= 0.0 {
+            return;
+        }
+        let (pieces, n) = one_sign_pieces(v, h);
+        for &(a, b) in &pieces[..n] {
+            let s = sign_on(v, a, b);
+            if s == 0.0 {
+                continue;
+            }
+            let u = displacement(v, a, b).abs();
+            self.f = advance(&self.p, self.f, s, u);
+        }
+    }
+
+    /// State `[F]`.
+    pub fn state_to_vec(&self) -> Vec<f64> {
+        vec![self.f]
+    }
+
+    /// Restores `[F]` (any finite value).
+    pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
+        match s {
+            [f] if f.is_finite() => {
+                self.f = *f;
+                Ok(())
+            }
+            [f] => Err(format!("Dahl state F = {f} is not finite")),
+            _ => Err(format!("Dahl state has 1 value, got {}", s.len())),
+        }
+    }
+}
+
+/// Exact Dahl update of `F` over a displacement `u ≥ 0` in direction `s = ±1`.
+fn advance(p: &DahlParams, f: f64, s: f64, u: f64) -> f64 {
+    let y = 1.0 - f * s / p.fc;
+    if y == 0.0 || u <= 0.0 {
+        return f;
+    }
+    let ay = y.abs();
+    let k = p.sigma * u / p.fc;
+    let a = p.alpha;
+    // Increment of |y| (≤ 0).
+    let d_ay = if a == 1.0 {
+        ay * (-k).exp_m1()
+    } else if a < 1.0 {
+        let c = (1.0 - a) * k * ay.powf(a - 1.0);
+        if c >= 1.0 {
+            -ay
+        } else {
+            ay * ((-c).ln_1p() / (1.0 - a)).exp_m1()
+        }
+    } else {
+        let c = (a - 1.0) * k * ay.powf(a - 1.0);
+        ay * (-c.ln_1p() / (a - 1.0)).exp_m1()
+    };
+    if !(d_ay > -ay) {
+        // Reached y = 0 (or underflowed there): fully developed sliding.
+        return s * p.fc;
+    }
+    f - s * p.fc * y.signum() * d_ay
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn closed_form(p: &DahlParams, x: f64) -> f64 {
+        p.fc * -(-p.sigma * x / p.fc).exp_m1()
+    }
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs().max(1e-300)
+    }
+
+    #[test]
+    fn defaults_are_seed_001_table_7_and_validation_names_the_parameter() {
+        let p = DahlParams::default();
+        assert_eq!((p.sigma, p.fc, p.alpha), (87_750.0, 2.0, 1.0));
+        let e = Dahl::new(DahlParams { fc: -1.0, ..p }).unwrap_err();
+        assert_eq!(e.name, "Fc");
+        assert!(Dahl::new(DahlParams { alpha: 0.0, ..p }).is_err());
+        assert!(Dahl::new(DahlParams { sigma: f64::NAN, ..p }).is_err());
+    }
+
+    #[test]
+    fn constant_velocity_follows_the_closed_form_for_any_step() {
+        let p = DahlParams::default();
+        let x_end = 5.0 * p.fc / p.sigma;
+        for &h in &[1e-7, 1e-5, 1e-3, 1e-1, 1.0] {
+            for &n in &[37usize, 2000] {
+                let v = x_end / (n as f64 * h);
+                let mut d = Dahl::new(p).unwrap();
+                for k in 1..=n {
+                    d.step(Ramp::constant(v), h);
+                    let x = v * h * k as f64;
+                    let e = rel(d.force(), closed_form(&p, x));
+                    assert!(e < 1e-9, "h {h} n {n} k {k}: rel err {e}");
+                }
+            }
+        }
+        // Many tiny steps: 1e5 steps of 1e-7 s.
+        let mut d = Dahl::new(p).unwrap();
+        let v = 1e-3;
+        for k in 1..=100_000u32 {
+            d.step(Ramp::constant(v), 1e-7);
+            if k % 997 == 0 {
+                let x = v * 1e-7 * f64::from(k);
+                assert!(rel(d.force(), closed_form(&p, x)) < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn ramped_velocity_follows_the_closed_form() {
+        let p = DahlParams::default();
+        for &h in &[1e-7, 1e-4, 1e-2, 1.0] {
+            let n = 500;
+            let t_end = n as f64 * h;
+            // x(t) = a t²/2 reaches 4 Fc/σ at t_end.
+            let a = 2.0 * 4.0 * p.fc / p.sigma / (t_end * t_end);
+            let mut d = Dahl::new(p).unwrap();
+            for k in 0..n {
+                let t = k as f64 * h;
+                d.step(Ramp::new(a * t, a), h);
+                let t1 = (k + 1) as f64 * h;
+                let e = rel(d.force(), closed_form(&p, 0.5 * a * t1 * t1));
+                assert!(e < 1e-9, "h {h} k {k}: {e}");
+            }
+        }
+        // Negative direction mirrors.
+        let mut d = Dahl::new(p).unwrap();
+        d.step(Ramp::new(0.0, -2e-5), 1.0);
+        assert!(rel(-d.force(), closed_form(&p, 1e-5)) < 1e-12);
+    }
+
+    /// RK4 on dF/dx with `m` steps over `[0, x]` from `f0`, direction `s`.
+    fn rk4(p: &DahlParams, f0: f64, s: f64, x: f64, m: usize) -> f64 {
+        let rhs = |f: f64| {
+            let y = 1.0 - f * s / p.fc;
+            s * p.sigma * y.abs().powf(p.alpha) * y.signum()
+        };
+        let dx = x / m as f64;
+        let mut f = f0;
+        for _ in 0..m {
+            let k1 = rhs(f);
+            let k2 = rhs(f + 0.5 * dx * k1);
+            let k3 = rhs(f + 0.5 * dx * k2);
+            let k4 = rhs(f + dx * k3);
+            f += dx / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        }
+        f
+    }
+
+    #[test]
+    fn general_alpha_matches_a_fine_rk4_reference() {
+        for &alpha in &[0.3, 0.5, 0.8, 1.0, 1.5, 2.0, 3.0] {
+            let p = DahlParams {
+                alpha,
+                ..DahlParams::default()
+            };
+            // Stop before y = 0 so the reference ODE stays smooth (α < 1
+            // reaches sliding in finite distance).
+            let x_end = 0.6 * p.fc / p.sigma;
+            let mut d = Dahl::new(p).unwrap();
+            let n = 40;
+            let v = x_end / n as f64; // h = 1 s
+            for k in 1..=n {
+                d.step(Ramp::constant(v), 1.0);
+                let reference = rk4(&p, 0.0, 1.0, v * k as f64, 4000 * k);
+                let e = rel(d.force(), reference);
+                assert!(e < 1e-8, "alpha {alpha} k {k}: {e}");
+            }
+            // And back the other way from there.
+            let f0 = d.force();
+            d.step(Ramp::constant(-x_end), 0.5);
+            let reference = rk4(&p, f0, -1.0, 0.5 * x_end, 100_000);
+            assert!((d.force() - reference).abs() < 1e-8 * p.fc, "alpha {alpha} back");
+        }
+    }
+
+    #[test]
+    fn sub_unit_alpha_reaches_fc_in_finite_distance() {
+        let p = DahlParams {
+            alpha: 0.5,
+            ..DahlParams::default()
+        };
+        // |y|^(1/2) = 1 − (1/2)(σ/Fc)x → y = 0 at x = 2Fc/σ.
+        let mut d = Dahl::new(p).unwrap();
+        d.step(Ramp::constant(2.0 * p.fc / p.sigma * 1.0001), 1.0);
+        assert_eq!(d.force(), p.fc);
+        assert!(d.sliding(1.0) && !d.sliding(-1.0) && !d.sliding(0.0));
+    }
+
+    #[test]
+    fn reversal_unloads_with_twice_the_distance_of_loading() {
+        let p = DahlParams::default();
+        let mut d = Dahl::new(p).unwrap();
+        // Slide forward to saturation, then reverse: y starts at 2.
+        d.step(Ramp::constant(1.0), 1.0);
+        assert!((d.force() - p.fc).abs() < 1e-15);
+        assert!(d.sliding(1.0));
+        let x = 1e-5;
+        d.step(Ramp::constant(-x), 1.0);
+        let expect = -p.fc + 2.0 * p.fc * (-p.sigma * x / p.fc).exp();
+        assert!(rel(d.force(), expect) < 1e-12);
+        // A ramp through zero: forward 1e-5 then back 1e-5 in one step.
+        let mut e = Dahl::new(p).unwrap();
+        // v = 2e-5·(1 − 2τ) over [0, 1]: +5e-6 then −5e-6.
+        e.step(Ramp::new(2e-5, -4e-5), 1.0);
+        let f1 = closed_form(&p, 5e-6);
+        let expect = -p.fc + (f1 + p.fc) * (-p.sigma * 5e-6 / p.fc).exp();
+        assert!((e.force() - expect).abs() < 1e-12, "{} vs {}", e.force(), expect);
+        // Unloading is stiffer (slope σ(1 + F/Fc) > σ(1 − F/Fc)), so the same
+        // distance back overshoots below zero: hysteresis.
+        assert!(e.force() < 0.0, "hysteresis: {}", e.force());
+    }
+
+    #[test]
+    fn state_round_trip_and_finite_for_all_step_sizes() {
+        let p = DahlParams {
+            alpha: 0.7,
+            ..DahlParams::default()
+        };
+        let mut d = Dahl::new(p).unwrap();
+        d.step(Ramp::new(1e-4, -3e-3), 0.1);
+        let mut e = Dahl::new(p).unwrap();
+        e.state_from_slice(&d.state_to_vec()).unwrap();
+        for &h in &[1e-7, 1e-3, 1.0] {
+            for &(v, a) in &[(1.0, -3.0), (-1e3, 5e3), (0.0, 0.0), (1e-12, 1e6)] {
+                d.step(Ramp::new(v, a), h);
+                e.step(Ramp::new(v, a), h);
+                assert!(d.force().is_finite() && d.force().abs() <= p.fc * (1.0 + 1e-12));
+                assert_eq!(d.force().to_bits(), e.force().to_bits());
+            }
+        }
+        assert!(e.state_from_slice(&[1.0, 2.0]).is_err());
+        assert!(e.state_from_slice(&[f64::INFINITY]).is_err());
+    }
+}

@@ -1,0 +1,764 @@
+//! LuGre friction (seed 001 eq. 9–12; seed 002 eq. 1–3; seed 003 eq.
+//! 2.8–2.9; MODELS.md "LuGre" and "Position- and direction-dependent
+//! levels").
+//!
+//! `ż = v − σ0·|v|·z / g(v)`, `g(v) = Fc + (Fs − Fc)·exp(−|v/vs|^δ)`,
+//! `F = σ0·z + σ1(v)·ż + σ2·v`, `σ1(v) = σ1·exp(−(v/vd)²)` (vd = 0: constant).
+//!
+//! Options:
+//! - direction-dependent levels: `Fc_neg`, `Fs_neg` (and `scale_neg`) for
+//!   `v < 0` (seed 003);
+//! - position-dependent levels: `Fc` and `Fs` multiplied by a scale factor
+//!   piecewise-linear in the position input `x`, constant beyond the table
+//!   ends (seed 003);
+//! - normal-force form (seed 002): `σ0, σ1, σ2, Fc, Fs` are per unit normal
+//!   force and the force is multiplied by the input `Fn`; the ratio `σ0/g`
+//!   and hence the `z` dynamics do not depend on `Fn`.
+//!
+//! At constant inputs `ż` is linear in `z` with rate `λ = σ0·|v|/g`, so
+//! `z ← zss + (z − zss)·e^(−λh)`, `zss = g·sgn(v)/σ0`, is exact for any `h`.
+
+use crate::error::{require_non_negative, require_positive};
+use crate::interval::{one_sign_pieces, sign_on};
+use crate::{ParamError, Ramp};
+
+/// Capacity of the position table.
+pub const TABLE_POINTS: usize = 32;
+
+/// Most sub-steps per one-sign piece of a step.
+const MAX_SUBSTEPS: usize = 10_000;
+/// Largest relative change of `|v| + vs` per sub-step.
+const KAPPA_V: f64 = 1e-3;
+/// Largest relative change of the level scale factor per sub-step.
+const KAPPA_X: f64 = 1e-3;
+
+/// LuGre parameters (SI units). In the normal-force form the stiffnesses,
+/// dampings and levels are per newton of normal force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LuGreParams {
+    /// Bristle stiffness σ0 (N/m).
+    pub sigma0: f64,
+    /// Micro-damping σ1 (N·s/m).
+    pub sigma1: f64,
+    /// Viscous coefficient σ2 (N·s/m).
+    pub sigma2: f64,
+    /// Coulomb level Fc (N), for `v ≥ 0` when direction-dependent.
+    pub fc: f64,
+    /// Static (break-away) level Fs ≥ Fc (N).
+    pub fs: f64,
+    /// Stribeck velocity vs (m/s).
+    pub vs: f64,
+    /// Stribeck exponent δ (–).
+    pub stribeck_exponent: f64,
+    /// Micro-damping decay velocity vd (m/s); 0 = constant σ1.
+    pub vd: f64,
+    /// Use `fc_neg`, `fs_neg` (and `scale_neg`) for `v < 0`.
+    pub direction_dependent: bool,
+    pub fc_neg: f64,
+    pub fs_neg: f64,
+    /// Multiply the force by the normal-force input (seed 002 form).
+    pub normal_force_form: bool,
+    /// Scale Fc and Fs by the position table.
+    pub position_dependent: bool,
+    /// Number of table points used (2..=32).
+    pub n_table: usize,
+    /// Table positions (m), strictly increasing over the first `n_table`.
+    pub x_table: [f64; TABLE_POINTS],
+    /// Scale factors (> 0) on Fc, Fs at `x_table` (both directions, or
+    /// `v ≥ 0` when direction-dependent).
+    pub scale_pos: [f64; TABLE_POINTS],
+    /// Scale factors for `v < 0` when direction-dependent.
+    pub scale_neg: [f64; TABLE_POINTS],
+}
+
+impl Default for LuGreParams {
+    /// Canudas de Wit et al. 1995 benchmark: σ0 = 1e5 N/m, σ1 = √1e5 N·s/m,
+    /// σ2 = 0.4 N·s/m, Fc = 1 N, Fs = 1.5 N, vs = 1e-3 m/s, δ = 2, vd = 0;
+    /// negative levels equal to the positive ones, options off, table
+    /// x = 0..1 m evenly over 32 points with unit scales.
+    fn default() -> Self {
+        let mut x_table = [0.0; TABLE_POINTS];
+        for (i, x) in x_table.iter_mut().enumerate() {
+            *x = i as f64 / (TABLE_POINTS - 1) as f64;
+        }
+        LuGreParams {
+            sigma0: 1e5,
+            sigma1: 1e5_f64.sqrt(),
+            sigma2: 0.4,
+            fc: 1.0,
+            fs: 1.5,
+            vs: 1e-3,
+            stribeck_exponent: 2.0,
+            vd: 0.0,
+            direction_dependent: false,
+            fc_neg: 1.0,
+            fs_neg: 1.5,
+            normal_force_form: false,
+            position_dependent: false,
+            n_table: TABLE_POINTS,
+            x_table,
+            scale_pos: [1.0; TABLE_POINTS],
+            scale_neg: [1.0; TABLE_POINTS],
+        }
+    }
+}
+
+impl LuGreParams {
+    /// Seed 001 (brass on steel, m ≈ 1 kg): Table 6 static part (Fc = 1.284 N,
+    /// Fs = 2.35 N, vs = 1.13975e-3 m/s, σ2 = 173 N·s/m), σ0 = 66 967.231 N/m
+    /// (Table 9), σ1 = 2√σ0 − σ2 ≈ 344.56 N·s/m (eq. 24, critical damping
+    /// with m = 1).
+    pub fn seed001() -> Self {
+        let sigma0 = 66_967.231;
+        let sigma2 = 173.0;
+        LuGreParams {
+            sigma0,
+            sigma1: 2.0 * f64::sqrt(sigma0) - sigma2,
+            sigma2,
+            fc: 1.284,
+            fs: 2.35,
+            vs: 1.139_75e-3,
+            fc_neg: 1.284,
+            fs_neg: 2.35,
+            ..LuGreParams::default()
+        }
+    }
+
+    /// σ0 > 0, σ1 ≥ 0, σ2 ≥ 0, Fc > 0, Fs ≥ Fc, vs > 0, δ > 0, vd ≥ 0, all
+    /// finite; the negative levels likewise when direction-dependent; the
+    /// table (2..=32 points, strictly increasing, scales > 0) when
+    /// position-dependent.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        require_positive("sigma0", self.sigma0)?;
+        require_non_negative("sigma1", self.sigma1)?;
+        require_non_negative("sigma2", self.sigma2)?;
+        require_positive("Fc", self.fc)?;
+        require_at_least("Fs", self.fs, "Fc", self.fc)?;
+        require_positive("vs", self.vs)?;
+        require_positive("stribeck_exponent", self.stribeck_exponent)?;
+        require_non_negative("vd", self.vd)?;
+        if self.direction_dependent {
+            require_positive("Fc_neg", self.fc_neg)?;
+            require_at_least("Fs_neg", self.fs_neg, "Fc_neg", self.fc_neg)?;
+        }
+        if self.position_dependent {
+            let n = self.n_table;
+            if !(2..=TABLE_POINTS).contains(&n) {
+                return Err(ParamError::new(
+                    "n_table",
+                    n as f64,
+                    format!("must be in 2..={TABLE_POINTS}"),
+                ));
+            }
+            for i in 0..n {
+                let x = self.x_table[i];
+                if !x.is_finite() {
+                    return Err(ParamError::new(
+                        "x_table",
+                        x,
+                        format!("x_table[{}] must be finite", i + 1),
+                    ));
+                }
+                if i > 0 && !(x > self.x_table[i - 1]) {
+                    return Err(ParamError::new(
+                        "x_table",
+                        x,
+                        format!(
+                            "x_table[{}] must be > x_table[{}] = {} (strictly increasing)",
+                            i + 1,
+                            i,
+                            self.x_table[i - 1]
+                        ),
+                    ));
+                }
+                check_scale("scale_pos", self.scale_pos[i], i)?;
+                if self.direction_dependent {
+                    check_scale("scale_neg", self.scale_neg[i], i)?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+fn require_at_least(
+    name: &'static str,
+    value: f64,
+    other: &str,
+    bound: f64,
+) -> Result<(), ParamError> {
+    if value.is_finite() && value >= bound {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, value, format!("must be >= {other} = {bound}")))
+    }
+}
+
+fn check_scale(name: &'static str, s: f64, i: usize) -> Result<(), ParamError> {
+    if s.is_finite() && s > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(
+            name,
+            s,
+            format!("{name}[{}] must be finite and > 0", i + 1),
+        ))
+    }
+}
+
+/// Instantaneous inputs over a step: velocity `v` (m/s), position `x` (m,
+/// used by the position table) and normal force `fn_` (N, used in the
+/// normal-force form; negative values count as 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LuGreInputs {
+    pub v: Ramp,
+    pub x: Ramp,
+    pub fn_: Ramp,
+}
+
+/// LuGre state: the mean bristle deflection `z` (m).
+#[derive(Clone, Debug)]
+pub struct LuGre {
+    p: LuGreParams,
+    z: f64,
+    /// Largest relative slope of the scale tables (1/m), 0 without table.
+    table_rate: f64,
+}
+
+impl LuGre {
+    /// Relaxed state `z = 0` with validated parameters.
+    pub fn new(p: LuGreParams) -> Result<Self, ParamError> {
+        p.validate()?;
+        let mut table_rate: f64 = 0.0;
+        if p.position_dependent {
+            let n = p.n_table;
+            let mut tables = vec![&p.scale_pos];
+            if p.direction_dependent {
+                tables.push(&p.scale_neg);
+            }
+            for s in tables {
+                let min = s[..n].iter().cloned().fold(f64::INFINITY, f64::min);
+                for i in 1..n {
+                    let slope = (s[i] - s[i - 1]).abs() / (p.x_table[i] - p.x_table[i - 1]);
+                    table_rate = table_rate.max(slope / min);
+                }
+            }
+        }
+        Ok(LuGre {
+            p,
+            z: 0.0,
+            table_rate,
+        })
+    }
+
+    pub fn params(&self) -> &LuGreParams {
+        &self.p
+    }
+
+    pub fn z(&self) -> f64 {
+        self.z
+    }
+
+    /// Sets the deflection (any finite value).
+    pub fn set_z(&mut self, z: f64) {
+        self.z = z;
+    }
+
+    /// Normal-force multiplier: `max(Fn, 0)` in the normal-force form, else 1.
+    fn fn_factor(&self, fn_: f64) -> f64 {
+        if self.p.normal_force_form {
+            fn_.max(0.0)
+        } else {
+            1.0
+        }
+    }
+
+    /// Position scale factor: piecewise-linear interpolation of the table
+    /// for direction `dir` (`< 0` uses `scale_neg` when direction-dependent),
+    /// constant beyond the ends.
+    fn scale(&self, dir: f64, x: f64) -> f64 {
+        let p = &self.p;
+        if !p.position_dependent {
+            return 1.0;
+        }
+        let n = p.n_table.clamp(2, TABLE_POINTS);
+        let s = if dir < 0.0 && p.direction_dependent {
+            &p.scale_neg
+        } else {
+            &p.scale_pos
+        };
+        let xs = &p.x_table[..n];
+        if !(x > xs[0]) {
+            return s[0];
+        }
+        if x >= xs[n - 1] {
+            return s[n - 1];
+        }
+        // First index with xs[i] > x, in 1..n.
+        let i = xs.partition_point(|&xi| xi <= x);
+        let w = (x - xs[i - 1]) / (xs[i] - xs[i - 1]);
+        s[i - 1] + w * (s[i] - s[i - 1])
+    }
+
+    /// Stribeck level per unit normal force for speed `w = |v|`, direction
+    /// `dir` and position `x`: `Fc' + (Fs' − Fc')·exp(−(w/vs)^δ)`.
+    fn g_unit(&self, w: f64, dir: f64, x: f64) -> f64 {
+        let p = &self.p;
+        let (fc, fs) = if dir < 0.0 && p.direction_dependent {
+            (p.fc_neg, p.fs_neg)
+        } else {
+            (p.fc, p.fs)
+        };
+        let r = w / p.vs;
+        let e = if p.stribeck_exponent == 2.0 {
+            r * r
+        } else {
+            r.powf(p.stribeck_exponent)
+        };
+        self.scale(dir, x) * (fc + (fs - fc) * (-e).exp())
+    }
+
+    /// Stribeck level `g(v)` (N) with the direction, position and
+    /// normal-force scaling (MODELS.md "LuGre"; seed 003 for the levels;
+    /// seed 002 for the `Fn` factor). At `v = 0` the positive-direction
+    /// levels are used.
+    pub fn g(&self, v: f64, x: f64, fn_: f64) -> f64 {
+        self.g_unit(v.abs(), v, x) * self.fn_factor(fn_)
+    }
+
+    /// Steady-state (Stribeck) force `Fss = g(v)·sgn v + σ2·v` (σ2 per unit
+    /// `Fn` in the normal-force form); seed 001 eq. 12.
+    pub fn steady_force(&self, v: f64, x: f64, fn_: f64) -> f64 {
+        if v == 0.0 {
+            return 0.0;
+        }
+        (self.g_unit(v.abs(), v, x) * v.signum() + self.p.sigma2 * v) * self.fn_factor(fn_)
+    }
+
+    /// `ż = v − σ0·|v|·z/g(v)` at the current state (independent of `Fn`:
+    /// the ratio σ0/g is per unit normal force).
+    pub fn z_dot(&self, v: f64, x: f64, fn_: f64) -> f64 {
+        let _ = fn_;
+        if v == 0.0 {
+            return 0.0;
+        }
+        v - self.p.sigma0 * v.abs() * self.z / self.g_unit(v.abs(), v, x)
+    }
+
+    /// Micro-damping `σ1(v) = σ1·exp(−(v/vd)²)`, constant when `vd = 0`.
+    fn sigma1_at(&self, v: f64) -> f64 {
+        if self.p.vd > 0.0 {
+            let r = v / self.p.vd;
+            self.p.sigma1 * (-r * r).exp()
+        } else {
+            self.p.sigma1
+        }
+    }
+
+    /// `F = (σ0·z + σ1(v)·ż + σ2·v)·[Fn]` at the current state and the given
+    /// instantaneous inputs (direct feedthrough of `v`; seed 001 eq. 11,
+    /// seed 002 eq. 1).
+    pub fn force(&self, v: f64, x: f64, fn_: f64) -> f64 {
+        let zd = self.z_dot(v, x, fn_);
+        (self.p.sigma0 * self.z + self.sigma1_at(v) * zd + self.p.sigma2 * v) * self.fn_factor(fn_)
+    }
+
+    /// `true` when moving with the bristles at the sliding level:
+    /// `v ≠ 0` and `sgn(v)·σ0·z ≥ 0.99·g(v)`.
+    pub fn sliding(&self, v: f64, x: f64, fn_: f64) -> bool {
+        let _ = fn_;
+        v != 0.0 && v.signum() * self.p.sigma0 * self.z >= 0.99 * self.g_unit(v.abs(), v, x)
+    }
+
+    /// Steady deflection `zss = g·s/σ0` for speed `w`, direction `s`.
+    fn zss(&self, w: f64, s: f64, x: f64) -> f64 {
+        self.g_unit(w, s, x) * s / self.p.sigma0
+    }
+
+    /// Advances `z` over `[0, h]`.
+    ///
+    /// Constant inputs: the exact update `z ← zss + (z − zss)·e^(−λh)`.
+    /// Ramped inputs: the step is split exactly at the zero crossing of `v`,
+    /// then into sub-steps on which `|v| + vs` changes by at most 0.1 % and the
+    /// level scale factor by at most 0.1 % (at most 10 000 per piece), ending
+    /// exactly where `x(t)` passes a table point. On each sub-step
+    /// the rate `λ = σ0|v|/g` is taken at the midpoint and `zss` varies
+    /// linearly between its end-point values, which the linear ODE
+    /// `ż = −λ(z − zss(τ))` integrates exactly:
+    /// `z ← zss_b + (z − zss_a)·e^(−λh) − (zss_b − zss_a)·(1 − e^(−λh))/(λh)`.
+    /// This reduces to the exact constant-input update and, unlike freezing
+    /// `zss` at the midpoint too, stays second-order accurate when `λh ≫ 1`
+    /// (sliding), where `z` tracks `zss(v(t))`. `Fn` does not enter.
+    pub fn step(&mut self, inp: &LuGreInputs, h: f64) {
+        if !(h > 0.0) {
+            return;
+        }
+        let (pieces, n) = one_sign_pieces(inp.v, h);
+        for &(a, b) in &pieces[..n] {
+            let s = sign_on(inp.v, a, b);
+            if s != 0.0 && b > a {
+                self.integrate_piece(inp, a, b, s);
+            }
+        }
+    }
+
+    /// Sub-stepped integration over `[a, b]` on which `sgn v = s ≠ 0`.
+    fn integrate_piece(&mut self, inp: &LuGreInputs, a: f64, b: f64, s: f64) {
+        let v = inp.v;
+        let x = inp.x;
+        let min_len = (b - a) / MAX_SUBSTEPS as f64;
+        let rate_x = self.table_rate * x.slope.abs();
+        let vs = self.p.vs;
+        // Times in (a, b) at which x(t) passes a table point (kinks of the
+        // scale factor), in increasing order; sub-steps end exactly there.
+        let mut kinks = [0.0; TABLE_POINTS];
+        let mut n_kinks = 0;
+        if self.p.position_dependent && x.slope != 0.0 {
+            let n = self.p.n_table.clamp(2, TABLE_POINTS);
+            for j in 0..n {
+                let i = if x.slope > 0.0 { j } else { n - 1 - j };
+                let tk = (self.p.x_table[i] - x.value) / x.slope;
+                if tk > a && tk < b {
+                    kinks[n_kinks] = tk;
+                    n_kinks += 1;
+                }
+            }
+        }
+        let mut next_kink = 0;
+        let mut t = a;
+        let mut zss_a = self.zss(v.at(t).abs(), s, x.at(t));
+        let mut z = self.z;
+        let mut count = 0;
+        while t < b {
+            count += 1;
+            while next_kink < n_kinks && kinks[next_kink] <= t {
+                next_kink += 1;
+            }
+            let end = if next_kink < n_kinks { kinks[next_kink] } else { b };
+            let rest = end - t;
+            let mut len = rest;
+            if count < MAX_SUBSTEPS {
+                let rate = (v.slope.abs() / (v.at(t).abs() + vs) / KAPPA_V).max(rate_x / KAPPA_X);
+                if rate * rest > 1.0 {
+                    len = (1.0 / rate).max(min_len);
+                }
+            }
+            let t1 = if len >= rest { end } else { t + len };
+            let hs = t1 - t;
+            let tm = 0.5 * (t + t1);
+            let wm = v.at(tm).abs();
+            let lambda = self.p.sigma0 * wm / self.g_unit(wm, s, x.at(tm));
+            let zss_b = self.zss(v.at(t1).abs(), s, x.at(t1));
+            let lh = lambda * hs;
+            let decay = (-lh).exp();
+            let phi = if lh > 0.0 { -(-lh).exp_m1() / lh } else { 1.0 };
+            z = zss_b + (z - zss_a) * decay - (zss_b - zss_a) * phi;
+            zss_a = zss_b;
+            t = t1;
+        }
+        self.z = z;
+    }
+
+    /// State `[z]`.
+    pub fn state_to_vec(&self) -> Vec<f64> {
+        vec![self.z]
+    }
+
+    /// Restores `[z]` (finite).
+    pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
+        match s {
+            [z] if z.is_finite() => {
+                self.z = *z;
+                Ok(())
+            }
+            [z] => Err(format!("LuGre state z = {z} is not finite")),
+            _ => Err(format!("LuGre state has 1 value, got {}", s.len())),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn inputs(v: Ramp) -> LuGreInputs {
+        LuGreInputs {
+            v,
+            x: Ramp::constant(0.0),
+            fn_: Ramp::constant(1.0),
+        }
+    }
+
+    fn stribeck(p: &LuGreParams, v: f64) -> f64 {
+        v.signum() * (p.fc + (p.fs - p.fc) * (-(v / p.vs).powi(2)).exp()) + p.sigma2 * v
+    }
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    #[test]
+    fn parameter_sets_and_validation() {
+        let p = LuGreParams::seed001();
+        assert!((p.sigma1 - 344.56).abs() < 0.01, "{}", p.sigma1);
+        assert!(LuGre::new(p).is_ok());
+        assert!(LuGre::new(LuGreParams::default()).is_ok());
+        let e = LuGre::new(LuGreParams { fs: 1.0, ..p }).unwrap_err();
+        assert_eq!(e.name, "Fs");
+        assert!(e.rule.contains(">= Fc = 1.284"), "{}", e.rule);
+        let bad = |q: LuGreParams| LuGre::new(q).unwrap_err().name;
+        assert_eq!(bad(LuGreParams { sigma0: 0.0, ..p }), "sigma0");
+        assert_eq!(bad(LuGreParams { sigma1: -1.0, ..p }), "sigma1");
+        assert_eq!(bad(LuGreParams { sigma2: f64::NAN, ..p }), "sigma2");
+        assert_eq!(bad(LuGreParams { fc: 0.0, ..p }), "Fc");
+        assert_eq!(bad(LuGreParams { vs: 0.0, ..p }), "vs");
+        assert_eq!(bad(LuGreParams { stribeck_exponent: 0.0, ..p }), "stribeck_exponent");
+        assert_eq!(bad(LuGreParams { vd: -1.0, ..p }), "vd");
+        let dd = LuGreParams {
+            direction_dependent: true,
+            ..p
+        };
+        assert_eq!(bad(LuGreParams { fc_neg: -1.0, ..dd }), "Fc_neg");
+        assert_eq!(bad(LuGreParams { fs_neg: 1.0, ..dd }), "Fs_neg");
+        let pd = LuGreParams {
+            position_dependent: true,
+            ..dd
+        };
+        assert_eq!(bad(LuGreParams { n_table: 1, ..pd }), "n_table");
+        assert_eq!(bad(LuGreParams { n_table: 33, ..pd }), "n_table");
+        let mut q = pd;
+        q.x_table[4] = q.x_table[3];
+        let e = LuGre::new(q).unwrap_err();
+        assert_eq!(e.name, "x_table");
+        assert!(e.rule.contains("x_table[5]"), "{}", e.rule);
+        q.n_table = 4; // the bad point is no longer used
+        assert!(LuGre::new(q).is_ok());
+        let mut q = pd;
+        q.scale_neg[0] = 0.0;
+        assert_eq!(bad(q), "scale_neg");
+        q.direction_dependent = false; // scale_neg unused
+        assert!(LuGre::new(q).is_ok());
+        q.scale_pos[31] = -1.0;
+        assert_eq!(bad(q), "scale_pos");
+    }
+
+    #[test]
+    fn steady_force_follows_the_stribeck_curve() {
+        let p = LuGreParams::seed001();
+        let mut worst: f64 = 0.0;
+        for i in 0..20 {
+            // ±1e-5 … ±1e-1 m/s, ten log-spaced speeds per sign.
+            let w = 1e-5 * 10f64.powf(4.0 * (i % 10) as f64 / 9.0);
+            let v = if i < 10 { w } else { -w };
+            let mut l = LuGre::new(p).unwrap();
+            l.step(&inputs(Ramp::constant(v)), 1e3);
+            let f = l.force(v, 0.0, 1.0);
+            let e = rel(f, stribeck(&p, v));
+            worst = worst.max(e);
+            assert!(e < 1e-6, "v {v}: {f} vs {}", stribeck(&p, v));
+            assert!((l.steady_force(v, 0.0, 1.0) - stribeck(&p, v)).abs() < 1e-12);
+            assert!(l.sliding(v, 0.0, 1.0) && !l.sliding(-v, 0.0, 1.0));
+        }
+        assert!(worst < 1e-6);
+    }
+
+    #[test]
+    fn small_displacement_is_elastic() {
+        let p = LuGreParams::seed001();
+        let mut l = LuGre::new(p).unwrap();
+        // 1e-8 m in 1 ms, then at rest: F = σ0·z ≈ σ0·x.
+        let x = 1e-8;
+        l.step(&inputs(Ramp::constant(x / 1e-3)), 1e-3);
+        assert!(rel(l.force(0.0, 0.0, 1.0), p.sigma0 * x) < 1e-3);
+        assert!(!l.sliding(x / 1e-3, 0.0, 1.0));
+        // 1e-7 m: the exact solution z = zss(1 − e^(−σ0 x/g)).
+        let mut l = LuGre::new(p).unwrap();
+        let v = 1e-4;
+        l.step(&inputs(Ramp::constant(v)), 1e-3);
+        let g = l.g(v, 0.0, 1.0);
+        let expect = g / p.sigma0 * -(-p.sigma0 * 1e-7 / g).exp_m1();
+        assert!(rel(l.z(), expect) < 1e-12);
+        assert!(rel(l.z(), 1e-7) < 3e-3);
+    }
+
+    /// Fine RK4 of `ż = v(t) − σ0|v(t)|z/g(v(t), x(t))` on a piecewise-linear
+    /// input, `m` sub-steps per communication step.
+    fn rk4(l: &LuGre, z0: f64, inp: &LuGreInputs, h: f64, m: usize) -> f64 {
+        let f = |t: f64, z: f64| {
+            let v = inp.v.at(t);
+            if v == 0.0 {
+                return 0.0;
+            }
+            v - l.p.sigma0 * v.abs() * z / l.g_unit(v.abs(), v, inp.x.at(t))
+        };
+        let dt = h / m as f64;
+        let mut z = z0;
+        for k in 0..m {
+            let t = k as f64 * dt;
+            let k1 = f(t, z);
+            let k2 = f(t + 0.5 * dt, z + 0.5 * dt * k1);
+            let k3 = f(t + 0.5 * dt, z + 0.5 * dt * k2);
+            let k4 = f(t + dt, z + dt * k3);
+            z += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        }
+        z
+    }
+
+    fn check_against_rk4(p: LuGreParams, h: f64, n: usize, vel: impl Fn(f64) -> f64) {
+        let mut l = LuGre::new(p).unwrap();
+        let mut r = LuGre::new(p).unwrap();
+        let mut x = 0.0;
+        let scale = p.fs;
+        let mut worst: f64 = 0.0;
+        for k in 0..n {
+            let t = k as f64 * h;
+            let (v0, v1) = (vel(t), vel(t + h));
+            let inp = LuGreInputs {
+                v: Ramp::new(v0, (v1 - v0) / h),
+                x: Ramp::new(x, v0),
+                fn_: Ramp::constant(1.0),
+            };
+            x += 0.5 * (v0 + v1) * h;
+            l.step(&inp, h);
+            // Reference sub-step 1e-6 s or finer.
+            let m = ((h / 1e-6).ceil() as usize).max(20);
+            let zr = rk4(&r, r.z, &inp, h, m);
+            r.set_z(zr);
+            let (fl, fr) = (l.force(v1, x, 1.0), r.force(v1, x, 1.0));
+            worst = worst.max((fl - fr).abs() / scale);
+        }
+        assert!(worst < 1e-6, "h {h}: worst force error {worst:e} of Fs");
+    }
+
+    #[test]
+    fn ramped_inputs_match_a_fine_rk4_reference() {
+        let p = LuGreParams::default();
+        // Through the Stribeck region and zero crossings, slow and fast.
+        let slow = |t: f64| 5e-3 * (2.0 * std::f64::consts::PI * t).sin();
+        check_against_rk4(p, 1e-2, 150, slow);
+        check_against_rk4(p, 0.25, 6, slow);
+        let fast = |t: f64| 0.2 * (3.0 * t).sin() + 0.05;
+        check_against_rk4(p, 0.1, 20, fast);
+        // With position- and direction-dependent levels.
+        let mut q = LuGreParams::seed001();
+        q.direction_dependent = true;
+        q.fc_neg = 1.0;
+        q.fs_neg = 2.0;
+        q.position_dependent = true;
+        q.n_table = 5;
+        for i in 0..5 {
+            q.x_table[i] = -1e-3 + 5e-4 * i as f64;
+            q.scale_pos[i] = 1.0 + 0.3 * (i as f64).sin();
+            q.scale_neg[i] = 1.0 + 0.2 * (i as f64).cos();
+        }
+        check_against_rk4(q, 2e-2, 60, |t| 3e-3 * (5.0 * t).sin());
+    }
+
+    #[test]
+    fn step_size_independence_on_smooth_input() {
+        let p = LuGreParams::default();
+        let vel = |t: f64| 0.01 * (std::f64::consts::PI * t).sin() + 2e-3 * (7.0 * t).cos();
+        let run = |h: f64, n: usize| {
+            let mut l = LuGre::new(p).unwrap();
+            let mut out = Vec::new();
+            let per_sample = (1e-2 / h).round() as usize;
+            for k in 0..n {
+                let t = k as f64 * h;
+                let (v0, v1) = (vel(t), vel(t + h));
+                l.step(&inputs(Ramp::new(v0, (v1 - v0) / h)), h);
+                if (k + 1) % per_sample == 0 {
+                    out.push(l.force(v1, 0.0, 1.0));
+                }
+            }
+            out
+        };
+        let fine = run(1e-5, 200_000);
+        let coarse = run(1e-2, 200);
+        assert_eq!(fine.len(), coarse.len());
+        let worst = fine
+            .iter()
+            .zip(&coarse)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-3 * p.fs, "worst {worst}");
+    }
+
+    #[test]
+    fn direction_position_and_normal_force_scale_the_steady_force() {
+        let mut p = LuGreParams::default();
+        p.direction_dependent = true;
+        p.fc_neg = 0.8;
+        p.fs_neg = 1.1;
+        p.position_dependent = true;
+        p.n_table = 3;
+        p.x_table[..3].copy_from_slice(&[0.0, 0.1, 0.3]);
+        p.scale_pos[..3].copy_from_slice(&[1.0, 2.0, 0.5]);
+        p.scale_neg[..3].copy_from_slice(&[1.5, 1.0, 1.0]);
+        p.normal_force_form = true;
+        let fn_ = 40.0;
+        for &(v, x, scale) in &[
+            (2e-3, 0.05, 1.5),
+            (2e-3, 0.2, 1.25),
+            (2e-3, -1.0, 1.0),
+            (2e-3, 5.0, 0.5),
+            (-2e-3, 0.05, 1.25),
+            (-2e-3, 0.3, 1.0),
+        ] {
+            let (fc, fs) = if v > 0.0 { (p.fc, p.fs) } else { (p.fc_neg, p.fs_neg) };
+            let level = scale * (fc + (fs - fc) * (-(v / p.vs).powi(2)).exp());
+            let expect = fn_ * (level * v.signum() + p.sigma2 * v);
+            let mut l = LuGre::new(p).unwrap();
+            let inp = LuGreInputs {
+                v: Ramp::constant(v),
+                x: Ramp::constant(x),
+                fn_: Ramp::constant(fn_),
+            };
+            l.step(&inp, 10.0);
+            assert!(rel(l.force(v, x, fn_), expect) < 1e-9, "v {v} x {x}");
+            assert!(rel(l.steady_force(v, x, fn_), expect) < 1e-12);
+            assert!(rel(l.g(v, x, fn_), fn_ * level) < 1e-12);
+            // z is independent of Fn; Fn = 0 gives F = 0.
+            assert!(rel(l.z(), level * v.signum() / p.sigma0) < 1e-9);
+            assert_eq!(l.force(v, x, 0.0), 0.0);
+            assert_eq!(l.force(v, x, -5.0), 0.0);
+        }
+    }
+
+    #[test]
+    fn velocity_dependent_micro_damping() {
+        let p = LuGreParams {
+            vd: 1e-3,
+            ..LuGreParams::default()
+        };
+        let l = LuGre::new(p).unwrap();
+        // z = 0: ż = v, F = σ1·e^(−(v/vd)²)·v + σ2·v.
+        let v = 2e-3;
+        let expect = p.sigma1 * (-4.0f64).exp() * v + p.sigma2 * v;
+        assert!(rel(l.force(v, 0.0, 1.0), expect) < 1e-14);
+    }
+
+    #[test]
+    fn state_round_trip_and_finite_for_all_step_sizes() {
+        let p = LuGreParams::seed001();
+        let mut a = LuGre::new(p).unwrap();
+        a.step(&inputs(Ramp::new(1e-3, -0.1)), 0.3);
+        let mut b = LuGre::new(p).unwrap();
+        b.state_from_slice(&a.state_to_vec()).unwrap();
+        for &h in &[1e-7, 1e-4, 1e-1, 1.0] {
+            for &(v, s) in &[(1.0, -3.0), (-1e3, 5e3), (0.0, 0.0), (1e-12, 1e6), (0.0, -1e-9)] {
+                let inp = LuGreInputs {
+                    v: Ramp::new(v, s),
+                    x: Ramp::new(1.0, v),
+                    fn_: Ramp::new(3.0, -1.0),
+                };
+                a.step(&inp, h);
+                b.step(&inp, h);
+                assert!(a.z().is_finite() && a.force(v, 1.0, 3.0).is_finite());
+                assert!(a.z().abs() <= p.fs / p.sigma0 * (1.0 + 1e-9));
+                assert_eq!(a.z().to_bits(), b.z().to_bits());
+            }
+        }
+        assert!(b.state_from_slice(&[f64::NAN]).is_err());
+        assert!(b.state_from_slice(&[0.0, 0.0]).is_err());
+    }
+}

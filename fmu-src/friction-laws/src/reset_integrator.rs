@@ -1,0 +1,237 @@
+//! Reset-integrator friction, 1-D (Haessig & Friedland 1991; the base of the
+//! 2-D model of seed 004; MODELS.md "Reset integrator, 1-D").
+//!
+//! `ż = 0` if (`v > 0` and `z ≥ z0`) or (`v < 0` and `z ≤ −z0`), else `ż = v`;
+//! `F = (1 + a(z))·σ0·z + σ1·ż`, `a(z) = a` for `|z| < z0`, else 0.
+//! Sliding level `Fc = σ0·z0`, break-away peak `Fs = (1 + a)·σ0·z0`.
+
+use crate::error::{require_non_negative, require_positive};
+use crate::interval::{displacement, one_sign_pieces, sign_on};
+use crate::{ParamError, Ramp};
+
+/// Reset-integrator parameters: stiffness `sigma0` (N/m), damping `sigma1`
+/// (N·s/m), stiction gradient `a` (–), stiction range `z0` (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ResetParams {
+    pub sigma0: f64,
+    pub sigma1: f64,
+    pub a: f64,
+    pub z0: f64,
+}
+
+impl Default for ResetParams {
+    /// Seed 004 numerical set in 1-D: σ0 = 1e4 N/m, σ1 = 74.15 N·s/m,
+    /// a = 0.1, z0 = 1e-4 m.
+    fn default() -> Self {
+        ResetParams {
+            sigma0: 1e4,
+            sigma1: 74.15,
+            a: 0.1,
+            z0: 1e-4,
+        }
+    }
+}
+
+impl ResetParams {
+    /// σ0 > 0, σ1 ≥ 0, a ≥ 0 (a break-away peak not below the sliding
+    /// level; the equations only need a > −1), z0 > 0, all finite.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        require_positive("sigma0", self.sigma0)?;
+        require_non_negative("sigma1", self.sigma1)?;
+        require_non_negative("a", self.a)?;
+        require_positive("z0", self.z0)?;
+        Ok(())
+    }
+}
+
+/// Reset-integrator state: the bristle strain `z` (m).
+#[derive(Clone, Debug)]
+pub struct ResetIntegrator {
+    p: ResetParams,
+    z: f64,
+}
+
+impl ResetIntegrator {
+    /// Relaxed state `z = 0` with validated parameters.
+    pub fn new(p: ResetParams) -> Result<Self, ParamError> {
+        p.validate()?;
+        Ok(ResetIntegrator { p, z: 0.0 })
+    }
+
+    pub fn params(&self) -> &ResetParams {
+        &self.p
+    }
+
+    pub fn z(&self) -> f64 {
+        self.z
+    }
+
+    /// Sets the strain (any finite value; `|z| > z0` is held until the motion
+    /// brings it back).
+    pub fn set_z(&mut self, z: f64) {
+        self.z = z;
+    }
+
+    fn saturated(&self, v: f64) -> bool {
+        (v > 0.0 && self.z >= self.p.z0) || (v < 0.0 && self.z <= -self.p.z0)
+    }
+
+    /// `ż = 0` when saturated (`v > 0, z ≥ z0` or `v < 0, z ≤ −z0`), else `v`.
+    pub fn z_dot(&self, v: f64) -> f64 {
+        if self.saturated(v) {
+            0.0
+        } else {
+            v
+        }
+    }
+
+    /// `F = (1 + a(z))·σ0·z + σ1·ż(v)`, `a(z) = a` inside `|z| < z0`, else 0.
+    pub fn force(&self, v: f64) -> f64 {
+        let gain = if self.z.abs() < self.p.z0 {
+            1.0 + self.p.a
+        } else {
+            1.0
+        };
+        gain * self.p.sigma0 * self.z + self.p.sigma1 * self.z_dot(v)
+    }
+
+    /// Saturated and moving outward: `ż = 0` and the force is `σ0·z0·sgn v`.
+    pub fn sliding(&self, v: f64) -> bool {
+        self.saturated(v)
+    }
+
+    /// Exact update over `[0, h]` for ramped `v`: split at the zero crossing;
+    /// on each one-sign piece with exact displacement `Δx`,
+    /// `v > 0: z ← max(z, min(z + Δx, z0))`, `v < 0: z ← min(z, max(z + Δx, −z0))`
+    /// (a strain already beyond the range is held, not pulled back).
+    pub fn step(&mut self, v: Ramp, h: f64) {
+        if h <= 0.0 {
+            return;
+        }
+        let (pieces, n) = one_sign_pieces(v, h);
+        let z0 = self.p.z0;
+        for &(a, b) in &pieces[..n] {
+            let s = sign_on(v, a, b);
+            let dx = displacement(v, a, b);
+            if s > 0.0 {
+                if self.z < z0 {
+                    self.z = (self.z + dx).min(z0);
+                }
+            } else if s < 0.0 && self.z > -z0 {
+                self.z = (self.z + dx).max(-z0);
+            }
+        }
+    }
+
+    /// State `[z]`.
+    pub fn state_to_vec(&self) -> Vec<f64> {
+        vec![self.z]
+    }
+
+    /// Restores `[z]` (finite).
+    pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
+        match s {
+            [z] if z.is_finite() => {
+                self.z = *z;
+                Ok(())
+            }
+            [z] => Err(format!("reset-integrator state z = {z} is not finite")),
+            _ => Err(format!("reset-integrator state has 1 value, got {}", s.len())),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    #[test]
+    fn break_away_peak_then_sliding_level() {
+        let p = ResetParams {
+            sigma1: 0.0,
+            ..ResetParams::default()
+        };
+        let (fs, fc) = ((1.0 + p.a) * p.sigma0 * p.z0, p.sigma0 * p.z0);
+        let v = 1e-3;
+        let mut r = ResetIntegrator::new(p).unwrap();
+        // Steps of 1e-3 s (1e-6 m); the force grows as (1 + a)σ0·v·t.
+        let mut peak: f64 = 0.0;
+        for k in 1..=99 {
+            r.step(Ramp::constant(v), 1e-3);
+            let f = r.force(v);
+            assert!(rel(f, (1.0 + p.a) * p.sigma0 * v * 1e-3 * k as f64) < 1e-12);
+            peak = peak.max(f);
+            assert!(!r.sliding(v));
+        }
+        // The last pre-sliding instant approaches the peak arbitrarily closely.
+        r.step(Ramp::constant(v), (p.z0 - r.z()) / v * (1.0 - 1e-12));
+        assert!(rel(r.force(v), fs) < 1e-9, "{} vs {}", r.force(v), fs);
+        assert!(peak <= fs);
+        r.step(Ramp::constant(v), 1e-3);
+        assert_eq!(r.z(), p.z0);
+        assert!(r.sliding(v));
+        assert_eq!(r.force(v), fc);
+        for _ in 0..100 {
+            r.step(Ramp::constant(v), 1e-3);
+            assert_eq!(r.force(v), fc);
+        }
+        // Stop: stays stuck at the level, a = 0 on the boundary.
+        assert_eq!(r.force(0.0), fc);
+        assert!(!r.sliding(0.0));
+        // Reverse: leaves the boundary at once with ż = v.
+        assert_eq!(r.z_dot(-v), -v);
+    }
+
+    #[test]
+    fn big_steps_are_exact() {
+        let p = ResetParams::default();
+        let mut r = ResetIntegrator::new(p).unwrap();
+        r.step(Ramp::constant(5e-5), 1.0);
+        assert_eq!(r.z(), 5e-5);
+        r.step(Ramp::constant(10.0), 1.0);
+        assert_eq!(r.z(), p.z0);
+        // Ramp from −3e-4 to +1e-4 m/s over 1 s: v(τ) = −3e-4 + 4e-4·τ is zero
+        // at τ = 0.75, Δx− = −1.125e-4 m, then Δx+ = 1.25e-5 m.
+        r.step(Ramp::new(-3e-4, 4e-4), 1.0);
+        let expect = (p.z0 - 1.125e-4_f64).max(-p.z0) + 1.25e-5;
+        assert!((r.z() - expect).abs() < 1e-18, "{} vs {expect}", r.z());
+        // Far enough back to saturate at −z0, then forward again.
+        r.step(Ramp::new(-3e-4, 1e-4), 2.0); // Δx = −4e-4
+        assert_eq!(r.z(), -p.z0);
+        r.step(Ramp::constant(3e-5), 1.0);
+        assert!((r.z() - (-p.z0 + 3e-5)).abs() < 1e-19);
+        // Same motion in 1e5 small steps gives the same strain.
+        let mut q = ResetIntegrator::new(p).unwrap();
+        q.set_z(p.z0);
+        let h = 1e-5;
+        for k in 0..100_000 {
+            let t = k as f64 * h;
+            q.step(Ramp::new(-3e-4 + 4e-4 * t, 4e-4), h);
+        }
+        assert!((q.z() - expect).abs() < 1e-14);
+    }
+
+    #[test]
+    fn validation_and_state_round_trip() {
+        let p = ResetParams::default();
+        assert_eq!(ResetIntegrator::new(ResetParams { a: -0.5, ..p }).unwrap_err().name, "a");
+        assert_eq!(ResetIntegrator::new(ResetParams { z0: 0.0, ..p }).unwrap_err().name, "z0");
+        let mut r = ResetIntegrator::new(p).unwrap();
+        r.step(Ramp::new(1e-4, -1e-3), 0.37);
+        let mut q = ResetIntegrator::new(p).unwrap();
+        q.state_from_slice(&r.state_to_vec()).unwrap();
+        for &h in &[1e-7, 1e-2, 1.0] {
+            for &(v, a) in &[(1.0, -3.0), (-1e3, 5e3), (0.0, 0.0)] {
+                r.step(Ramp::new(v, a), h);
+                q.step(Ramp::new(v, a), h);
+                assert!(r.force(v).is_finite());
+                assert_eq!(r.z().to_bits(), q.z().to_bits());
+            }
+        }
+        assert!(q.state_from_slice(&[]).is_err());
+    }
+}
