@@ -598,7 +598,7 @@ pub unsafe fn get_status<T: Copy>(
 #[macro_export]
 macro_rules! export_fmi2 {
     ($registry:expr) => {
-        mod fmi2_exports {
+        pub mod fmi2_exports {
             #![allow(non_snake_case, clippy::missing_safety_doc)]
             use super::*;
             use std::os::raw::c_char;

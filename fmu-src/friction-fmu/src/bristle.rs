@@ -73,6 +73,10 @@ impl BristleFmu {
     pub fn params(values: &Values) -> Result<BristleParams, String> {
         let (c, mu_c, fn_) = (values.real(vr::C), values.real(vr::MU_C), values.real(vr::FN));
         let delta_max = values.real(vr::DELTA_MAX);
+        // Checked first: the from-load stiffness divides by it.
+        if !(delta_max.is_finite() && delta_max > 0.0) {
+            return Err(format!("invalid parameter delta_max = {delta_max}: must be finite and > 0"));
+        }
         let seed = values.integer(vr::SEED) as u32 as u64;
         let from_load = BristleParams::from_load(c, mu_c, fn_, delta_max, values.real(vr::X_REL), seed);
         let needs_load = values.boolean(vr::STIFFNESS_FROM_LOAD) || values.boolean(vr::COUNT_FROM_LOAD);

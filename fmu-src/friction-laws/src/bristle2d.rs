@@ -191,7 +191,7 @@ impl Bristle2D {
     /// the deflection's lag behind a turning slip direction second-order
     /// accurate also when a sub-step slides over many `z0`.
     pub fn step(&mut self, v1: Ramp, v2: Ramp, h: f64) {
-        if !(h > 0.0) {
+        if h.is_nan() || h <= 0.0 {
             return;
         }
         let acc = v1.slope.hypot(v2.slope);
@@ -252,7 +252,7 @@ impl Bristle2D {
     /// straight path back into the disc.
     pub fn advance_constant(&mut self, v: [f64; 2], h: f64) {
         let speed2 = dot(v, v);
-        if !(h > 0.0) || speed2 == 0.0 {
+        if h.is_nan() || h <= 0.0 || speed2 == 0.0 {
             return;
         }
         let z0 = self.p.z0;
@@ -351,7 +351,10 @@ mod tests {
             b.step(Ramp::constant(v[0]), Ramp::constant(v[1]), 0.1);
             assert!(b.sliding(v));
             let f = b.force(v);
-            assert!((norm(f) / (p.sigma01 * p.z0) - 1.0).abs() < 1e-9, "k {k}: {f:?}");
+            assert!(
+                (norm(f) / (p.sigma01 * p.z0) - 1.0).abs() < 1e-9,
+                "k {k}: {f:?}"
+            );
             // Force along the slip direction.
             assert!((f[0] * v[1] - f[1] * v[0]).abs() < 1e-9 * norm(f) * norm(v));
             // Turn by 90° while sliding: stays on the circle.
@@ -381,7 +384,11 @@ mod tests {
         let mut b = Bristle2D::new(p).unwrap();
         let v = [3e-5, 4e-5];
         // |v|·t = 0.999·z0: still sticking, F = (1 + a)σ0 z + σ1 v.
-        b.step(Ramp::constant(v[0]), Ramp::constant(v[1]), 0.999 * p.z0 / 5e-5);
+        b.step(
+            Ramp::constant(v[0]),
+            Ramp::constant(v[1]),
+            0.999 * p.z0 / 5e-5,
+        );
         assert!(!b.sliding(v));
         let damp = (-(5e-5f64 / p.av).powi(2)).exp();
         let f = b.force(v);
@@ -394,7 +401,11 @@ mod tests {
         let w = [-v[0], -v[1]];
         assert!(!b.sliding(w));
         assert_eq!(b.z_dot(w), w);
-        b.step(Ramp::constant(w[0]), Ramp::constant(w[1]), 2.0 * p.z0 / 5e-5 * 0.5);
+        b.step(
+            Ramp::constant(w[0]),
+            Ramp::constant(w[1]),
+            2.0 * p.z0 / 5e-5 * 0.5,
+        );
         assert!(norm(b.z()) < 1e-12 * p.z0);
         // Crosses the disc and slides on the far side.
         b.step(Ramp::constant(w[0]), Ramp::constant(w[1]), 10.0);
@@ -404,7 +415,11 @@ mod tests {
     #[test]
     fn turning_slip_direction_keeps_sliding() {
         let p = Bristle2DParams::default();
-        for &(h, omega, speed) in &[(1e-3, 2.0 * PI, 0.1), (1e-2, 4.0 * PI, 0.05), (0.05, 6.0, 0.2)] {
+        for &(h, omega, speed) in &[
+            (1e-3, 2.0 * PI, 0.1),
+            (1e-2, 4.0 * PI, 0.05),
+            (0.05, 6.0, 0.2),
+        ] {
             let mut b = Bristle2D::new(p).unwrap();
             let vel = |t: f64| [speed * (omega * t).cos(), speed * (omega * t).sin()];
             let n = (2.0 / h) as usize;
@@ -458,8 +473,8 @@ mod tests {
             if !self.inside {
                 let c = |s: f64, ph: f64| v1.at(s) * ph.cos() + v2.at(s) * ph.sin();
                 if c(t, self.phi) < 0.0 {
-                    self.inside = true;
                     self.z = self.z();
+                    self.inside = true;
                 } else {
                     let ph = self.phi_after(self.phi, v1, v2, t, dt);
                     if c(t + dt, ph) >= 0.0 {
@@ -477,8 +492,8 @@ mod tests {
                         }
                     }
                     self.phi = self.phi_after(self.phi, v1, v2, t, lo);
-                    self.inside = true;
                     self.z = self.z();
+                    self.inside = true;
                     return self.advance(v1, v2, t + lo, dt - lo);
                 }
             }
@@ -530,7 +545,10 @@ mod tests {
         let mut worst: f64 = 0.0;
         for k in 0..n {
             let (a, c) = vel(k);
-            let (v1, v2) = (Ramp::new(a[0], (c[0] - a[0]) / h), Ramp::new(a[1], (c[1] - a[1]) / h));
+            let (v1, v2) = (
+                Ramp::new(a[0], (c[0] - a[0]) / h),
+                Ramp::new(a[1], (c[1] - a[1]) / h),
+            );
             b.step(v1, v2, h);
             for j in 0..m {
                 r.advance(v1, v2, j as f64 * dt, dt);
@@ -548,7 +566,14 @@ mod tests {
         let p = Bristle2DParams::default();
         // Piecewise-constant velocities: sticking, boundary hits, sliding,
         // reversals through the disc.
-        let pattern = [[3e-3, 1e-3], [-2e-3, 2e-3], [-1e-3, -3e-3], [4e-3, 0.0], [0.0, 5e-3], [-4e-3, -4e-3]];
+        let pattern = [
+            [3e-3, 1e-3],
+            [-2e-3, 2e-3],
+            [-1e-3, -3e-3],
+            [4e-3, 0.0],
+            [0.0, 5e-3],
+            [-4e-3, -4e-3],
+        ];
         let e = compare_with_reference(p, 0.03, 6, |k| (pattern[k], pattern[k]));
         assert!(e < 1e-8, "constant velocities: {e:e}");
         // Ramped: a smooth planar slip path, sliding and sticking.
@@ -560,22 +585,45 @@ mod tests {
         assert!(e < 1e-6, "ramped h 0.1: {e:e}");
         // Fast sliding with a turning direction (many z0 per sub-step).
         let vel = |t: f64| [0.5 * (0.7 * t).cos(), 0.5 * (0.7 * t).sin()];
-        let e = compare_with_reference(p, 0.05, 10, |k| (vel(k as f64 * 0.05), vel((k + 1) as f64 * 0.05)));
+        let e = compare_with_reference(p, 0.05, 10, |k| {
+            (vel(k as f64 * 0.05), vel((k + 1) as f64 * 0.05))
+        });
         assert!(e < 1e-6, "fast turning: {e:e}");
     }
 
     #[test]
     fn validation_state_round_trip_and_finite_for_all_steps() {
         let p = Bristle2DParams::default();
-        assert_eq!(Bristle2D::new(Bristle2DParams { z0: 0.0, ..p }).unwrap_err().name, "z0");
-        assert_eq!(Bristle2D::new(Bristle2DParams { a2: -0.1, ..p }).unwrap_err().name, "a2");
-        assert_eq!(Bristle2D::new(Bristle2DParams { sigma02: -1.0, ..p }).unwrap_err().name, "sigma02");
+        assert_eq!(
+            Bristle2D::new(Bristle2DParams { z0: 0.0, ..p })
+                .unwrap_err()
+                .name,
+            "z0"
+        );
+        assert_eq!(
+            Bristle2D::new(Bristle2DParams { a2: -0.1, ..p })
+                .unwrap_err()
+                .name,
+            "a2"
+        );
+        assert_eq!(
+            Bristle2D::new(Bristle2DParams { sigma02: -1.0, ..p })
+                .unwrap_err()
+                .name,
+            "sigma02"
+        );
         let mut a = Bristle2D::new(p).unwrap();
         a.step(Ramp::new(1e-3, -0.1), Ramp::new(-2e-3, 0.05), 0.03);
         let mut b = Bristle2D::new(p).unwrap();
         b.state_from_slice(&a.state_to_vec()).unwrap();
         for &h in &[1e-7, 1e-4, 1e-1, 1.0] {
-            for &(v, s) in &[(1.0, -3.0), (-1e3, 5e3), (0.0, 0.0), (1e-12, 1e6), (0.0, -1e-9)] {
+            for &(v, s) in &[
+                (1.0, -3.0),
+                (-1e3, 5e3),
+                (0.0, 0.0),
+                (1e-12, 1e6),
+                (0.0, -1e-9),
+            ] {
                 a.step(Ramp::new(v, s), Ramp::new(-0.5 * v, s), h);
                 b.step(Ramp::new(v, s), Ramp::new(-0.5 * v, s), h);
                 assert!(norm(a.z()) <= p.z0 * (1.0 + 4.0 * f64::EPSILON));

@@ -13,13 +13,21 @@ pub struct ParamError {
 
 impl ParamError {
     pub fn new(name: &'static str, value: f64, rule: impl Into<String>) -> Self {
-        ParamError { name, value, rule: rule.into() }
+        ParamError {
+            name,
+            value,
+            rule: rule.into(),
+        }
     }
 }
 
 impl fmt::Display for ParamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "invalid parameter {} = {}: {}", self.name, self.value, self.rule)
+        write!(
+            f,
+            "invalid parameter {} = {}: {}",
+            self.name, self.value, self.rule
+        )
     }
 }
 

@@ -159,7 +159,7 @@ impl LuGreParams {
                         format!("x_table[{}] must be finite", i + 1),
                     ));
                 }
-                if i > 0 && !(x > self.x_table[i - 1]) {
+                if i > 0 && x <= self.x_table[i - 1] {
                     return Err(ParamError::new(
                         "x_table",
                         x,
@@ -190,7 +190,11 @@ fn require_at_least(
     if value.is_finite() && value >= bound {
         Ok(())
     } else {
-        Err(ParamError::new(name, value, format!("must be >= {other} = {bound}")))
+        Err(ParamError::new(
+            name,
+            value,
+            format!("must be >= {other} = {bound}"),
+        ))
     }
 }
 
@@ -288,7 +292,7 @@ impl LuGre {
             &p.scale_pos
         };
         let xs = &p.x_table[..n];
-        if !(x > xs[0]) {
+        if x.is_nan() || x <= xs[0] {
             return s[0];
         }
         if x >= xs[n - 1] {
@@ -390,7 +394,7 @@ impl LuGre {
     /// `zss` at the midpoint too, stays second-order accurate when `λh ≫ 1`
     /// (sliding), where `z` tracks `zss(v(t))`. `Fn` does not enter.
     pub fn step(&mut self, inp: &LuGreInputs, h: f64) {
-        if !(h > 0.0) {
+        if h.is_nan() || h <= 0.0 {
             return;
         }
         let (pieces, n) = one_sign_pieces(inp.v, h);
@@ -434,7 +438,11 @@ impl LuGre {
             while next_kink < n_kinks && kinks[next_kink] <= t {
                 next_kink += 1;
             }
-            let end = if next_kink < n_kinks { kinks[next_kink] } else { b };
+            let end = if next_kink < n_kinks {
+                kinks[next_kink]
+            } else {
+                b
+            };
             let rest = end - t;
             let mut len = rest;
             if count < MAX_SUBSTEPS {
@@ -509,10 +517,22 @@ mod tests {
         let bad = |q: LuGreParams| LuGre::new(q).unwrap_err().name;
         assert_eq!(bad(LuGreParams { sigma0: 0.0, ..p }), "sigma0");
         assert_eq!(bad(LuGreParams { sigma1: -1.0, ..p }), "sigma1");
-        assert_eq!(bad(LuGreParams { sigma2: f64::NAN, ..p }), "sigma2");
+        assert_eq!(
+            bad(LuGreParams {
+                sigma2: f64::NAN,
+                ..p
+            }),
+            "sigma2"
+        );
         assert_eq!(bad(LuGreParams { fc: 0.0, ..p }), "Fc");
         assert_eq!(bad(LuGreParams { vs: 0.0, ..p }), "vs");
-        assert_eq!(bad(LuGreParams { stribeck_exponent: 0.0, ..p }), "stribeck_exponent");
+        assert_eq!(
+            bad(LuGreParams {
+                stribeck_exponent: 0.0,
+                ..p
+            }),
+            "stribeck_exponent"
+        );
         assert_eq!(bad(LuGreParams { vd: -1.0, ..p }), "vd");
         let dd = LuGreParams {
             direction_dependent: true,
@@ -685,16 +705,18 @@ mod tests {
 
     #[test]
     fn direction_position_and_normal_force_scale_the_steady_force() {
-        let mut p = LuGreParams::default();
-        p.direction_dependent = true;
-        p.fc_neg = 0.8;
-        p.fs_neg = 1.1;
-        p.position_dependent = true;
-        p.n_table = 3;
+        let mut p = LuGreParams {
+            direction_dependent: true,
+            fc_neg: 0.8,
+            fs_neg: 1.1,
+            position_dependent: true,
+            n_table: 3,
+            normal_force_form: true,
+            ..LuGreParams::default()
+        };
         p.x_table[..3].copy_from_slice(&[0.0, 0.1, 0.3]);
         p.scale_pos[..3].copy_from_slice(&[1.0, 2.0, 0.5]);
         p.scale_neg[..3].copy_from_slice(&[1.5, 1.0, 1.0]);
-        p.normal_force_form = true;
         let fn_ = 40.0;
         for &(v, x, scale) in &[
             (2e-3, 0.05, 1.5),
@@ -704,7 +726,11 @@ mod tests {
             (-2e-3, 0.05, 1.25),
             (-2e-3, 0.3, 1.0),
         ] {
-            let (fc, fs) = if v > 0.0 { (p.fc, p.fs) } else { (p.fc_neg, p.fs_neg) };
+            let (fc, fs) = if v > 0.0 {
+                (p.fc, p.fs)
+            } else {
+                (p.fc_neg, p.fs_neg)
+            };
             let level = scale * (fc + (fs - fc) * (-(v / p.vs).powi(2)).exp());
             let expect = fn_ * (level * v.signum() + p.sigma2 * v);
             let mut l = LuGre::new(p).unwrap();
@@ -745,7 +771,13 @@ mod tests {
         let mut b = LuGre::new(p).unwrap();
         b.state_from_slice(&a.state_to_vec()).unwrap();
         for &h in &[1e-7, 1e-4, 1e-1, 1.0] {
-            for &(v, s) in &[(1.0, -3.0), (-1e3, 5e3), (0.0, 0.0), (1e-12, 1e6), (0.0, -1e-9)] {
+            for &(v, s) in &[
+                (1.0, -3.0),
+                (-1e3, 5e3),
+                (0.0, 0.0),
+                (1e-12, 1e6),
+                (0.0, -1e-9),
+            ] {
                 let inp = LuGreInputs {
                     v: Ramp::new(v, s),
                     x: Ramp::new(1.0, v),

@@ -105,7 +105,7 @@ impl ResetIntegrator {
     /// `v > 0: z ← max(z, min(z + Δx, z0))`, `v < 0: z ← min(z, max(z + Δx, −z0))`
     /// (a strain already beyond the range is held, not pulled back).
     pub fn step(&mut self, v: Ramp, h: f64) {
-        if h <= 0.0 {
+        if h.is_nan() || h <= 0.0 {
             return;
         }
         let (pieces, n) = one_sign_pieces(v, h);
@@ -136,7 +136,10 @@ impl ResetIntegrator {
                 Ok(())
             }
             [z] => Err(format!("reset-integrator state z = {z} is not finite")),
-            _ => Err(format!("reset-integrator state has 1 value, got {}", s.len())),
+            _ => Err(format!(
+                "reset-integrator state has 1 value, got {}",
+                s.len()
+            )),
         }
     }
 }
@@ -218,8 +221,18 @@ mod tests {
     #[test]
     fn validation_and_state_round_trip() {
         let p = ResetParams::default();
-        assert_eq!(ResetIntegrator::new(ResetParams { a: -0.5, ..p }).unwrap_err().name, "a");
-        assert_eq!(ResetIntegrator::new(ResetParams { z0: 0.0, ..p }).unwrap_err().name, "z0");
+        assert_eq!(
+            ResetIntegrator::new(ResetParams { a: -0.5, ..p })
+                .unwrap_err()
+                .name,
+            "a"
+        );
+        assert_eq!(
+            ResetIntegrator::new(ResetParams { z0: 0.0, ..p })
+                .unwrap_err()
+                .name,
+            "z0"
+        );
         let mut r = ResetIntegrator::new(p).unwrap();
         r.step(Ramp::new(1e-4, -1e-3), 0.37);
         let mut q = ResetIntegrator::new(p).unwrap();

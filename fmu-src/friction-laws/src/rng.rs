@@ -99,15 +99,17 @@ impl Rng {
 /// `__ieee754_log` algorithm as in musl; error < 1 ulp). Returns NaN for
 /// `x < 0` or NaN, −∞ for 0, +∞ for +∞.
 pub(crate) fn ln_det(x: f64) -> f64 {
-    const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-01; // 0x3fe62e42_fee00000
-    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10; // 0x3dea39ef_35793c76
-    const LG1: f64 = 6.666_666_666_666_735_130e-01;
-    const LG2: f64 = 3.999_999_999_940_941_908e-01;
-    const LG3: f64 = 2.857_142_874_366_239_149e-01;
-    const LG4: f64 = 2.222_219_843_214_978_396e-01;
-    const LG5: f64 = 1.818_357_216_161_805_012e-01;
-    const LG6: f64 = 1.531_383_769_920_937_332e-01;
-    const LG7: f64 = 1.479_819_860_511_658_591e-01;
+    // Shortest literals of the fdlibm constants (bit patterns in comments,
+    // checked by `log_constants_have_the_fdlibm_bit_patterns`).
+    const LN2_HI: f64 = 0.693_147_180_369_123_8; // 0x3fe62e42_fee00000
+    const LN2_LO: f64 = 1.908_214_929_270_587_7e-10; // 0x3dea39ef_35793c76
+    const LG1: f64 = 0.666_666_666_666_673_5; // 0x3fe55555_55555593
+    const LG2: f64 = 0.399_999_999_994_094_2; // 0x3fd99999_9997fa04
+    const LG3: f64 = 0.285_714_287_436_623_9; // 0x3fd24924_94229359
+    const LG4: f64 = 0.222_221_984_321_497_84; // 0x3fcc71c5_1d8e78af
+    const LG5: f64 = 0.181_835_721_616_180_5; // 0x3fc74664_96cb03de
+    const LG6: f64 = 0.153_138_376_992_093_73; // 0x3fc39a09_d078c69f
+    const LG7: f64 = 0.147_981_986_051_165_86; // 0x3fc2f112_df3e5244
 
     let mut x = x;
     let mut ui = x.to_bits();
@@ -225,8 +227,33 @@ mod tests {
         assert!((m - mean).abs() < 0.01 * std, "mean {m}");
         assert!((var.sqrt() / std - 1.0).abs() < 0.01, "std {}", var.sqrt());
         // Tail fraction beyond 2σ: 4.55 %.
-        let tail = xs.iter().filter(|&&x| ((x - mean) / std).abs() > 2.0).count() as f64 / n as f64;
+        let tail = xs
+            .iter()
+            .filter(|&&x| ((x - mean) / std).abs() > 2.0)
+            .count() as f64
+            / n as f64;
         assert!((tail - 0.0455).abs() < 0.003, "tail {tail}");
+    }
+
+    #[test]
+    fn log_constants_have_the_fdlibm_bit_patterns() {
+        let src = include_str!("rng.rs");
+        let mut n = 0;
+        for line in src
+            .lines()
+            .filter(|l| l.trim_start().starts_with("const L"))
+        {
+            let lit = line.split('=').nth(1).unwrap().split(';').next().unwrap();
+            let value: f64 = lit.trim().replace('_', "").parse().unwrap();
+            let hex = line.split("// 0x").nth(1).unwrap().replace('_', "");
+            assert_eq!(
+                value.to_bits(),
+                u64::from_str_radix(hex.trim(), 16).unwrap(),
+                "{line}"
+            );
+            n += 1;
+        }
+        assert_eq!(n, 9);
     }
 
     #[test]
@@ -236,7 +263,10 @@ mod tests {
             let x = r.uniform() * 10f64.powi((r.next_u64() % 40) as i32 - 20);
             let a = ln_det(x);
             let b = x.ln();
-            assert!((a - b).abs() <= 2.0 * f64::EPSILON * b.abs().max(1e-300), "{x}: {a} vs {b}");
+            assert!(
+                (a - b).abs() <= 2.0 * f64::EPSILON * b.abs().max(1e-300),
+                "{x}: {a} vs {b}"
+            );
         }
         assert_eq!(ln_det(1.0), 0.0);
         assert_eq!(ln_det(0.0), f64::NEG_INFINITY);

@@ -1,0 +1,171 @@
+//! Everything that can go wrong when importing and running an FMU. Each
+//! variant carries the values needed to say what failed and where; the
+//! message is written once, here.
+
+use crate::fmu::Status;
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// Why an archive was refused (see [`crate::fmu::archive`]).
+#[derive(Debug, Error)]
+pub enum ArchiveProblem {
+    #[error("not a readable zip archive: {0}")]
+    NotAZip(String),
+    #[error("the entry name contains a `..` component (path traversal)")]
+    ParentComponent,
+    #[error("the entry name is an absolute path")]
+    AbsolutePath,
+    #[error("the entry name has a Windows drive prefix")]
+    DrivePrefix,
+    #[error("the entry name contains a NUL character")]
+    NulInName,
+    #[error("the entry is a symbolic link")]
+    Symlink,
+    #[error("the entry name occurs more than once")]
+    Duplicate,
+    #[error("the entry unpacks to more than the limit of {limit} bytes")]
+    EntryTooLarge { limit: u64 },
+    #[error("the archive unpacks to more than the limit of {limit} bytes in total")]
+    TotalTooLarge { limit: u64 },
+    #[error("the archive has {count} entries, more than the limit of {limit}")]
+    TooManyEntries { count: usize, limit: usize },
+    #[error("the archive has no modelDescription.xml at its root")]
+    MissingModelDescription,
+    #[error("cannot read the entry: {0}")]
+    Corrupt(String),
+    #[error("cannot write the entry: {0}")]
+    Write(std::io::Error),
+}
+
+/// Errors of the importer. Display gives a complete, one-line message.
+#[derive(Debug, Error)]
+pub enum FmuError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// An archive was refused; `entry` names the offending entry if there is one.
+    #[error("{path}: {}{problem}", entry.as_ref().map(|e| format!("entry \"{e}\": ")).unwrap_or_default())]
+    Archive {
+        path: PathBuf,
+        entry: Option<String>,
+        problem: ArchiveProblem,
+    },
+
+    /// modelDescription.xml is not well-formed XML or does not match the
+    /// FMI 2.0 schema; `line` and `column` (1-based) locate the problem.
+    #[error("modelDescription.xml:{line}:{column}: {message}")]
+    XmlSyntax {
+        line: usize,
+        column: usize,
+        message: String,
+    },
+
+    #[error("modelDescription.xml: fmiVersion is \"{found}\", but only FMI 2.0 is supported")]
+    UnsupportedFmiVersion { found: String },
+
+    #[error("modelDescription.xml: not a co-simulation FMU (it has no <CoSimulation> element)")]
+    NotCoSimulation,
+
+    /// The description is well-formed but breaks a rule of the standard;
+    /// `location` says where (e.g. `variable "F" (index 4)`).
+    #[error("modelDescription.xml: {location}: {message}")]
+    InvalidModelDescription { location: String, message: String },
+
+    #[error("FMU has no binary for {platform}: expected {expected}; it has: {}", list_or_none(found))]
+    MissingBinary {
+        platform: &'static str,
+        expected: String,
+        found: Vec<String>,
+    },
+
+    #[error("cannot load {path} as a shared library: {message}")]
+    LoadLibrary { path: PathBuf, message: String },
+
+    #[error("{path} does not export the required FMI 2.0 functions: {}", symbols.join(", "))]
+    MissingFunctions { path: PathBuf, symbols: Vec<&'static str> },
+
+    #[error("{path}: modelDescription.xml declares {capability}, but the binary does not export {}", symbols.join(", "))]
+    MissingCapabilityFunctions {
+        path: PathBuf,
+        capability: &'static str,
+        symbols: Vec<&'static str>,
+    },
+
+    #[error("{path}: fmi2GetVersion() returned \"{found}\", expected \"2.0\"")]
+    WrongFmiVersion { path: PathBuf, found: String },
+
+    #[error("no variable named \"{name}\" in model {model}")]
+    UnknownVariable { name: String, model: String },
+
+    #[error("{function} is not available: the FMU does not declare {capability}")]
+    NotSupported {
+        function: &'static str,
+        capability: &'static str,
+    },
+
+    #[error("fmi2Instantiate failed for instance \"{instance}\"{}", log_suffix(messages))]
+    Instantiate { instance: String, messages: Vec<String> },
+
+    /// An FMU function returned Discard, Error, Fatal or Pending;
+    /// `messages` are what the instance logged during the call.
+    #[error("{function} failed for instance \"{instance}\" with {status}{}", log_suffix(messages))]
+    Call {
+        function: &'static str,
+        instance: String,
+        status: Status,
+        messages: Vec<String>,
+    },
+
+    #[error("{function} refused for instance \"{instance}\": an earlier call returned fmi2Fatal, so the FMU may not be called again")]
+    AfterFatal {
+        function: &'static str,
+        instance: String,
+    },
+
+    #[error("{function}: {what} has length {found}, expected {expected}")]
+    LengthMismatch {
+        function: &'static str,
+        what: &'static str,
+        expected: usize,
+        found: usize,
+    },
+
+    #[error("{function}: the FMU state belongs to another instance than \"{instance}\"")]
+    ForeignState {
+        function: &'static str,
+        instance: String,
+    },
+
+    #[error("{what} must not contain a NUL character: {value:?}")]
+    NulInString { what: &'static str, value: String },
+}
+
+impl FmuError {
+    /// The status of a failed FMU call, if this error is one.
+    pub fn status(&self) -> Option<Status> {
+        match self {
+            FmuError::Call { status, .. } => Some(*status),
+            _ => None,
+        }
+    }
+}
+
+fn list_or_none(items: &[String]) -> String {
+    if items.is_empty() {
+        "no binaries".to_string()
+    } else {
+        items.join(", ")
+    }
+}
+
+fn log_suffix(messages: &[String]) -> String {
+    if messages.is_empty() {
+        " (the FMU logged nothing)".to_string()
+    } else {
+        format!(": {}", messages.join(" | "))
+    }
+}

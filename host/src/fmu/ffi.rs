@@ -1,0 +1,133 @@
+//! C types of the FMI 2.0 standard (`fmi2TypesPlatform.h`,
+//! `fmi2FunctionTypes.h`; FMI 2.0.4 §2.1.2–§2.1.5 and §4.2), as the importer
+//! sees them.
+//!
+//! Every function returns its `fmi2Status` as a plain `c_int` here, not as a
+//! Rust enum: an FMU built by someone else may return any integer, and an
+//! out-of-range value in a `#[repr(C)] enum` would be undefined behaviour.
+//! [`Status::from_raw`](super::Status::from_raw) converts it.
+#![allow(non_camel_case_types, non_snake_case)]
+
+use std::os::raw::{c_char, c_int, c_uint, c_void};
+
+pub type fmi2Component = *mut c_void;
+pub type fmi2ComponentEnvironment = *mut c_void;
+pub type fmi2FMUstate = *mut c_void;
+pub type fmi2ValueReference = c_uint;
+pub type fmi2Real = f64;
+pub type fmi2Integer = c_int;
+pub type fmi2Boolean = c_int;
+pub type fmi2Char = c_char;
+pub type fmi2String = *const fmi2Char;
+pub type fmi2Byte = c_char;
+/// An `fmi2Status` as returned by the FMU (0 = OK … 5 = Pending).
+pub type fmi2Status = c_int;
+
+pub const fmi2True: fmi2Boolean = 1;
+pub const fmi2False: fmi2Boolean = 0;
+
+pub type fmi2Type = c_int;
+pub const fmi2CoSimulation: fmi2Type = 1;
+
+pub type fmi2StatusKind = c_int;
+pub const fmi2DoStepStatus: fmi2StatusKind = 0;
+pub const fmi2LastSuccessfulTime: fmi2StatusKind = 2;
+pub const fmi2Terminated: fmi2StatusKind = 3;
+
+/// The importer's logger (§2.1.5). Variadic in C: ours is written in C
+/// (`logger.c`).
+pub type fmi2CallbackLogger = Option<
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...),
+>;
+pub type fmi2CallbackAllocateMemory = Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>;
+pub type fmi2CallbackFreeMemory = Option<unsafe extern "C" fn(*mut c_void)>;
+pub type fmi2StepFinished = Option<unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2Status)>;
+
+#[repr(C)]
+pub struct fmi2CallbackFunctions {
+    pub logger: fmi2CallbackLogger,
+    pub allocateMemory: fmi2CallbackAllocateMemory,
+    pub freeMemory: fmi2CallbackFreeMemory,
+    pub stepFinished: fmi2StepFinished,
+    pub componentEnvironment: fmi2ComponentEnvironment,
+}
+
+// Function types (fmi2FunctionTypes.h), common part (§2.1).
+pub type fmi2GetTypesPlatformTYPE = unsafe extern "C" fn() -> *const c_char;
+pub type fmi2GetVersionTYPE = unsafe extern "C" fn() -> *const c_char;
+pub type fmi2SetDebugLoggingTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2Boolean, usize, *const fmi2String) -> fmi2Status;
+pub type fmi2InstantiateTYPE = unsafe extern "C" fn(
+    fmi2String,
+    fmi2Type,
+    fmi2String,
+    fmi2String,
+    *const fmi2CallbackFunctions,
+    fmi2Boolean,
+    fmi2Boolean,
+) -> fmi2Component;
+pub type fmi2FreeInstanceTYPE = unsafe extern "C" fn(fmi2Component);
+pub type fmi2SetupExperimentTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2Boolean, fmi2Real, fmi2Real, fmi2Boolean, fmi2Real) -> fmi2Status;
+pub type fmi2ComponentTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+pub type fmi2GetRealTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2Real) -> fmi2Status;
+pub type fmi2GetIntegerTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2Integer) -> fmi2Status;
+pub type fmi2GetBooleanTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2Boolean) -> fmi2Status;
+pub type fmi2GetStringTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2String) -> fmi2Status;
+pub type fmi2SetRealTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2Real) -> fmi2Status;
+pub type fmi2SetIntegerTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2Integer) -> fmi2Status;
+pub type fmi2SetBooleanTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2Boolean) -> fmi2Status;
+pub type fmi2SetStringTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2String) -> fmi2Status;
+
+// FMU state (§2.1.8).
+pub type fmi2GetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
+pub type fmi2SetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> fmi2Status;
+pub type fmi2FreeFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
+pub type fmi2SerializedFMUstateSizeTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut usize) -> fmi2Status;
+pub type fmi2SerializeFMUstateTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut fmi2Byte, usize) -> fmi2Status;
+pub type fmi2DeSerializeFMUstateTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2Byte, usize, *mut fmi2FMUstate) -> fmi2Status;
+
+// Directional derivatives (§2.1.9).
+pub type fmi2GetDirectionalDerivativeTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Real,
+    *mut fmi2Real,
+) -> fmi2Status;
+
+// Co-simulation (§4.2).
+pub type fmi2SetRealInputDerivativesTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Integer,
+    *const fmi2Real,
+) -> fmi2Status;
+pub type fmi2GetRealOutputDerivativesTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Integer,
+    *mut fmi2Real,
+) -> fmi2Status;
+pub type fmi2DoStepTYPE = unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> fmi2Status;
+pub type fmi2GetStatusTYPE = unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Status) -> fmi2Status;
+pub type fmi2GetRealStatusTYPE = unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Real) -> fmi2Status;
+pub type fmi2GetIntegerStatusTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Integer) -> fmi2Status;
+pub type fmi2GetBooleanStatusTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Boolean) -> fmi2Status;
+pub type fmi2GetStringStatusTYPE = unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2String) -> fmi2Status;

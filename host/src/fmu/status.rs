@@ -1,0 +1,53 @@
+//! `fmi2Status` (FMI 2.0.4 §2.1.3) as a Rust value.
+
+use std::fmt;
+use std::os::raw::c_int;
+
+/// The status an FMU function returned. `Ok` and `Warning` are successes
+/// (a warning is logged by the FMU); every other status becomes an
+/// [`FmuError::Call`](crate::FmuError::Call).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    Ok,
+    Warning,
+    Discard,
+    Error,
+    Fatal,
+    Pending,
+    /// A value outside the standard's 0..=5 (a broken FMU).
+    Invalid(c_int),
+}
+
+impl Status {
+    /// The status an FMU returned as a C integer.
+    pub fn from_raw(raw: c_int) -> Status {
+        match raw {
+            0 => Status::Ok,
+            1 => Status::Warning,
+            2 => Status::Discard,
+            3 => Status::Error,
+            4 => Status::Fatal,
+            5 => Status::Pending,
+            other => Status::Invalid(other),
+        }
+    }
+
+    /// `Ok` or `Warning`: the call did what was asked.
+    pub fn is_success(self) -> bool {
+        matches!(self, Status::Ok | Status::Warning)
+    }
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Status::Ok => f.write_str("fmi2OK"),
+            Status::Warning => f.write_str("fmi2Warning"),
+            Status::Discard => f.write_str("fmi2Discard"),
+            Status::Error => f.write_str("fmi2Error"),
+            Status::Fatal => f.write_str("fmi2Fatal"),
+            Status::Pending => f.write_str("fmi2Pending"),
+            Status::Invalid(raw) => write!(f, "invalid status {raw}"),
+        }
+    }
+}
