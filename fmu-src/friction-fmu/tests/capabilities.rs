@@ -1,0 +1,248 @@
+//! The capabilities every friction FMU declares, checked through the C ABI:
+//! directional derivatives against finite differences, FMU states that
+//! reproduce a run bit for bit (in memory and serialized, in a fresh
+//! instance), step-size independence with interpolated inputs, output
+//! derivatives, and invalid parameters (issue 2).
+
+mod common;
+use common::{last_error, Fmu};
+use std::f64::consts::PI;
+
+/// A driving input for each model: (input name, value at time t).
+fn drive(model: &str) -> Vec<(&'static str, fn(f64) -> f64)> {
+    match model {
+        "Dahl" | "ResetIntegrator" => vec![("v", |t| 1e-3 * (2.0 * PI * t).sin())],
+        "LuGre" => vec![("v", |t| 2e-3 * (2.0 * PI * t).sin()), ("x", |t| 0.4 + 0.1 * t)],
+        "Bristle" => vec![("x", |t| 5e-8 * (2.0 * PI * t).sin())],
+        "Bristle2D" => vec![("v1", |t| 1e-3 * (2.0 * PI * t).cos()), ("v2", |t| 5e-4 * (2.0 * PI * t).sin())],
+        _ => unreachable!(),
+    }
+}
+
+const LUGRE_TABLE: &[(&str, f64)] = &[
+    ("position_dependent", 1.0),
+    ("n_table", 3.0),
+    ("x_table[1]", 0.0),
+    ("x_table[2]", 0.5),
+    ("x_table[3]", 1.0),
+    ("scale_pos[1]", 1.0),
+    ("scale_pos[2]", 1.3),
+    ("scale_pos[3]", 0.8),
+];
+
+fn params(model: &str) -> &'static [(&'static str, f64)] {
+    if model == "LuGre" {
+        LUGRE_TABLE
+    } else {
+        &[]
+    }
+}
+
+const MODELS: [&str; 5] = ["Dahl", "LuGre", "ResetIntegrator", "Bristle", "Bristle2D"];
+
+fn outputs(model: &str) -> &'static [&'static str] {
+    match model {
+        "Bristle2D" => &["F1", "F2", "z1", "z2"],
+        "Bristle" => &["F"],
+        _ => &["F", "z"],
+    }
+}
+
+fn run(fmu: &mut Fmu, steps: usize, h: f64, record: &mut Vec<u64>) {
+    let model = fmu.model;
+    for _ in 0..steps {
+        for (name, f) in drive(model) {
+            fmu.set(name, f(fmu.t));
+        }
+        fmu.step(h);
+        for o in outputs(model) {
+            record.push(fmu.get(o).to_bits());
+        }
+    }
+}
+
+#[test]
+fn restored_states_reproduce_the_run_bit_for_bit() {
+    for model in MODELS {
+        let mut a = Fmu::new(model, params(model));
+        let mut ignored = Vec::new();
+        run(&mut a, 300, 1e-3, &mut ignored);
+        let t_saved = a.t;
+        let saved = a.state();
+        let bytes = a.serialize(saved);
+        let mut original = Vec::new();
+        run(&mut a, 500, 1e-3, &mut original);
+
+        // same instance, in-memory state
+        a.restore(saved, t_saved);
+        let mut again = Vec::new();
+        run(&mut a, 500, 1e-3, &mut again);
+        assert_eq!(original, again, "{model}: in-memory state");
+
+        // fresh instance, serialized state
+        let mut b = Fmu::new(model, params(model));
+        let s = b.deserialize(&bytes);
+        b.restore(s, t_saved);
+        let mut fresh = Vec::new();
+        run(&mut b, 500, 1e-3, &mut fresh);
+        assert_eq!(original, fresh, "{model}: serialized state in a new instance");
+        // the continuation really moves
+        assert!(original.windows(2).any(|w| w[0] != w[1]), "{model}: nothing changed");
+    }
+}
+
+/// J = ∂F(t+h)/∂u (u held over the step) from the FMU, against central
+/// differences computed outside it by rolling back with fmi2SetFMUstate.
+fn check_step_sensitivity(model: &'static str, params: &[(&str, f64)], output: &str, input: &str, warmup: &[(&str, f64)], h: f64) {
+    let mut fmu = Fmu::new(model, params);
+    for _ in 0..200 {
+        for (name, value) in warmup {
+            fmu.set(name, *value);
+        }
+        fmu.step(h);
+    }
+    let (t0, s0) = (fmu.t, fmu.state());
+    let u0 = fmu.get(input);
+    let delta = 1e-5 * u0.abs().max(fmu.var(input).nominal.unwrap());
+    let mut f_at = |u: f64| {
+        fmu.restore(s0, t0);
+        fmu.set(input, u);
+        fmu.step(h);
+        fmu.get(output)
+    };
+    let fd = (f_at(u0 + delta) - f_at(u0 - delta)) / (2.0 * delta);
+    // the FMU's own answer, right after the unperturbed step
+    fmu.restore(s0, t0);
+    fmu.set(input, u0);
+    fmu.step(h);
+    let j = fmu.directional_derivative(output, input);
+    let scale = fd.abs().max(1e-12);
+    assert!(
+        (j - fd).abs() <= 1e-4 * scale,
+        "{model} d{output}/d{input}: FMU {j:e}, finite differences {fd:e}"
+    );
+}
+
+#[test]
+fn directional_derivatives_agree_with_finite_differences() {
+    let h = 1e-3;
+    // LuGre sticking (the σ0·h term dominates) and sliding
+    check_step_sensitivity("LuGre", &[], "F", "v", &[("v", 1e-5)], h);
+    check_step_sensitivity("LuGre", &[], "F", "v", &[("v", 5e-2)], h);
+    check_step_sensitivity("LuGre", LUGRE_TABLE, "F", "x", &[("v", 5e-2), ("x", 0.3)], h);
+    check_step_sensitivity("Dahl", &[], "F", "v", &[("v", 1e-4)], h);
+    check_step_sensitivity("ResetIntegrator", &[], "F", "v", &[("v", 1e-6)], h);
+    check_step_sensitivity("Bristle2D", &[], "F1", "v2", &[("v1", 1e-2), ("v2", 5e-3)], h);
+    check_step_sensitivity("Bristle2D", &[], "F2", "v2", &[("v1", 1e-6), ("v2", 1e-6)], h);
+}
+
+#[test]
+fn bristle_stiffness_agrees_with_finite_differences() {
+    // ∂F/∂x of the displacement-driven law is its tangent stiffness.
+    let mut fmu = Fmu::new("Bristle", &[("seed", 3.0)]);
+    let mut x = 0.0;
+    for _ in 0..20 {
+        x += 1e-9;
+        fmu.set("x", x);
+        fmu.step(1e-3);
+    }
+    let j = fmu.directional_derivative("F", "x");
+    let (t0, s0) = (fmu.t, fmu.state());
+    let delta = 1e-15;
+    let mut f_at = |u: f64| {
+        fmu.restore(s0, t0);
+        fmu.set("x", u);
+        fmu.get("F")
+    };
+    // One-sided, in the direction of motion: the law is hysteretic, and a
+    // backward perturbation is a reversal (bristles reconnect, F jumps).
+    let fd = (f_at(x + delta) - f_at(x)) / delta;
+    assert!((j - fd).abs() <= 1e-6 * fd.abs(), "FMU {j:e}, finite differences {fd:e}");
+    assert!(j > 0.0);
+}
+
+/// The same smooth velocity history, communicated every 1e-5 s and every
+/// 1e-2 s with first-order interpolation: F agrees at the common points to
+/// 1e-3 of the force scale.
+#[test]
+fn step_size_independence_with_interpolated_inputs() {
+    let v = |t: f64| 2e-3 * (2.0 * PI * t).sin() + 1e-3 * (PI * t).sin();
+    for (model, scale) in [("LuGre", 1.5), ("Dahl", 2.0)] {
+        let sample = |h: f64| -> Vec<f64> {
+            let mut fmu = Fmu::new(model, &[]);
+            let n = (2.0 / h).round() as usize;
+            let every = (1e-2 / h).round() as usize;
+            let mut out = Vec::new();
+            for k in 0..n {
+                let t = k as f64 * h;
+                fmu.set("v", v(t));
+                fmu.set_slope("v", (v(t + h) - v(t)) / h);
+                assert_eq!(unsafe { friction_fmu::exported::fmi2_exports::fmi2DoStep(fmu.c, t, h, 0) }, common::OK);
+                if (k + 1) % every == 0 {
+                    out.push(fmu.get("F"));
+                }
+            }
+            out
+        };
+        let fine = sample(1e-5);
+        let coarse = sample(1e-2);
+        assert_eq!(fine.len(), coarse.len());
+        let worst = fine.iter().zip(&coarse).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-3 * scale, "{model}: worst difference {worst:e} N");
+        // the history drives the law through sticking and sliding
+        let peak = fine.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+        assert!(peak > 0.5 * scale, "{model}: peak {peak}");
+    }
+}
+
+/// dF/dt from fmi2GetRealOutputDerivatives against a short forward step
+/// with the input moving at the slope that was declared.
+#[test]
+fn output_derivatives_agree_with_a_short_step() {
+    let cases: [(&str, &str, f64, f64); 5] = [
+        ("LuGre", "v", 1e-4, 3e-3),
+        ("Dahl", "v", 1e-4, 2e-3),
+        ("ResetIntegrator", "v", 1e-6, 1e-4),
+        ("Bristle", "x", 1e-9, 1e-8),
+        ("LuGre", "v", 2e-2, -0.5),
+    ];
+    for (model, input, u, slope) in cases {
+        let mut fmu = Fmu::new(model, &[]);
+        for _ in 0..5 {
+            fmu.set(input, u);
+            fmu.step(1e-4);
+        }
+        fmu.set(input, u);
+        fmu.set_slope(input, slope);
+        let rate = fmu.output_derivative("F");
+        let f0 = fmu.get("F");
+        let dt = 1e-8;
+        fmu.step(dt);
+        let fd = (fmu.get("F") - f0) / dt;
+        assert!((rate - fd).abs() <= 1e-3 * fd.abs().max(1e-9), "{model}: dF/dt {rate:e}, short step {fd:e}");
+    }
+}
+
+#[test]
+fn invalid_parameters_are_refused_with_name_and_value() {
+    let cases: &[(&str, &[(&str, f64)], &str)] = &[
+        ("Dahl", &[("sigma", -2.0)], "sigma = -2"),
+        ("Dahl", &[("Fc", 0.0)], "Fc = 0"),
+        ("LuGre", &[("sigma0", 0.0)], "sigma0 = 0"),
+        ("LuGre", &[("Fs", 0.9)], "Fs = 0.9"),
+        ("LuGre", &[("direction_dependent", 1.0), ("Fs_neg", 0.5)], "Fs_neg = 0.5"),
+        ("LuGre", &[("position_dependent", 1.0), ("n_table", 1.0)], "n_table = 1"),
+        ("LuGre", &[("position_dependent", 1.0), ("n_table", 2.0), ("x_table[2]", 0.0)], "x_table"),
+        ("ResetIntegrator", &[("z0", -1e-4)], "z0 = -0.0001"),
+        ("Bristle", &[("delta_max", -1.0)], "delta_max = -1"),
+        ("Bristle", &[("count_from_load", 0.0), ("n_bristles", 0.0)], "n_bristles = 0"),
+        ("Bristle", &[("stiffness_from_load", 0.0), ("sigma_ini", 0.0)], "sigma_ini = 0"),
+        ("Bristle2D", &[("sigma11", -1.0)], "sigma11 = -1"),
+    ];
+    for (model, bad, needle) in cases {
+        let fmu = Fmu::instantiated(model, bad);
+        assert_eq!(fmu.exit_initialization(), fmi2_cs::ffi::fmi2Status::fmi2Error, "{model} {bad:?}");
+        let m = last_error();
+        assert!(m.contains("fmi2ExitInitializationMode") && m.contains(needle), "{model}: {m}");
+    }
+}
