@@ -61,7 +61,13 @@ pub unsafe fn call(
             ));
             return fmi2Status::fmi2Error;
         }
-        instance.logger.call(|| format!("{function} (state {}, t = {})", instance.state.name(), instance.time));
+        instance.logger.call(|| {
+            format!(
+                "{function} (state {}, t = {})",
+                instance.state.name(),
+                instance.time
+            )
+        });
         match body(instance) {
             Ok(status) => status,
             Err(message) => {
@@ -74,7 +80,9 @@ pub unsafe fn call(
         let message = panic_message(&*payload);
         let _ = catch_unwind(AssertUnwindSafe(|| {
             instance.state = State::Fatal;
-            instance.logger.fatal(&format!("{function}: internal error (panic): {message}"));
+            instance
+                .logger
+                .fatal(&format!("{function}: internal error (panic): {message}"));
         }));
         fmi2Status::fmi2Fatal
     })
@@ -93,7 +101,9 @@ pub unsafe fn in_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a
         return Err(format!("argument {what} is NULL but its length is {n}"));
     }
     if n > MAX_ARRAY_LENGTH {
-        return Err(format!("length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"));
+        return Err(format!(
+            "length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"
+        ));
     }
     if !ptr.is_aligned() {
         return Err(format!("argument {what} = {ptr:p} is not aligned"));
@@ -114,7 +124,9 @@ pub unsafe fn out_slice<'a, T>(ptr: *mut T, n: usize, what: &str) -> Result<&'a 
         return Err(format!("argument {what} is NULL but its length is {n}"));
     }
     if n > MAX_ARRAY_LENGTH {
-        return Err(format!("length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"));
+        return Err(format!(
+            "length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"
+        ));
     }
     if !ptr.is_aligned() {
         return Err(format!("argument {what} = {ptr:p} is not aligned"));
@@ -157,7 +169,9 @@ pub unsafe fn instantiate(
     logging_on: fmi2Boolean,
 ) -> fmi2Component {
     let outcome = catch_unwind(AssertUnwindSafe(|| {
-        if functions.is_null() || !(functions as usize).is_multiple_of(std::mem::align_of::<fmi2CallbackFunctions>()) {
+        if functions.is_null()
+            || !(functions as usize).is_multiple_of(std::mem::align_of::<fmi2CallbackFunctions>())
+        {
             return std::ptr::null_mut();
         }
         // SAFETY: non-null and aligned; the importer owns it for the call.
@@ -190,14 +204,22 @@ pub unsafe fn instantiate(
             }
         };
         let Some(factory) = registry.iter().find(|f| f.info.guid == guid) else {
-            let known: Vec<String> = registry.iter().map(|f| format!("{} {}", f.info.model_name, f.info.guid)).collect();
+            let known: Vec<String> = registry
+                .iter()
+                .map(|f| format!("{} {}", f.info.model_name, f.info.guid))
+                .collect();
             logger.error(&format!(
                 "fmi2Instantiate: unknown fmuGUID {guid}; this binary holds {}",
                 known.join(", ")
             ));
             return std::ptr::null_mut();
         };
-        let instance = Box::new(Instance::new(factory.info, (factory.create)(), &name, logger));
+        let instance = Box::new(Instance::new(
+            factory.info,
+            (factory.create)(),
+            &name,
+            logger,
+        ));
         let address = Box::into_raw(instance);
         live().insert(address as usize);
         address as fmi2Component
@@ -226,7 +248,12 @@ pub unsafe fn free_instance(c: fmi2Component) {
 
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn set_debug_logging(c: fmi2Component, on: fmi2Boolean, n: usize, categories: *const fmi2String) -> fmi2Status {
+pub unsafe fn set_debug_logging(
+    c: fmi2Component,
+    on: fmi2Boolean,
+    n: usize,
+    categories: *const fmi2String,
+) -> fmi2Status {
     unsafe {
         call(c, "fmi2SetDebugLogging", |inst| {
             let cats = in_slice(categories, n, "categories[]")?;
@@ -272,14 +299,27 @@ macro_rules! simple_call {
         }
     };
 }
-simple_call!(enter_initialization_mode, "fmi2EnterInitializationMode", enter_initialization_mode);
-simple_call!(exit_initialization_mode, "fmi2ExitInitializationMode", exit_initialization_mode);
+simple_call!(
+    enter_initialization_mode,
+    "fmi2EnterInitializationMode",
+    enter_initialization_mode
+);
+simple_call!(
+    exit_initialization_mode,
+    "fmi2ExitInitializationMode",
+    exit_initialization_mode
+);
 simple_call!(terminate, "fmi2Terminate", terminate);
 simple_call!(reset, "fmi2Reset", reset);
 
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn get_real(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *mut f64) -> fmi2Status {
+pub unsafe fn get_real(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *mut f64,
+) -> fmi2Status {
     unsafe {
         call(c, "fmi2GetReal", |inst| {
             let vrs = in_slice(vr, n, "vr[]")?;
@@ -292,14 +332,32 @@ pub unsafe fn get_real(c: fmi2Component, vr: *const fmi2ValueReference, n: usize
 
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn get_integer(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *mut fmi2Integer) -> fmi2Status {
-    unsafe { get_converted(c, "fmi2GetInteger", VarType::Integer, vr, n, value, |x| x as fmi2Integer) }
+pub unsafe fn get_integer(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *mut fmi2Integer,
+) -> fmi2Status {
+    unsafe {
+        get_converted(c, "fmi2GetInteger", VarType::Integer, vr, n, value, |x| {
+            x as fmi2Integer
+        })
+    }
 }
 
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn get_boolean(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *mut fmi2Boolean) -> fmi2Status {
-    unsafe { get_converted(c, "fmi2GetBoolean", VarType::Boolean, vr, n, value, |x| (x != 0.0) as fmi2Boolean) }
+pub unsafe fn get_boolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    unsafe {
+        get_converted(c, "fmi2GetBoolean", VarType::Boolean, vr, n, value, |x| {
+            (x != 0.0) as fmi2Boolean
+        })
+    }
 }
 
 unsafe fn get_converted<T>(
@@ -329,17 +387,29 @@ unsafe fn get_converted<T>(
 ///
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn get_or_set_string(c: fmi2Component, function: &'static str, vr: *const fmi2ValueReference, n: usize, value: *const fmi2String) -> fmi2Status {
+pub unsafe fn get_or_set_string(
+    c: fmi2Component,
+    function: &'static str,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const fmi2String,
+) -> fmi2Status {
     unsafe {
         call(c, function, |inst| {
             let vrs = in_slice(vr, n, "vr[]")?;
             in_slice(value, n, "value[]")?;
             if let Some(first) = vrs.first() {
                 let what = match inst.info.variable(*first) {
-                    Some(v) => format!("value reference {first} ({}) is not a String variable", v.name),
+                    Some(v) => format!(
+                        "value reference {first} ({}) is not a String variable",
+                        v.name
+                    ),
                     None => format!("unknown value reference {first}"),
                 };
-                return Err(format!("{what}: {} has no String variables", inst.info.model_name));
+                return Err(format!(
+                    "{what}: {} has no String variables",
+                    inst.info.model_name
+                ));
             }
             Ok(fmi2Status::fmi2OK)
         })
@@ -348,7 +418,12 @@ pub unsafe fn get_or_set_string(c: fmi2Component, function: &'static str, vr: *c
 
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn set_real(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *const f64) -> fmi2Status {
+pub unsafe fn set_real(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const f64,
+) -> fmi2Status {
     unsafe {
         call(c, "fmi2SetReal", |inst| {
             let vrs = in_slice(vr, n, "vr[]")?;
@@ -361,11 +436,19 @@ pub unsafe fn set_real(c: fmi2Component, vr: *const fmi2ValueReference, n: usize
 
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn set_integer(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *const fmi2Integer) -> fmi2Status {
+pub unsafe fn set_integer(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const fmi2Integer,
+) -> fmi2Status {
     unsafe {
         call(c, "fmi2SetInteger", |inst| {
             let vrs = in_slice(vr, n, "vr[]")?;
-            let values: Vec<f64> = in_slice(value, n, "value[]")?.iter().map(|x| *x as f64).collect();
+            let values: Vec<f64> = in_slice(value, n, "value[]")?
+                .iter()
+                .map(|x| *x as f64)
+                .collect();
             inst.set(VarType::Integer, vrs, &values)?;
             Ok(fmi2Status::fmi2OK)
         })
@@ -374,12 +457,19 @@ pub unsafe fn set_integer(c: fmi2Component, vr: *const fmi2ValueReference, n: us
 
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn set_boolean(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, value: *const fmi2Boolean) -> fmi2Status {
+pub unsafe fn set_boolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const fmi2Boolean,
+) -> fmi2Status {
     unsafe {
         call(c, "fmi2SetBoolean", |inst| {
             let vrs = in_slice(vr, n, "vr[]")?;
-            let values: Vec<f64> =
-                in_slice(value, n, "value[]")?.iter().map(|x| if *x != 0 { 1.0 } else { 0.0 }).collect();
+            let values: Vec<f64> = in_slice(value, n, "value[]")?
+                .iter()
+                .map(|x| if *x != 0 { 1.0 } else { 0.0 })
+                .collect();
             inst.set(VarType::Boolean, vrs, &values)?;
             Ok(fmi2Status::fmi2OK)
         })
@@ -436,7 +526,11 @@ pub unsafe fn free_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2
 
 /// # Safety
 /// See [`call`].
-pub unsafe fn serialized_fmu_state_size(c: fmi2Component, state: fmi2FMUstate, size: *mut usize) -> fmi2Status {
+pub unsafe fn serialized_fmu_state_size(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
     unsafe {
         call(c, "fmi2SerializedFMUstateSize", |inst| {
             let out = out_slice(size, 1, "size")?;
@@ -448,7 +542,12 @@ pub unsafe fn serialized_fmu_state_size(c: fmi2Component, state: fmi2FMUstate, s
 
 /// # Safety
 /// See [`call`] and [`out_slice`].
-pub unsafe fn serialize_fmu_state(c: fmi2Component, state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) -> fmi2Status {
+pub unsafe fn serialize_fmu_state(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    bytes: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
     unsafe {
         call(c, "fmi2SerializeFMUstate", |inst| {
             let data = inst.saved_snapshot(state as usize)?.to_bytes();
@@ -467,7 +566,12 @@ pub unsafe fn serialize_fmu_state(c: fmi2Component, state: fmi2FMUstate, bytes: 
 
 /// # Safety
 /// See [`call`] and [`in_slice`].
-pub unsafe fn deserialize_fmu_state(c: fmi2Component, bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate) -> fmi2Status {
+pub unsafe fn deserialize_fmu_state(
+    c: fmi2Component,
+    bytes: *const fmi2Byte,
+    size: usize,
+    state: *mut fmi2FMUstate,
+) -> fmi2Status {
     unsafe {
         call(c, "fmi2DeSerializeFMUstate", |inst| {
             let slot = out_slice(state, 1, "FMUstate")?;
@@ -592,7 +696,6 @@ pub unsafe fn get_status<T: Copy>(
     }
 }
 
-
 /// Emit every FMI 2.0 Co-Simulation function for the models in `registry`
 /// (an expression of type `&'static [ModelFactory]`). Invoke once in a cdylib.
 #[macro_export]
@@ -614,7 +717,12 @@ macro_rules! export_fmi2 {
                 x::version()
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetDebugLogging(c: fmi2Component, on: fmi2Boolean, n: usize, cats: *const fmi2String) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetDebugLogging(
+                c: fmi2Component,
+                on: fmi2Boolean,
+                n: usize,
+                cats: *const fmi2String,
+            ) -> fmi2Status {
                 unsafe { x::set_debug_logging(c, on, n, cats) }
             }
             #[no_mangle]
@@ -627,14 +735,25 @@ macro_rules! export_fmi2 {
                 visible: fmi2Boolean,
                 logging_on: fmi2Boolean,
             ) -> fmi2Component {
-                unsafe { x::instantiate($registry, name, fmu_type, guid, resources, functions, visible, logging_on) }
+                unsafe {
+                    x::instantiate(
+                        $registry, name, fmu_type, guid, resources, functions, visible, logging_on,
+                    )
+                }
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
                 unsafe { x::free_instance(c) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetupExperiment(c: fmi2Component, tol_defined: fmi2Boolean, tol: f64, start: f64, stop_defined: fmi2Boolean, stop: f64) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetupExperiment(
+                c: fmi2Component,
+                tol_defined: fmi2Boolean,
+                tol: f64,
+                start: f64,
+                stop_defined: fmi2Boolean,
+                stop: f64,
+            ) -> fmi2Status {
                 unsafe { x::setup_experiment(c, tol_defined, tol, start, stop_defined, stop) }
             }
             #[no_mangle]
@@ -654,59 +773,122 @@ macro_rules! export_fmi2 {
                 unsafe { x::reset(c) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetReal(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Real) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetReal(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                v: *mut fmi2Real,
+            ) -> fmi2Status {
                 unsafe { x::get_real(c, vr, n, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetInteger(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Integer) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetInteger(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                v: *mut fmi2Integer,
+            ) -> fmi2Status {
                 unsafe { x::get_integer(c, vr, n, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetBoolean(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Boolean) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetBoolean(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                v: *mut fmi2Boolean,
+            ) -> fmi2Status {
                 unsafe { x::get_boolean(c, vr, n, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetString(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2String) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetString(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                v: *mut fmi2String,
+            ) -> fmi2Status {
                 unsafe { x::get_or_set_string(c, "fmi2GetString", vr, n, v as *const fmi2String) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetReal(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Real) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetReal(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                v: *const fmi2Real,
+            ) -> fmi2Status {
                 unsafe { x::set_real(c, vr, n, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetInteger(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Integer) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetInteger(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                v: *const fmi2Integer,
+            ) -> fmi2Status {
                 unsafe { x::set_integer(c, vr, n, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetBoolean(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Boolean) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetBoolean(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                v: *const fmi2Boolean,
+            ) -> fmi2Status {
                 unsafe { x::set_boolean(c, vr, n, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetString(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2String) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetString(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                v: *const fmi2String,
+            ) -> fmi2Status {
                 unsafe { x::get_or_set_string(c, "fmi2SetString", vr, n, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetFMUstate(
+                c: fmi2Component,
+                s: *mut fmi2FMUstate,
+            ) -> fmi2Status {
                 unsafe { x::get_fmu_state(c, s) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, s: fmi2FMUstate) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetFMUstate(
+                c: fmi2Component,
+                s: fmi2FMUstate,
+            ) -> fmi2Status {
                 unsafe { x::set_fmu_state(c, s) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2FreeFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2FreeFMUstate(
+                c: fmi2Component,
+                s: *mut fmi2FMUstate,
+            ) -> fmi2Status {
                 unsafe { x::free_fmu_state(c, s) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: fmi2Component, s: fmi2FMUstate, size: *mut usize) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+                c: fmi2Component,
+                s: fmi2FMUstate,
+                size: *mut usize,
+            ) -> fmi2Status {
                 unsafe { x::serialized_fmu_state_size(c, s, size) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SerializeFMUstate(c: fmi2Component, s: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SerializeFMUstate(
+                c: fmi2Component,
+                s: fmi2FMUstate,
+                bytes: *mut fmi2Byte,
+                size: usize,
+            ) -> fmi2Status {
                 unsafe { x::serialize_fmu_state(c, s, bytes, size) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2DeSerializeFMUstate(c: fmi2Component, bytes: *const fmi2Byte, size: usize, s: *mut fmi2FMUstate) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+                c: fmi2Component,
+                bytes: *const fmi2Byte,
+                size: usize,
+                s: *mut fmi2FMUstate,
+            ) -> fmi2Status {
                 unsafe { x::deserialize_fmu_state(c, bytes, size, s) }
             }
             #[no_mangle]
@@ -719,18 +901,39 @@ macro_rules! export_fmi2 {
                 dv_known: *const fmi2Real,
                 dv_unknown: *mut fmi2Real,
             ) -> fmi2Status {
-                unsafe { x::get_directional_derivative(c, unknown, n_unknown, known, n_known, dv_known, dv_unknown) }
+                unsafe {
+                    x::get_directional_derivative(
+                        c, unknown, n_unknown, known, n_known, dv_known, dv_unknown,
+                    )
+                }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetRealInputDerivatives(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, order: *const fmi2Integer, v: *const fmi2Real) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                order: *const fmi2Integer,
+                v: *const fmi2Real,
+            ) -> fmi2Status {
                 unsafe { x::set_real_input_derivatives(c, vr, n, order, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, order: *const fmi2Integer, v: *mut fmi2Real) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                n: usize,
+                order: *const fmi2Integer,
+                v: *mut fmi2Real,
+            ) -> fmi2Status {
                 unsafe { x::get_real_output_derivatives(c, vr, n, order, v) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2DoStep(c: fmi2Component, t: fmi2Real, h: fmi2Real, no_set_prior: fmi2Boolean) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2DoStep(
+                c: fmi2Component,
+                t: fmi2Real,
+                h: fmi2Real,
+                no_set_prior: fmi2Boolean,
+            ) -> fmi2Status {
                 unsafe { x::do_step(c, t, h, no_set_prior) }
             }
             #[no_mangle]
@@ -738,23 +941,55 @@ macro_rules! export_fmi2 {
                 unsafe { x::cancel_step(c) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2Status) -> fmi2Status {
-                unsafe { x::get_status(c, "fmi2GetStatus", kind, v, |_, k| (k == fmi2DoStepStatus).then_some(fmi2Status::fmi2OK)) }
+            pub unsafe extern "C" fn fmi2GetStatus(
+                c: fmi2Component,
+                kind: fmi2StatusKind,
+                v: *mut fmi2Status,
+            ) -> fmi2Status {
+                unsafe {
+                    x::get_status(c, "fmi2GetStatus", kind, v, |_, k| {
+                        (k == fmi2DoStepStatus).then_some(fmi2Status::fmi2OK)
+                    })
+                }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetRealStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2Real) -> fmi2Status {
-                unsafe { x::get_status(c, "fmi2GetRealStatus", kind, v, |i, k| (k == fmi2LastSuccessfulTime).then_some(i.time)) }
+            pub unsafe extern "C" fn fmi2GetRealStatus(
+                c: fmi2Component,
+                kind: fmi2StatusKind,
+                v: *mut fmi2Real,
+            ) -> fmi2Status {
+                unsafe {
+                    x::get_status(c, "fmi2GetRealStatus", kind, v, |i, k| {
+                        (k == fmi2LastSuccessfulTime).then_some(i.time)
+                    })
+                }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetIntegerStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2Integer) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetIntegerStatus(
+                c: fmi2Component,
+                kind: fmi2StatusKind,
+                v: *mut fmi2Integer,
+            ) -> fmi2Status {
                 unsafe { x::get_status(c, "fmi2GetIntegerStatus", kind, v, |_, _| None) }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetBooleanStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2Boolean) -> fmi2Status {
-                unsafe { x::get_status(c, "fmi2GetBooleanStatus", kind, v, |_, k| (k == fmi2Terminated).then_some(fmi2False)) }
+            pub unsafe extern "C" fn fmi2GetBooleanStatus(
+                c: fmi2Component,
+                kind: fmi2StatusKind,
+                v: *mut fmi2Boolean,
+            ) -> fmi2Status {
+                unsafe {
+                    x::get_status(c, "fmi2GetBooleanStatus", kind, v, |_, k| {
+                        (k == fmi2Terminated).then_some(fmi2False)
+                    })
+                }
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetStringStatus(c: fmi2Component, kind: fmi2StatusKind, v: *mut fmi2String) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetStringStatus(
+                c: fmi2Component,
+                kind: fmi2StatusKind,
+                v: *mut fmi2String,
+            ) -> fmi2Status {
                 unsafe { x::get_status(c, "fmi2GetStringStatus", kind, v, |_, _| None) }
             }
         }

@@ -42,14 +42,7 @@ pub const fmi2Terminated: fmi2StatusKind = 3;
 /// The importer's logger. It is variadic in C; we always call it with the
 /// format `"%s"` and one string, so a message can never act as a format.
 pub type fmi2CallbackLogger = Option<
-    unsafe extern "C" fn(
-        fmi2ComponentEnvironment,
-        fmi2String,
-        c_int,
-        fmi2String,
-        fmi2String,
-        ...
-    ),
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...),
 >;
 pub type fmi2CallbackAllocateMemory = Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>;
 pub type fmi2CallbackFreeMemory = Option<unsafe extern "C" fn(*mut c_void)>;

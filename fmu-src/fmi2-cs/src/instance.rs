@@ -62,7 +62,12 @@ fn type_name(t: VarType) -> &'static str {
 }
 
 impl Instance {
-    pub fn new(info: &'static ModelInfo, model: Box<dyn Model>, name: &str, logger: Logger) -> Self {
+    pub fn new(
+        info: &'static ModelInfo,
+        model: Box<dyn Model>,
+        name: &str,
+        logger: Logger,
+    ) -> Self {
         let values = Values::from_start(info.variables);
         let n = values.len();
         Instance {
@@ -120,7 +125,9 @@ impl Instance {
         }
         if let Some(stop) = stop {
             if !(stop.is_finite() && stop >= start) {
-                return Err(format!("stopTime must be finite and >= startTime = {start} but was {stop}"));
+                return Err(format!(
+                    "stopTime must be finite and >= startTime = {start} but was {stop}"
+                ));
             }
         }
         self.start_time = start;
@@ -184,7 +191,9 @@ impl Instance {
         for vr in vrs {
             self.variable_of_type(*vr, t)?;
         }
-        let wants_outputs = vrs.iter().any(|vr| self.info.variables[*vr as usize].causality == Causality::Output);
+        let wants_outputs = vrs
+            .iter()
+            .any(|vr| self.info.variables[*vr as usize].causality == Causality::Output);
         if wants_outputs {
             self.ensure_outputs()?;
         }
@@ -199,11 +208,17 @@ impl Instance {
         let in_step_mode = self.state == State::StepComplete;
         for (vr, value) in vrs.iter().zip(values) {
             let v = self.variable_of_type(*vr, t)?;
-            let allowed = if in_step_mode { v.settable_in_step_mode() } else { v.settable_before_init() };
+            let allowed = if in_step_mode {
+                v.settable_in_step_mode()
+            } else {
+                v.settable_before_init()
+            };
             if !allowed {
                 let what = match v.causality {
                     Causality::Output => "an output".to_string(),
-                    Causality::Parameter => "a fixed parameter, which cannot change after initialization".to_string(),
+                    Causality::Parameter => {
+                        "a fixed parameter, which cannot change after initialization".to_string()
+                    }
                     _ => format!("{:?}", v.causality).to_lowercase(),
                 };
                 return Err(format!(
@@ -213,7 +228,10 @@ impl Instance {
                 ));
             }
             if !value.is_finite() {
-                return Err(format!("{} (value reference {vr}) must be finite but was {value}", v.name));
+                return Err(format!(
+                    "{} (value reference {vr}) must be finite but was {value}",
+                    v.name
+                ));
             }
             if v.causality == Causality::Input {
                 self.model
@@ -222,7 +240,9 @@ impl Instance {
             }
         }
         for (vr, value) in vrs.iter().zip(values) {
-            if self.values.real(*vr) != *value || self.info.variables[*vr as usize].causality != Causality::Input {
+            if self.values.real(*vr) != *value
+                || self.info.variables[*vr as usize].causality != Causality::Input
+            {
                 self.replay.valid = false;
             }
             self.values.set(*vr, *value);
@@ -233,7 +253,12 @@ impl Instance {
         Ok(())
     }
 
-    pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], slopes: &[f64]) -> Result<(), String> {
+    pub fn set_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        slopes: &[f64],
+    ) -> Result<(), String> {
         for ((vr, order), slope) in vrs.iter().zip(orders).zip(slopes) {
             let v = self.variable_of_type(*vr, VarType::Real)?;
             if v.causality != Causality::Input {
@@ -246,7 +271,10 @@ impl Instance {
                 ));
             }
             if !slope.is_finite() {
-                return Err(format!("derivative of {} must be finite but was {slope}", v.name));
+                return Err(format!(
+                    "derivative of {} must be finite but was {slope}",
+                    v.name
+                ));
             }
         }
         for (vr, slope) in vrs.iter().zip(slopes) {
@@ -258,22 +286,39 @@ impl Instance {
         Ok(())
     }
 
-    pub fn get_output_derivatives(&mut self, vrs: &[u32], orders: &[i32], out: &mut [f64]) -> Result<(), String> {
+    pub fn get_output_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        out: &mut [f64],
+    ) -> Result<(), String> {
         let max_order = self.info.capabilities.max_output_derivative_order as i32;
         for (vr, order) in vrs.iter().zip(orders) {
             let v = self.variable_of_type(*vr, VarType::Real)?;
             if v.causality != Causality::Output {
-                return Err(format!("{} (value reference {vr}) is not an output", v.name));
+                return Err(format!(
+                    "{} (value reference {vr}) is not an output",
+                    v.name
+                ));
             }
             if *order < 1 || *order > max_order {
-                return Err(format!("derivative order {order} for {} is outside 1..={max_order}", v.name));
+                return Err(format!(
+                    "derivative order {order} for {} is outside 1..={max_order}",
+                    v.name
+                ));
             }
         }
         self.ensure_outputs()?;
         for (o, vr) in out.iter_mut().zip(vrs) {
-            *o = self.model.output_derivative(&self.values, &self.slopes, *vr).ok_or_else(|| {
-                format!("{} has no time derivative in this model", self.info.variables[*vr as usize].name)
-            })?;
+            *o = self
+                .model
+                .output_derivative(&self.values, &self.slopes, *vr)
+                .ok_or_else(|| {
+                    format!(
+                        "{} has no time derivative in this model",
+                        self.info.variables[*vr as usize].name
+                    )
+                })?;
         }
         Ok(())
     }
@@ -282,7 +327,9 @@ impl Instance {
 
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<fmi2Status, String> {
         if !(h.is_finite() && h > 0.0) {
-            return Err(format!("communicationStepSize must be finite and > 0 but was {h}"));
+            return Err(format!(
+                "communicationStepSize must be finite and > 0 but was {h}"
+            ));
         }
         let tolerance = TIME_TOLERANCE * self.time.abs().max(1.0);
         if !t.is_finite() || (t - self.time).abs() > tolerance {
@@ -334,16 +381,25 @@ impl Instance {
         for vr in unknowns {
             let v = self.variable_of_type(*vr, VarType::Real)?;
             if v.causality != Causality::Output {
-                return Err(format!("unknown {} (value reference {vr}) is not an output", v.name));
+                return Err(format!(
+                    "unknown {} (value reference {vr}) is not an output",
+                    v.name
+                ));
             }
         }
         for (vr, dv) in knowns.iter().zip(dv_known) {
             let v = self.variable_of_type(*vr, VarType::Real)?;
             if v.causality != Causality::Input {
-                return Err(format!("known {} (value reference {vr}) is not an input", v.name));
+                return Err(format!(
+                    "known {} (value reference {vr}) is not an input",
+                    v.name
+                ));
             }
             if !dv.is_finite() {
-                return Err(format!("seed dvKnown for {} must be finite but was {dv}", v.name));
+                return Err(format!(
+                    "seed dvKnown for {} must be finite but was {dv}",
+                    v.name
+                ));
             }
         }
         self.ensure_outputs()?;
@@ -353,7 +409,9 @@ impl Instance {
             .iter()
             .map(|u| {
                 knowns.iter().zip(dv_known).try_fold(0.0, |acc, (k, dv)| {
-                    self.model.partial_derivative(&self.values, *u, *k).map(|d| acc + d * dv)
+                    self.model
+                        .partial_derivative(&self.values, *u, *k)
+                        .map(|d| acc + d * dv)
                 })
             })
             .collect();
@@ -384,7 +442,13 @@ impl Instance {
         Ok(())
     }
 
-    fn perturbed_outputs(&self, knowns: &[u32], dv: &[f64], eps: f64, unknowns: &[u32]) -> Result<Vec<f64>, String> {
+    fn perturbed_outputs(
+        &self,
+        knowns: &[u32],
+        dv: &[f64],
+        eps: f64,
+        unknowns: &[u32],
+    ) -> Result<Vec<f64>, String> {
         let mut values = self.values.clone();
         if self.replay.valid {
             let mut model = self.model.clone_model();
@@ -427,17 +491,25 @@ impl Instance {
 
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
         if snap.guid != self.info.guid || snap.values.len() != self.values.len() {
-            return Err(format!("the FMU state belongs to GUID {}, not this FMU ({})", snap.guid, self.info.guid));
+            return Err(format!(
+                "the FMU state belongs to GUID {}, not this FMU ({})",
+                snap.guid, self.info.guid
+            ));
         }
         let previous = self.values.clone();
         self.values.copy_from_slice(&snap.values);
         if snap.initialized {
             let same_parameters = self.initialized
                 && self.info.variables.iter().all(|v| {
-                    v.causality != Causality::Parameter || previous.real(v.vr) == snap.values[v.vr as usize]
+                    v.causality != Causality::Parameter
+                        || previous.real(v.vr) == snap.values[v.vr as usize]
                 });
-            let result = if same_parameters { Ok(()) } else { self.model.initialize(&self.values) }
-                .and_then(|_| self.model.restore_state(&snap.model_state));
+            let result = if same_parameters {
+                Ok(())
+            } else {
+                self.model.initialize(&self.values)
+            }
+            .and_then(|_| self.model.restore_state(&snap.model_state));
             if let Err(e) = result {
                 // Lose nothing: put the previous values and model back.
                 self.values = previous;
@@ -469,16 +541,25 @@ impl Instance {
     }
 
     pub fn saved_snapshot(&self, address: usize) -> Result<&Snapshot, String> {
-        self.saved_states.get(&address).map(|b| &**b).ok_or_else(|| {
-            format!("FMUstate {address:#x} was not created by this instance (or was already freed)")
-        })
+        self.saved_states
+            .get(&address)
+            .map(|b| &**b)
+            .ok_or_else(|| {
+                format!(
+                    "FMUstate {address:#x} was not created by this instance (or was already freed)"
+                )
+            })
     }
 
     pub fn free_snapshot(&mut self, address: usize) -> Result<(), String> {
         self.saved_states
             .remove(&address)
             .map(|_| ())
-            .ok_or_else(|| format!("FMUstate {address:#x} was not created by this instance (or was already freed)"))
+            .ok_or_else(|| {
+                format!(
+                    "FMUstate {address:#x} was not created by this instance (or was already freed)"
+                )
+            })
     }
 
     pub fn n_values(&self) -> usize {

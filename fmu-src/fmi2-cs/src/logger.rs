@@ -59,7 +59,10 @@ impl Logger {
                 Some(i) => indices.push(i),
                 None => {
                     let known: Vec<&str> = LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
-                    return Err(format!("unknown log category \"{c}\" (known: {})", known.join(", ")));
+                    return Err(format!(
+                        "unknown log category \"{c}\" (known: {})",
+                        known.join(", ")
+                    ));
                 }
             }
         }

@@ -20,7 +20,10 @@ const UNITS: &[(&str, [i32; 3])] = &[
 ];
 
 fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
 
 /// Shortest representation that parses back to the same `f64`.
@@ -54,7 +57,10 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     let caps = &info.capabilities;
     let w = &mut x;
     let _ = writeln!(w, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
-    let _ = writeln!(w, "<!-- Generated from the variable table in the source code; do not edit by hand. -->");
+    let _ = writeln!(
+        w,
+        "<!-- Generated from the variable table in the source code; do not edit by hand. -->"
+    );
     let _ = writeln!(
         w,
         r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="{}" description="{}" author="friction-fmu project" generationTool="{}" variableNamingConvention="structured" numberOfEventIndicators="0">"#,
@@ -81,24 +87,38 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     if !used.is_empty() {
         let _ = writeln!(w, "  <UnitDefinitions>");
         for unit in used {
-            let (_, [kg, m, s]) = UNITS
-                .iter()
-                .find(|(name, _)| *name == unit)
-                .ok_or_else(|| format!("{}: unit {unit} has no base-unit definition", info.model_name))?;
+            let (_, [kg, m, s]) =
+                UNITS
+                    .iter()
+                    .find(|(name, _)| *name == unit)
+                    .ok_or_else(|| {
+                        format!(
+                            "{}: unit {unit} has no base-unit definition",
+                            info.model_name
+                        )
+                    })?;
             let mut base = String::new();
             for (name, e) in [("kg", kg), ("m", m), ("s", s)] {
                 if *e != 0 {
                     let _ = write!(base, r#" {name}="{e}""#);
                 }
             }
-            let _ = writeln!(w, r#"    <Unit name="{}"><BaseUnit{base}/></Unit>"#, escape(unit));
+            let _ = writeln!(
+                w,
+                r#"    <Unit name="{}"><BaseUnit{base}/></Unit>"#,
+                escape(unit)
+            );
         }
         let _ = writeln!(w, "  </UnitDefinitions>");
     }
 
     let _ = writeln!(w, "  <LogCategories>");
     for (name, description) in LOG_CATEGORIES {
-        let _ = writeln!(w, r#"    <Category name="{name}" description="{}"/>"#, escape(description));
+        let _ = writeln!(
+            w,
+            r#"    <Category name="{name}" description="{}"/>"#,
+            escape(description)
+        );
     }
     let _ = writeln!(w, "  </LogCategories>");
 
@@ -156,7 +176,12 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     let _ = writeln!(w, "  </ModelVariables>");
 
     let _ = writeln!(w, "  <ModelStructure>");
-    let outputs: Vec<_> = info.variables.iter().enumerate().filter(|(_, v)| v.causality == Causality::Output).collect();
+    let outputs: Vec<_> = info
+        .variables
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.causality == Causality::Output)
+        .collect();
     let _ = writeln!(w, "    <Outputs>");
     for (i, v) in &outputs {
         let deps: Vec<String> = v.depends_on.iter().map(|d| (d + 1).to_string()).collect();

@@ -36,7 +36,8 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 impl Snapshot {
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::with_capacity(
-            64 + self.guid.len() + 8 * (self.values.len() + self.slopes.len() + self.model_state.len()),
+            64 + self.guid.len()
+                + 8 * (self.values.len() + self.slopes.len() + self.model_state.len()),
         );
         out.extend_from_slice(MAGIC);
         out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
@@ -60,31 +61,47 @@ impl Snapshot {
     /// `n_values` variables.
     pub fn from_bytes(bytes: &[u8], guid: &str, n_values: usize) -> Result<Snapshot, String> {
         if bytes.len() < MAGIC.len() + 8 {
-            return Err(format!("serialized state is {} bytes, too short to be one", bytes.len()));
+            return Err(format!(
+                "serialized state is {} bytes, too short to be one",
+                bytes.len()
+            ));
         }
         let (body, tail) = bytes.split_at(bytes.len() - 8);
         let stored = u64::from_le_bytes(tail.try_into().expect("8 bytes"));
-        let mut r = Reader { bytes: body, pos: 0 };
+        let mut r = Reader {
+            bytes: body,
+            pos: 0,
+        };
         if r.take(8)? != MAGIC {
-            return Err("serialized state does not start with the magic FRICFMI2: not a state of this FMU".into());
+            return Err(
+                "serialized state does not start with the magic FRICFMI2: not a state of this FMU"
+                    .into(),
+            );
         }
         let version = r.u32()?;
         if version != FORMAT_VERSION {
-            return Err(format!("serialized state has format version {version}, expected {FORMAT_VERSION}"));
+            return Err(format!(
+                "serialized state has format version {version}, expected {FORMAT_VERSION}"
+            ));
         }
         if fnv1a(body) != stored {
-            return Err("serialized state checksum mismatch: the bytes are corrupted or truncated".into());
+            return Err(
+                "serialized state checksum mismatch: the bytes are corrupted or truncated".into(),
+            );
         }
         let guid_len = r.u32()? as usize;
         let stored_guid = std::str::from_utf8(r.take(guid_len)?)
             .map_err(|_| "serialized state GUID is not UTF-8".to_string())?
             .to_string();
         if stored_guid != guid {
-            return Err(format!("serialized state belongs to the FMU with GUID {stored_guid}, not {guid}"));
+            return Err(format!(
+                "serialized state belongs to the FMU with GUID {stored_guid}, not {guid}"
+            ));
         }
         let state_bits = r.u32()?;
-        let state = State::from_u32(state_bits)
-            .ok_or_else(|| format!("serialized state has an invalid instance state {state_bits}"))?;
+        let state = State::from_u32(state_bits).ok_or_else(|| {
+            format!("serialized state has an invalid instance state {state_bits}")
+        })?;
         let initialized = match r.take(1)?[0] {
             0 => false,
             1 => true,
@@ -93,17 +110,34 @@ impl Snapshot {
         let time = r.f64()?;
         let values = r.f64_array()?;
         if values.len() != n_values {
-            return Err(format!("serialized state holds {} variable values, this FMU has {n_values}", values.len()));
+            return Err(format!(
+                "serialized state holds {} variable values, this FMU has {n_values}",
+                values.len()
+            ));
         }
         let slopes = r.f64_array()?;
         if slopes.len() != n_values {
-            return Err(format!("serialized state holds {} input slopes, this FMU has {n_values}", slopes.len()));
+            return Err(format!(
+                "serialized state holds {} input slopes, this FMU has {n_values}",
+                slopes.len()
+            ));
         }
         let model_state = r.f64_array()?;
         if r.pos != body.len() {
-            return Err(format!("serialized state has {} trailing bytes", body.len() - r.pos));
+            return Err(format!(
+                "serialized state has {} trailing bytes",
+                body.len() - r.pos
+            ));
         }
-        Ok(Snapshot { guid: stored_guid, state, initialized, time, values, slopes, model_state })
+        Ok(Snapshot {
+            guid: stored_guid,
+            state,
+            initialized,
+            time,
+            values,
+            slopes,
+            model_state,
+        })
     }
 }
 
@@ -114,27 +148,43 @@ struct Reader<'a> {
 
 impl<'a> Reader<'a> {
     fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self.pos.checked_add(n).filter(|e| *e <= self.bytes.len()).ok_or_else(|| {
-            format!("serialized state is truncated: needed {n} bytes at offset {}, {} left", self.pos, self.bytes.len() - self.pos)
-        })?;
+        let end = self
+            .pos
+            .checked_add(n)
+            .filter(|e| *e <= self.bytes.len())
+            .ok_or_else(|| {
+                format!(
+                    "serialized state is truncated: needed {n} bytes at offset {}, {} left",
+                    self.pos,
+                    self.bytes.len() - self.pos
+                )
+            })?;
         let s = &self.bytes[self.pos..end];
         self.pos = end;
         Ok(s)
     }
     fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
     }
     fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
     }
     fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+        Ok(f64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
     }
     fn f64_array(&mut self) -> Result<Vec<f64>, String> {
         let n = self.u64()?;
         let left = (self.bytes.len() - self.pos) as u64 / 8;
         if n > left {
-            return Err(format!("serialized state declares {n} numbers but only {left} fit in the rest"));
+            return Err(format!(
+                "serialized state declares {n} numbers but only {left} fit in the rest"
+            ));
         }
         (0..n).map(|_| self.f64()).collect()
     }
@@ -166,12 +216,18 @@ mod tests {
     fn every_truncation_and_bit_flip_is_refused() {
         let bytes = sample().to_bytes();
         for n in 0..bytes.len() {
-            assert!(Snapshot::from_bytes(&bytes[..n], "{g}", 3).is_err(), "truncated to {n}");
+            assert!(
+                Snapshot::from_bytes(&bytes[..n], "{g}", 3).is_err(),
+                "truncated to {n}"
+            );
         }
         for i in 0..bytes.len() {
             let mut b = bytes.clone();
             b[i] ^= 0x10;
-            assert!(Snapshot::from_bytes(&b, "{g}", 3).is_err(), "bit flip at {i}");
+            assert!(
+                Snapshot::from_bytes(&b, "{g}", 3).is_err(),
+                "bit flip at {i}"
+            );
         }
     }
 

@@ -96,10 +96,22 @@ pub const ALLOWED: &[(&str, u32)] = &[
     ("fmi2GetInteger", AFTER_INSTANTIATE),
     ("fmi2GetBoolean", AFTER_INSTANTIATE),
     ("fmi2GetString", AFTER_INSTANTIATE),
-    ("fmi2SetReal", mask(&[Instantiated, InitializationMode, StepComplete])),
-    ("fmi2SetInteger", mask(&[Instantiated, InitializationMode, StepComplete])),
-    ("fmi2SetBoolean", mask(&[Instantiated, InitializationMode, StepComplete])),
-    ("fmi2SetString", mask(&[Instantiated, InitializationMode, StepComplete])),
+    (
+        "fmi2SetReal",
+        mask(&[Instantiated, InitializationMode, StepComplete]),
+    ),
+    (
+        "fmi2SetInteger",
+        mask(&[Instantiated, InitializationMode, StepComplete]),
+    ),
+    (
+        "fmi2SetBoolean",
+        mask(&[Instantiated, InitializationMode, StepComplete]),
+    ),
+    (
+        "fmi2SetString",
+        mask(&[Instantiated, InitializationMode, StepComplete]),
+    ),
     ("fmi2GetFMUstate", ANY_LIVE),
     ("fmi2SetFMUstate", ANY_LIVE),
     ("fmi2FreeFMUstate", ANY_LIVE),
@@ -107,15 +119,36 @@ pub const ALLOWED: &[(&str, u32)] = &[
     ("fmi2SerializeFMUstate", ANY_LIVE),
     ("fmi2DeSerializeFMUstate", ANY_LIVE),
     ("fmi2GetDirectionalDerivative", AFTER_INSTANTIATE),
-    ("fmi2SetRealInputDerivatives", mask(&[Instantiated, InitializationMode, StepComplete])),
-    ("fmi2GetRealOutputDerivatives", mask(&[StepComplete, StepFailed, StepCanceled, Terminated, Error])),
+    (
+        "fmi2SetRealInputDerivatives",
+        mask(&[Instantiated, InitializationMode, StepComplete]),
+    ),
+    (
+        "fmi2GetRealOutputDerivatives",
+        mask(&[StepComplete, StepFailed, StepCanceled, Terminated, Error]),
+    ),
     ("fmi2DoStep", StepComplete as u32),
     ("fmi2CancelStep", StepInProgress as u32),
-    ("fmi2GetStatus", mask(&[StepComplete, StepInProgress, StepFailed, Terminated])),
-    ("fmi2GetRealStatus", mask(&[StepComplete, StepInProgress, StepFailed, Terminated])),
-    ("fmi2GetIntegerStatus", mask(&[StepComplete, StepInProgress, StepFailed, Terminated])),
-    ("fmi2GetBooleanStatus", mask(&[StepComplete, StepInProgress, StepFailed, Terminated])),
-    ("fmi2GetStringStatus", mask(&[StepComplete, StepInProgress, StepFailed, Terminated])),
+    (
+        "fmi2GetStatus",
+        mask(&[StepComplete, StepInProgress, StepFailed, Terminated]),
+    ),
+    (
+        "fmi2GetRealStatus",
+        mask(&[StepComplete, StepInProgress, StepFailed, Terminated]),
+    ),
+    (
+        "fmi2GetIntegerStatus",
+        mask(&[StepComplete, StepInProgress, StepFailed, Terminated]),
+    ),
+    (
+        "fmi2GetBooleanStatus",
+        mask(&[StepComplete, StepInProgress, StepFailed, Terminated]),
+    ),
+    (
+        "fmi2GetStringStatus",
+        mask(&[StepComplete, StepInProgress, StepFailed, Terminated]),
+    ),
 ];
 
 /// The allowed-state mask of `function`; panics on a name not in the table
@@ -139,7 +172,13 @@ mod tests {
     #[test]
     fn do_step_only_in_step_complete() {
         assert!(is_allowed("fmi2DoStep", StepComplete));
-        for s in [Instantiated, InitializationMode, Terminated, Error, StepFailed] {
+        for s in [
+            Instantiated,
+            InitializationMode,
+            Terminated,
+            Error,
+            StepFailed,
+        ] {
             assert!(!is_allowed("fmi2DoStep", s), "{s:?}");
         }
     }

@@ -9,7 +9,9 @@ pub struct Values {
 impl Values {
     /// Start values of a table; outputs start at 0.
     pub fn from_start(variables: &[crate::Variable]) -> Self {
-        Values { data: variables.iter().map(|v| v.start.unwrap_or(0.0)).collect() }
+        Values {
+            data: variables.iter().map(|v| v.start.unwrap_or(0.0)).collect(),
+        }
     }
 
     pub fn real(&self, vr: u32) -> f64 {

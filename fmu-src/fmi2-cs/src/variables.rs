@@ -256,8 +256,14 @@ pub struct ModelInfo {
 
 /// Log categories every FMU of this layer declares, in this order.
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
-    ("logStatusError", "Errors: invalid calls, arguments and parameters (on by default)"),
-    ("logStatusFatal", "Fatal errors: internal failures (on by default)"),
+    (
+        "logStatusError",
+        "Errors: invalid calls, arguments and parameters (on by default)",
+    ),
+    (
+        "logStatusFatal",
+        "Fatal errors: internal failures (on by default)",
+    ),
     ("logStatusWarning", "Warnings"),
     ("logCalls", "Every FMI function call with its arguments"),
 ];
@@ -277,19 +283,33 @@ impl ModelInfo {
         let mut names = std::collections::HashSet::new();
         for (i, v) in self.variables.iter().enumerate() {
             if v.vr as usize != i {
-                return Err(format!("{}: variable {} has vr {} at index {}", self.model_name, v.name, v.vr, i));
+                return Err(format!(
+                    "{}: variable {} has vr {} at index {}",
+                    self.model_name, v.name, v.vr, i
+                ));
             }
             if !names.insert(v.name) {
-                return Err(format!("{}: duplicate variable name {}", self.model_name, v.name));
+                return Err(format!(
+                    "{}: duplicate variable name {}",
+                    self.model_name, v.name
+                ));
             }
             let needs_start = matches!(v.causality, Causality::Parameter | Causality::Input);
             if needs_start != v.start.is_some() {
-                return Err(format!("{}: variable {} start value presence is wrong", self.model_name, v.name));
+                return Err(format!(
+                    "{}: variable {} start value presence is wrong",
+                    self.model_name, v.name
+                ));
             }
             for d in v.depends_on {
                 match self.variable(*d) {
                     Some(dep) if dep.causality == Causality::Input => {}
-                    _ => return Err(format!("{}: {} depends on vr {} which is not an input", self.model_name, v.name, d)),
+                    _ => {
+                        return Err(format!(
+                            "{}: {} depends on vr {} which is not an input",
+                            self.model_name, v.name, d
+                        ))
+                    }
                 }
             }
         }

@@ -4,10 +4,10 @@
 
 use fmi2_cs::ffi::*;
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelFactory, ModelInfo, Values, Variable};
+use std::cell::RefCell;
 use std::ffi::{c_void, CStr, CString};
 use std::os::raw::{c_char, c_int};
 use std::ptr::{null, null_mut};
-use std::cell::RefCell;
 
 // ---- a toy model: y = k*u + s, ds/dt = u; panics in a step when u = 13 ----
 
@@ -26,7 +26,11 @@ static INFO: ModelInfo = ModelInfo {
     description: "test model",
     source: "test",
     variables: &VARIABLES,
-    default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 0.1 },
+    default_experiment: DefaultExperiment {
+        start_time: 0.0,
+        stop_time: 1.0,
+        step_size: 0.1,
+    },
     capabilities: Capabilities::FULL,
 };
 
@@ -76,7 +80,10 @@ impl Model for Toy {
     }
 }
 
-static REGISTRY: [ModelFactory; 1] = [ModelFactory { info: &INFO, create: || Box::new(Toy { k: 1.0, s: 0.0 }) }];
+static REGISTRY: [ModelFactory; 1] = [ModelFactory {
+    info: &INFO,
+    create: || Box::new(Toy { k: 1.0, s: 0.0 }),
+}];
 fmi2_cs::export_fmi2!(&REGISTRY[..]);
 use fmi2_exports::*;
 
@@ -96,17 +103,34 @@ fn log_clear() {
     LOG.with(|l| l.borrow_mut().clear());
 }
 
-extern "C" fn record(_env: *mut c_void, _name: *const c_char, status: c_int, category: *const c_char, message: *const c_char) {
+extern "C" fn record(
+    _env: *mut c_void,
+    _name: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
     // SAFETY: the FMU passes NUL-terminated strings.
     let (c, m) = unsafe { (CStr::from_ptr(category), CStr::from_ptr(message)) };
-    LOG.with(|l| l.borrow_mut().push((status, c.to_string_lossy().into(), m.to_string_lossy().into())));
+    LOG.with(|l| {
+        l.borrow_mut().push((
+            status,
+            c.to_string_lossy().into(),
+            m.to_string_lossy().into(),
+        ))
+    });
 }
 
 fn callbacks() -> fmi2CallbackFunctions {
     // SAFETY: on x86-64 and aarch64 a non-variadic function with these five
     // arguments can be called through the variadic pointer type (the FMU
     // passes no variadic arguments); this is what ctypes importers do.
-    let logger = unsafe { std::mem::transmute::<*const (), unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...)>(record as *const ()) };
+    let logger = unsafe {
+        std::mem::transmute::<
+            *const (),
+            unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...),
+        >(record as *const ())
+    };
     fmi2CallbackFunctions {
         logger: Some(logger),
         allocateMemory: None,
@@ -118,14 +142,29 @@ fn callbacks() -> fmi2CallbackFunctions {
 
 fn last_error_containing(needle: &str) -> String {
     let log = log_snapshot();
-    let found = log.iter().rev().find(|(s, _, m)| *s >= 3 && m.contains(needle));
-    found.map(|(_, _, m)| m.clone()).unwrap_or_else(|| panic!("no error message containing {needle:?} in {log:?}"))
+    let found = log
+        .iter()
+        .rev()
+        .find(|(s, _, m)| *s >= 3 && m.contains(needle));
+    found
+        .map(|(_, _, m)| m.clone())
+        .unwrap_or_else(|| panic!("no error message containing {needle:?} in {log:?}"))
 }
 
 fn new_instance(name: &str) -> fmi2Component {
     let cb = Box::leak(Box::new(callbacks()));
     let name = CString::new(name).unwrap();
-    let c = unsafe { fmi2Instantiate(name.as_ptr(), fmi2CoSimulation, c"{toy}".as_ptr(), null(), cb, 0, 0) };
+    let c = unsafe {
+        fmi2Instantiate(
+            name.as_ptr(),
+            fmi2CoSimulation,
+            c"{toy}".as_ptr(),
+            null(),
+            cb,
+            0,
+            0,
+        )
+    };
     assert!(!c.is_null());
     c
 }
@@ -133,7 +172,10 @@ fn new_instance(name: &str) -> fmi2Component {
 fn initialized(name: &str) -> fmi2Component {
     let c = new_instance(name);
     unsafe {
-        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2Status::fmi2OK);
+        assert_eq!(
+            fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0),
+            fmi2Status::fmi2OK
+        );
         assert_eq!(fmi2EnterInitializationMode(c), fmi2Status::fmi2OK);
         assert_eq!(fmi2ExitInitializationMode(c), fmi2Status::fmi2OK);
     }
@@ -142,7 +184,10 @@ fn initialized(name: &str) -> fmi2Component {
 
 fn get(c: fmi2Component, vr: u32) -> f64 {
     let mut x = f64::NAN;
-    assert_eq!(unsafe { fmi2GetReal(c, &vr, 1, &mut x) }, fmi2Status::fmi2OK);
+    assert_eq!(
+        unsafe { fmi2GetReal(c, &vr, 1, &mut x) },
+        fmi2Status::fmi2OK
+    );
     x
 }
 
@@ -170,13 +215,42 @@ fn lifecycle_and_feedthrough() {
 fn instantiate_refuses_bad_arguments_with_a_message() {
     let cb = Box::leak(Box::new(callbacks()));
     unsafe {
-        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2ModelExchange, c"{toy}".as_ptr(), null(), cb, 0, 0).is_null());
+        assert!(fmi2Instantiate(
+            c"x".as_ptr(),
+            fmi2ModelExchange,
+            c"{toy}".as_ptr(),
+            null(),
+            cb,
+            0,
+            0
+        )
+        .is_null());
         last_error_containing("fmuType = 0");
-        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, c"{nope}".as_ptr(), null(), cb, 0, 0).is_null());
+        assert!(fmi2Instantiate(
+            c"x".as_ptr(),
+            fmi2CoSimulation,
+            c"{nope}".as_ptr(),
+            null(),
+            cb,
+            0,
+            0
+        )
+        .is_null());
         last_error_containing("unknown fmuGUID {nope}");
-        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, null(), null(), cb, 0, 0).is_null());
+        assert!(
+            fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, null(), null(), cb, 0, 0).is_null()
+        );
         last_error_containing("fmuGUID is NULL");
-        assert!(fmi2Instantiate(c"x".as_ptr(), fmi2CoSimulation, c"{toy}".as_ptr(), null(), null(), 0, 0).is_null());
+        assert!(fmi2Instantiate(
+            c"x".as_ptr(),
+            fmi2CoSimulation,
+            c"{toy}".as_ptr(),
+            null(),
+            null(),
+            0,
+            0
+        )
+        .is_null());
     }
 }
 
@@ -233,13 +307,19 @@ fn non_finite_values_are_refused_and_nothing_is_lost() {
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
         assert_eq!(set(c, U, bad), ERR);
         let m = last_error_containing("fmi2SetReal: u (value reference 0) must be finite");
-        assert!(m.to_lowercase().contains(&bad.to_string().to_lowercase()), "{m}");
+        assert!(
+            m.to_lowercase().contains(&bad.to_string().to_lowercase()),
+            "{m}"
+        );
         assert_eq!(get(c, U), 0.25);
     }
     // a batch with one bad value sets nothing
     let vrs = [U, U];
     let vals = [0.5, f64::NAN];
-    assert_eq!(unsafe { fmi2SetReal(c, vrs.as_ptr(), 2, vals.as_ptr()) }, ERR);
+    assert_eq!(
+        unsafe { fmi2SetReal(c, vrs.as_ptr(), 2, vals.as_ptr()) },
+        ERR
+    );
     assert_eq!(get(c, U), 0.25);
     unsafe { fmi2FreeInstance(c) };
 }
@@ -293,9 +373,15 @@ fn state_table_is_enforced() {
     };
     type Probe = (&'static str, fn(fmi2Component) -> fmi2Status);
     let probes: &[Probe] = &[
-        ("fmi2SetupExperiment", |c| unsafe { fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0) }),
-        ("fmi2EnterInitializationMode", |c| unsafe { fmi2EnterInitializationMode(c) }),
-        ("fmi2ExitInitializationMode", |c| unsafe { fmi2ExitInitializationMode(c) }),
+        ("fmi2SetupExperiment", |c| unsafe {
+            fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0)
+        }),
+        ("fmi2EnterInitializationMode", |c| unsafe {
+            fmi2EnterInitializationMode(c)
+        }),
+        ("fmi2ExitInitializationMode", |c| unsafe {
+            fmi2ExitInitializationMode(c)
+        }),
         ("fmi2Terminate", |c| unsafe { fmi2Terminate(c) }),
         ("fmi2DoStep", |c| unsafe { fmi2DoStep(c, 0.0, 0.1, 0) }),
         ("fmi2CancelStep", |c| unsafe { fmi2CancelStep(c) }),
@@ -317,17 +403,27 @@ fn state_table_is_enforced() {
             unsafe { fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &mut t) }
         }),
     ];
-    for state in [State::Instantiated, State::InitializationMode, State::StepComplete, State::Terminated] {
+    for state in [
+        State::Instantiated,
+        State::InitializationMode,
+        State::StepComplete,
+        State::Terminated,
+    ] {
         for (name, probe) in probes {
             let c = reach(state);
             log_clear();
             let status = probe(c);
-            let illegal = log_snapshot().iter().any(|(_, _, m)| m.contains("illegal call sequence"));
+            let illegal = log_snapshot()
+                .iter()
+                .any(|(_, _, m)| m.contains("illegal call sequence"));
             if is_allowed(name, state) {
                 assert!(!illegal, "{name} in {state:?} was refused as illegal");
             } else {
                 assert_eq!(status, ERR, "{name} in {state:?}");
-                assert!(illegal, "{name} in {state:?}: no 'illegal call sequence' message");
+                assert!(
+                    illegal,
+                    "{name} in {state:?}: no 'illegal call sequence' message"
+                );
             }
             unsafe { fmi2FreeInstance(c) };
         }
@@ -341,7 +437,9 @@ fn panic_becomes_fatal_and_never_unwinds() {
     let status = unsafe { fmi2DoStep(c, 0.0, 0.1, 0) };
     assert_eq!(status, fmi2Status::fmi2Fatal);
     let log = log_snapshot();
-    assert!(log.iter().any(|(s, _, m)| *s == 4 && m.contains("fmi2DoStep: internal error (panic): unlucky input")));
+    assert!(log.iter().any(
+        |(s, _, m)| *s == 4 && m.contains("fmi2DoStep: internal error (panic): unlucky input")
+    ));
     // after fatal, nothing but free is possible
     assert_eq!(unsafe { fmi2DoStep(c, 0.0, 0.1, 0) }, ERR);
     unsafe { fmi2FreeInstance(c) };
@@ -359,7 +457,10 @@ fn state_round_trip_and_corruption() {
         assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
         let mut bytes = vec![0 as c_char; size];
         assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
-        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size - 1), ERR);
+        assert_eq!(
+            fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size - 1),
+            ERR
+        );
         fmi2DoStep(c, 0.1, 0.1, 0);
         let y_after = get(c, Y);
         // restore the in-memory state and the deserialized one: same continuation
@@ -373,10 +474,16 @@ fn state_round_trip_and_corruption() {
         assert_eq!(get(c, Y).to_bits(), y_after.to_bits());
         // truncated and corrupted bytes are refused with a reason
         let mut e: fmi2FMUstate = null_mut();
-        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size / 2, &mut e), ERR);
+        assert_eq!(
+            fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size / 2, &mut e),
+            ERR
+        );
         last_error_containing("fmi2DeSerializeFMUstate");
         bytes[size / 2] ^= 0x55;
-        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut e), ERR);
+        assert_eq!(
+            fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut e),
+            ERR
+        );
         last_error_containing("checksum");
         assert!(e.is_null());
         // a pointer that is not one of ours
@@ -398,13 +505,22 @@ fn directional_derivative_of_the_last_step() {
     unsafe {
         let (unknown, known, seed) = (Y, U, 1.0);
         let mut d = 0.0;
-        assert_eq!(fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, &mut d), OK);
+        assert_eq!(
+            fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, &mut d),
+            OK
+        );
         assert!((d - 2.0).abs() < 1e-8, "feedthrough {d}");
         fmi2DoStep(c, 0.0, 0.25, 0);
-        assert_eq!(fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, &mut d), OK);
+        assert_eq!(
+            fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, &mut d),
+            OK
+        );
         assert!((d - 2.25).abs() < 1e-8, "step sensitivity {d}");
         // unknown must be an output, known an input
-        assert_eq!(fmi2GetDirectionalDerivative(c, &known, 1, &known, 1, &seed, &mut d), ERR);
+        assert_eq!(
+            fmi2GetDirectionalDerivative(c, &known, 1, &known, 1, &seed, &mut d),
+            ERR
+        );
         last_error_containing("is not an output");
         fmi2FreeInstance(c);
     }
@@ -413,11 +529,23 @@ fn directional_derivative_of_the_last_step() {
 #[test]
 fn logging_categories() {
     let cb = Box::leak(Box::new(callbacks()));
-    let c = unsafe { fmi2Instantiate(c"logged".as_ptr(), fmi2CoSimulation, c"{toy}".as_ptr(), null(), cb, 0, 1) };
+    let c = unsafe {
+        fmi2Instantiate(
+            c"logged".as_ptr(),
+            fmi2CoSimulation,
+            c"{toy}".as_ptr(),
+            null(),
+            cb,
+            0,
+            1,
+        )
+    };
     log_clear();
     unsafe {
         fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0);
-        assert!(log_snapshot().iter().any(|(_, cat, m)| cat == "logCalls" && m.contains("fmi2SetupExperiment")));
+        assert!(log_snapshot()
+            .iter()
+            .any(|(_, cat, m)| cat == "logCalls" && m.contains("fmi2SetupExperiment")));
         let cats = [c"logCalls".as_ptr()];
         assert_eq!(fmi2SetDebugLogging(c, 0, 1, cats.as_ptr()), OK);
         log_clear();

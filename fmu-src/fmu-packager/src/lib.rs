@@ -23,21 +23,85 @@ pub fn description_path(dir: &Path, info: &ModelInfo) -> PathBuf {
 /// Write `dist/<Name>.fmu`: `modelDescription.xml` and
 /// `binaries/linux64/<modelIdentifier>.so`.
 pub fn package(info: &ModelInfo, library: &Path, out_dir: &Path) -> Result<PathBuf, String> {
-    let binary = std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+    let binary =
+        std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
     let xml = render(info)?;
-    std::fs::create_dir_all(out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
+    std::fs::create_dir_all(out_dir)
+        .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
     let path = out_dir.join(format!("{}.fmu", info.model_name));
-    let file = std::fs::File::create(&path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+    let file = std::fs::File::create(&path)
+        .map_err(|e| format!("cannot create {}: {e}", path.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
         .unix_permissions(0o644);
     let mut add = |name: &str, data: &[u8]| -> Result<(), String> {
-        zip.start_file(name, options).map_err(|e| format!("{}: {e}", path.display()))?;
-        zip.write_all(data).map_err(|e| format!("{}: {e}", path.display()))
+        zip.start_file(name, options)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        zip.write_all(data)
+            .map_err(|e| format!("{}: {e}", path.display()))
     };
     add("modelDescription.xml", xml.as_bytes())?;
-    add(&format!("binaries/linux64/{}.so", info.model_identifier), &binary)?;
-    zip.finish().map_err(|e| format!("{}: {e}", path.display()))?;
+    add(
+        &format!("binaries/linux64/{}.so", info.model_identifier),
+        &binary,
+    )?;
+    zip.finish()
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(path)
+}
+
+/// Markdown tables of every model's variables, for the README (arrays such
+/// as `x_table[1]`…`x_table[32]` collapse into one row `x_table[i]`).
+pub fn variables_markdown() -> String {
+    use fmi2_cs::{Causality, VarType};
+    let mut md = String::new();
+    for info in all_models() {
+        md.push_str(&format!("#### {} — {}\n\n", info.model_name, info.source));
+        md.push_str("| variable | causality | type | start | unit | description |\n|---|---|---|---|---|---|\n");
+        let mut seen_arrays: Vec<&str> = Vec::new();
+        for v in info.variables {
+            let (name, start) = match v.name.split_once('[') {
+                Some((base, _)) => {
+                    if seen_arrays.contains(&base) {
+                        continue;
+                    }
+                    seen_arrays.push(base);
+                    let n = info
+                        .variables
+                        .iter()
+                        .filter(|w| w.name.starts_with(&format!("{base}[")))
+                        .count();
+                    (format!("{base}[i], i = 1..{n}"), "see XML".to_string())
+                }
+                None => (
+                    v.name.to_string(),
+                    match (v.start, v.var_type) {
+                        (None, _) => String::new(),
+                        (Some(s), VarType::Boolean) => (s != 0.0).to_string(),
+                        (Some(s), VarType::Integer) => format!("{}", s as i64),
+                        (Some(s), VarType::Real) => format!("{s}"),
+                    },
+                ),
+            };
+            let causality = match v.causality {
+                Causality::Parameter => "parameter",
+                Causality::Input => "input",
+                Causality::Output => "output",
+                Causality::Local => "local",
+            };
+            let ty = match v.var_type {
+                VarType::Real => "Real",
+                VarType::Integer => "Integer",
+                VarType::Boolean => "Boolean",
+            };
+            md.push_str(&format!(
+                "| `{name}` | {causality} | {ty} | {start} | {} | {} |\n",
+                v.unit.unwrap_or(""),
+                v.description.replace('|', "\\|")
+            ));
+        }
+        md.push('\n');
+    }
+    md
 }

@@ -16,9 +16,17 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Write <dir>/<Name>.xml for every model from its variable table.
-    Render { #[arg(default_value = "modelDescription")] dir: PathBuf },
+    Render {
+        #[arg(default_value = "modelDescription")]
+        dir: PathBuf,
+    },
     /// Fail if any checked-in <dir>/<Name>.xml differs from the rendering.
-    Check { #[arg(default_value = "modelDescription")] dir: PathBuf },
+    Check {
+        #[arg(default_value = "modelDescription")]
+        dir: PathBuf,
+    },
+    /// Print the README's variable tables (Markdown).
+    VariablesMd,
     /// Package every model: <out>/<Name>.fmu from the shared library.
     Build {
         /// The built cdylib (e.g. target/release/libfriction_fmu.so).
@@ -35,7 +43,8 @@ fn run(cli: Cli) -> Result<(), String> {
             std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
             for info in all_models() {
                 let path = description_path(&dir, info);
-                std::fs::write(&path, render(info)?).map_err(|e| format!("{}: {e}", path.display()))?;
+                std::fs::write(&path, render(info)?)
+                    .map_err(|e| format!("{}: {e}", path.display()))?;
                 println!("wrote {}", path.display());
             }
         }
@@ -56,6 +65,7 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             println!("model descriptions match the code");
         }
+        Command::VariablesMd => print!("{}", fmu_packager::variables_markdown()),
         Command::Build { lib, out } => {
             for info in all_models() {
                 println!("wrote {}", package(info, &lib, &out)?.display());

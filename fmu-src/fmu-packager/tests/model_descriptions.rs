@@ -9,7 +9,8 @@ fn checked_in_model_descriptions_match_the_code() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../modelDescription");
     for info in all_models() {
         let path = description_path(&dir, info);
-        let on_disk = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let on_disk =
+            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert!(
             on_disk == render(info).unwrap(),
             "{} differs from the variable table of {}: run `cargo run -p fmu-packager -- render`",
@@ -28,4 +29,15 @@ fn every_model_has_a_distinct_guid_and_identifier() {
             assert_ne!(a.model_identifier, b.model_identifier);
         }
     }
+}
+
+#[test]
+fn readme_variable_tables_match_the_code() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md"))
+            .unwrap();
+    assert!(
+        readme.contains(&fmu_packager::variables_markdown()),
+        "README.md's variable tables differ from the code: paste `cargo run -p fmu-packager -- variables-md`"
+    );
 }

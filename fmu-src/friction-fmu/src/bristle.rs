@@ -64,31 +64,46 @@ pub struct BristleFmu {
 
 impl Default for BristleFmu {
     fn default() -> Self {
-        BristleFmu { law: Bristle::new(BristleParams::default()).expect("default parameters are valid") }
+        BristleFmu {
+            law: Bristle::new(BristleParams::default()).expect("default parameters are valid"),
+        }
     }
 }
 
 impl BristleFmu {
     /// The law's parameters from the FMU's, resolving the from-load options.
     pub fn params(values: &Values) -> Result<BristleParams, String> {
-        let (c, mu_c, fn_) = (values.real(vr::C), values.real(vr::MU_C), values.real(vr::FN));
+        let (c, mu_c, fn_) = (
+            values.real(vr::C),
+            values.real(vr::MU_C),
+            values.real(vr::FN),
+        );
         let delta_max = values.real(vr::DELTA_MAX);
         // Checked first: the from-load stiffness divides by it.
         if !(delta_max.is_finite() && delta_max > 0.0) {
-            return Err(format!("invalid parameter delta_max = {delta_max}: must be finite and > 0"));
+            return Err(format!(
+                "invalid parameter delta_max = {delta_max}: must be finite and > 0"
+            ));
         }
         let seed = values.integer(vr::SEED) as u32 as u64;
-        let from_load = BristleParams::from_load(c, mu_c, fn_, delta_max, values.real(vr::X_REL), seed);
-        let needs_load = values.boolean(vr::STIFFNESS_FROM_LOAD) || values.boolean(vr::COUNT_FROM_LOAD);
+        let from_load =
+            BristleParams::from_load(c, mu_c, fn_, delta_max, values.real(vr::X_REL), seed);
+        let needs_load =
+            values.boolean(vr::STIFFNESS_FROM_LOAD) || values.boolean(vr::COUNT_FROM_LOAD);
         if needs_load {
             for (name, value) in [("mu_c", mu_c), ("Fn", fn_)] {
                 if !(value.is_finite() && value > 0.0) {
-                    return Err(format!("invalid parameter {name} = {value}: must be finite and > 0"));
+                    return Err(format!(
+                        "invalid parameter {name} = {value}: must be finite and > 0"
+                    ));
                 }
             }
         }
-        let sigma_ini =
-            if values.boolean(vr::STIFFNESS_FROM_LOAD) { from_load.sigma_ini } else { values.real(vr::SIGMA_INI) };
+        let sigma_ini = if values.boolean(vr::STIFFNESS_FROM_LOAD) {
+            from_load.sigma_ini
+        } else {
+            values.real(vr::SIGMA_INI)
+        };
         let n_bristles = if values.boolean(vr::COUNT_FROM_LOAD) {
             if !(c.is_finite() && c > 0.0) {
                 return Err(format!("invalid parameter c = {c}: must be finite and > 0"));
@@ -101,7 +116,11 @@ impl BristleFmu {
             }
             n as usize
         };
-        Ok(BristleParams { sigma_ini, n_bristles, ..from_load })
+        Ok(BristleParams {
+            sigma_ini,
+            n_bristles,
+            ..from_load
+        })
     }
 }
 
@@ -130,7 +149,8 @@ impl Model for BristleFmu {
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        self.law.step(Ramp::new(values.real(vr::X), slopes[vr::X as usize]), h);
+        self.law
+            .step(Ramp::new(values.real(vr::X), slopes[vr::X as usize]), h);
         Ok(())
     }
 
@@ -158,6 +178,7 @@ impl Model for BristleFmu {
 
     /// dF/dt = (tangent stiffness)·dx/dt.
     fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {
-        (output == vr::F).then(|| self.law.stiffness_at(values.real(vr::X)) * slopes[vr::X as usize])
+        (output == vr::F)
+            .then(|| self.law.stiffness_at(values.real(vr::X)) * slopes[vr::X as usize])
     }
 }

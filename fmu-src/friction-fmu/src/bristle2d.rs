@@ -30,19 +30,78 @@ const V: &[u32] = &[vr::V1, vr::V2];
 static VARIABLES: [Variable; 15] = [
     Variable::input(vr::V1, "v1", 0.0, "m/s", 1e-3, "Slip velocity along axis 1"),
     Variable::input(vr::V2, "v2", 0.0, "m/s", 1e-3, "Slip velocity along axis 2"),
-    Variable::output(vr::F1, "F1", "N", "Friction force along axis 1 (the rig applies -F1)", V),
-    Variable::output(vr::F2, "F2", "N", "Friction force along axis 2 (the rig applies -F2)", V),
+    Variable::output(
+        vr::F1,
+        "F1",
+        "N",
+        "Friction force along axis 1 (the rig applies -F1)",
+        V,
+    ),
+    Variable::output(
+        vr::F2,
+        "F2",
+        "N",
+        "Friction force along axis 2 (the rig applies -F2)",
+        V,
+    ),
     Variable::output(vr::Z1, "z1", "m", "Bristle deflection along axis 1", &[]),
     Variable::output(vr::Z2, "z2", "m", "Bristle deflection along axis 2", &[]),
-    Variable::boolean_output(vr::SLIDING, "sliding", "True when |z| = z0 and the slip strains the bristle outward", V),
-    Variable::parameter(vr::SIGMA01, "sigma01", 1e4, "N/m", "Bristle stiffness along axis 1 (seed 004)").with_min(0.0),
-    Variable::parameter(vr::SIGMA02, "sigma02", 1e4, "N/m", "Bristle stiffness along axis 2 (seed 004)").with_min(0.0),
-    Variable::parameter(vr::SIGMA11, "sigma11", 74.15, "N.s/m", "Bristle damping along axis 1 (seed 004)").with_min(0.0),
-    Variable::parameter(vr::SIGMA12, "sigma12", 74.15, "N.s/m", "Bristle damping along axis 2 (seed 004)").with_min(0.0),
+    Variable::boolean_output(
+        vr::SLIDING,
+        "sliding",
+        "True when |z| = z0 and the slip strains the bristle outward",
+        V,
+    ),
+    Variable::parameter(
+        vr::SIGMA01,
+        "sigma01",
+        1e4,
+        "N/m",
+        "Bristle stiffness along axis 1 (seed 004)",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::SIGMA02,
+        "sigma02",
+        1e4,
+        "N/m",
+        "Bristle stiffness along axis 2 (seed 004)",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::SIGMA11,
+        "sigma11",
+        74.15,
+        "N.s/m",
+        "Bristle damping along axis 1 (seed 004)",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::SIGMA12,
+        "sigma12",
+        74.15,
+        "N.s/m",
+        "Bristle damping along axis 2 (seed 004)",
+    )
+    .with_min(0.0),
     Variable::parameter(vr::A1, "a1", 0.1, "", "Stiction gradient along axis 1").with_min(0.0),
     Variable::parameter(vr::A2, "a2", 0.1, "", "Stiction gradient along axis 2").with_min(0.0),
-    Variable::parameter(vr::Z0, "z0", 1e-4, "m", "Radius of the stiction disc |z| < z0").with_min(0.0),
-    Variable::parameter(vr::AV, "av", 1e-2, "m/s", "Damping decay velocity: sigma1i(|v|) = sigma1i*exp(-(|v|/av)^2); 0 = constant").with_min(0.0),
+    Variable::parameter(
+        vr::Z0,
+        "z0",
+        1e-4,
+        "m",
+        "Radius of the stiction disc |z| < z0",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::AV,
+        "av",
+        1e-2,
+        "m/s",
+        "Damping decay velocity: sigma1i(|v|) = sigma1i*exp(-(|v|/av)^2); 0 = constant",
+    )
+    .with_min(0.0),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -63,7 +122,9 @@ pub struct Bristle2DFmu {
 
 impl Default for Bristle2DFmu {
     fn default() -> Self {
-        Bristle2DFmu { law: Bristle2D::new(Bristle2DParams::default()).expect("default parameters are valid") }
+        Bristle2DFmu {
+            law: Bristle2D::new(Bristle2DParams::default()).expect("default parameters are valid"),
+        }
     }
 }
 

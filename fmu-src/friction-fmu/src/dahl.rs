@@ -17,13 +17,52 @@ pub mod vr {
 }
 
 static VARIABLES: [Variable; 7] = [
-    Variable::input(vr::V, "v", 0.0, "m/s", 1e-3, "Sliding velocity of the body relative to the surface"),
-    Variable::output(vr::F, "F", "N", "Friction force, resisting positive motion (the rig applies -F)", &[]),
+    Variable::input(
+        vr::V,
+        "v",
+        0.0,
+        "m/s",
+        1e-3,
+        "Sliding velocity of the body relative to the surface",
+    ),
+    Variable::output(
+        vr::F,
+        "F",
+        "N",
+        "Friction force, resisting positive motion (the rig applies -F)",
+        &[],
+    ),
     Variable::output(vr::Z, "z", "m", "Bristle deflection z = F/sigma", &[]),
-    Variable::boolean_output(vr::SLIDING, "sliding", "True when moving and |F| has reached 99 % of Fc", &[vr::V]),
-    Variable::parameter(vr::SIGMA, "sigma", 87750.0, "N/m", "Rest stiffness dF/dx at F = 0 (seed 001 Table 7)").with_min(0.0),
-    Variable::parameter(vr::FC, "Fc", 2.0, "N", "Coulomb friction level (seed 001 Table 7)").with_min(0.0),
-    Variable::parameter(vr::ALPHA, "alpha", 1.0, "", "Shape exponent (alpha = 1: classical Dahl)").with_min(0.0),
+    Variable::boolean_output(
+        vr::SLIDING,
+        "sliding",
+        "True when moving and |F| has reached 99 % of Fc",
+        &[vr::V],
+    ),
+    Variable::parameter(
+        vr::SIGMA,
+        "sigma",
+        87750.0,
+        "N/m",
+        "Rest stiffness dF/dx at F = 0 (seed 001 Table 7)",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::FC,
+        "Fc",
+        2.0,
+        "N",
+        "Coulomb friction level (seed 001 Table 7)",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::ALPHA,
+        "alpha",
+        1.0,
+        "",
+        "Shape exponent (alpha = 1: classical Dahl)",
+    )
+    .with_min(0.0),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -44,13 +83,19 @@ pub struct DahlFmu {
 
 impl Default for DahlFmu {
     fn default() -> Self {
-        DahlFmu { law: Dahl::new(DahlParams::default()).expect("default parameters are valid") }
+        DahlFmu {
+            law: Dahl::new(DahlParams::default()).expect("default parameters are valid"),
+        }
     }
 }
 
 impl DahlFmu {
     pub fn params(values: &Values) -> DahlParams {
-        DahlParams { sigma: values.real(vr::SIGMA), fc: values.real(vr::FC), alpha: values.real(vr::ALPHA) }
+        DahlParams {
+            sigma: values.real(vr::SIGMA),
+            fc: values.real(vr::FC),
+            alpha: values.real(vr::ALPHA),
+        }
     }
 }
 
@@ -72,7 +117,8 @@ impl Model for DahlFmu {
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        self.law.step(Ramp::new(values.real(vr::V), slopes[vr::V as usize]), h);
+        self.law
+            .step(Ramp::new(values.real(vr::V), slopes[vr::V as usize]), h);
         Ok(())
     }
 
@@ -93,7 +139,11 @@ impl Model for DahlFmu {
         let p = self.law.params();
         let v = values.real(vr::V);
         let y = 1.0 - self.law.force() / p.fc * v.signum();
-        let rate = if v == 0.0 { 0.0 } else { p.sigma * y.abs().powf(p.alpha) * y.signum() * v };
+        let rate = if v == 0.0 {
+            0.0
+        } else {
+            p.sigma * y.abs().powf(p.alpha) * y.signum() * v
+        };
         match output {
             vr::F => Some(rate),
             vr::Z => Some(rate / p.sigma),

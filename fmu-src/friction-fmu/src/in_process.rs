@@ -31,8 +31,12 @@ pub fn simulate(
     for (vr, v) in parameters {
         values.set(*vr, *v);
     }
-    let outputs: Vec<u32> =
-        info.variables.iter().filter(|v| v.causality == Causality::Output).map(|v| v.vr).collect();
+    let outputs: Vec<u32> = info
+        .variables
+        .iter()
+        .filter(|v| v.causality == Causality::Output)
+        .map(|v| v.vr)
+        .collect();
     let mut slopes = vec![0.0; values.len()];
     let apply = |n: usize, values: &mut Values, slopes: &mut [f64]| {
         for (vr, u, du) in &table.inputs {
@@ -44,7 +48,10 @@ pub fn simulate(
     model.initialize(&values)?;
     model.compute_outputs(&mut values);
     let mut out = OutputTable {
-        names: outputs.iter().map(|vr| info.variables[*vr as usize].name).collect(),
+        names: outputs
+            .iter()
+            .map(|vr| info.variables[*vr as usize].name)
+            .collect(),
         time: vec![table.time[0]],
         rows: vec![outputs.iter().map(|vr| values.real(*vr)).collect()],
     };
@@ -59,7 +66,8 @@ pub fn simulate(
         }
         model.compute_outputs(&mut values);
         out.time.push(table.time[n + 1]);
-        out.rows.push(outputs.iter().map(|vr| values.real(*vr)).collect());
+        out.rows
+            .push(outputs.iter().map(|vr| values.real(*vr)).collect());
     }
     Ok(out)
 }

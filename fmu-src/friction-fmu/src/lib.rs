@@ -18,11 +18,26 @@ use std::sync::LazyLock;
 /// Every model this binary holds.
 pub static REGISTRY: LazyLock<[ModelFactory; 5]> = LazyLock::new(|| {
     [
-        ModelFactory { info: &dahl::INFO, create: || Box::new(dahl::DahlFmu::default()) },
-        ModelFactory { info: &lugre::INFO, create: || Box::new(lugre::LuGreFmu::default()) },
-        ModelFactory { info: &reset_integrator::INFO, create: || Box::new(reset_integrator::ResetFmu::default()) },
-        ModelFactory { info: &bristle::INFO, create: || Box::new(bristle::BristleFmu::default()) },
-        ModelFactory { info: &bristle2d::INFO, create: || Box::new(bristle2d::Bristle2DFmu::default()) },
+        ModelFactory {
+            info: &dahl::INFO,
+            create: || Box::new(dahl::DahlFmu::default()),
+        },
+        ModelFactory {
+            info: &lugre::INFO,
+            create: || Box::new(lugre::LuGreFmu::default()),
+        },
+        ModelFactory {
+            info: &reset_integrator::INFO,
+            create: || Box::new(reset_integrator::ResetFmu::default()),
+        },
+        ModelFactory {
+            info: &bristle::INFO,
+            create: || Box::new(bristle::BristleFmu::default()),
+        },
+        ModelFactory {
+            info: &bristle2d::INFO,
+            create: || Box::new(bristle2d::Bristle2DFmu::default()),
+        },
     ]
 });
 
@@ -33,7 +48,10 @@ pub fn models() -> Vec<&'static ModelInfo> {
 
 /// A fresh model by name (for in-process runs that bypass the C ABI).
 pub fn create(model_name: &str) -> Option<Box<dyn Model>> {
-    REGISTRY.iter().find(|f| f.info.model_name == model_name).map(|f| (f.create)())
+    REGISTRY
+        .iter()
+        .find(|f| f.info.model_name == model_name)
+        .map(|f| (f.create)())
 }
 
 /// Name and version written into `generationTool`.

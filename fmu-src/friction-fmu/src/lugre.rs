@@ -42,43 +42,185 @@ const INPUTS: &[u32] = &[vr::V, vr::X, vr::FN];
 fn variables() -> Vec<Variable> {
     let d = LuGreParams::default();
     let mut v = vec![
-        Variable::input(vr::V, "v", 0.0, "m/s", 1e-3, "Sliding velocity of the body relative to the surface"),
-        Variable::input(vr::X, "x", 0.0, "m", 0.1, "Position along the travel (used when position_dependent)"),
-        Variable::input(vr::FN, "Fn", 1.0, "N", 1.0, "Normal force (used when normal_force_form), >= 0"),
-        Variable::output(vr::F, "F", "N", "Friction force F = sigma0*z + sigma1(v)*dz/dt + sigma2*v", INPUTS),
+        Variable::input(
+            vr::V,
+            "v",
+            0.0,
+            "m/s",
+            1e-3,
+            "Sliding velocity of the body relative to the surface",
+        ),
+        Variable::input(
+            vr::X,
+            "x",
+            0.0,
+            "m",
+            0.1,
+            "Position along the travel (used when position_dependent)",
+        ),
+        Variable::input(
+            vr::FN,
+            "Fn",
+            1.0,
+            "N",
+            1.0,
+            "Normal force (used when normal_force_form), >= 0",
+        ),
+        Variable::output(
+            vr::F,
+            "F",
+            "N",
+            "Friction force F = sigma0*z + sigma1(v)*dz/dt + sigma2*v",
+            INPUTS,
+        ),
         Variable::output(vr::Z, "z", "m", "Mean bristle deflection", &[]),
-        Variable::boolean_output(vr::SLIDING, "sliding", "True when moving and sigma0*|z| has reached 99 % of g(v)", INPUTS),
-        Variable::parameter(vr::SIGMA0, "sigma0", d.sigma0, "N/m", "Bristle stiffness (per unit Fn, 1/m, in the normal-force form)").with_min(0.0),
-        Variable::parameter(vr::SIGMA1, "sigma1", d.sigma1, "N.s/m", "Bristle damping (per unit Fn, s/m, in the normal-force form)").with_min(0.0),
-        Variable::parameter(vr::SIGMA2, "sigma2", d.sigma2, "N.s/m", "Viscous friction (per unit Fn, s/m, in the normal-force form)").with_min(0.0),
-        Variable::parameter(vr::FC, "Fc", d.fc, "N", "Coulomb level for v >= 0 (friction coefficient mu_d in the normal-force form)").with_min(0.0),
-        Variable::parameter(vr::FS, "Fs", d.fs, "N", "Static (break-away) level for v >= 0, >= Fc (mu_s in the normal-force form)").with_min(0.0),
+        Variable::boolean_output(
+            vr::SLIDING,
+            "sliding",
+            "True when moving and sigma0*|z| has reached 99 % of g(v)",
+            INPUTS,
+        ),
+        Variable::parameter(
+            vr::SIGMA0,
+            "sigma0",
+            d.sigma0,
+            "N/m",
+            "Bristle stiffness (per unit Fn, 1/m, in the normal-force form)",
+        )
+        .with_min(0.0),
+        Variable::parameter(
+            vr::SIGMA1,
+            "sigma1",
+            d.sigma1,
+            "N.s/m",
+            "Bristle damping (per unit Fn, s/m, in the normal-force form)",
+        )
+        .with_min(0.0),
+        Variable::parameter(
+            vr::SIGMA2,
+            "sigma2",
+            d.sigma2,
+            "N.s/m",
+            "Viscous friction (per unit Fn, s/m, in the normal-force form)",
+        )
+        .with_min(0.0),
+        Variable::parameter(
+            vr::FC,
+            "Fc",
+            d.fc,
+            "N",
+            "Coulomb level for v >= 0 (friction coefficient mu_d in the normal-force form)",
+        )
+        .with_min(0.0),
+        Variable::parameter(
+            vr::FS,
+            "Fs",
+            d.fs,
+            "N",
+            "Static (break-away) level for v >= 0, >= Fc (mu_s in the normal-force form)",
+        )
+        .with_min(0.0),
         Variable::parameter(vr::VS, "vs", d.vs, "m/s", "Stribeck velocity").with_min(0.0),
-        Variable::parameter(vr::STRIBECK_EXPONENT, "stribeck_exponent", d.stribeck_exponent, "", "Stribeck exponent delta in exp(-|v/vs|^delta)").with_min(0.0),
-        Variable::parameter(vr::VD, "vd", d.vd, "m/s", "Micro-damping decay velocity: sigma1(v) = sigma1*exp(-(v/vd)^2); 0 = constant sigma1").with_min(0.0),
-        Variable::boolean_parameter(vr::DIRECTION_DEPENDENT, "direction_dependent", false, "Use Fc_neg, Fs_neg and scale_neg for v < 0"),
-        Variable::parameter(vr::FC_NEG, "Fc_neg", d.fc_neg, "N", "Coulomb level for v < 0 (when direction_dependent)").with_min(0.0),
-        Variable::parameter(vr::FS_NEG, "Fs_neg", d.fs_neg, "N", "Static level for v < 0, >= Fc_neg (when direction_dependent)").with_min(0.0),
-        Variable::boolean_parameter(vr::NORMAL_FORCE_FORM, "normal_force_form", false, "Seed 002 form: stiffness, damping and levels are per unit normal force Fn"),
-        Variable::boolean_parameter(vr::POSITION_DEPENDENT, "position_dependent", false, "Scale Fc and Fs by a piecewise-linear table over the input x"),
-        Variable::integer_parameter(vr::N_TABLE, "n_table", d.n_table as i32, "Number of table points used (2..32)"),
+        Variable::parameter(
+            vr::STRIBECK_EXPONENT,
+            "stribeck_exponent",
+            d.stribeck_exponent,
+            "",
+            "Stribeck exponent delta in exp(-|v/vs|^delta)",
+        )
+        .with_min(0.0),
+        Variable::parameter(
+            vr::VD,
+            "vd",
+            d.vd,
+            "m/s",
+            "Micro-damping decay velocity: sigma1(v) = sigma1*exp(-(v/vd)^2); 0 = constant sigma1",
+        )
+        .with_min(0.0),
+        Variable::boolean_parameter(
+            vr::DIRECTION_DEPENDENT,
+            "direction_dependent",
+            false,
+            "Use Fc_neg, Fs_neg and scale_neg for v < 0",
+        ),
+        Variable::parameter(
+            vr::FC_NEG,
+            "Fc_neg",
+            d.fc_neg,
+            "N",
+            "Coulomb level for v < 0 (when direction_dependent)",
+        )
+        .with_min(0.0),
+        Variable::parameter(
+            vr::FS_NEG,
+            "Fs_neg",
+            d.fs_neg,
+            "N",
+            "Static level for v < 0, >= Fc_neg (when direction_dependent)",
+        )
+        .with_min(0.0),
+        Variable::boolean_parameter(
+            vr::NORMAL_FORCE_FORM,
+            "normal_force_form",
+            false,
+            "Seed 002 form: stiffness, damping and levels are per unit normal force Fn",
+        ),
+        Variable::boolean_parameter(
+            vr::POSITION_DEPENDENT,
+            "position_dependent",
+            false,
+            "Scale Fc and Fs by a piecewise-linear table over the input x",
+        ),
+        Variable::integer_parameter(
+            vr::N_TABLE,
+            "n_table",
+            d.n_table as i32,
+            "Number of table points used (2..32)",
+        ),
     ];
     let names = |base: &str| -> Vec<&'static str> {
-        (1..=TABLE_POINTS).map(|i| &*Box::leak(format!("{base}[{i}]").into_boxed_str())).collect()
+        (1..=TABLE_POINTS)
+            .map(|i| &*Box::leak(format!("{base}[{i}]").into_boxed_str()))
+            .collect()
     };
     for (i, name) in names("x_table").into_iter().enumerate() {
-        v.push(Variable::parameter(vr::X_TABLE + i as u32, name, d.x_table[i], "m", "Table position (strictly increasing over the points used)"));
+        v.push(Variable::parameter(
+            vr::X_TABLE + i as u32,
+            name,
+            d.x_table[i],
+            "m",
+            "Table position (strictly increasing over the points used)",
+        ));
     }
     for (i, name) in names("scale_pos").into_iter().enumerate() {
-        v.push(Variable::parameter(vr::SCALE_POS + i as u32, name, d.scale_pos[i], "", "Scale factor on Fc and Fs at x_table[i], v >= 0").with_min(0.0));
+        v.push(
+            Variable::parameter(
+                vr::SCALE_POS + i as u32,
+                name,
+                d.scale_pos[i],
+                "",
+                "Scale factor on Fc and Fs at x_table[i], v >= 0",
+            )
+            .with_min(0.0),
+        );
     }
     for (i, name) in names("scale_neg").into_iter().enumerate() {
-        v.push(Variable::parameter(vr::SCALE_NEG + i as u32, name, d.scale_neg[i], "", "Scale factor on Fc_neg and Fs_neg at x_table[i], v < 0 (when direction_dependent)").with_min(0.0));
+        v.push(
+            Variable::parameter(
+                vr::SCALE_NEG + i as u32,
+                name,
+                d.scale_neg[i],
+                "",
+                "Scale factor on Fc_neg and Fs_neg at x_table[i], v < 0 (when direction_dependent)",
+            )
+            .with_min(0.0),
+        );
     }
     v
 }
 
-pub static INFO: LazyLock<ModelInfo> = LazyLock::new(|| ModelInfo {
+pub static INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
+    ModelInfo {
     model_name: "LuGre",
     model_identifier: "LuGre",
     guid: "{cc09ec7b-20f5-4798-9c84-4aa863242977}",
@@ -87,6 +229,7 @@ pub static INFO: LazyLock<ModelInfo> = LazyLock::new(|| ModelInfo {
     variables: Box::leak(variables().into_boxed_slice()),
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
+}
 });
 
 #[derive(Clone, Debug)]
@@ -96,13 +239,17 @@ pub struct LuGreFmu {
 
 impl Default for LuGreFmu {
     fn default() -> Self {
-        LuGreFmu { law: LuGre::new(LuGreParams::default()).expect("default parameters are valid") }
+        LuGreFmu {
+            law: LuGre::new(LuGreParams::default()).expect("default parameters are valid"),
+        }
     }
 }
 
 impl LuGreFmu {
     pub fn params(values: &Values) -> LuGreParams {
-        let table = |base: u32| -> [f64; TABLE_POINTS] { std::array::from_fn(|i| values.real(base + i as u32)) };
+        let table = |base: u32| -> [f64; TABLE_POINTS] {
+            std::array::from_fn(|i| values.real(base + i as u32))
+        };
         LuGreParams {
             sigma0: values.real(vr::SIGMA0),
             sigma1: values.real(vr::SIGMA1),
@@ -161,7 +308,11 @@ impl Model for LuGreFmu {
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
         let ramp = |i: u32| Ramp::new(values.real(i), slopes[i as usize]);
-        let inputs = LuGreInputs { v: ramp(vr::V), x: ramp(vr::X), fn_: ramp(vr::FN) };
+        let inputs = LuGreInputs {
+            v: ramp(vr::V),
+            x: ramp(vr::X),
+            fn_: ramp(vr::FN),
+        };
         self.law.step(&inputs, h);
         Ok(())
     }
@@ -195,10 +346,12 @@ impl Model for LuGreFmu {
                 let a = slopes[vr::V as usize];
                 let g = self.law.g(v, x, fn_);
                 let dv = 1e-7 * v.abs().max(p.vs);
-                let g_prime = (self.law.g(v + dv, x, fn_) - self.law.g(v - dv, x, fn_)) / (2.0 * dv);
+                let g_prime =
+                    (self.law.g(v + dv, x, fn_) - self.law.g(v - dv, x, fn_)) / (2.0 * dv);
                 let z = self.law.z();
                 let d_abs_v = v.signum() * a;
-                let z_ddot = a - p.sigma0 * (d_abs_v * z / g + v.abs() * z_dot / g - v.abs() * z * g_prime * a / (g * g));
+                let z_ddot = a - p.sigma0
+                    * (d_abs_v * z / g + v.abs() * z_dot / g - v.abs() * z * g_prime * a / (g * g));
                 Some(p.sigma0 * z_dot + p.sigma1 * z_ddot + p.sigma2 * a)
             }
             _ => None,

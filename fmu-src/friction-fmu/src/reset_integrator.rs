@@ -18,14 +18,46 @@ pub mod vr {
 }
 
 static VARIABLES: [Variable; 8] = [
-    Variable::input(vr::V, "v", 0.0, "m/s", 1e-3, "Sliding velocity of the body relative to the surface"),
-    Variable::output(vr::F, "F", "N", "Friction force F = (1 + a(z))*sigma0*z + sigma1*dz/dt", &[vr::V]),
+    Variable::input(
+        vr::V,
+        "v",
+        0.0,
+        "m/s",
+        1e-3,
+        "Sliding velocity of the body relative to the surface",
+    ),
+    Variable::output(
+        vr::F,
+        "F",
+        "N",
+        "Friction force F = (1 + a(z))*sigma0*z + sigma1*dz/dt",
+        &[vr::V],
+    ),
     Variable::output(vr::Z, "z", "m", "Bristle strain, |z| <= z0", &[]),
-    Variable::boolean_output(vr::SLIDING, "sliding", "True when z is at the stiction limit and moving outward", &[vr::V]),
+    Variable::boolean_output(
+        vr::SLIDING,
+        "sliding",
+        "True when z is at the stiction limit and moving outward",
+        &[vr::V],
+    ),
     Variable::parameter(vr::SIGMA0, "sigma0", 1e4, "N/m", "Bristle stiffness").with_min(0.0),
     Variable::parameter(vr::SIGMA1, "sigma1", 74.15, "N.s/m", "Bristle damping").with_min(0.0),
-    Variable::parameter(vr::A, "a", 0.1, "", "Stiction gradient: break-away peak (1 + a)*sigma0*z0").with_min(0.0),
-    Variable::parameter(vr::Z0, "z0", 1e-4, "m", "Stiction range: sliding level sigma0*z0").with_min(0.0),
+    Variable::parameter(
+        vr::A,
+        "a",
+        0.1,
+        "",
+        "Stiction gradient: break-away peak (1 + a)*sigma0*z0",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::Z0,
+        "z0",
+        1e-4,
+        "m",
+        "Stiction range: sliding level sigma0*z0",
+    )
+    .with_min(0.0),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -46,7 +78,10 @@ pub struct ResetFmu {
 
 impl Default for ResetFmu {
     fn default() -> Self {
-        ResetFmu { law: ResetIntegrator::new(ResetParams::default()).expect("default parameters are valid") }
+        ResetFmu {
+            law: ResetIntegrator::new(ResetParams::default())
+                .expect("default parameters are valid"),
+        }
     }
 }
 
@@ -79,7 +114,8 @@ impl Model for ResetFmu {
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        self.law.step(Ramp::new(values.real(vr::V), slopes[vr::V as usize]), h);
+        self.law
+            .step(Ramp::new(values.real(vr::V), slopes[vr::V as usize]), h);
         Ok(())
     }
 
@@ -105,7 +141,10 @@ impl Model for ResetFmu {
         match output {
             vr::Z => Some(z_dot),
             vr::F if z_dot == 0.0 => Some(0.0),
-            vr::F => Some(if inside { 1.0 + p.a } else { 1.0 } * p.sigma0 * z_dot + p.sigma1 * slopes[vr::V as usize]),
+            vr::F => Some(
+                if inside { 1.0 + p.a } else { 1.0 } * p.sigma0 * z_dot
+                    + p.sigma1 * slopes[vr::V as usize],
+            ),
             _ => None,
         }
     }

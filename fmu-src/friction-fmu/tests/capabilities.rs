@@ -8,13 +8,24 @@ mod common;
 use common::{last_error, Fmu};
 use std::f64::consts::PI;
 
-/// A driving input for each model: (input name, value at time t).
-fn drive(model: &str) -> Vec<(&'static str, fn(f64) -> f64)> {
+/// An input signal: its name and its value at time t.
+type Signal = (&'static str, fn(f64) -> f64);
+/// An invalid-parameter case: model, assignments, text the message must contain.
+type BadCase<'a> = (&'a str, &'a [(&'a str, f64)], &'a str);
+
+/// A driving input for each model.
+fn drive(model: &str) -> Vec<Signal> {
     match model {
         "Dahl" | "ResetIntegrator" => vec![("v", |t| 1e-3 * (2.0 * PI * t).sin())],
-        "LuGre" => vec![("v", |t| 2e-3 * (2.0 * PI * t).sin()), ("x", |t| 0.4 + 0.1 * t)],
+        "LuGre" => vec![
+            ("v", |t| 2e-3 * (2.0 * PI * t).sin()),
+            ("x", |t| 0.4 + 0.1 * t),
+        ],
         "Bristle" => vec![("x", |t| 5e-8 * (2.0 * PI * t).sin())],
-        "Bristle2D" => vec![("v1", |t| 1e-3 * (2.0 * PI * t).cos()), ("v2", |t| 5e-4 * (2.0 * PI * t).sin())],
+        "Bristle2D" => vec![
+            ("v1", |t| 1e-3 * (2.0 * PI * t).cos()),
+            ("v2", |t| 5e-4 * (2.0 * PI * t).sin()),
+        ],
         _ => unreachable!(),
     }
 }
@@ -85,15 +96,28 @@ fn restored_states_reproduce_the_run_bit_for_bit() {
         b.restore(s, t_saved);
         let mut fresh = Vec::new();
         run(&mut b, 500, 1e-3, &mut fresh);
-        assert_eq!(original, fresh, "{model}: serialized state in a new instance");
+        assert_eq!(
+            original, fresh,
+            "{model}: serialized state in a new instance"
+        );
         // the continuation really moves
-        assert!(original.windows(2).any(|w| w[0] != w[1]), "{model}: nothing changed");
+        assert!(
+            original.windows(2).any(|w| w[0] != w[1]),
+            "{model}: nothing changed"
+        );
     }
 }
 
 /// J = ∂F(t+h)/∂u (u held over the step) from the FMU, against central
 /// differences computed outside it by rolling back with fmi2SetFMUstate.
-fn check_step_sensitivity(model: &'static str, params: &[(&str, f64)], output: &str, input: &str, warmup: &[(&str, f64)], h: f64) {
+fn check_step_sensitivity(
+    model: &'static str,
+    params: &[(&str, f64)],
+    output: &str,
+    input: &str,
+    warmup: &[(&str, f64)],
+    h: f64,
+) {
     let mut fmu = Fmu::new(model, params);
     for _ in 0..200 {
         for (name, value) in warmup {
@@ -129,11 +153,32 @@ fn directional_derivatives_agree_with_finite_differences() {
     // LuGre sticking (the σ0·h term dominates) and sliding
     check_step_sensitivity("LuGre", &[], "F", "v", &[("v", 1e-5)], h);
     check_step_sensitivity("LuGre", &[], "F", "v", &[("v", 5e-2)], h);
-    check_step_sensitivity("LuGre", LUGRE_TABLE, "F", "x", &[("v", 5e-2), ("x", 0.3)], h);
+    check_step_sensitivity(
+        "LuGre",
+        LUGRE_TABLE,
+        "F",
+        "x",
+        &[("v", 5e-2), ("x", 0.3)],
+        h,
+    );
     check_step_sensitivity("Dahl", &[], "F", "v", &[("v", 1e-4)], h);
     check_step_sensitivity("ResetIntegrator", &[], "F", "v", &[("v", 1e-6)], h);
-    check_step_sensitivity("Bristle2D", &[], "F1", "v2", &[("v1", 1e-2), ("v2", 5e-3)], h);
-    check_step_sensitivity("Bristle2D", &[], "F2", "v2", &[("v1", 1e-6), ("v2", 1e-6)], h);
+    check_step_sensitivity(
+        "Bristle2D",
+        &[],
+        "F1",
+        "v2",
+        &[("v1", 1e-2), ("v2", 5e-3)],
+        h,
+    );
+    check_step_sensitivity(
+        "Bristle2D",
+        &[],
+        "F2",
+        "v2",
+        &[("v1", 1e-6), ("v2", 1e-6)],
+        h,
+    );
 }
 
 #[test]
@@ -157,7 +202,10 @@ fn bristle_stiffness_agrees_with_finite_differences() {
     // One-sided, in the direction of motion: the law is hysteretic, and a
     // backward perturbation is a reversal (bristles reconnect, F jumps).
     let fd = (f_at(x + delta) - f_at(x)) / delta;
-    assert!((j - fd).abs() <= 1e-6 * fd.abs(), "FMU {j:e}, finite differences {fd:e}");
+    assert!(
+        (j - fd).abs() <= 1e-6 * fd.abs(),
+        "FMU {j:e}, finite differences {fd:e}"
+    );
     assert!(j > 0.0);
 }
 
@@ -169,7 +217,7 @@ fn step_size_independence_with_interpolated_inputs() {
     let v = |t: f64| 2e-3 * (2.0 * PI * t).sin() + 1e-3 * (PI * t).sin();
     for (model, scale) in [("LuGre", 1.5), ("Dahl", 2.0)] {
         let sample = |h: f64| -> Vec<f64> {
-            let mut fmu = Fmu::new(model, &[]);
+            let fmu = Fmu::new(model, &[]);
             let n = (2.0 / h).round() as usize;
             let every = (1e-2 / h).round() as usize;
             let mut out = Vec::new();
@@ -177,7 +225,10 @@ fn step_size_independence_with_interpolated_inputs() {
                 let t = k as f64 * h;
                 fmu.set("v", v(t));
                 fmu.set_slope("v", (v(t + h) - v(t)) / h);
-                assert_eq!(unsafe { friction_fmu::exported::fmi2_exports::fmi2DoStep(fmu.c, t, h, 0) }, common::OK);
+                assert_eq!(
+                    unsafe { friction_fmu::exported::fmi2_exports::fmi2DoStep(fmu.c, t, h, 0) },
+                    common::OK
+                );
                 if (k + 1) % every == 0 {
                     out.push(fmu.get("F"));
                 }
@@ -187,8 +238,15 @@ fn step_size_independence_with_interpolated_inputs() {
         let fine = sample(1e-5);
         let coarse = sample(1e-2);
         assert_eq!(fine.len(), coarse.len());
-        let worst = fine.iter().zip(&coarse).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-        assert!(worst <= 1e-3 * scale, "{model}: worst difference {worst:e} N");
+        let worst = fine
+            .iter()
+            .zip(&coarse)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            worst <= 1e-3 * scale,
+            "{model}: worst difference {worst:e} N"
+        );
         // the history drives the law through sticking and sliding
         let peak = fine.iter().fold(0.0f64, |m, f| m.max(f.abs()));
         assert!(peak > 0.5 * scale, "{model}: peak {peak}");
@@ -219,30 +277,64 @@ fn output_derivatives_agree_with_a_short_step() {
         let dt = 1e-8;
         fmu.step(dt);
         let fd = (fmu.get("F") - f0) / dt;
-        assert!((rate - fd).abs() <= 1e-3 * fd.abs().max(1e-9), "{model}: dF/dt {rate:e}, short step {fd:e}");
+        assert!(
+            (rate - fd).abs() <= 1e-3 * fd.abs().max(1e-9),
+            "{model}: dF/dt {rate:e}, short step {fd:e}"
+        );
     }
 }
 
 #[test]
 fn invalid_parameters_are_refused_with_name_and_value() {
-    let cases: &[(&str, &[(&str, f64)], &str)] = &[
+    let cases: &[BadCase] = &[
         ("Dahl", &[("sigma", -2.0)], "sigma = -2"),
         ("Dahl", &[("Fc", 0.0)], "Fc = 0"),
         ("LuGre", &[("sigma0", 0.0)], "sigma0 = 0"),
         ("LuGre", &[("Fs", 0.9)], "Fs = 0.9"),
-        ("LuGre", &[("direction_dependent", 1.0), ("Fs_neg", 0.5)], "Fs_neg = 0.5"),
-        ("LuGre", &[("position_dependent", 1.0), ("n_table", 1.0)], "n_table = 1"),
-        ("LuGre", &[("position_dependent", 1.0), ("n_table", 2.0), ("x_table[2]", 0.0)], "x_table"),
+        (
+            "LuGre",
+            &[("direction_dependent", 1.0), ("Fs_neg", 0.5)],
+            "Fs_neg = 0.5",
+        ),
+        (
+            "LuGre",
+            &[("position_dependent", 1.0), ("n_table", 1.0)],
+            "n_table = 1",
+        ),
+        (
+            "LuGre",
+            &[
+                ("position_dependent", 1.0),
+                ("n_table", 2.0),
+                ("x_table[2]", 0.0),
+            ],
+            "x_table",
+        ),
         ("ResetIntegrator", &[("z0", -1e-4)], "z0 = -0.0001"),
         ("Bristle", &[("delta_max", -1.0)], "delta_max = -1"),
-        ("Bristle", &[("count_from_load", 0.0), ("n_bristles", 0.0)], "n_bristles = 0"),
-        ("Bristle", &[("stiffness_from_load", 0.0), ("sigma_ini", 0.0)], "sigma_ini = 0"),
+        (
+            "Bristle",
+            &[("count_from_load", 0.0), ("n_bristles", 0.0)],
+            "n_bristles = 0",
+        ),
+        (
+            "Bristle",
+            &[("stiffness_from_load", 0.0), ("sigma_ini", 0.0)],
+            "sigma_ini = 0",
+        ),
         ("Bristle2D", &[("sigma11", -1.0)], "sigma11 = -1"),
     ];
     for (model, bad, needle) in cases {
         let fmu = Fmu::instantiated(model, bad);
-        assert_eq!(fmu.exit_initialization(), fmi2_cs::ffi::fmi2Status::fmi2Error, "{model} {bad:?}");
+        assert_eq!(
+            fmu.exit_initialization(),
+            fmi2_cs::ffi::fmi2Status::fmi2Error,
+            "{model} {bad:?}"
+        );
         let m = last_error();
-        assert!(m.contains("fmi2ExitInitializationMode") && m.contains(needle), "{model}: {m}");
+        assert!(
+            m.contains("fmi2ExitInitializationMode") && m.contains(needle),
+            "{model}: {m}"
+        );
     }
 }

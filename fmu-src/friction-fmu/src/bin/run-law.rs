@@ -13,14 +13,21 @@ fn run(args: &[String]) -> Result<(), String> {
         return Err("usage: run-law MODEL INPUT.csv OUTPUT.csv [name=value ...]".into());
     };
     let model = friction_fmu::create(model_name).ok_or_else(|| {
-        let names: Vec<_> = friction_fmu::models().iter().map(|m| m.model_name).collect();
+        let names: Vec<_> = friction_fmu::models()
+            .iter()
+            .map(|m| m.model_name)
+            .collect();
         format!("unknown model {model_name} (known: {})", names.join(", "))
     })?;
     let info = model.info();
     let mut parameters = Vec::new();
     for a in assignments {
-        let (name, value) = a.split_once('=').ok_or_else(|| format!("expected name=value, got {a}"))?;
-        let var = info.by_name(name).ok_or_else(|| format!("{model_name} has no variable {name}"))?;
+        let (name, value) = a
+            .split_once('=')
+            .ok_or_else(|| format!("expected name=value, got {a}"))?;
+        let var = info
+            .by_name(name)
+            .ok_or_else(|| format!("{model_name} has no variable {name}"))?;
         let value = match value {
             "true" => 1.0,
             "false" => 0.0,
@@ -31,7 +38,11 @@ fn run(args: &[String]) -> Result<(), String> {
 
     let text = std::fs::read_to_string(input).map_err(|e| format!("{input}: {e}"))?;
     let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().ok_or_else(|| format!("{input} is empty"))?.split(',').collect();
+    let header: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| format!("{input} is empty"))?
+        .split(',')
+        .collect();
     if header.first() != Some(&"time") {
         return Err(format!("{input}: the first column must be `time`"));
     }
@@ -39,19 +50,33 @@ fn run(args: &[String]) -> Result<(), String> {
     for (i, line) in lines.enumerate() {
         let cells: Vec<&str> = line.split(',').collect();
         if cells.len() != header.len() {
-            return Err(format!("{input} line {}: {} cells, header has {}", i + 2, cells.len(), header.len()));
+            return Err(format!(
+                "{input} line {}: {} cells, header has {}",
+                i + 2,
+                cells.len(),
+                header.len()
+            ));
         }
         for (c, cell) in columns.iter_mut().zip(cells) {
-            c.push(cell.trim().parse().map_err(|e| format!("{input} line {}: {cell}: {e}", i + 2))?);
+            c.push(
+                cell.trim()
+                    .parse()
+                    .map_err(|e| format!("{input} line {}: {cell}: {e}", i + 2))?,
+            );
         }
     }
     let n = columns[0].len();
-    let mut table = InputTable { time: columns[0].clone(), inputs: Vec::new() };
+    let mut table = InputTable {
+        time: columns[0].clone(),
+        inputs: Vec::new(),
+    };
     for (k, name) in header.iter().enumerate().skip(1) {
         if name.starts_with("der(") {
             continue;
         }
-        let var = info.by_name(name).ok_or_else(|| format!("{model_name} has no input {name}"))?;
+        let var = info
+            .by_name(name)
+            .ok_or_else(|| format!("{model_name} has no input {name}"))?;
         let slope = header
             .iter()
             .position(|h| *h == format!("der({name})"))

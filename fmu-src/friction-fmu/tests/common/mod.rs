@@ -14,23 +14,39 @@ thread_local! {
     pub static LOG: RefCell<Vec<(i32, String)>> = const { RefCell::new(Vec::new()) };
 }
 
-extern "C" fn record(_e: *mut c_void, _n: *const c_char, status: c_int, _c: *const c_char, message: *const c_char) {
+extern "C" fn record(
+    _e: *mut c_void,
+    _n: *const c_char,
+    status: c_int,
+    _c: *const c_char,
+    message: *const c_char,
+) {
     // SAFETY: the FMU passes NUL-terminated strings.
-    let m = unsafe { CStr::from_ptr(message) }.to_string_lossy().into_owned();
+    let m = unsafe { CStr::from_ptr(message) }
+        .to_string_lossy()
+        .into_owned();
     LOG.with(|l| l.borrow_mut().push((status, m)));
 }
 
 pub fn last_error() -> String {
-    LOG.with(|l| l.borrow().iter().rev().find(|(s, _)| *s >= 3).map(|(_, m)| m.clone()).unwrap_or_default())
+    LOG.with(|l| {
+        l.borrow()
+            .iter()
+            .rev()
+            .find(|(s, _)| *s >= 3)
+            .map(|(_, m)| m.clone())
+            .unwrap_or_default()
+    })
 }
 
 fn callbacks() -> &'static fmi2CallbackFunctions {
     // SAFETY: a five-argument non-variadic function called through the
     // variadic pointer type with no variadic arguments (as ctypes importers do).
     let logger = unsafe {
-        std::mem::transmute::<*const (), unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...)>(
-            record as *const (),
-        )
+        std::mem::transmute::<
+            *const (),
+            unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...),
+        >(record as *const ())
     };
     Box::leak(Box::new(fmi2CallbackFunctions {
         logger: Some(logger),
@@ -54,29 +70,60 @@ impl Fmu {
     /// Instantiate `model`, set `params` (by name; booleans and integers as
     /// f64) and leave it in initialization mode.
     pub fn instantiated(model: &'static str, params: &[(&str, f64)]) -> Fmu {
-        let info = friction_fmu::models().into_iter().find(|m| m.model_name == model).expect("model");
+        let info = friction_fmu::models()
+            .into_iter()
+            .find(|m| m.model_name == model)
+            .expect("model");
         let guid = CString::new(info.guid).unwrap();
-        let c = unsafe { fmi2Instantiate(c"test".as_ptr(), fmi2CoSimulation, guid.as_ptr(), null(), callbacks(), 0, 0) };
+        let c = unsafe {
+            fmi2Instantiate(
+                c"test".as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                null(),
+                callbacks(),
+                0,
+                0,
+            )
+        };
         assert!(!c.is_null());
-        let fmu = Fmu { c, model, variables: info.variables, t: 0.0 };
+        let fmu = Fmu {
+            c,
+            model,
+            variables: info.variables,
+            t: 0.0,
+        };
         unsafe {
             assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
             assert_eq!(fmi2EnterInitializationMode(c), OK);
         }
         for (name, value) in params {
-            assert_eq!(fmu.set_any(name, *value), OK, "{model}.{name} = {value}: {}", last_error());
+            assert_eq!(
+                fmu.set_any(name, *value),
+                OK,
+                "{model}.{name} = {value}: {}",
+                last_error()
+            );
         }
         fmu
     }
 
     pub fn new(model: &'static str, params: &[(&str, f64)]) -> Fmu {
         let fmu = Fmu::instantiated(model, params);
-        assert_eq!(unsafe { fmi2ExitInitializationMode(fmu.c) }, OK, "{}", last_error());
+        assert_eq!(
+            unsafe { fmi2ExitInitializationMode(fmu.c) },
+            OK,
+            "{}",
+            last_error()
+        );
         fmu
     }
 
     pub fn var(&self, name: &str) -> &'static Variable {
-        self.variables.iter().find(|v| v.name == name).unwrap_or_else(|| panic!("{} has no {name}", self.model))
+        self.variables
+            .iter()
+            .find(|v| v.name == name)
+            .unwrap_or_else(|| panic!("{} has no {name}", self.model))
     }
 
     pub fn set_any(&self, name: &str, value: f64) -> fmi2Status {
@@ -97,17 +144,32 @@ impl Fmu {
     pub fn get(&self, name: &str) -> f64 {
         let v = self.var(name);
         let mut x = f64::NAN;
-        assert_eq!(unsafe { fmi2GetReal(self.c, &v.vr, 1, &mut x) }, OK, "{}", last_error());
+        assert_eq!(
+            unsafe { fmi2GetReal(self.c, &v.vr, 1, &mut x) },
+            OK,
+            "{}",
+            last_error()
+        );
         x
     }
 
     pub fn set_slope(&self, name: &str, slope: f64) {
         let v = self.var(name);
-        assert_eq!(unsafe { fmi2SetRealInputDerivatives(self.c, &v.vr, 1, &1, &slope) }, OK, "{}", last_error());
+        assert_eq!(
+            unsafe { fmi2SetRealInputDerivatives(self.c, &v.vr, 1, &1, &slope) },
+            OK,
+            "{}",
+            last_error()
+        );
     }
 
     pub fn step(&mut self, h: f64) {
-        assert_eq!(unsafe { fmi2DoStep(self.c, self.t, h, 0) }, OK, "{}", last_error());
+        assert_eq!(
+            unsafe { fmi2DoStep(self.c, self.t, h, 0) },
+            OK,
+            "{}",
+            last_error()
+        );
         self.t += h;
     }
 
@@ -118,7 +180,12 @@ impl Fmu {
     }
 
     pub fn restore(&mut self, s: fmi2FMUstate, t: f64) {
-        assert_eq!(unsafe { fmi2SetFMUstate(self.c, s) }, OK, "{}", last_error());
+        assert_eq!(
+            unsafe { fmi2SetFMUstate(self.c, s) },
+            OK,
+            "{}",
+            last_error()
+        );
         self.t = t;
     }
 
@@ -127,28 +194,46 @@ impl Fmu {
         unsafe {
             assert_eq!(fmi2SerializedFMUstateSize(self.c, s, &mut size), OK);
             let mut bytes = vec![0 as c_char; size];
-            assert_eq!(fmi2SerializeFMUstate(self.c, s, bytes.as_mut_ptr(), size), OK);
+            assert_eq!(
+                fmi2SerializeFMUstate(self.c, s, bytes.as_mut_ptr(), size),
+                OK
+            );
             bytes
         }
     }
 
     pub fn deserialize(&self, bytes: &[c_char]) -> fmi2FMUstate {
         let mut s = null_mut();
-        assert_eq!(unsafe { fmi2DeSerializeFMUstate(self.c, bytes.as_ptr(), bytes.len(), &mut s) }, OK, "{}", last_error());
+        assert_eq!(
+            unsafe { fmi2DeSerializeFMUstate(self.c, bytes.as_ptr(), bytes.len(), &mut s) },
+            OK,
+            "{}",
+            last_error()
+        );
         s
     }
 
     pub fn directional_derivative(&self, output: &str, input: &str) -> f64 {
         let (o, i) = (self.var(output).vr, self.var(input).vr);
         let mut d = f64::NAN;
-        assert_eq!(unsafe { fmi2GetDirectionalDerivative(self.c, &o, 1, &i, 1, &1.0, &mut d) }, OK, "{}", last_error());
+        assert_eq!(
+            unsafe { fmi2GetDirectionalDerivative(self.c, &o, 1, &i, 1, &1.0, &mut d) },
+            OK,
+            "{}",
+            last_error()
+        );
         d
     }
 
     pub fn output_derivative(&self, output: &str) -> f64 {
         let o = self.var(output).vr;
         let mut d = f64::NAN;
-        assert_eq!(unsafe { fmi2GetRealOutputDerivatives(self.c, &o, 1, &1, &mut d) }, OK, "{}", last_error());
+        assert_eq!(
+            unsafe { fmi2GetRealOutputDerivatives(self.c, &o, 1, &1, &mut d) },
+            OK,
+            "{}",
+            last_error()
+        );
         d
     }
 
