@@ -5,14 +5,43 @@ use fmi2_cs::ModelInfo;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// The FMU libraries of this project: crate name (the shared library is
+/// `lib<crate>.so`), generation tool, and the models it holds.
+pub fn libraries() -> Vec<(&'static str, &'static str, Vec<&'static ModelInfo>)> {
+    vec![
+        (
+            "friction_fmu_c",
+            friction_fmu::GENERATION_TOOL,
+            friction_fmu::models(),
+        ),
+        ("rig_fmu_c", rig_fmu::GENERATION_TOOL, rig_fmu::models()),
+    ]
+}
+
 /// Every model we ship, in a stable order.
 pub fn all_models() -> Vec<&'static ModelInfo> {
-    friction_fmu::models()
+    libraries()
+        .into_iter()
+        .flat_map(|(_, _, models)| models)
+        .collect()
+}
+
+/// The library crate that holds `info`.
+pub fn library_of(info: &ModelInfo) -> &'static str {
+    libraries()
+        .into_iter()
+        .find(|(_, _, m)| m.iter().any(|i| i.guid == info.guid))
+        .map(|(l, _, _)| l)
+        .expect("listed")
 }
 
 /// The model description of `info`, as shipped.
 pub fn render(info: &ModelInfo) -> Result<String, String> {
-    fmi2_cs::model_description::render(info, friction_fmu::GENERATION_TOOL)
+    let tool = libraries()
+        .into_iter()
+        .find(|(_, _, m)| m.iter().any(|i| i.guid == info.guid))
+        .map(|(_, t, _)| t);
+    fmi2_cs::model_description::render(info, tool.unwrap_or("unknown"))
 }
 
 /// Path of the checked-in description of `info` under `dir`.

@@ -29,9 +29,9 @@ enum Command {
     VariablesMd,
     /// Package every model: <out>/<Name>.fmu from the shared library.
     Build {
-        /// The built cdylib (e.g. target/release/libfriction_fmu.so).
-        #[arg(long)]
-        lib: PathBuf,
+        /// Directory with the built cdylibs (lib<crate>.so).
+        #[arg(long, default_value = "target/release")]
+        lib_dir: PathBuf,
         #[arg(long, default_value = "dist")]
         out: PathBuf,
     },
@@ -66,8 +66,9 @@ fn run(cli: Cli) -> Result<(), String> {
             println!("model descriptions match the code");
         }
         Command::VariablesMd => print!("{}", fmu_packager::variables_markdown()),
-        Command::Build { lib, out } => {
+        Command::Build { lib_dir, out } => {
             for info in all_models() {
+                let lib = lib_dir.join(format!("lib{}.so", fmu_packager::library_of(info)));
                 println!("wrote {}", package(info, &lib, &out)?.display());
             }
         }

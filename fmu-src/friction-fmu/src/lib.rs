@@ -3,7 +3,7 @@
 //! and a [`fmi2_cs::Model`] implementation. The same binary is packaged as
 //! `Dahl.fmu`, `LuGre.fmu`, `ResetIntegrator.fmu`, `Bristle.fmu` and
 //! `Bristle2D.fmu`; `fmi2Instantiate` picks the law by GUID.
-#![deny(unsafe_code)] // the only exception: the generated C exports below
+#![forbid(unsafe_code)]
 
 pub mod bristle;
 pub mod bristle2d;
@@ -56,12 +56,6 @@ pub fn create(model_name: &str) -> Option<Box<dyn Model>> {
 
 /// Name and version written into `generationTool`.
 pub const GENERATION_TOOL: &str = concat!("friction-fmu ", env!("CARGO_PKG_VERSION"));
-
-#[allow(unsafe_code)]
-pub mod exported {
-    use super::REGISTRY;
-    fmi2_cs::export_fmi2!(&REGISTRY[..]);
-}
 
 /// Convert a law's parameter error into the message the FMI layer logs.
 fn param_err(e: friction_laws::ParamError) -> String {

@@ -4,7 +4,9 @@
 
 use fmi2_cs::ffi::*;
 use fmi2_cs::{VarType, Variable};
-use friction_fmu::exported::fmi2_exports::*;
+// The same exports the shipped library has, generated into this test binary.
+fmi2_cs::export_fmi2!(&friction_fmu::REGISTRY[..]);
+pub use fmi2_exports::*;
 use std::cell::RefCell;
 use std::ffi::{c_void, CStr, CString};
 use std::os::raw::{c_char, c_int};
