@@ -3,5 +3,9 @@
 
 fn main() {
     println!("cargo:rerun-if-changed=src/fmu/logger.c");
-    cc::Build::new().file("src/fmu/logger.c").warnings(true).extra_warnings(true).compile("fricsim_logger");
+    cc::Build::new()
+        .file("src/fmu/logger.c")
+        .warnings(true)
+        .extra_warnings(true)
+        .compile("fricsim_logger");
 }

@@ -75,7 +75,10 @@ pub enum FmuError {
     #[error("modelDescription.xml: {location}: {message}")]
     InvalidModelDescription { location: String, message: String },
 
-    #[error("FMU has no binary for {platform}: expected {expected}; it has: {}", list_or_none(found))]
+    #[error(
+        "FMU has no binary for {platform}: expected {expected}; it has: {}",
+        list_or_none(found)
+    )]
     MissingBinary {
         platform: &'static str,
         expected: String,
@@ -86,7 +89,10 @@ pub enum FmuError {
     LoadLibrary { path: PathBuf, message: String },
 
     #[error("{path} does not export the required FMI 2.0 functions: {}", symbols.join(", "))]
-    MissingFunctions { path: PathBuf, symbols: Vec<&'static str> },
+    MissingFunctions {
+        path: PathBuf,
+        symbols: Vec<&'static str>,
+    },
 
     #[error("{path}: modelDescription.xml declares {capability}, but the binary does not export {}", symbols.join(", "))]
     MissingCapabilityFunctions {
@@ -107,12 +113,21 @@ pub enum FmuError {
         capability: &'static str,
     },
 
-    #[error("fmi2Instantiate failed for instance \"{instance}\"{}", log_suffix(messages))]
-    Instantiate { instance: String, messages: Vec<String> },
+    #[error(
+        "fmi2Instantiate failed for instance \"{instance}\"{}",
+        log_suffix(messages)
+    )]
+    Instantiate {
+        instance: String,
+        messages: Vec<String>,
+    },
 
     /// An FMU function returned Discard, Error, Fatal or Pending;
     /// `messages` are what the instance logged during the call.
-    #[error("{function} failed for instance \"{instance}\" with {status}{}", log_suffix(messages))]
+    #[error(
+        "{function} failed for instance \"{instance}\" with {status}{}",
+        log_suffix(messages)
+    )]
     Call {
         function: &'static str,
         instance: String,
@@ -138,6 +153,13 @@ pub enum FmuError {
     ForeignState {
         function: &'static str,
         instance: String,
+    },
+
+    #[error("{function} for instance \"{instance}\" returned success but a null {what}")]
+    NullPointer {
+        function: &'static str,
+        instance: String,
+        what: &'static str,
     },
 
     #[error("{what} must not contain a NUL character: {value:?}")]

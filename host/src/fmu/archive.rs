@@ -40,7 +40,11 @@ pub struct UnpackOptions {
 
 impl Default for UnpackOptions {
     fn default() -> Self {
-        UnpackOptions { max_bytes: DEFAULT_MAX_BYTES, max_entries: DEFAULT_MAX_ENTRIES, temp_parent: None }
+        UnpackOptions {
+            max_bytes: DEFAULT_MAX_BYTES,
+            max_entries: DEFAULT_MAX_ENTRIES,
+            temp_parent: None,
+        }
     }
 }
 
@@ -52,17 +56,28 @@ pub fn unpack(path: &Path, options: &UnpackOptions) -> Result<TempDir, FmuError>
         entry: entry.map(str::to_string),
         problem,
     };
-    let file = File::open(path).map_err(|source| FmuError::Io { path: path.to_path_buf(), source })?;
-    let mut archive =
-        ZipArchive::new(BufReader::new(file)).map_err(|e| refuse(None, ArchiveProblem::NotAZip(e.to_string())))?;
+    let file = File::open(path).map_err(|source| FmuError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut archive = ZipArchive::new(BufReader::new(file))
+        .map_err(|e| refuse(None, ArchiveProblem::NotAZip(e.to_string())))?;
 
     if archive.has_duplicate_names() {
         let start = archive.central_directory_start();
-        let name = File::open(path).ok().and_then(|f| first_duplicate_name(&mut BufReader::new(f), start));
+        let name = File::open(path)
+            .ok()
+            .and_then(|f| first_duplicate_name(&mut BufReader::new(f), start));
         return Err(refuse(name.as_deref(), ArchiveProblem::Duplicate));
     }
     if archive.len() > options.max_entries {
-        return Err(refuse(None, ArchiveProblem::TooManyEntries { count: archive.len(), limit: options.max_entries }));
+        return Err(refuse(
+            None,
+            ArchiveProblem::TooManyEntries {
+                count: archive.len(),
+                limit: options.max_entries,
+            },
+        ));
     }
 
     // Check every entry before writing anything.
@@ -71,21 +86,37 @@ pub fn unpack(path: &Path, options: &UnpackOptions) -> Result<TempDir, FmuError>
     let mut seen = HashSet::with_capacity(archive.len());
     let mut declared_total: u64 = 0;
     for index in 0..archive.len() {
-        let entry = metadata.entry(index).map_err(|e| refuse(None, ArchiveProblem::NotAZip(e.to_string())))?;
+        let entry = metadata
+            .entry(index)
+            .map_err(|e| refuse(None, ArchiveProblem::NotAZip(e.to_string())))?;
         let name = String::from_utf8_lossy(entry.name_raw()).into_owned();
         let relative = checked_relative_path(&name).map_err(|p| refuse(Some(&name), p))?;
-        if entry.is_symlink() || entry.unix_mode().is_some_and(|mode| mode & S_IFMT == S_IFLNK) {
+        if entry.is_symlink()
+            || entry
+                .unix_mode()
+                .is_some_and(|mode| mode & S_IFMT == S_IFLNK)
+        {
             return Err(refuse(Some(&name), ArchiveProblem::Symlink));
         }
         if !seen.insert(relative.clone()) {
             return Err(refuse(Some(&name), ArchiveProblem::Duplicate));
         }
         if entry.size() > options.max_bytes {
-            return Err(refuse(Some(&name), ArchiveProblem::EntryTooLarge { limit: options.max_bytes }));
+            return Err(refuse(
+                Some(&name),
+                ArchiveProblem::EntryTooLarge {
+                    limit: options.max_bytes,
+                },
+            ));
         }
         declared_total = declared_total.saturating_add(entry.size());
         if declared_total > options.max_bytes {
-            return Err(refuse(Some(&name), ArchiveProblem::TotalTooLarge { limit: options.max_bytes }));
+            return Err(refuse(
+                Some(&name),
+                ArchiveProblem::TotalTooLarge {
+                    limit: options.max_bytes,
+                },
+            ));
         }
         plan.push((index, name, relative, entry.is_dir()));
     }
@@ -99,7 +130,13 @@ pub fn unpack(path: &Path, options: &UnpackOptions) -> Result<TempDir, FmuError>
         Some(parent) => builder.tempdir_in(parent),
         None => builder.tempdir(),
     }
-    .map_err(|source| FmuError::Io { path: options.temp_parent.clone().unwrap_or_else(std::env::temp_dir), source })?;
+    .map_err(|source| FmuError::Io {
+        path: options
+            .temp_parent
+            .clone()
+            .unwrap_or_else(std::env::temp_dir),
+        source,
+    })?;
 
     let mut budget = options.max_bytes;
     for (index, name, relative, is_dir) in plan {
@@ -112,15 +149,25 @@ pub fn unpack(path: &Path, options: &UnpackOptions) -> Result<TempDir, FmuError>
         if let Some(parent) = target.parent() {
             fs::create_dir_all(parent).map_err(write_err)?;
         }
-        let mut entry = archive.by_index(index).map_err(|e| refuse(Some(&name), ArchiveProblem::Corrupt(e.to_string())))?;
+        let mut entry = archive
+            .by_index(index)
+            .map_err(|e| refuse(Some(&name), ArchiveProblem::Corrupt(e.to_string())))?;
         let mut out = File::create_new(&target).map_err(write_err)?;
         let written = copy_limited(&mut entry, &mut out, budget).map_err(|e| match e {
             CopyError::Read(e) => refuse(Some(&name), ArchiveProblem::Corrupt(e.to_string())),
             CopyError::Write(e) => write_err(e),
-            CopyError::Limit if budget == options.max_bytes => {
-                refuse(Some(&name), ArchiveProblem::EntryTooLarge { limit: options.max_bytes })
-            }
-            CopyError::Limit => refuse(Some(&name), ArchiveProblem::TotalTooLarge { limit: options.max_bytes }),
+            CopyError::Limit if budget == options.max_bytes => refuse(
+                Some(&name),
+                ArchiveProblem::EntryTooLarge {
+                    limit: options.max_bytes,
+                },
+            ),
+            CopyError::Limit => refuse(
+                Some(&name),
+                ArchiveProblem::TotalTooLarge {
+                    limit: options.max_bytes,
+                },
+            ),
         })?;
         budget -= written;
     }
@@ -199,7 +246,9 @@ fn first_duplicate_name(reader: &mut (impl Read + Seek), directory_start: u64) -
         let (name_len, extra_len, comment_len) = (field(28), field(30), field(32));
         let mut name = vec![0u8; name_len];
         reader.read_exact(&mut name).ok()?;
-        reader.seek(SeekFrom::Current((extra_len + comment_len) as i64)).ok()?;
+        reader
+            .seek(SeekFrom::Current((extra_len + comment_len) as i64))
+            .ok()?;
         let name = String::from_utf8_lossy(&name).into_owned();
         if !seen.insert(name.clone()) {
             return Some(name);
@@ -214,15 +263,42 @@ mod tests {
 
     #[test]
     fn names_are_checked() {
-        assert_eq!(checked_relative_path("a/b.txt").unwrap(), PathBuf::from("a/b.txt"));
-        assert_eq!(checked_relative_path("./a\\b").unwrap(), PathBuf::from("a/b"));
-        assert!(matches!(checked_relative_path("../evil"), Err(ArchiveProblem::ParentComponent)));
-        assert!(matches!(checked_relative_path("a/../../evil"), Err(ArchiveProblem::ParentComponent)));
-        assert!(matches!(checked_relative_path("a\\..\\evil"), Err(ArchiveProblem::ParentComponent)));
-        assert!(matches!(checked_relative_path("/tmp/evil"), Err(ArchiveProblem::AbsolutePath)));
-        assert!(matches!(checked_relative_path("\\evil"), Err(ArchiveProblem::AbsolutePath)));
-        assert!(matches!(checked_relative_path("C:/evil"), Err(ArchiveProblem::DrivePrefix)));
-        assert!(matches!(checked_relative_path("c:evil"), Err(ArchiveProblem::DrivePrefix)));
+        assert_eq!(
+            checked_relative_path("a/b.txt").unwrap(),
+            PathBuf::from("a/b.txt")
+        );
+        assert_eq!(
+            checked_relative_path("./a\\b").unwrap(),
+            PathBuf::from("a/b")
+        );
+        assert!(matches!(
+            checked_relative_path("../evil"),
+            Err(ArchiveProblem::ParentComponent)
+        ));
+        assert!(matches!(
+            checked_relative_path("a/../../evil"),
+            Err(ArchiveProblem::ParentComponent)
+        ));
+        assert!(matches!(
+            checked_relative_path("a\\..\\evil"),
+            Err(ArchiveProblem::ParentComponent)
+        ));
+        assert!(matches!(
+            checked_relative_path("/tmp/evil"),
+            Err(ArchiveProblem::AbsolutePath)
+        ));
+        assert!(matches!(
+            checked_relative_path("\\evil"),
+            Err(ArchiveProblem::AbsolutePath)
+        ));
+        assert!(matches!(
+            checked_relative_path("C:/evil"),
+            Err(ArchiveProblem::DrivePrefix)
+        ));
+        assert!(matches!(
+            checked_relative_path("c:evil"),
+            Err(ArchiveProblem::DrivePrefix)
+        ));
     }
 
     /// The limit applies to the bytes that come out, whatever was declared.
@@ -230,8 +306,14 @@ mod tests {
     fn copy_stops_at_the_limit_of_an_endless_stream() {
         let mut sink = io::sink();
         let mut endless = io::repeat(0);
-        assert!(matches!(copy_limited(&mut endless, &mut sink, 1_000_000), Err(CopyError::Limit)));
+        assert!(matches!(
+            copy_limited(&mut endless, &mut sink, 1_000_000),
+            Err(CopyError::Limit)
+        ));
         let mut short = io::repeat(7).take(1000);
-        assert!(matches!(copy_limited(&mut short, &mut sink, 1000), Ok(1000)));
+        assert!(matches!(
+            copy_limited(&mut short, &mut sink, 1000),
+            Ok(1000)
+        ));
     }
 }

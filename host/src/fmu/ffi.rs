@@ -6,7 +6,7 @@
 //! Rust enum: an FMU built by someone else may return any integer, and an
 //! out-of-range value in a `#[repr(C)] enum` would be undefined behaviour.
 //! [`Status::from_raw`](super::Status::from_raw) converts it.
-#![allow(non_camel_case_types, non_snake_case)]
+#![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
 
 use std::os::raw::{c_char, c_int, c_uint, c_void};
 
@@ -30,14 +30,20 @@ pub type fmi2Type = c_int;
 pub const fmi2CoSimulation: fmi2Type = 1;
 
 pub type fmi2StatusKind = c_int;
-pub const fmi2DoStepStatus: fmi2StatusKind = 0;
 pub const fmi2LastSuccessfulTime: fmi2StatusKind = 2;
 pub const fmi2Terminated: fmi2StatusKind = 3;
 
 /// The importer's logger (§2.1.5). Variadic in C: ours is written in C
 /// (`logger.c`).
 pub type fmi2CallbackLogger = Option<
-    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...),
+    unsafe extern "C" fn(
+        fmi2ComponentEnvironment,
+        fmi2String,
+        fmi2Status,
+        fmi2String,
+        fmi2String,
+        ...
+    ),
 >;
 pub type fmi2CallbackAllocateMemory = Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>;
 pub type fmi2CallbackFreeMemory = Option<unsafe extern "C" fn(*mut c_void)>;
@@ -67,31 +73,71 @@ pub type fmi2InstantiateTYPE = unsafe extern "C" fn(
     fmi2Boolean,
 ) -> fmi2Component;
 pub type fmi2FreeInstanceTYPE = unsafe extern "C" fn(fmi2Component);
-pub type fmi2SetupExperimentTYPE =
-    unsafe extern "C" fn(fmi2Component, fmi2Boolean, fmi2Real, fmi2Real, fmi2Boolean, fmi2Real) -> fmi2Status;
+pub type fmi2SetupExperimentTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    fmi2Boolean,
+    fmi2Real,
+    fmi2Real,
+    fmi2Boolean,
+    fmi2Real,
+) -> fmi2Status;
 pub type fmi2ComponentTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
-pub type fmi2GetRealTYPE =
-    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2Real) -> fmi2Status;
-pub type fmi2GetIntegerTYPE =
-    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2Integer) -> fmi2Status;
-pub type fmi2GetBooleanTYPE =
-    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2Boolean) -> fmi2Status;
-pub type fmi2GetStringTYPE =
-    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2String) -> fmi2Status;
-pub type fmi2SetRealTYPE =
-    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2Real) -> fmi2Status;
-pub type fmi2SetIntegerTYPE =
-    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2Integer) -> fmi2Status;
-pub type fmi2SetBooleanTYPE =
-    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2Boolean) -> fmi2Status;
-pub type fmi2SetStringTYPE =
-    unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2String) -> fmi2Status;
+pub type fmi2GetRealTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *mut fmi2Real,
+) -> fmi2Status;
+pub type fmi2GetIntegerTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *mut fmi2Integer,
+) -> fmi2Status;
+pub type fmi2GetBooleanTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *mut fmi2Boolean,
+) -> fmi2Status;
+pub type fmi2GetStringTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *mut fmi2String,
+) -> fmi2Status;
+pub type fmi2SetRealTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Real,
+) -> fmi2Status;
+pub type fmi2SetIntegerTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Integer,
+) -> fmi2Status;
+pub type fmi2SetBooleanTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Boolean,
+) -> fmi2Status;
+pub type fmi2SetStringTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2String,
+) -> fmi2Status;
 
 // FMU state (§2.1.8).
 pub type fmi2GetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
 pub type fmi2SetFMUstateTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> fmi2Status;
-pub type fmi2FreeFMUstateTYPE = unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
-pub type fmi2SerializedFMUstateSizeTYPE = unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut usize) -> fmi2Status;
+pub type fmi2FreeFMUstateTYPE =
+    unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status;
+pub type fmi2SerializedFMUstateSizeTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut usize) -> fmi2Status;
 pub type fmi2SerializeFMUstateTYPE =
     unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut fmi2Byte, usize) -> fmi2Status;
 pub type fmi2DeSerializeFMUstateTYPE =
@@ -123,11 +169,15 @@ pub type fmi2GetRealOutputDerivativesTYPE = unsafe extern "C" fn(
     *const fmi2Integer,
     *mut fmi2Real,
 ) -> fmi2Status;
-pub type fmi2DoStepTYPE = unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> fmi2Status;
-pub type fmi2GetStatusTYPE = unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Status) -> fmi2Status;
-pub type fmi2GetRealStatusTYPE = unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Real) -> fmi2Status;
+pub type fmi2DoStepTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> fmi2Status;
+pub type fmi2GetStatusTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Status) -> fmi2Status;
+pub type fmi2GetRealStatusTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Real) -> fmi2Status;
 pub type fmi2GetIntegerStatusTYPE =
     unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Integer) -> fmi2Status;
 pub type fmi2GetBooleanStatusTYPE =
     unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Boolean) -> fmi2Status;
-pub type fmi2GetStringStatusTYPE = unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2String) -> fmi2Status;
+pub type fmi2GetStringStatusTYPE =
+    unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2String) -> fmi2Status;

@@ -23,7 +23,10 @@ macro_rules! functions {
     ) => {
         /// The FMI functions of one loaded binary. The optional ones are
         /// `None` when the model description does not declare them.
+        /// (`fmi2GetStatus` & co. are required by the standard but only
+        /// meaningful for asynchronous steps, which this host does not use.)
         #[derive(Clone, Copy)]
+        #[allow(dead_code)]
         pub(crate) struct Functions {
             $(pub $field: $ty,)*
             $(pub $ofield: Option<$oty>,)*
@@ -109,7 +112,10 @@ pub struct Library {
 
 impl std::fmt::Debug for Library {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Library").field("path", &self.path).field("version", &self.version).finish_non_exhaustive()
+        f.debug_struct("Library")
+            .field("path", &self.path)
+            .field("version", &self.version)
+            .finish_non_exhaustive()
     }
 }
 
@@ -122,7 +128,11 @@ impl Library {
         let relative = format!("binaries/{PLATFORM}/{identifier}.so");
         let path = dir.join(&relative);
         if !path.is_file() {
-            return Err(FmuError::MissingBinary { platform: PLATFORM, expected: relative, found: platforms(dir) });
+            return Err(FmuError::MissingBinary {
+                platform: PLATFORM,
+                expected: relative,
+                found: platforms(dir),
+            });
         }
         Library::load_file(&path, description)
     }
@@ -133,20 +143,36 @@ impl Library {
         // RTLD_NOW: an unresolved dependency fails here, not in mid-run.
         // SAFETY: loading runs the library's initialisers; importing an FMU
         // means trusting its binary to that extent.
-        let library: libloading::Library = unsafe { UnixLibrary::open(Some(path), RTLD_NOW | RTLD_LOCAL) }
-            .map_err(|e| FmuError::LoadLibrary { path: path.to_path_buf(), message: e.to_string() })?
-            .into();
-        let mut functions = Functions::resolve(&library)
-            .map_err(|symbols| FmuError::MissingFunctions { path: path.to_path_buf(), symbols })?;
+        let library: libloading::Library =
+            unsafe { UnixLibrary::open(Some(path), RTLD_NOW | RTLD_LOCAL) }
+                .map_err(|e| FmuError::LoadLibrary {
+                    path: path.to_path_buf(),
+                    message: error_chain(&e),
+                })?
+                .into();
+        let mut functions =
+            Functions::resolve(&library).map_err(|symbols| FmuError::MissingFunctions {
+                path: path.to_path_buf(),
+                symbols,
+            })?;
         check_capabilities(&mut functions, description, path)?;
 
         // SAFETY: both functions take no arguments and return a static string.
         let version = unsafe { c_text((functions.get_version)()) };
         if version != "2.0" {
-            return Err(FmuError::WrongFmiVersion { path: path.to_path_buf(), found: version });
+            return Err(FmuError::WrongFmiVersion {
+                path: path.to_path_buf(),
+                found: version,
+            });
         }
         let types_platform = unsafe { c_text((functions.get_types_platform)()) };
-        Ok(Library { functions, path: path.to_path_buf(), version, types_platform, _library: library })
+        Ok(Library {
+            functions,
+            path: path.to_path_buf(),
+            version,
+            types_platform,
+            _library: library,
+        })
     }
 
     pub fn path(&self) -> &Path {
@@ -166,9 +192,15 @@ impl Library {
 
 /// Each optional group must be exported if its capability is declared, and
 /// is not used (set to `None`) if it is not.
-fn check_capabilities(f: &mut Functions, d: &ModelDescription, path: &Path) -> Result<(), FmuError> {
+fn check_capabilities(
+    f: &mut Functions,
+    d: &ModelDescription,
+    path: &Path,
+) -> Result<(), FmuError> {
     let cs = &d.co_simulation;
-    let groups: [(&'static str, bool, Vec<(&'static str, bool)>); 5] = [
+    // (capability, declared, [(function, exported)])
+    type Group = (&'static str, bool, Vec<(&'static str, bool)>);
+    let groups: [Group; 5] = [
         (
             "canGetAndSetFMUstate=\"true\"",
             cs.can_get_and_set_fmu_state,
@@ -182,7 +214,10 @@ fn check_capabilities(f: &mut Functions, d: &ModelDescription, path: &Path) -> R
             "canSerializeFMUstate=\"true\"",
             cs.can_serialize_fmu_state,
             vec![
-                ("fmi2SerializedFMUstateSize", f.serialized_fmu_state_size.is_some()),
+                (
+                    "fmi2SerializedFMUstateSize",
+                    f.serialized_fmu_state_size.is_some(),
+                ),
                 ("fmi2SerializeFMUstate", f.serialize_fmu_state.is_some()),
                 ("fmi2DeSerializeFMUstate", f.deserialize_fmu_state.is_some()),
             ],
@@ -190,30 +225,51 @@ fn check_capabilities(f: &mut Functions, d: &ModelDescription, path: &Path) -> R
         (
             "providesDirectionalDerivative=\"true\"",
             cs.provides_directional_derivative,
-            vec![("fmi2GetDirectionalDerivative", f.get_directional_derivative.is_some())],
+            vec![(
+                "fmi2GetDirectionalDerivative",
+                f.get_directional_derivative.is_some(),
+            )],
         ),
         (
             "canInterpolateInputs=\"true\"",
             cs.can_interpolate_inputs,
-            vec![("fmi2SetRealInputDerivatives", f.set_real_input_derivatives.is_some())],
+            vec![(
+                "fmi2SetRealInputDerivatives",
+                f.set_real_input_derivatives.is_some(),
+            )],
         ),
         (
             "maxOutputDerivativeOrder > 0",
             cs.max_output_derivative_order > 0,
-            vec![("fmi2GetRealOutputDerivatives", f.get_real_output_derivatives.is_some())],
+            vec![(
+                "fmi2GetRealOutputDerivatives",
+                f.get_real_output_derivatives.is_some(),
+            )],
         ),
     ];
     for (capability, declared, symbols) in groups {
-        let missing: Vec<&'static str> = symbols.iter().filter(|(_, present)| !present).map(|(s, _)| *s).collect();
+        let missing: Vec<&'static str> = symbols
+            .iter()
+            .filter(|(_, present)| !present)
+            .map(|(s, _)| *s)
+            .collect();
         if declared && !missing.is_empty() {
-            return Err(FmuError::MissingCapabilityFunctions { path: path.to_path_buf(), capability, symbols: missing });
+            return Err(FmuError::MissingCapabilityFunctions {
+                path: path.to_path_buf(),
+                capability,
+                symbols: missing,
+            });
         }
     }
     if !cs.can_get_and_set_fmu_state {
         (f.get_fmu_state, f.set_fmu_state, f.free_fmu_state) = (None, None, None);
     }
     if !cs.can_serialize_fmu_state {
-        (f.serialized_fmu_state_size, f.serialize_fmu_state, f.deserialize_fmu_state) = (None, None, None);
+        (
+            f.serialized_fmu_state_size,
+            f.serialize_fmu_state,
+            f.deserialize_fmu_state,
+        ) = (None, None, None);
     }
     if !cs.provides_directional_derivative {
         f.get_directional_derivative = None;
@@ -225,6 +281,18 @@ fn check_capabilities(f: &mut Functions, d: &ModelDescription, path: &Path) -> R
         f.get_real_output_derivatives = None;
     }
     Ok(())
+}
+
+/// An error and its sources, e.g. "dlopen failed: <dlerror text>".
+fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut message = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        message.push_str(": ");
+        message.push_str(&s.to_string());
+        source = s.source();
+    }
+    message
 }
 
 /// A C string returned by the FMU, or "" for null.

@@ -4,7 +4,7 @@
 //! The callback itself is C (`logger.c`: it is variadic); it formats the
 //! message and hands the finished string to [`fricsim_log_sink`], which
 //! appends it to the [`Log`] of the instance's FMU. Each instance passes a
-//! [`Sink`] as its `componentEnvironment`, so messages are attributed to the
+//! `Sink` as its `componentEnvironment`, so messages are attributed to the
 //! instance that the host created, whatever name the FMU reports.
 
 use super::Status;
@@ -47,7 +47,11 @@ pub struct LogMessage {
 
 impl fmt::Display for LogMessage {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "[{}] {} [{}]: {}", self.instance, self.status, self.category, self.message)
+        write!(
+            f,
+            "[{}] {} [{}]: {}",
+            self.instance, self.status, self.category, self.message
+        )
     }
 }
 
@@ -86,7 +90,12 @@ impl Log {
 
     /// The messages of the instance called `instance`, oldest first.
     pub fn messages_of(&self, instance: &str) -> Vec<LogMessage> {
-        self.lock().messages.iter().filter(|m| m.instance == instance).cloned().collect()
+        self.lock()
+            .messages
+            .iter()
+            .filter(|m| m.instance == instance)
+            .cloned()
+            .collect()
     }
 
     pub fn clear(&self) {
@@ -109,12 +118,18 @@ impl Log {
     pub(crate) fn messages_since(&self, sink: &Sink, mark: u64, fallback: usize) -> Vec<String> {
         let buffer = self.lock();
         let mine = || buffer.messages.iter().filter(|m| m.instance_id == sink.id);
-        let recent: Vec<String> = mine().filter(|m| m.sequence > mark).map(|m| m.message.clone()).collect();
+        let recent: Vec<String> = mine()
+            .filter(|m| m.sequence > mark)
+            .map(|m| m.message.clone())
+            .collect();
         if !recent.is_empty() {
             return recent;
         }
         let earlier: Vec<&LogMessage> = mine().collect();
-        earlier[earlier.len().saturating_sub(fallback)..].iter().map(|m| format!("(earlier) {}", m.message)).collect()
+        earlier[earlier.len().saturating_sub(fallback)..]
+            .iter()
+            .map(|m| format!("(earlier) {}", m.message))
+            .collect()
     }
 }
 
@@ -130,7 +145,12 @@ pub(crate) struct Sink {
 
 impl Sink {
     pub fn new(log: Log, instance: &str, id: u64) -> Sink {
-        Sink { log, instance: instance.to_string(), id, count: AtomicU64::new(0) }
+        Sink {
+            log,
+            instance: instance.to_string(),
+            id,
+            count: AtomicU64::new(0),
+        }
     }
 
     /// The number of messages received so far (a mark for [`Log::messages_since`]).
@@ -166,7 +186,7 @@ fn text(s: *const c_char) -> String {
 ///
 /// # Safety
 /// `env` is null or the `componentEnvironment` the host passed to
-/// `fmi2Instantiate`, i.e. a live [`Sink`]; the strings are null or
+/// `fmi2Instantiate`, i.e. a live `Sink`; the strings are null or
 /// NUL-terminated.
 #[no_mangle]
 pub unsafe extern "C" fn fricsim_log_sink(

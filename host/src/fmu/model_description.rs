@@ -233,10 +233,17 @@ fn combination_allowed(c: Causality, v: Variability) -> bool {
 impl ModelDescription {
     /// Read and parse the file at `path`.
     pub fn from_file(path: &Path) -> Result<ModelDescription, FmuError> {
-        let bytes = std::fs::read(path).map_err(|source| FmuError::Io { path: path.to_path_buf(), source })?;
+        let bytes = std::fs::read(path).map_err(|source| FmuError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         let text = std::str::from_utf8(&bytes).map_err(|e| {
             let (line, column) = line_column(&bytes, e.valid_up_to());
-            FmuError::XmlSyntax { line, column, message: format!("not valid UTF-8: {e}") }
+            FmuError::XmlSyntax {
+                line,
+                column,
+                message: format!("not valid UTF-8: {e}"),
+            }
         })?;
         ModelDescription::parse(text)
     }
@@ -248,12 +255,20 @@ impl ModelDescription {
         let mut de = quick_xml::de::Deserializer::from_str(xml);
         let raw = RawModelDescription::deserialize(&mut de).map_err(|e| {
             let reader = de.get_ref().get_ref();
+            // Syntax errors point at the offending markup; errors found at
+            // the end of input (truncation) or by serde at the last event.
             let position = match e {
-                quick_xml::DeError::InvalidXml(_) => reader.error_position(),
+                quick_xml::DeError::InvalidXml(_) if reader.error_position() > 0 => {
+                    reader.error_position()
+                }
                 _ => reader.buffer_position(),
             };
             let (line, column) = line_column(xml.as_bytes(), position as usize);
-            FmuError::XmlSyntax { line, column, message: e.to_string() }
+            FmuError::XmlSyntax {
+                line,
+                column,
+                message: e.to_string(),
+            }
         })?;
         raw.validate()
     }
@@ -263,16 +278,25 @@ impl ModelDescription {
         self.by_name
             .get(name)
             .map(|&i| &self.variables[i])
-            .ok_or_else(|| FmuError::UnknownVariable { name: name.to_string(), model: self.model_name.clone() })
+            .ok_or_else(|| FmuError::UnknownVariable {
+                name: name.to_string(),
+                model: self.model_name.clone(),
+            })
     }
 }
 
 /// 1-based line and column (in characters) of byte `offset`.
 fn line_column(text: &[u8], offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
-    let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
     let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-    let column = String::from_utf8_lossy(&before[line_start..]).chars().count() + 1;
+    let column = String::from_utf8_lossy(&before[line_start..])
+        .chars()
+        .count()
+        + 1;
     (line, column)
 }
 
@@ -282,24 +306,40 @@ fn check_fmi_version(xml: &str) -> Result<(), FmuError> {
     let mut reader = quick_xml::Reader::from_str(xml);
     let syntax = |reader: &quick_xml::Reader<&[u8]>, message: String| {
         let (line, column) = line_column(xml.as_bytes(), reader.error_position() as usize);
-        FmuError::XmlSyntax { line, column, message }
+        FmuError::XmlSyntax {
+            line,
+            column,
+            message,
+        }
     };
     loop {
         match reader.read_event() {
             Err(e) => return Err(syntax(&reader, e.to_string())),
             Ok(Event::Eof) => return Err(syntax(&reader, "no root element".into())),
             Ok(Event::Start(e) | Event::Empty(e)) => {
-                if e.name().as_ref() != b"fmiModelDescription" {
-                    let found = String::from_utf8_lossy(e.name().as_ref()).into_owned();
-                    return Err(syntax(&reader, format!("root element is <{found}>, expected <fmiModelDescription>")));
+                if e.name().0 != "fmiModelDescription" {
+                    let found = e.name().0.to_string();
+                    return Err(syntax(
+                        &reader,
+                        format!("root element is <{found}>, expected <fmiModelDescription>"),
+                    ));
                 }
                 let version = e
                     .try_get_attribute("fmiVersion")
                     .map_err(|err| syntax(&reader, err.to_string()))?
-                    .ok_or_else(|| syntax(&reader, "<fmiModelDescription> has no fmiVersion attribute".into()))?;
-                let version = version.unescape_value().map_err(|err| syntax(&reader, err.to_string()))?;
+                    .ok_or_else(|| {
+                        syntax(
+                            &reader,
+                            "<fmiModelDescription> has no fmiVersion attribute".into(),
+                        )
+                    })?;
+                let version = version
+                    .normalized_value(quick_xml::XmlVersion::Implicit1_0)
+                    .map_err(|err| syntax(&reader, err.to_string()))?;
                 if version.trim() != "2.0" {
-                    return Err(FmuError::UnsupportedFmiVersion { found: version.into_owned() });
+                    return Err(FmuError::UnsupportedFmiVersion {
+                        found: version.into_owned(),
+                    });
                 }
                 return Ok(());
             }
@@ -309,7 +349,10 @@ fn check_fmi_version(xml: &str) -> Result<(), FmuError> {
 }
 
 fn invalid(location: impl Into<String>, message: impl Into<String>) -> FmuError {
-    FmuError::InvalidModelDescription { location: location.into(), message: message.into() }
+    FmuError::InvalidModelDescription {
+        location: location.into(),
+        message: message.into(),
+    }
 }
 
 /// A valid C identifier: `modelIdentifier` names the binary and prefixes
@@ -514,36 +557,54 @@ struct RawUnknown {
 impl RawModelDescription {
     fn validate(self) -> Result<ModelDescription, FmuError> {
         if self.fmi_version.trim() != "2.0" {
-            return Err(FmuError::UnsupportedFmiVersion { found: self.fmi_version });
+            return Err(FmuError::UnsupportedFmiVersion {
+                found: self.fmi_version,
+            });
         }
         let cs = self.co_simulation.ok_or(FmuError::NotCoSimulation)?;
         if !is_c_identifier(&cs.model_identifier) {
             return Err(invalid(
                 "<CoSimulation>",
-                format!("modelIdentifier \"{}\" is not a valid C identifier", cs.model_identifier),
+                format!(
+                    "modelIdentifier \"{}\" is not a valid C identifier",
+                    cs.model_identifier
+                ),
             ));
         }
         let co_simulation = CoSimulation {
             model_identifier: cs.model_identifier,
             needs_execution_tool: cs.needs_execution_tool.unwrap_or(false),
-            can_handle_variable_communication_step_size: cs.can_handle_variable_communication_step_size.unwrap_or(false),
+            can_handle_variable_communication_step_size: cs
+                .can_handle_variable_communication_step_size
+                .unwrap_or(false),
             can_interpolate_inputs: cs.can_interpolate_inputs.unwrap_or(false),
             max_output_derivative_order: cs.max_output_derivative_order.unwrap_or(0),
             can_run_asynchronuously: cs.can_run_asynchronuously.unwrap_or(false),
-            can_be_instantiated_only_once_per_process: cs.can_be_instantiated_only_once_per_process.unwrap_or(false),
+            can_be_instantiated_only_once_per_process: cs
+                .can_be_instantiated_only_once_per_process
+                .unwrap_or(false),
             can_get_and_set_fmu_state: cs.can_get_and_set_fmu_state.unwrap_or(false),
             can_serialize_fmu_state: cs.can_serialize_fmu_state.unwrap_or(false),
             provides_directional_derivative: cs.provides_directional_derivative.unwrap_or(false),
         };
         if co_simulation.can_serialize_fmu_state && !co_simulation.can_get_and_set_fmu_state {
-            return Err(invalid("<CoSimulation>", "canSerializeFMUstate=\"true\" requires canGetAndSetFMUstate=\"true\""));
+            return Err(invalid(
+                "<CoSimulation>",
+                "canSerializeFMUstate=\"true\" requires canGetAndSetFMUstate=\"true\"",
+            ));
         }
 
-        let unit_definitions =
-            self.unit_definitions.map(|u| u.units.into_iter().map(|u| u.name).collect::<Vec<_>>());
+        let unit_definitions = self
+            .unit_definitions
+            .map(|u| u.units.into_iter().map(|u| u.name).collect::<Vec<_>>());
         let raw_variables = self
             .model_variables
-            .ok_or_else(|| invalid("<fmiModelDescription>", "the <ModelVariables> element is missing"))?
+            .ok_or_else(|| {
+                invalid(
+                    "<fmiModelDescription>",
+                    "the <ModelVariables> element is missing",
+                )
+            })?
             .variables;
 
         let mut variables = Vec::with_capacity(raw_variables.len());
@@ -553,35 +614,64 @@ impl RawModelDescription {
             if let Some(&first) = by_name.get(&variable.name) {
                 return Err(invalid(
                     format!("variable \"{}\" (index {})", variable.name, i + 1),
-                    format!("the name is already used by the variable at index {}", first + 1),
+                    format!(
+                        "the name is already used by the variable at index {}",
+                        first + 1
+                    ),
                 ));
             }
             by_name.insert(variable.name.clone(), i);
             variables.push(variable);
         }
         for v in &variables {
-            if let VariableKind::Real { derivative: Some(d), .. } = v.kind {
+            if let VariableKind::Real {
+                derivative: Some(d),
+                ..
+            } = v.kind
+            {
                 if d == 0 || d > variables.len() {
                     return Err(invalid(
                         format!("variable \"{}\" (index {})", v.name, v.index),
-                        format!("derivative=\"{d}\" is not an index of ModelVariables (1..={})", variables.len()),
+                        format!(
+                            "derivative=\"{d}\" is not an index of ModelVariables (1..={})",
+                            variables.len()
+                        ),
                     ));
                 }
             }
         }
 
         let mut outputs = Vec::new();
-        for (i, raw) in self.model_structure.and_then(|s| s.outputs).map(|o| o.unknowns).unwrap_or_default().into_iter().enumerate() {
-            let location = format!("ModelStructure/Outputs/Unknown[{}] (index {})", i + 1, raw.index);
+        for (i, raw) in self
+            .model_structure
+            .and_then(|s| s.outputs)
+            .map(|o| o.unknowns)
+            .unwrap_or_default()
+            .into_iter()
+            .enumerate()
+        {
+            let location = format!(
+                "ModelStructure/Outputs/Unknown[{}] (index {})",
+                i + 1,
+                raw.index
+            );
             let variable = raw
                 .index
                 .checked_sub(1)
                 .and_then(|k| variables.get(k))
-                .ok_or_else(|| invalid(&location, format!("not an index of ModelVariables (1..={})", variables.len())))?;
+                .ok_or_else(|| {
+                    invalid(
+                        &location,
+                        format!("not an index of ModelVariables (1..={})", variables.len()),
+                    )
+                })?;
             if variable.causality != Causality::Output {
                 return Err(invalid(
                     &location,
-                    format!("variable \"{}\" has causality \"{}\", expected \"output\"", variable.name, variable.causality),
+                    format!(
+                        "variable \"{}\" has causality \"{}\", expected \"output\"",
+                        variable.name, variable.causality
+                    ),
                 ));
             }
             let dependencies = match raw.dependencies {
@@ -593,13 +683,23 @@ impl RawModelDescription {
                             .parse()
                             .ok()
                             .filter(|&d| d >= 1 && d <= variables.len())
-                            .ok_or_else(|| invalid(&location, format!("dependency \"{word}\" is not an index of ModelVariables")))?;
+                            .ok_or_else(|| {
+                                invalid(
+                                    &location,
+                                    format!(
+                                        "dependency \"{word}\" is not an index of ModelVariables"
+                                    ),
+                                )
+                            })?;
                         deps.push(d);
                     }
                     Some(deps)
                 }
             };
-            outputs.push(Unknown { index: raw.index, dependencies });
+            outputs.push(Unknown {
+                index: raw.index,
+                dependencies,
+            });
         }
 
         Ok(ModelDescription {
@@ -615,7 +715,15 @@ impl RawModelDescription {
             unit_definitions,
             log_categories: self
                 .log_categories
-                .map(|c| c.categories.into_iter().map(|c| LogCategory { name: c.name, description: c.description }).collect())
+                .map(|c| {
+                    c.categories
+                        .into_iter()
+                        .map(|c| LogCategory {
+                            name: c.name,
+                            description: c.description,
+                        })
+                        .collect()
+                })
                 .unwrap_or_default(),
             default_experiment: self.default_experiment.map(|e| DefaultExperiment {
                 start_time: e.start_time,
@@ -634,27 +742,48 @@ impl RawScalarVariable {
     fn validate(self, index: usize, units: Option<&[String]>) -> Result<ScalarVariable, FmuError> {
         let name = match self.name {
             Some(n) if !n.is_empty() => n,
-            _ => return Err(invalid(format!("variable at index {index}"), "the name attribute is missing or empty")),
+            _ => {
+                return Err(invalid(
+                    format!("variable at index {index}"),
+                    "the name attribute is missing or empty",
+                ))
+            }
         };
         let location = format!("variable \"{name}\" (index {index})");
-        let value_reference =
-            self.value_reference.ok_or_else(|| invalid(&location, "the valueReference attribute is missing"))?;
+        let value_reference = self
+            .value_reference
+            .ok_or_else(|| invalid(&location, "the valueReference attribute is missing"))?;
         let causality = match self.causality.as_deref() {
             None => Causality::Local,
             Some(text) => Causality::parse(text).ok_or_else(|| {
-                invalid(&location, format!("causality \"{text}\" is not one of {}", list(Causality::ALL)))
+                invalid(
+                    &location,
+                    format!(
+                        "causality \"{text}\" is not one of {}",
+                        list(Causality::ALL)
+                    ),
+                )
             })?,
         };
         let variability = match self.variability.as_deref() {
             None => Variability::Continuous,
             Some(text) => Variability::parse(text).ok_or_else(|| {
-                invalid(&location, format!("variability \"{text}\" is not one of {}", list(Variability::ALL)))
+                invalid(
+                    &location,
+                    format!(
+                        "variability \"{text}\" is not one of {}",
+                        list(Variability::ALL)
+                    ),
+                )
             })?,
         };
         let initial = match self.initial.as_deref() {
             None => None,
             Some(text) => Some(Initial::parse(text).ok_or_else(|| {
-                invalid(&location, format!("initial \"{text}\" is not one of {}", list(Initial::ALL)))
+                invalid(
+                    &location,
+                    format!("initial \"{text}\" is not one of {}", list(Initial::ALL)),
+                )
             })?),
         };
         if !combination_allowed(causality, variability) {
@@ -668,7 +797,10 @@ impl RawScalarVariable {
         if let Some(r) = self.real {
             if let (Some(unit), Some(units)) = (&r.unit, units) {
                 if !units.iter().any(|u| u == unit) {
-                    return Err(invalid(&location, format!("unit \"{unit}\" is not defined in <UnitDefinitions>")));
+                    return Err(invalid(
+                        &location,
+                        format!("unit \"{unit}\" is not defined in <UnitDefinitions>"),
+                    ));
                 }
             }
             kinds.push(VariableKind::Real {
@@ -681,7 +813,11 @@ impl RawScalarVariable {
             });
         }
         if let Some(i) = self.integer {
-            kinds.push(VariableKind::Integer { start: i.start, min: i.min, max: i.max });
+            kinds.push(VariableKind::Integer {
+                start: i.start,
+                min: i.min,
+                max: i.max,
+            });
         }
         if let Some(b) = self.boolean {
             kinds.push(VariableKind::Boolean { start: b.start });
@@ -690,10 +826,15 @@ impl RawScalarVariable {
             kinds.push(VariableKind::String { start: s.start });
         }
         if let Some(e) = self.enumeration {
-            let declared_type = e
-                .declared_type
-                .ok_or_else(|| invalid(&location, "an <Enumeration> needs a declaredType attribute"))?;
-            kinds.push(VariableKind::Enumeration { declared_type, start: e.start, min: e.min, max: e.max });
+            let declared_type = e.declared_type.ok_or_else(|| {
+                invalid(&location, "an <Enumeration> needs a declaredType attribute")
+            })?;
+            kinds.push(VariableKind::Enumeration {
+                declared_type,
+                start: e.start,
+                min: e.min,
+                max: e.max,
+            });
         }
         if kinds.len() != 1 {
             return Err(invalid(
@@ -716,5 +857,9 @@ impl RawScalarVariable {
 }
 
 fn list<T: fmt::Display>(items: &[T]) -> String {
-    items.iter().map(|i| format!("\"{i}\"")).collect::<Vec<_>>().join(", ")
+    items
+        .iter()
+        .map(|i| format!("\"{i}\""))
+        .collect::<Vec<_>>()
+        .join(", ")
 }

@@ -1,0 +1,146 @@
+//! `fricsim info FMU`: what `fmpy info` shows — the model, its
+//! capabilities, the default experiment and a table of all variables. Reads
+//! the archive and the model description only; the binary is not loaded, so
+//! FMUs for other platforms can be inspected too.
+
+use fricsim::fmu::archive::{unpack, UnpackOptions};
+use fricsim::fmu::library::platforms;
+use fricsim::fmu::ModelDescription;
+use fricsim::FmuError;
+use std::fmt::Write;
+use std::path::Path;
+
+pub fn run(path: &Path) -> Result<(), FmuError> {
+    let dir = unpack(path, &UnpackOptions::default())?;
+    let description = ModelDescription::from_file(&dir.path().join("modelDescription.xml"))?;
+    print!("{}", render(&description, &platforms(dir.path())));
+    Ok(())
+}
+
+fn or_dash(value: Option<impl ToString>) -> String {
+    value
+        .map(|v| v.to_string())
+        .unwrap_or_else(|| "-".to_string())
+}
+
+/// The report, as printed.
+pub fn render(d: &ModelDescription, platforms: &[String]) -> String {
+    let mut out = String::new();
+    let w = &mut out;
+    let _ = writeln!(w, "\nModel Info\n");
+    let rows = [
+        ("FMI Version", d.fmi_version.clone()),
+        ("FMI Type", "Co-Simulation".to_string()),
+        ("Model Name", d.model_name.clone()),
+        ("Model Identifier", d.co_simulation.model_identifier.clone()),
+        ("GUID", d.guid.clone()),
+        ("Description", or_dash(d.description.as_deref())),
+        ("Generation Tool", or_dash(d.generation_tool.as_deref())),
+        (
+            "Generation Date",
+            or_dash(d.generation_date_and_time.as_deref()),
+        ),
+        (
+            "Platforms",
+            if platforms.is_empty() {
+                "-".to_string()
+            } else {
+                platforms.join(", ")
+            },
+        ),
+        ("Variables", d.variables.len().to_string()),
+    ];
+    for (key, value) in rows {
+        let _ = writeln!(w, "  {key:<18} {value}");
+    }
+
+    let cs = &d.co_simulation;
+    let _ = writeln!(w, "\nCapabilities\n");
+    let capabilities = [
+        (
+            "canHandleVariableCommunicationStepSize",
+            cs.can_handle_variable_communication_step_size.to_string(),
+        ),
+        (
+            "canInterpolateInputs",
+            cs.can_interpolate_inputs.to_string(),
+        ),
+        (
+            "maxOutputDerivativeOrder",
+            cs.max_output_derivative_order.to_string(),
+        ),
+        (
+            "canGetAndSetFMUstate",
+            cs.can_get_and_set_fmu_state.to_string(),
+        ),
+        (
+            "canSerializeFMUstate",
+            cs.can_serialize_fmu_state.to_string(),
+        ),
+        (
+            "providesDirectionalDerivative",
+            cs.provides_directional_derivative.to_string(),
+        ),
+    ];
+    for (key, value) in capabilities {
+        let _ = writeln!(w, "  {key:<40} {value}");
+    }
+
+    let _ = writeln!(w, "\nDefault Experiment\n");
+    match &d.default_experiment {
+        None => {
+            let _ = writeln!(w, "  -");
+        }
+        Some(e) => {
+            for (key, value) in [
+                ("Start Time", e.start_time),
+                ("Stop Time", e.stop_time),
+                ("Tolerance", e.tolerance),
+                ("Step Size", e.step_size),
+            ] {
+                let _ = writeln!(
+                    w,
+                    "  {key:<18} {}",
+                    or_dash(value.map(|v| format!("{v:?}")))
+                );
+            }
+        }
+    }
+
+    let _ = writeln!(w, "\nVariables\n");
+    let mut table = vec![[
+        "Name".to_string(),
+        "Causality".to_string(),
+        "Variability".to_string(),
+        "Type".to_string(),
+        "Start".to_string(),
+        "Unit".to_string(),
+        "Description".to_string(),
+    ]];
+    for v in &d.variables {
+        table.push([
+            v.name.clone(),
+            v.causality.to_string(),
+            v.variability.to_string(),
+            v.kind.type_name().to_string(),
+            v.kind.start_text().unwrap_or_default(),
+            v.kind.unit().unwrap_or_default().to_string(),
+            v.description.clone().unwrap_or_default(),
+        ]);
+    }
+    let mut widths = [0usize; 6];
+    for row in &table {
+        for (width, cell) in widths.iter_mut().zip(row) {
+            *width = (*width).max(cell.chars().count());
+        }
+    }
+    for row in &table {
+        let mut line = String::from(" ");
+        for (width, cell) in widths.iter().zip(row) {
+            let _ = write!(line, " {cell:<width$}");
+        }
+        let _ = write!(line, " {}", row[6]);
+        let _ = writeln!(w, "{}", line.trim_end());
+    }
+    out
+}

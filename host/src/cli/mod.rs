@@ -1,0 +1,4 @@
+//! The subcommands of the `fricsim` binary (not part of the library).
+
+pub mod cosim;
+pub mod info;

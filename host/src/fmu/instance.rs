@@ -1,0 +1,922 @@
+//! An imported FMU ([`Fmu`]: unpacked files, model description, loaded
+//! binary) and its instances ([`Instance`]: the FMI 2.0 Co-Simulation API of
+//! FMI 2.0.4 §2.1 and §4.2 as safe methods).
+//!
+//! Every FMU call returns `Result<Status, FmuError>`: `fmi2OK` and
+//! `fmi2Warning` are `Ok` (a warning is in the log), `fmi2Discard`,
+//! `fmi2Error`, `fmi2Fatal` and `fmi2Pending` become [`FmuError::Call`] with
+//! the function, the instance, the status and what the instance logged during
+//! the call. Slice lengths are checked before the FMU sees a pointer. The
+//! value-access and step functions do not allocate unless they fail.
+
+use super::archive::{unpack, UnpackOptions};
+use super::ffi::*;
+use super::library::{c_text, Functions, Library};
+use super::logger::{fricsim_fmi2_logger, Log, Sink};
+use super::model_description::{ModelDescription, ScalarVariable, ValueReference};
+use super::Status;
+use crate::error::FmuError;
+use std::ffi::CString;
+use std::mem::ManuallyDrop;
+use std::os::raw::c_void;
+use std::path::{Path, PathBuf};
+use std::ptr::null_mut;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use tempfile::TempDir;
+
+/// Error messages logged earlier are shown when a call logged nothing.
+const EARLIER_MESSAGES: usize = 3;
+/// Booleans are converted to `fmi2Boolean` through a stack buffer this long.
+const BOOLEAN_CHUNK: usize = 64;
+
+extern "C" {
+    fn calloc(count: usize, size: usize) -> *mut c_void;
+    fn free(pointer: *mut c_void);
+}
+
+unsafe extern "C" fn allocate_memory(count: usize, size: usize) -> *mut c_void {
+    // SAFETY: C's calloc, as §2.1.5 asks of allocateMemory.
+    unsafe { calloc(count, size) }
+}
+
+unsafe extern "C" fn free_memory(pointer: *mut c_void) {
+    // SAFETY: `pointer` came from `allocate_memory` (or is null).
+    unsafe { free(pointer) }
+}
+
+/// An imported FMU. Cloning is cheap and shares everything; the unpacked
+/// files and the binary stay until the last clone and instance are dropped.
+#[derive(Clone, Debug)]
+pub struct Fmu {
+    shared: Arc<Shared>,
+}
+
+#[derive(Debug)]
+struct Shared {
+    // Dropped in this order: the binary is unloaded before its files go.
+    library: Library,
+    description: ModelDescription,
+    log: Log,
+    dir: FmuDir,
+}
+
+#[derive(Debug)]
+enum FmuDir {
+    /// Unpacked by us; removed on drop.
+    Temporary(TempDir),
+    /// Given by the caller; left alone.
+    External(PathBuf),
+}
+
+impl FmuDir {
+    fn path(&self) -> &Path {
+        match self {
+            FmuDir::Temporary(t) => t.path(),
+            FmuDir::External(p) => p,
+        }
+    }
+}
+
+impl Fmu {
+    /// Unpack the `.fmu` at `path` with the default limits, parse its model
+    /// description and load its binary.
+    pub fn open(path: impl AsRef<Path>) -> Result<Fmu, FmuError> {
+        Fmu::open_with(path, &UnpackOptions::default())
+    }
+
+    /// [`Fmu::open`] with explicit unpacking limits.
+    pub fn open_with(path: impl AsRef<Path>, options: &UnpackOptions) -> Result<Fmu, FmuError> {
+        let dir = unpack(path.as_ref(), options)?;
+        Fmu::load(FmuDir::Temporary(dir))
+    }
+
+    /// An FMU already unpacked in `dir` (not removed on drop).
+    pub fn from_dir(dir: impl AsRef<Path>) -> Result<Fmu, FmuError> {
+        Fmu::load(FmuDir::External(dir.as_ref().to_path_buf()))
+    }
+
+    fn load(dir: FmuDir) -> Result<Fmu, FmuError> {
+        let description = ModelDescription::from_file(&dir.path().join("modelDescription.xml"))?;
+        let library = Library::load(dir.path(), &description)?;
+        Ok(Fmu {
+            shared: Arc::new(Shared {
+                library,
+                description,
+                log: Log::new(),
+                dir,
+            }),
+        })
+    }
+
+    pub fn description(&self) -> &ModelDescription {
+        &self.shared.description
+    }
+
+    /// The variable called `name` (look it up once, then use its
+    /// `value_reference`).
+    pub fn variable(&self, name: &str) -> Result<&ScalarVariable, FmuError> {
+        self.shared.description.variable(name)
+    }
+
+    /// The messages of all instances of this FMU.
+    pub fn log(&self) -> &Log {
+        &self.shared.log
+    }
+
+    /// Where the FMU is unpacked.
+    pub fn dir(&self) -> &Path {
+        self.shared.dir.path()
+    }
+
+    pub fn library(&self) -> &Library {
+        &self.shared.library
+    }
+
+    /// A new co-simulation instance called `name` (see [`Instance::instantiate`]).
+    pub fn instantiate(&self, name: &str) -> Result<Instance, FmuError> {
+        Instance::instantiate(self, name)
+    }
+}
+
+/// A snapshot of an instance's state (`fmi2FMUstate`, §2.1.8). It belongs to
+/// the instance that made it, which frees it with
+/// [`Instance::free_state`] or when the instance is dropped.
+#[derive(Debug)]
+pub struct FmuState {
+    pointer: fmi2FMUstate,
+    owner: u64,
+}
+
+static NEXT_INSTANCE_ID: AtomicU64 = AtomicU64::new(1);
+
+/// One FMU instance in co-simulation mode. Dropping it frees its states and
+/// calls `fmi2FreeInstance` — unless a call returned `fmi2Fatal`, after which
+/// §2.1.3 allows no further call and the instance is leaked.
+pub struct Instance {
+    fmu: Fmu,
+    functions: Functions,
+    component: fmi2Component,
+    name: String,
+    id: u64,
+    /// The logger's environment and the callbacks: the FMU may keep pointers
+    /// to both until it is freed (and forever after `fmi2Fatal`).
+    sink: ManuallyDrop<Box<Sink>>,
+    callbacks: ManuallyDrop<Box<fmi2CallbackFunctions>>,
+    states: Vec<fmi2FMUstate>,
+    fatal: bool,
+}
+
+impl std::fmt::Debug for Instance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Instance")
+            .field("name", &self.name)
+            .field("model", &self.fmu.description().model_name)
+            .field("states", &self.states.len())
+            .field("fatal", &self.fatal)
+            .finish_non_exhaustive()
+    }
+}
+
+fn same_length(
+    function: &'static str,
+    what: &'static str,
+    expected: usize,
+    found: usize,
+) -> Result<(), FmuError> {
+    if expected == found {
+        Ok(())
+    } else {
+        Err(FmuError::LengthMismatch {
+            function,
+            what,
+            expected,
+            found,
+        })
+    }
+}
+
+fn c_string(what: &'static str, value: &str) -> Result<CString, FmuError> {
+    CString::new(value).map_err(|_| FmuError::NulInString {
+        what,
+        value: value.to_string(),
+    })
+}
+
+/// `file:///…` URI of a directory (§2.1.5 `fmuResourceLocation`), with
+/// every byte outside the unreserved set and `/` percent-encoded.
+fn file_uri(path: &Path) -> String {
+    use std::os::unix::ffi::OsStrExt;
+    let mut uri = String::from("file://");
+    for &b in path.as_os_str().as_bytes() {
+        if b.is_ascii_alphanumeric() || b"/-._~".contains(&b) {
+            uri.push(b as char);
+        } else {
+            uri.push_str(&format!("%{b:02X}"));
+        }
+    }
+    uri
+}
+
+impl Instance {
+    /// `fmi2Instantiate` in co-simulation mode, not visible, with debug
+    /// logging off (errors are still logged; see [`Instance::set_debug_logging`]).
+    pub fn instantiate(fmu: &Fmu, name: &str) -> Result<Instance, FmuError> {
+        let description = fmu.description();
+        let name_c = c_string("the instance name", name)?;
+        let guid = c_string("the GUID", &description.guid)?;
+        let resources = c_string(
+            "the resource location",
+            &file_uri(&fmu.dir().join("resources")),
+        )?;
+        let id = NEXT_INSTANCE_ID.fetch_add(1, Ordering::Relaxed);
+        let sink = Box::new(Sink::new(fmu.log().clone(), name, id));
+        let callbacks = Box::new(fmi2CallbackFunctions {
+            logger: Some(fricsim_fmi2_logger),
+            allocateMemory: Some(allocate_memory),
+            freeMemory: Some(free_memory),
+            stepFinished: None,
+            componentEnvironment: &*sink as *const Sink as *mut c_void,
+        });
+        let functions = fmu.shared.library.functions;
+        // SAFETY: all strings are NUL-terminated and outlive the call; the
+        // callbacks and their environment live as long as the instance.
+        let component = unsafe {
+            (functions.instantiate)(
+                name_c.as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                resources.as_ptr(),
+                &*callbacks,
+                fmi2False,
+                fmi2False,
+            )
+        };
+        if component.is_null() {
+            return Err(FmuError::Instantiate {
+                instance: name.to_string(),
+                messages: fmu.log().messages_since(&sink, 0, 0),
+            });
+        }
+        Ok(Instance {
+            fmu: fmu.clone(),
+            functions,
+            component,
+            name: name.to_string(),
+            id,
+            sink: ManuallyDrop::new(sink),
+            callbacks: ManuallyDrop::new(callbacks),
+            states: Vec::new(),
+            fatal: false,
+        })
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn fmu(&self) -> &Fmu {
+        &self.fmu
+    }
+
+    /// Refuse any call after `fmi2Fatal`; otherwise the log mark before the call.
+    #[inline]
+    fn begin(&self, function: &'static str) -> Result<u64, FmuError> {
+        if self.fatal {
+            return Err(FmuError::AfterFatal {
+                function,
+                instance: self.name.clone(),
+            });
+        }
+        Ok(self.sink.mark())
+    }
+
+    /// The status of a call as a `Result`.
+    #[inline]
+    fn finish(
+        &mut self,
+        function: &'static str,
+        mark: u64,
+        raw: fmi2Status,
+    ) -> Result<Status, FmuError> {
+        match Status::from_raw(raw) {
+            Status::Ok => Ok(Status::Ok),
+            Status::Warning => {
+                if self.sink.mark() == mark {
+                    self.sink.record(
+                        Status::Warning,
+                        "fricsim",
+                        format!("{function} returned fmi2Warning"),
+                    );
+                }
+                Ok(Status::Warning)
+            }
+            status => {
+                if status == Status::Fatal {
+                    self.fatal = true;
+                }
+                Err(FmuError::Call {
+                    function,
+                    instance: self.name.clone(),
+                    status,
+                    messages: self
+                        .fmu
+                        .log()
+                        .messages_since(&self.sink, mark, EARLIER_MESSAGES),
+                })
+            }
+        }
+    }
+
+    /// `fmi2SetDebugLogging`: switch the named log categories (all if empty).
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[&str]) -> Result<Status, FmuError> {
+        const F: &str = "fmi2SetDebugLogging";
+        let mark = self.begin(F)?;
+        let owned = categories
+            .iter()
+            .map(|c| c_string("a log category", c))
+            .collect::<Result<Vec<_>, _>>()?;
+        let pointers: Vec<fmi2String> = owned.iter().map(|c| c.as_ptr()).collect();
+        let on = if on { fmi2True } else { fmi2False };
+        // SAFETY: `pointers` holds `len` valid strings for the call.
+        let raw = unsafe {
+            (self.functions.set_debug_logging)(
+                self.component,
+                on,
+                pointers.len(),
+                pointers.as_ptr(),
+            )
+        };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2SetupExperiment` without tolerance; `stop` = `None` leaves the
+    /// stop time undefined.
+    pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<Status, FmuError> {
+        const F: &str = "fmi2SetupExperiment";
+        let mark = self.begin(F)?;
+        let (stop_defined, stop) = match stop {
+            Some(s) => (fmi2True, s),
+            None => (fmi2False, 0.0),
+        };
+        // SAFETY: plain values.
+        let raw = unsafe {
+            (self.functions.setup_experiment)(
+                self.component,
+                fmi2False,
+                0.0,
+                start,
+                stop_defined,
+                stop,
+            )
+        };
+        self.finish(F, mark, raw)
+    }
+
+    fn component_call(
+        &mut self,
+        function: &'static str,
+        f: impl FnOnce(fmi2Component) -> fmi2Status,
+    ) -> Result<Status, FmuError> {
+        let mark = self.begin(function)?;
+        let raw = f(self.component);
+        self.finish(function, mark, raw)
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization_mode(&mut self) -> Result<Status, FmuError> {
+        let f = self.functions.enter_initialization_mode;
+        // SAFETY: the component is live.
+        self.component_call("fmi2EnterInitializationMode", |c| unsafe { f(c) })
+    }
+
+    /// `fmi2ExitInitializationMode`.
+    pub fn exit_initialization_mode(&mut self) -> Result<Status, FmuError> {
+        let f = self.functions.exit_initialization_mode;
+        // SAFETY: the component is live.
+        self.component_call("fmi2ExitInitializationMode", |c| unsafe { f(c) })
+    }
+
+    /// `fmi2Terminate`.
+    pub fn terminate(&mut self) -> Result<Status, FmuError> {
+        let f = self.functions.terminate;
+        // SAFETY: the component is live.
+        self.component_call("fmi2Terminate", |c| unsafe { f(c) })
+    }
+
+    /// `fmi2Reset`: back to the state after instantiation.
+    pub fn reset(&mut self) -> Result<Status, FmuError> {
+        let f = self.functions.reset;
+        // SAFETY: the component is live.
+        self.component_call("fmi2Reset", |c| unsafe { f(c) })
+    }
+
+    /// `fmi2CancelStep` (§4.2.2).
+    pub fn cancel_step(&mut self) -> Result<Status, FmuError> {
+        let f = self.functions.cancel_step;
+        // SAFETY: the component is live.
+        self.component_call("fmi2CancelStep", |c| unsafe { f(c) })
+    }
+
+    /// `fmi2GetReal`: `values[i]` = value of `vrs[i]`. Does not allocate.
+    pub fn get_real(
+        &mut self,
+        vrs: &[ValueReference],
+        values: &mut [f64],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2GetReal";
+        let mark = self.begin(F)?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        // SAFETY: both arrays hold `vrs.len()` elements.
+        let raw = unsafe {
+            (self.functions.get_real)(self.component, vrs.as_ptr(), vrs.len(), values.as_mut_ptr())
+        };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2SetReal`. Does not allocate.
+    pub fn set_real(&mut self, vrs: &[ValueReference], values: &[f64]) -> Result<Status, FmuError> {
+        const F: &str = "fmi2SetReal";
+        let mark = self.begin(F)?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        // SAFETY: both arrays hold `vrs.len()` elements.
+        let raw = unsafe {
+            (self.functions.set_real)(self.component, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2GetInteger`. Does not allocate.
+    pub fn get_integer(
+        &mut self,
+        vrs: &[ValueReference],
+        values: &mut [i32],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2GetInteger";
+        let mark = self.begin(F)?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        // SAFETY: both arrays hold `vrs.len()` elements.
+        let raw = unsafe {
+            (self.functions.get_integer)(
+                self.component,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_mut_ptr(),
+            )
+        };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2SetInteger`. Does not allocate.
+    pub fn set_integer(
+        &mut self,
+        vrs: &[ValueReference],
+        values: &[i32],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2SetInteger";
+        let mark = self.begin(F)?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        // SAFETY: both arrays hold `vrs.len()` elements.
+        let raw = unsafe {
+            (self.functions.set_integer)(self.component, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2GetBoolean`. Does not allocate (converts through a stack buffer).
+    pub fn get_boolean(
+        &mut self,
+        vrs: &[ValueReference],
+        values: &mut [bool],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2GetBoolean";
+        let mark = self.begin(F)?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        let mut status = Status::Ok;
+        for (vrs, values) in vrs
+            .chunks(BOOLEAN_CHUNK)
+            .zip(values.chunks_mut(BOOLEAN_CHUNK))
+        {
+            let mut buffer = [fmi2False; BOOLEAN_CHUNK];
+            // SAFETY: `vrs` and `buffer` hold at least `vrs.len()` elements.
+            let raw = unsafe {
+                (self.functions.get_boolean)(
+                    self.component,
+                    vrs.as_ptr(),
+                    vrs.len(),
+                    buffer.as_mut_ptr(),
+                )
+            };
+            status = worst(status, self.finish(F, mark, raw)?);
+            for (value, b) in values.iter_mut().zip(buffer) {
+                *value = b != fmi2False;
+            }
+        }
+        Ok(status)
+    }
+
+    /// `fmi2SetBoolean`. Does not allocate.
+    pub fn set_boolean(
+        &mut self,
+        vrs: &[ValueReference],
+        values: &[bool],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2SetBoolean";
+        let mark = self.begin(F)?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        let mut status = Status::Ok;
+        for (vrs, values) in vrs.chunks(BOOLEAN_CHUNK).zip(values.chunks(BOOLEAN_CHUNK)) {
+            let mut buffer = [fmi2False; BOOLEAN_CHUNK];
+            for (b, value) in buffer.iter_mut().zip(values) {
+                *b = if *value { fmi2True } else { fmi2False };
+            }
+            // SAFETY: `vrs` and `buffer` hold at least `vrs.len()` elements.
+            let raw = unsafe {
+                (self.functions.set_boolean)(
+                    self.component,
+                    vrs.as_ptr(),
+                    vrs.len(),
+                    buffer.as_ptr(),
+                )
+            };
+            status = worst(status, self.finish(F, mark, raw)?);
+        }
+        Ok(status)
+    }
+
+    /// `fmi2GetString`: the strings are copied out at once (the FMU's
+    /// pointers are only valid until its next call).
+    pub fn get_string(&mut self, vrs: &[ValueReference]) -> Result<Vec<String>, FmuError> {
+        const F: &str = "fmi2GetString";
+        let mark = self.begin(F)?;
+        let mut pointers: Vec<fmi2String> = vec![std::ptr::null(); vrs.len()];
+        // SAFETY: both arrays hold `vrs.len()` elements.
+        let raw = unsafe {
+            (self.functions.get_string)(
+                self.component,
+                vrs.as_ptr(),
+                vrs.len(),
+                pointers.as_mut_ptr(),
+            )
+        };
+        self.finish(F, mark, raw)?;
+        // SAFETY: the FMU returned NUL-terminated strings (or null).
+        Ok(pointers.into_iter().map(|p| unsafe { c_text(p) }).collect())
+    }
+
+    /// `fmi2SetString`.
+    pub fn set_string(
+        &mut self,
+        vrs: &[ValueReference],
+        values: &[&str],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2SetString";
+        let mark = self.begin(F)?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        let owned = values
+            .iter()
+            .map(|v| c_string("a string value", v))
+            .collect::<Result<Vec<_>, _>>()?;
+        let pointers: Vec<fmi2String> = owned.iter().map(|c| c.as_ptr()).collect();
+        // SAFETY: both arrays hold `vrs.len()` elements, the strings outlive the call.
+        let raw = unsafe {
+            (self.functions.set_string)(self.component, vrs.as_ptr(), vrs.len(), pointers.as_ptr())
+        };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2DoStep` from communication point `t` over `h`, with
+    /// `noSetFMUStatePriorToCurrentPoint = false` (states may be restored).
+    /// Does not allocate.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<Status, FmuError> {
+        const F: &str = "fmi2DoStep";
+        let mark = self.begin(F)?;
+        // SAFETY: plain values.
+        let raw = unsafe { (self.functions.do_step)(self.component, t, h, fmi2False) };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`: where a discarded step stopped.
+    pub fn last_successful_time(&mut self) -> Result<f64, FmuError> {
+        const F: &str = "fmi2GetRealStatus";
+        let mark = self.begin(F)?;
+        let mut time = f64::NAN;
+        // SAFETY: `time` is a valid out-pointer.
+        let raw = unsafe {
+            (self.functions.get_real_status)(self.component, fmi2LastSuccessfulTime, &mut time)
+        };
+        self.finish(F, mark, raw)?;
+        Ok(time)
+    }
+
+    /// `fmi2GetBooleanStatus(fmi2Terminated)`: whether the FMU wants to stop.
+    pub fn terminated(&mut self) -> Result<bool, FmuError> {
+        const F: &str = "fmi2GetBooleanStatus";
+        let mark = self.begin(F)?;
+        let mut value = fmi2False;
+        // SAFETY: `value` is a valid out-pointer.
+        let raw = unsafe {
+            (self.functions.get_boolean_status)(self.component, fmi2Terminated, &mut value)
+        };
+        self.finish(F, mark, raw)?;
+        Ok(value != fmi2False)
+    }
+
+    /// `fmi2SetRealInputDerivatives` (§4.2.1): `values[i]` is the
+    /// `orders[i]`-th time derivative of input `vrs[i]`.
+    pub fn set_real_input_derivatives(
+        &mut self,
+        vrs: &[ValueReference],
+        orders: &[i32],
+        values: &[f64],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2SetRealInputDerivatives";
+        let f = self
+            .functions
+            .set_real_input_derivatives
+            .ok_or(FmuError::NotSupported {
+                function: F,
+                capability: "canInterpolateInputs=\"true\"",
+            })?;
+        let mark = self.begin(F)?;
+        same_length(F, "orders", vrs.len(), orders.len())?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        // SAFETY: all arrays hold `vrs.len()` elements.
+        let raw = unsafe {
+            f(
+                self.component,
+                vrs.as_ptr(),
+                vrs.len(),
+                orders.as_ptr(),
+                values.as_ptr(),
+            )
+        };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2GetRealOutputDerivatives` (§4.2.3).
+    pub fn get_real_output_derivatives(
+        &mut self,
+        vrs: &[ValueReference],
+        orders: &[i32],
+        values: &mut [f64],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2GetRealOutputDerivatives";
+        let f = self
+            .functions
+            .get_real_output_derivatives
+            .ok_or(FmuError::NotSupported {
+                function: F,
+                capability: "maxOutputDerivativeOrder > 0",
+            })?;
+        let mark = self.begin(F)?;
+        same_length(F, "orders", vrs.len(), orders.len())?;
+        same_length(F, "values", vrs.len(), values.len())?;
+        // SAFETY: all arrays hold `vrs.len()` elements.
+        let raw = unsafe {
+            f(
+                self.component,
+                vrs.as_ptr(),
+                vrs.len(),
+                orders.as_ptr(),
+                values.as_mut_ptr(),
+            )
+        };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2GetDirectionalDerivative` (§2.1.9): `out` = ∂unknowns/∂knowns · `seed`.
+    pub fn get_directional_derivative(
+        &mut self,
+        unknowns: &[ValueReference],
+        knowns: &[ValueReference],
+        seed: &[f64],
+        out: &mut [f64],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2GetDirectionalDerivative";
+        let f = self
+            .functions
+            .get_directional_derivative
+            .ok_or(FmuError::NotSupported {
+                function: F,
+                capability: "providesDirectionalDerivative=\"true\"",
+            })?;
+        let mark = self.begin(F)?;
+        same_length(F, "seed", knowns.len(), seed.len())?;
+        same_length(F, "out", unknowns.len(), out.len())?;
+        // SAFETY: each array holds as many elements as its length argument says.
+        let raw = unsafe {
+            f(
+                self.component,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                knowns.as_ptr(),
+                knowns.len(),
+                seed.as_ptr(),
+                out.as_mut_ptr(),
+            )
+        };
+        self.finish(F, mark, raw)
+    }
+
+    fn own(&self, function: &'static str, state: &FmuState) -> Result<(), FmuError> {
+        if state.owner == self.id {
+            Ok(())
+        } else {
+            Err(FmuError::ForeignState {
+                function,
+                instance: self.name.clone(),
+            })
+        }
+    }
+
+    fn state_function<T>(
+        &self,
+        function: &'static str,
+        f: Option<T>,
+        capability: &'static str,
+    ) -> Result<T, FmuError> {
+        f.ok_or(FmuError::NotSupported {
+            function,
+            capability,
+        })
+    }
+
+    /// `fmi2GetFMUstate` into a new state.
+    pub fn get_state(&mut self) -> Result<FmuState, FmuError> {
+        const F: &str = "fmi2GetFMUstate";
+        let f = self.state_function(
+            F,
+            self.functions.get_fmu_state,
+            "canGetAndSetFMUstate=\"true\"",
+        )?;
+        let mark = self.begin(F)?;
+        let mut pointer: fmi2FMUstate = null_mut();
+        // SAFETY: `pointer` is a valid out-pointer, null asks for a new state.
+        let raw = unsafe { f(self.component, &mut pointer) };
+        self.finish(F, mark, raw)?;
+        if pointer.is_null() {
+            return Err(FmuError::NullPointer {
+                function: F,
+                instance: self.name.clone(),
+                what: "FMU state",
+            });
+        }
+        self.states.push(pointer);
+        Ok(FmuState {
+            pointer,
+            owner: self.id,
+        })
+    }
+
+    /// `fmi2GetFMUstate` into an existing state (the FMU may reuse its memory).
+    pub fn update_state(&mut self, state: &mut FmuState) -> Result<Status, FmuError> {
+        const F: &str = "fmi2GetFMUstate";
+        let f = self.state_function(
+            F,
+            self.functions.get_fmu_state,
+            "canGetAndSetFMUstate=\"true\"",
+        )?;
+        self.own(F, state)?;
+        let mark = self.begin(F)?;
+        let before = state.pointer;
+        // SAFETY: `state.pointer` is a live state of this instance.
+        let raw = unsafe { f(self.component, &mut state.pointer) };
+        if state.pointer != before {
+            if let Some(slot) = self.states.iter_mut().find(|p| **p == before) {
+                *slot = state.pointer;
+            }
+        }
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2SetFMUstate`: continue from `state`.
+    pub fn set_state(&mut self, state: &FmuState) -> Result<Status, FmuError> {
+        const F: &str = "fmi2SetFMUstate";
+        let f = self.state_function(
+            F,
+            self.functions.set_fmu_state,
+            "canGetAndSetFMUstate=\"true\"",
+        )?;
+        self.own(F, state)?;
+        let mark = self.begin(F)?;
+        // SAFETY: `state.pointer` is a live state of this instance.
+        let raw = unsafe { f(self.component, state.pointer) };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2FreeFMUstate`.
+    pub fn free_state(&mut self, state: FmuState) -> Result<Status, FmuError> {
+        const F: &str = "fmi2FreeFMUstate";
+        let f = self.state_function(
+            F,
+            self.functions.free_fmu_state,
+            "canGetAndSetFMUstate=\"true\"",
+        )?;
+        self.own(F, &state)?;
+        let mark = self.begin(F)?;
+        if let Some(i) = self.states.iter().position(|p| *p == state.pointer) {
+            self.states.swap_remove(i);
+        }
+        let mut pointer = state.pointer;
+        // SAFETY: `pointer` is a live state of this instance, freed once.
+        let raw = unsafe { f(self.component, &mut pointer) };
+        self.finish(F, mark, raw)
+    }
+
+    /// `fmi2SerializedFMUstateSize` + `fmi2SerializeFMUstate`.
+    pub fn serialize_state(&mut self, state: &FmuState) -> Result<Vec<u8>, FmuError> {
+        const CAPABILITY: &str = "canSerializeFMUstate=\"true\"";
+        const SIZE: &str = "fmi2SerializedFMUstateSize";
+        const F: &str = "fmi2SerializeFMUstate";
+        let size_f =
+            self.state_function(SIZE, self.functions.serialized_fmu_state_size, CAPABILITY)?;
+        let f = self.state_function(F, self.functions.serialize_fmu_state, CAPABILITY)?;
+        self.own(F, state)?;
+        let mark = self.begin(SIZE)?;
+        let mut size = 0usize;
+        // SAFETY: `state.pointer` is a live state of this instance.
+        let raw = unsafe { size_f(self.component, state.pointer, &mut size) };
+        self.finish(SIZE, mark, raw)?;
+        let mut bytes = vec![0u8; size];
+        let mark = self.begin(F)?;
+        // SAFETY: `bytes` holds `size` bytes.
+        let raw = unsafe {
+            f(
+                self.component,
+                state.pointer,
+                bytes.as_mut_ptr().cast(),
+                size,
+            )
+        };
+        self.finish(F, mark, raw)?;
+        Ok(bytes)
+    }
+
+    /// `fmi2DeSerializeFMUstate` into a new state of this instance.
+    pub fn deserialize_state(&mut self, bytes: &[u8]) -> Result<FmuState, FmuError> {
+        const F: &str = "fmi2DeSerializeFMUstate";
+        let f = self.state_function(
+            F,
+            self.functions.deserialize_fmu_state,
+            "canSerializeFMUstate=\"true\"",
+        )?;
+        let mark = self.begin(F)?;
+        let mut pointer: fmi2FMUstate = null_mut();
+        // SAFETY: `bytes` holds `bytes.len()` bytes; `pointer` is a valid out-pointer.
+        let raw = unsafe {
+            f(
+                self.component,
+                bytes.as_ptr().cast(),
+                bytes.len(),
+                &mut pointer,
+            )
+        };
+        self.finish(F, mark, raw)?;
+        if pointer.is_null() {
+            return Err(FmuError::NullPointer {
+                function: F,
+                instance: self.name.clone(),
+                what: "FMU state",
+            });
+        }
+        self.states.push(pointer);
+        Ok(FmuState {
+            pointer,
+            owner: self.id,
+        })
+    }
+}
+
+/// The more severe of two successful statuses.
+fn worst(a: Status, b: Status) -> Status {
+    if a == Status::Warning || b == Status::Warning {
+        Status::Warning
+    } else {
+        Status::Ok
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        if self.fatal {
+            // §2.1.3: after fmi2Fatal no function may be called, not even
+            // fmi2FreeInstance. The FMU may still hold the callbacks and the
+            // sink, so both are leaked with it.
+            return;
+        }
+        if let Some(free_state) = self.functions.free_fmu_state {
+            for mut pointer in self.states.drain(..) {
+                // SAFETY: each pointer is a live state of this instance.
+                unsafe { free_state(self.component, &mut pointer) };
+            }
+        }
+        // SAFETY: the component is live and not used after this.
+        unsafe { (self.functions.free_instance)(self.component) };
+        // SAFETY: the FMU is freed; nothing refers to these any more.
+        unsafe {
+            ManuallyDrop::drop(&mut self.callbacks);
+            ManuallyDrop::drop(&mut self.sink);
+        }
+    }
+}

@@ -1,0 +1,25 @@
+//! The FMU importer: FMI 2.0 Co-Simulation FMUs built by anyone.
+//!
+//! - [`archive`]: the `.fmu` zip unpacked safely into a temporary directory;
+//! - [`model_description`]: `modelDescription.xml` parsed and validated;
+//! - [`library`]: the `linux64` binary loaded and its functions resolved;
+//! - [`logger`]: the FMU's log messages (callback in `logger.c`);
+//! - [`instance`]: [`Fmu`] and its [`Instance`]s, the safe API.
+
+pub mod archive;
+mod ffi;
+pub mod instance;
+pub mod library;
+pub mod logger;
+pub mod model_description;
+mod status;
+
+pub use archive::UnpackOptions;
+pub use instance::{Fmu, FmuState, Instance};
+pub use library::Library;
+pub use logger::{Log, LogMessage};
+pub use model_description::{
+    Causality, CoSimulation, DefaultExperiment, Initial, ModelDescription, ScalarVariable,
+    ValueReference, Variability, VariableKind,
+};
+pub use status::Status;

@@ -1,0 +1,71 @@
+//! The hot path — `set_real`, `do_step`, `get_real` — does not allocate on
+//! the host side. A counting global allocator sees every Rust allocation of
+//! this process (the FMU binaries have their own). One test only, so no
+//! other test thread allocates meanwhile.
+
+mod common;
+
+use fricsim::fmu::{Fmu, Instance};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: delegates to the system allocator.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations made by 1000 steps of set, step, get.
+fn allocations_in_loop(i: &mut Instance, input: u32, output: u32) -> usize {
+    let mut out = [0.0];
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    for k in 0..1000u32 {
+        let t = k as f64 * 1e-3;
+        i.set_real(&[input], &[1e-3]).unwrap();
+        i.do_step(t, 1e-3).unwrap();
+        i.get_real(&[output], &mut out).unwrap();
+    }
+    ALLOCATIONS.load(Ordering::Relaxed) - before
+}
+
+#[test]
+fn set_step_get_do_not_allocate() {
+    // The C stub.
+    let dir = common::stub_fmu_dir("", &[]);
+    let stub = Fmu::from_dir(dir.path()).unwrap();
+    let mut a = stub.instantiate("a").unwrap();
+    assert_eq!(allocations_in_loop(&mut a, 0, 1), 0);
+
+    // The counter works: a failing call allocates its error.
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    a.set_real(&[0], &[f64::NAN]).unwrap_err();
+    assert!(ALLOCATIONS.load(Ordering::Relaxed) > before);
+
+    // LuGre.fmu.
+    let lugre = Fmu::open(common::lugre_fmu()).unwrap();
+    let (v, f) = (
+        lugre.variable("v").unwrap().value_reference,
+        lugre.variable("F").unwrap().value_reference,
+    );
+    let mut i = lugre.instantiate("lugre").unwrap();
+    i.setup_experiment(0.0, None).unwrap();
+    i.enter_initialization_mode().unwrap();
+    i.exit_initialization_mode().unwrap();
+    assert_eq!(allocations_in_loop(&mut i, v, f), 0);
+}

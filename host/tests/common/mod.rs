@@ -1,0 +1,128 @@
+//! Helpers shared by the integration tests: the C stub FMU (compiled with
+//! `cc` at test time), zipping a directory, and the repository's LuGre.fmu.
+#![allow(dead_code)]
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+use tempfile::TempDir;
+
+/// The stub FMU's C source.
+pub const STUB_SOURCE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/c/stub_fmu.c");
+
+/// Compile C `source` into the shared library `out` with extra `flags`.
+pub fn compile_shared(source: &Path, out: &Path, flags: &[&str]) {
+    let output = Command::new("cc")
+        .args([
+            "-shared",
+            "-fPIC",
+            "-fvisibility=hidden",
+            "-O1",
+            "-Wall",
+            "-Wextra",
+        ])
+        .args(flags)
+        .arg("-o")
+        .arg(out)
+        .arg(source)
+        .arg("-lm")
+        .output()
+        .expect("running cc");
+    assert!(
+        output.status.success(),
+        "cc failed:\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+/// The stub's model description; `capabilities` is spliced into `<CoSimulation>`.
+pub fn stub_description(capabilities: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="Stub" guid="{{stub}}" generationTool="hand-written C">
+  <CoSimulation modelIdentifier="Stub" {capabilities}/>
+  <UnitDefinitions><Unit name="m"/></UnitDefinitions>
+  <ModelVariables>
+    <ScalarVariable name="u" valueReference="0" causality="input"><Real start="0" unit="m"/></ScalarVariable>
+    <ScalarVariable name="y" valueReference="1" causality="output"><Real unit="m"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="2" dependencies="1"/></Outputs></ModelStructure>
+</fmiModelDescription>
+"#
+    )
+}
+
+/// An unpacked stub FMU: description with `capabilities`, binary compiled
+/// with `flags`.
+pub fn stub_fmu_dir(capabilities: &str, flags: &[&str]) -> TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("modelDescription.xml"),
+        stub_description(capabilities),
+    )
+    .unwrap();
+    let binaries = dir.path().join("binaries/linux64");
+    std::fs::create_dir_all(&binaries).unwrap();
+    compile_shared(Path::new(STUB_SOURCE), &binaries.join("Stub.so"), flags);
+    dir
+}
+
+/// Zip the files below `dir` into `out`.
+pub fn zip_dir(dir: &Path, out: &Path) {
+    fn add(zip: &mut zip::ZipWriter<std::fs::File>, root: &Path, dir: &Path) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path
+                .strip_prefix(root)
+                .unwrap()
+                .to_str()
+                .unwrap()
+                .to_string();
+            if path.is_dir() {
+                add(zip, root, &path);
+            } else {
+                zip.start_file(name, zip::write::SimpleFileOptions::default())
+                    .unwrap();
+                zip.write_all(&std::fs::read(&path).unwrap()).unwrap();
+            }
+        }
+    }
+    let mut zip = zip::ZipWriter::new(std::fs::File::create(out).unwrap());
+    add(&mut zip, dir, dir);
+    zip.finish().unwrap();
+}
+
+/// The repository root (the workspace).
+pub fn repository() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+/// `dist/LuGre.fmu`, built with `build-fmu.sh` if it is not there yet.
+pub fn lugre_fmu() -> PathBuf {
+    static BUILT: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    BUILT
+        .get_or_init(|| {
+            let fmu = repository().join("dist/LuGre.fmu");
+            if fmu.is_file() {
+                return Ok(fmu);
+            }
+            let output = Command::new(repository().join("build-fmu.sh"))
+                .current_dir(repository())
+                .output();
+            match output {
+                Err(e) => Err(format!("cannot run build-fmu.sh: {e}")),
+                Ok(o) if !o.status.success() || !fmu.is_file() => Err(format!(
+                    "build-fmu.sh did not produce {}:\n{}",
+                    fmu.display(),
+                    String::from_utf8_lossy(&o.stderr)
+                )),
+                Ok(_) => Ok(fmu),
+            }
+        })
+        .clone()
+        .unwrap_or_else(|e| panic!("{e}"))
+}

@@ -1,0 +1,387 @@
+//! modelDescription.xml: a valid FMI 2.0 description is read into typed
+//! values; malformed, truncated or rule-breaking ones are refused with a
+//! message that says what and where.
+
+use fricsim::fmu::model_description::Unknown;
+use fricsim::fmu::{Causality, Initial, ModelDescription, Variability, VariableKind};
+use fricsim::FmuError;
+
+const VALID: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<!-- a comment before the root -->
+<fmiModelDescription fmiVersion="2.0" modelName="Spring &amp; damper" guid="{1234-abcd}"
+    description="A test model" generationTool="hand" generationDateAndTime="2024-01-01T00:00:00Z"
+    variableNamingConvention="structured" numberOfEventIndicators="0">
+  <ModelExchange modelIdentifier="Other"/>
+  <CoSimulation modelIdentifier="Spring_1" canHandleVariableCommunicationStepSize="true"
+      canInterpolateInputs="1" maxOutputDerivativeOrder="2" canGetAndSetFMUstate="true"
+      canSerializeFMUstate="true" providesDirectionalDerivative="false"/>
+  <UnitDefinitions>
+    <Unit name="m"><BaseUnit m="1"/></Unit>
+    <Unit name="N"><BaseUnit kg="1" m="1" s="-2"/></Unit>
+  </UnitDefinitions>
+  <TypeDefinitions>
+    <SimpleType name="Mode"><Enumeration><Item name="a" value="1"/><Item name="b" value="2"/></Enumeration></SimpleType>
+  </TypeDefinitions>
+  <LogCategories>
+    <Category name="logError" description="Errors"/>
+    <Category name="logCalls"/>
+  </LogCategories>
+  <DefaultExperiment startTime="0" stopTime="2.5" stepSize="1e-3"/>
+  <ModelVariables>
+    <!-- index 1 -->
+    <ScalarVariable name="x" valueReference="0" causality="input" description="Position">
+      <Real start="0.5" unit="m" nominal="0.1" min="-INF" max="10"/>
+    </ScalarVariable>
+    <ScalarVariable name="F" valueReference="1" causality="output" initial="calculated">
+      <Real unit="N"/>
+    </ScalarVariable>
+    <ScalarVariable name="k" valueReference="2" causality="parameter" variability="fixed" initial="exact">
+      <Real start="100"/>
+      <Annotations><Tool name="x"/></Annotations>
+    </ScalarVariable>
+    <ScalarVariable name="n" valueReference="0" causality="parameter" variability="tunable">
+      <Integer start="-3" min="-10" max="10"/>
+    </ScalarVariable>
+    <ScalarVariable name="on" valueReference="0" causality="input" variability="discrete">
+      <Boolean start="true"/>
+    </ScalarVariable>
+    <ScalarVariable name="label" valueReference="0" variability="discrete">
+      <String start="hello"/>
+    </ScalarVariable>
+    <ScalarVariable name="mode" valueReference="3" causality="parameter" variability="fixed">
+      <Enumeration declaredType="Mode" start="2"/>
+    </ScalarVariable>
+    <ScalarVariable name="der(x)" valueReference="4">
+      <Real derivative="1"/>
+    </ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs>
+      <Unknown index="2" dependencies="1 5" dependenciesKind="dependent dependent"/>
+    </Outputs>
+    <InitialUnknowns><Unknown index="2"/></InitialUnknowns>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+
+#[test]
+fn a_valid_description_is_read() {
+    let d = ModelDescription::parse(VALID).unwrap();
+    assert_eq!(d.fmi_version, "2.0");
+    assert_eq!(d.model_name, "Spring & damper");
+    assert_eq!(d.guid, "{1234-abcd}");
+    assert_eq!(d.description.as_deref(), Some("A test model"));
+    assert_eq!(d.generation_tool.as_deref(), Some("hand"));
+
+    let cs = &d.co_simulation;
+    assert_eq!(cs.model_identifier, "Spring_1");
+    assert!(cs.can_handle_variable_communication_step_size);
+    assert!(cs.can_interpolate_inputs);
+    assert_eq!(cs.max_output_derivative_order, 2);
+    assert!(cs.can_get_and_set_fmu_state && cs.can_serialize_fmu_state);
+    assert!(!cs.provides_directional_derivative);
+
+    assert_eq!(
+        d.unit_definitions.as_deref(),
+        Some(&["m".to_string(), "N".to_string()][..])
+    );
+    let categories: Vec<_> = d.log_categories.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(categories, ["logError", "logCalls"]);
+    assert_eq!(d.log_categories[0].description.as_deref(), Some("Errors"));
+    let e = d.default_experiment.as_ref().unwrap();
+    assert_eq!(
+        (e.start_time, e.stop_time, e.tolerance, e.step_size),
+        (Some(0.0), Some(2.5), None, Some(1e-3))
+    );
+
+    assert_eq!(d.variables.len(), 8);
+    let x = d.variable("x").unwrap();
+    assert_eq!(
+        (x.index, x.value_reference, x.causality, x.variability),
+        (1, 0, Causality::Input, Variability::Continuous)
+    );
+    assert_eq!(x.description.as_deref(), Some("Position"));
+    assert_eq!(
+        x.kind,
+        VariableKind::Real {
+            start: Some(0.5),
+            unit: Some("m".into()),
+            nominal: Some(0.1),
+            min: Some(f64::NEG_INFINITY),
+            max: Some(10.0),
+            derivative: None
+        }
+    );
+    let f = d.variable("F").unwrap();
+    assert_eq!(
+        (f.causality, f.initial),
+        (Causality::Output, Some(Initial::Calculated))
+    );
+    let k = d.variable("k").unwrap();
+    assert_eq!(
+        (k.variability, k.initial, k.kind.start_text().as_deref()),
+        (Variability::Fixed, Some(Initial::Exact), Some("100.0"))
+    );
+    assert_eq!(
+        d.variable("n").unwrap().kind,
+        VariableKind::Integer {
+            start: Some(-3),
+            min: Some(-10),
+            max: Some(10)
+        }
+    );
+    assert_eq!(
+        d.variable("on").unwrap().kind,
+        VariableKind::Boolean { start: Some(true) }
+    );
+    let label = d.variable("label").unwrap();
+    assert_eq!(
+        (label.causality, &label.kind),
+        (
+            Causality::Local,
+            &VariableKind::String {
+                start: Some("hello".into())
+            }
+        )
+    );
+    assert_eq!(d.variable("mode").unwrap().kind.type_name(), "Enumeration");
+    assert!(matches!(
+        d.variable("der(x)").unwrap().kind,
+        VariableKind::Real {
+            derivative: Some(1),
+            ..
+        }
+    ));
+
+    assert_eq!(
+        d.outputs,
+        vec![Unknown {
+            index: 2,
+            dependencies: Some(vec![1, 5])
+        }]
+    );
+
+    let e = d.variable("nope").unwrap_err();
+    assert!(matches!(&e, FmuError::UnknownVariable { .. }));
+    assert!(e.to_string().contains("\"nope\""), "{e}");
+}
+
+#[test]
+fn a_minimal_description_uses_the_defaults() {
+    let d = ModelDescription::parse(
+        r#"<fmiModelDescription fmiVersion="2.0" modelName="M" guid="g">
+             <CoSimulation modelIdentifier="M"/>
+             <ModelVariables><ScalarVariable name="y" valueReference="7"><Real/></ScalarVariable></ModelVariables>
+           </fmiModelDescription>"#,
+    )
+    .unwrap();
+    let y = d.variable("y").unwrap();
+    assert_eq!(
+        (y.causality, y.variability, y.initial),
+        (Causality::Local, Variability::Continuous, None)
+    );
+    assert!(!d.co_simulation.can_get_and_set_fmu_state);
+    assert_eq!(d.co_simulation.max_output_derivative_order, 0);
+    assert!(d.unit_definitions.is_none() && d.default_experiment.is_none() && d.outputs.is_empty());
+}
+
+/// Parse `xml`, expecting an error whose message holds every part.
+fn refused(xml: &str, parts: &[&str]) -> FmuError {
+    let e = ModelDescription::parse(xml).expect_err("must be refused");
+    let message = e.to_string();
+    for part in parts {
+        assert!(
+            message.contains(part),
+            "message {message:?} does not contain {part:?}"
+        );
+    }
+    e
+}
+
+#[test]
+fn malformed_xml_is_refused_with_a_position() {
+    // Mismatched end tag on line 3.
+    let xml = "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"M\" guid=\"g\">\n  <CoSimulation modelIdentifier=\"M\">\n  </Cosimulation>\n</fmiModelDescription>";
+    let e = refused(xml, &["modelDescription.xml:3:"]);
+    assert!(matches!(e, FmuError::XmlSyntax { line: 3, .. }), "{e}");
+    // Not XML at all.
+    refused("just text", &["modelDescription.xml:1:"]);
+    refused("", &["no root element"]);
+    // Another root element.
+    refused(
+        "<fmiModelDescriptions fmiVersion=\"2.0\"/>",
+        &["<fmiModelDescriptions>"],
+    );
+    // An attribute with a value of the wrong type.
+    let bad_number = VALID.replace(r#"stopTime="2.5""#, r#"stopTime="later""#);
+    let e = refused(&bad_number, &["modelDescription.xml:"]);
+    assert!(matches!(e, FmuError::XmlSyntax { line: 21, .. }), "{e}");
+}
+
+#[test]
+fn truncated_xml_is_refused() {
+    for cut in [10, 100, VALID.len() / 2, VALID.len() - 30] {
+        let mut end = cut;
+        while !VALID.is_char_boundary(end) {
+            end -= 1;
+        }
+        let e = ModelDescription::parse(&VALID[..end])
+            .expect_err("a truncated description must be refused");
+        assert!(matches!(e, FmuError::XmlSyntax { .. }), "cut at {cut}: {e}");
+    }
+}
+
+#[test]
+fn other_fmi_versions_are_refused() {
+    for version in ["1.0", "3.0"] {
+        let xml = VALID.replace(r#"fmiVersion="2.0""#, &format!(r#"fmiVersion="{version}""#));
+        let e = refused(
+            &xml,
+            &[&format!("fmiVersion is \"{version}\""), "only FMI 2.0"],
+        );
+        assert!(matches!(e, FmuError::UnsupportedFmiVersion { .. }));
+    }
+    // An FMI 3.0 file has another structure altogether.
+    refused(
+        r#"<fmiModelDescription fmiVersion="3.0" modelName="M" instantiationToken="t"><CoSimulation modelIdentifier="M"/><ModelVariables><Float64 name="x" valueReference="0"/></ModelVariables></fmiModelDescription>"#,
+        &["\"3.0\""],
+    );
+    refused(
+        r#"<fmiModelDescription modelName="M" guid="g"/>"#,
+        &["no fmiVersion"],
+    );
+}
+
+#[test]
+fn duplicated_variable_names_are_refused() {
+    let xml = VALID.replace(r#"name="label""#, r#"name="x""#);
+    let e = refused(
+        &xml,
+        &["variable \"x\" (index 6)", "already used", "index 1"],
+    );
+    assert!(matches!(e, FmuError::InvalidModelDescription { .. }));
+}
+
+#[test]
+fn an_undefined_unit_is_refused() {
+    let xml = VALID.replace(r#"<Real unit="N"/>"#, r#"<Real unit="lbf"/>"#);
+    refused(
+        &xml,
+        &[
+            "variable \"F\" (index 2)",
+            "unit \"lbf\"",
+            "UnitDefinitions",
+        ],
+    );
+    // Without UnitDefinitions units are not checked.
+    let start = VALID.find("<UnitDefinitions>").unwrap();
+    let end = VALID.find("</UnitDefinitions>").unwrap() + "</UnitDefinitions>".len();
+    let without =
+        format!("{}{}", &VALID[..start], &VALID[end..]).replace(r#"unit="N""#, r#"unit="lbf""#);
+    ModelDescription::parse(&without).unwrap();
+}
+
+#[test]
+fn a_missing_co_simulation_element_is_refused() {
+    let start = VALID.find("<CoSimulation").unwrap();
+    let end = start + VALID[start..].find("/>").unwrap() + 2;
+    let xml = format!("{}{}", &VALID[..start], &VALID[end..]);
+    let e = refused(&xml, &["not a co-simulation FMU"]);
+    assert!(matches!(e, FmuError::NotCoSimulation));
+}
+
+#[test]
+fn variables_breaking_the_rules_are_refused() {
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            r#"name="F" valueReference="1" "#,
+            r#"name="F" "#,
+            &["variable \"F\" (index 2)", "valueReference"],
+        ),
+        (
+            r#"causality="input" description"#,
+            r#"causality="in" description"#,
+            &["\"x\" (index 1)", "causality \"in\""],
+        ),
+        (
+            r#"variability="tunable""#,
+            r#"variability="sometimes""#,
+            &["\"n\" (index 4)", "variability \"sometimes\""],
+        ),
+        (
+            r#"initial="exact""#,
+            r#"initial="maybe""#,
+            &["\"k\" (index 3)", "initial \"maybe\""],
+        ),
+        (
+            r#"causality="input" variability="discrete""#,
+            r#"causality="input" variability="fixed""#,
+            &[
+                "\"on\" (index 5)",
+                "causality \"input\" with variability \"fixed\"",
+            ],
+        ),
+        (
+            r#"<Real start="100"/>"#,
+            r#"<Real start="100"/><Integer/>"#,
+            &["\"k\" (index 3)", "exactly one", "found 2"],
+        ),
+        (r#"<Real unit="N"/>"#, "", &["\"F\" (index 2)", "found 0"]),
+        (
+            r#"<Enumeration declaredType="Mode" start="2"/>"#,
+            r#"<Enumeration start="2"/>"#,
+            &["\"mode\"", "declaredType"],
+        ),
+        (
+            r#"name="label""#,
+            r#"name="""#,
+            &["variable at index 6", "name"],
+        ),
+        (
+            r#"<Unknown index="2" dependencies"#,
+            r#"<Unknown index="3" dependencies"#,
+            &["Outputs", "\"k\"", "expected \"output\""],
+        ),
+        (
+            r#"<Unknown index="2" dependencies"#,
+            r#"<Unknown index="99" dependencies"#,
+            &["index 99", "1..=8"],
+        ),
+        (
+            r#"dependencies="1 5""#,
+            r#"dependencies="1 x""#,
+            &["dependency \"x\""],
+        ),
+        (
+            r#"<Real derivative="1"/>"#,
+            r#"<Real derivative="42"/>"#,
+            &["\"der(x)\"", "derivative=\"42\""],
+        ),
+        (
+            r#"modelIdentifier="Spring_1""#,
+            r#"modelIdentifier="../../evil""#,
+            &["modelIdentifier \"../../evil\"", "C identifier"],
+        ),
+    ];
+    for (from, to, parts) in cases {
+        assert!(VALID.contains(from), "test case does not apply: {from}");
+        let e = refused(&VALID.replacen(from, to, 1), parts);
+        assert!(
+            matches!(e, FmuError::InvalidModelDescription { .. }),
+            "{from} -> {to}: {e}"
+        );
+    }
+}
+
+#[test]
+fn invalid_utf8_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("modelDescription.xml");
+    let mut bytes = VALID.as_bytes().to_vec();
+    let at = VALID.find("A test model").unwrap();
+    bytes[at] = 0xFF;
+    std::fs::write(&path, &bytes).unwrap();
+    let e = ModelDescription::from_file(&path).unwrap_err();
+    assert!(matches!(e, FmuError::XmlSyntax { line: 4, .. }), "{e}");
+    assert!(e.to_string().contains("UTF-8"), "{e}");
+}
