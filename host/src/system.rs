@@ -23,6 +23,32 @@ pub struct Component {
     pub outputs: Vec<(String, ValueReference)>,
 }
 
+impl Component {
+    /// Whether output `vr` depends directly on an input (its model-structure
+    /// dependencies name an input; an absent attribute counts as yes).
+    pub fn has_feedthrough(&self, vr: ValueReference) -> bool {
+        let d = self.fmu.description();
+        let Some(var) = d
+            .variables
+            .iter()
+            .find(|v| v.value_reference == vr && v.causality == Causality::Output)
+        else {
+            return true;
+        };
+        match d.outputs.iter().find(|u| u.index == var.index) {
+            Some(u) => match &u.dependencies {
+                None => true,
+                Some(deps) => deps.iter().any(|i| {
+                    d.variables
+                        .get(i - 1)
+                        .is_some_and(|v| v.causality == Causality::Input)
+                }),
+            },
+            None => true,
+        }
+    }
+}
+
 /// `from.component.output → to.component.input`, by component index.
 #[derive(Clone, Debug)]
 pub struct Connection {

@@ -1,7 +1,7 @@
 //! `fricsim cosim`: connect FMUs given on the command line, co-simulate
 //! with a fixed macro step, write a CSV and a plot, print a summary.
 
-use fricsim::master::{jacobi::Jacobi, simulate, MasterAlgorithm};
+use fricsim::master::{gauss_seidel::GaussSeidel, jacobi::Jacobi, simulate, MasterAlgorithm};
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
 
@@ -16,6 +16,9 @@ pub struct CosimArgs {
     /// A connection: component.output->component.input (repeat).
     #[arg(long = "connect")]
     pub connections: Vec<String>,
+    /// Master algorithm: jacobi, gauss-seidel, gauss-seidel-interpolated.
+    #[arg(long, default_value = "jacobi")]
+    pub master: String,
     /// Macro step in seconds.
     #[arg(long, default_value_t = 1e-4)]
     pub step: f64,
@@ -77,9 +80,18 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
         components.iter().map(|(n, p)| (n.clone(), *p)).collect();
     let mut system =
         System::build(&components, &parameters, &connections).map_err(|e| e.to_string())?;
-    let mut master = Jacobi::default();
+    let mut master: Box<dyn MasterAlgorithm> = match a.master.as_str() {
+        "jacobi" => Box::new(Jacobi::default()),
+        "gauss-seidel" => Box::new(GaussSeidel::new(false)),
+        "gauss-seidel-interpolated" => Box::new(GaussSeidel::new(true)),
+        other => {
+            return Err(format!(
+                "unknown --master {other} (jacobi, gauss-seidel, gauss-seidel-interpolated)"
+            ))
+        }
+    };
     let started = std::time::Instant::now();
-    let run = simulate(&mut system, &mut master, a.step, a.stop).map_err(|e| e.to_string())?;
+    let run = simulate(&mut system, master.as_mut(), a.step, a.stop).map_err(|e| e.to_string())?;
     let elapsed = started.elapsed();
     fricsim::results::write_csv(&run, &a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
     if let Some(plot) = &a.plot {
@@ -88,7 +100,12 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
         } else {
             a.plot_signals.clone()
         };
-        fricsim::plot::plot_signals(&run, &signals, plot, "fricsim cosim (Jacobi)")?;
+        fricsim::plot::plot_signals(
+            &run,
+            &signals,
+            plot,
+            &format!("fricsim cosim ({})", master.name()),
+        )?;
     }
     println!(
         "{} macro steps of {} s with {}, {} columns, {:.3} s wall time",

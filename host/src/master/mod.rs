@@ -1,5 +1,6 @@
 //! Master algorithms: how a macro step advances the connected FMUs.
 
+pub mod gauss_seidel;
 pub mod jacobi;
 
 use crate::system::System;
