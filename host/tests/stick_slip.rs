@@ -137,7 +137,10 @@ fn configuration_errors_name_the_problem() {
 #[test]
 fn an_fmu_error_mid_run_keeps_the_results_so_far() {
     let (rig, lugre) = (dist("Rig1D.fmu"), dist("LuGre.fmu"));
-    let components = [("rig".to_string(), rig.as_path()), ("friction".to_string(), lugre.as_path())];
+    let components = [
+        ("rig".to_string(), rig.as_path()),
+        ("friction".to_string(), lugre.as_path()),
+    ];
     let parameters = [
         ("rig.x0".to_string(), 0.01),
         ("rig.k".to_string(), 0.0),
@@ -150,8 +153,15 @@ fn an_fmu_error_mid_run_keeps_the_results_so_far() {
     let mut system = System::build(&components, &parameters, &connections).unwrap();
     let run = simulate(&mut system, &mut Jacobi::default(), 1e-3, 1.0).unwrap();
     let error = run.error.expect("the run must stop");
-    assert!(error.contains("friction") && error.contains("fmi2SetReal") && error.contains("Fn"), "{error}");
+    assert!(
+        error.contains("friction") && error.contains("fmi2SetReal") && error.contains("Fn"),
+        "{error}"
+    );
     // x = 0.01 - 0.1 t turns negative after t = 0.1 s: about 100 rows kept
-    assert!((95..=105).contains(&run.rows.len()), "kept {} rows", run.rows.len());
+    assert!(
+        (95..=105).contains(&run.rows.len()),
+        "kept {} rows",
+        run.rows.len()
+    );
     assert_eq!(run.rows.len(), run.time.len());
 }

@@ -66,3 +66,23 @@ pub struct ModelFactory {
     pub info: &'static ModelInfo,
     pub create: fn() -> Box<dyn Model>,
 }
+
+/// The three `Model` methods that only forward to a law with
+/// `state_to_vec` / `state_from_slice` held in field `$law` of a `Clone`
+/// model: write `fmi2_cs::delegate_state!(law);` inside the `impl Model`.
+#[macro_export]
+macro_rules! delegate_state {
+    ($law:ident) => {
+        fn save_state(&self, out: &mut Vec<f64>) {
+            out.extend(self.$law.state_to_vec());
+        }
+
+        fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+            self.$law.state_from_slice(state)
+        }
+
+        fn clone_model(&self) -> Box<dyn $crate::Model> {
+            Box::new(self.clone())
+        }
+    };
+}

@@ -154,17 +154,7 @@ impl Model for BristleFmu {
         Ok(())
     }
 
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.extend(self.law.state_to_vec());
-    }
-
-    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
-        self.law.state_from_slice(state)
-    }
-
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    fmi2_cs::delegate_state!(law);
 
     /// ∂F/∂x is the tangent stiffness n_connected·σb at the current input,
     /// exact between disconnection events, whether or not a step preceded.

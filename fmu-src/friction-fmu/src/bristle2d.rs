@@ -170,17 +170,7 @@ impl Model for Bristle2DFmu {
         Ok(())
     }
 
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.extend(self.law.state_to_vec());
-    }
-
-    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
-        self.law.state_from_slice(state)
-    }
-
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    fmi2_cs::delegate_state!(law);
 
     fn output_derivative(&self, values: &Values, _slopes: &[f64], output: u32) -> Option<f64> {
         let z_dot = self.law.z_dot([values.real(vr::V1), values.real(vr::V2)]);

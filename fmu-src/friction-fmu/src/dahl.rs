@@ -122,17 +122,7 @@ impl Model for DahlFmu {
         Ok(())
     }
 
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.extend(self.law.state_to_vec());
-    }
-
-    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
-        self.law.state_from_slice(state)
-    }
-
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    fmi2_cs::delegate_state!(law);
 
     /// dF/dt = (dF/dx)·v (seed 001 eq. 3); dz/dt = (dF/dt)/σ.
     fn output_derivative(&self, values: &Values, _slopes: &[f64], output: u32) -> Option<f64> {

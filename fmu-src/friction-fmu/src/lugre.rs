@@ -317,17 +317,7 @@ impl Model for LuGreFmu {
         Ok(())
     }
 
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.extend(self.law.state_to_vec());
-    }
-
-    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
-        self.law.state_from_slice(state)
-    }
-
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    fmi2_cs::delegate_state!(law);
 
     /// dz/dt from the state equation; dF/dt = σ0·ż + σ1·z̈ + σ2·v̇ with
     /// z̈ = v̇ − σ0·d(|v|·z/g)/dt, for constant σ1 and x, Fn at rest (the

@@ -119,17 +119,7 @@ impl Model for ResetFmu {
         Ok(())
     }
 
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.extend(self.law.state_to_vec());
-    }
-
-    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
-        self.law.state_from_slice(state)
-    }
-
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    fmi2_cs::delegate_state!(law);
 
     /// Inside the stiction range ż = v, so dF/dt = (1 + a)·σ0·v + σ1·dv/dt;
     /// at the limit moving outward ż = 0 and F is constant.

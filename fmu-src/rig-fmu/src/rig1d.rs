@@ -165,15 +165,5 @@ impl Model for Rig1DFmu {
         Ok(())
     }
 
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.extend(self.rig.state_to_vec());
-    }
-
-    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
-        self.rig.state_from_slice(state)
-    }
-
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    fmi2_cs::delegate_state!(rig);
 }
