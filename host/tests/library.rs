@@ -2,20 +2,11 @@
 //! required or declared functions, wrong FMI version.
 
 mod common;
+use common::assert_message;
 
 use common::{stub_description, stub_fmu_dir};
 use fricsim::fmu::Fmu;
 use fricsim::FmuError;
-
-fn message_of(e: &FmuError, parts: &[&str]) {
-    let message = e.to_string();
-    for part in parts {
-        assert!(
-            message.contains(part),
-            "message {message:?} does not contain {part:?}"
-        );
-    }
-}
 
 #[test]
 fn the_stub_loads() {
@@ -40,12 +31,12 @@ fn a_missing_linux64_binary_is_refused_listing_the_platforms() {
     std::fs::write(dir.path().join("binaries/win64/Stub.dll"), b"MZ").unwrap();
     let e = Fmu::from_dir(dir.path()).unwrap_err();
     assert!(matches!(&e, FmuError::MissingBinary { .. }), "{e}");
-    message_of(&e, &["FMU has no binary for linux64: expected binaries/linux64/Stub.so; it has: darwin64, win64"]);
+    assert_message(&e, &["FMU has no binary for linux64: expected binaries/linux64/Stub.so; it has: darwin64, win64"]);
 
     // No binaries at all.
     std::fs::remove_dir_all(dir.path().join("binaries")).unwrap();
     let e = Fmu::from_dir(dir.path()).unwrap_err();
-    message_of(
+    assert_message(
         &e,
         &["expected binaries/linux64/Stub.so", "it has: no binaries"],
     );
@@ -73,7 +64,7 @@ fn a_file_that_is_not_a_shared_library_is_refused() {
     let e = Fmu::from_dir(dir.path()).unwrap_err();
     assert!(matches!(&e, FmuError::LoadLibrary { .. }), "{e}");
     // The path, and dlopen's reason (e.g. "invalid ELF header").
-    message_of(&e, &[path.to_str().unwrap(), "as a shared library", "ELF"]);
+    assert_message(&e, &[path.to_str().unwrap(), "as a shared library", "ELF"]);
 }
 
 #[test]
@@ -110,7 +101,7 @@ fn missing_required_functions_are_all_named() {
         "fmi2GetStringStatus",
     ];
     assert_eq!(symbols, &expected);
-    message_of(&e, &["Stub.so does not export the required FMI 2.0 functions: fmi2GetTypesPlatform, fmi2SetDebugLogging"]);
+    assert_message(&e, &["Stub.so does not export the required FMI 2.0 functions: fmi2GetTypesPlatform, fmi2SetDebugLogging"]);
     assert!(
         !e.to_string().contains("fmi2GetVersion"),
         "fmi2GetVersion is exported: {e}"
@@ -155,7 +146,7 @@ fn declared_but_missing_optional_functions_are_named() {
             .split('=')
             .next()
             .unwrap();
-        message_of(&e, &[first, &format!("does not export {missing}")]);
+        assert_message(&e, &[first, &format!("does not export {missing}")]);
     }
 }
 
@@ -164,7 +155,7 @@ fn a_wrong_fmi_version_is_refused() {
     let dir = stub_fmu_dir("", &["-DSTUB_VERSION=\"3.0\""]);
     let e = Fmu::from_dir(dir.path()).unwrap_err();
     assert!(matches!(&e, FmuError::WrongFmiVersion { .. }), "{e}");
-    message_of(&e, &["fmi2GetVersion() returned \"3.0\", expected \"2.0\""]);
+    assert_message(&e, &["fmi2GetVersion() returned \"3.0\", expected \"2.0\""]);
 }
 
 #[test]

@@ -17,12 +17,21 @@ fn dist(name: &str) -> std::path::PathBuf {
     p
 }
 
+/// The two components of every system here: `rig` and `friction`.
+fn components() -> [(String, std::path::PathBuf); 2] {
+    [
+        ("rig".to_string(), dist("Rig1D.fmu")),
+        ("friction".to_string(), dist("LuGre.fmu")),
+    ]
+}
+
+fn as_refs(c: &[(String, std::path::PathBuf)]) -> Vec<(String, &Path)> {
+    c.iter().map(|(n, p)| (n.clone(), p.as_path())).collect()
+}
+
 fn stick_slip_system() -> System {
-    let (rig, lugre) = (dist("Rig1D.fmu"), dist("LuGre.fmu"));
-    let components = [
-        ("rig".to_string(), rig.as_path()),
-        ("friction".to_string(), lugre.as_path()),
-    ];
+    let owned = components();
+    let components = as_refs(&owned);
     let connections = [
         ("rig.v".to_string(), "friction.v".to_string()),
         ("friction.F".to_string(), "rig.F".to_string()),
@@ -108,11 +117,8 @@ fn lugre_stick_slip_benchmark_matches_the_reference() {
 
 #[test]
 fn configuration_errors_name_the_problem() {
-    let (rig, lugre) = (dist("Rig1D.fmu"), dist("LuGre.fmu"));
-    let components = [
-        ("rig".to_string(), rig.as_path()),
-        ("friction".to_string(), lugre.as_path()),
-    ];
+    let owned = components();
+    let components = as_refs(&owned);
     let cases = [
         (("rig.nope", "friction.v"), "has no variable `nope`"),
         (("rig.v", "friction.F"), "`friction.F` is not an input"),
@@ -136,11 +142,8 @@ fn configuration_errors_name_the_problem() {
 /// turns negative at t = 0.1 s, which LuGre refuses.)
 #[test]
 fn an_fmu_error_mid_run_keeps_the_results_so_far() {
-    let (rig, lugre) = (dist("Rig1D.fmu"), dist("LuGre.fmu"));
-    let components = [
-        ("rig".to_string(), rig.as_path()),
-        ("friction".to_string(), lugre.as_path()),
-    ];
+    let owned = components();
+    let components = as_refs(&owned);
     let parameters = [
         ("rig.x0".to_string(), 0.01),
         ("rig.k".to_string(), 0.0),

@@ -2,6 +2,7 @@
 //! `cc` at test time), zipping a directory, and the repository's LuGre.fmu.
 #![allow(dead_code)]
 
+use fricsim::FmuError;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -125,4 +126,15 @@ pub fn lugre_fmu() -> PathBuf {
         })
         .clone()
         .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Assert that `error`'s message contains every one of `parts`.
+pub fn assert_message(error: &FmuError, parts: &[&str]) {
+    let message = error.to_string();
+    for part in parts {
+        assert!(
+            message.contains(part),
+            "message {message:?} does not contain {part:?}"
+        );
+    }
 }
