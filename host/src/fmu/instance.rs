@@ -587,13 +587,45 @@ impl Instance {
 
     /// `fmi2DoStep` from communication point `t` over `h`, with
     /// `noSetFMUStatePriorToCurrentPoint = false` (states may be restored).
-    /// Does not allocate.
+    /// Does not allocate unless it fails.
+    ///
+    /// `fmi2Discard` means the FMU completed only part of the step (§4.2.2).
+    /// The error then also says how far it got and whether it wants
+    /// the simulation to end, asked through `fmi2GetRealStatus
+    /// (fmi2LastSuccessfulTime)` and `fmi2GetBooleanStatus(fmi2Terminated)`,
+    /// or why the FMU could not say.
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Status, FmuError> {
         const F: &str = "fmi2DoStep";
         let mark = self.begin(F)?;
         // SAFETY: plain values.
         let raw = unsafe { (self.functions.do_step)(self.component, t, h, fmi2False) };
-        self.finish(F, mark, raw)
+        let mut result = self.finish(F, mark, raw);
+        if let Err(FmuError::Call {
+            status: Status::Discard,
+            messages,
+            ..
+        }) = &mut result
+        {
+            messages.push(self.discard_report());
+        }
+        result
+    }
+
+    /// After `fmi2DoStep` returned `fmi2Discard`: how far the step got and
+    /// whether the FMU asks to end the simulation, in words.
+    fn discard_report(&mut self) -> String {
+        let reached = match self.last_successful_time() {
+            Ok(time) => {
+                format!("the FMU completed the step only up to t = {time} (fmi2LastSuccessfulTime)")
+            }
+            Err(e) => format!("fmi2LastSuccessfulTime is not available ({e})"),
+        };
+        let terminated = match self.terminated() {
+            Ok(true) => "it asks to end the simulation (fmi2Terminated = true)".to_string(),
+            Ok(false) => "it does not ask to end the simulation (fmi2Terminated = false): the step could be retried with a smaller step from a saved FMU state".to_string(),
+            Err(e) => format!("fmi2Terminated is not available ({e})"),
+        };
+        format!("{reached}; {terminated}")
     }
 
     /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`: where a discarded step stopped.

@@ -147,7 +147,7 @@ impl Library {
             unsafe { UnixLibrary::open(Some(path), RTLD_NOW | RTLD_LOCAL) }
                 .map_err(|e| FmuError::LoadLibrary {
                     path: path.to_path_buf(),
-                    message: error_chain(&e),
+                    message: with_execution_tool_hint(error_chain(&e), description),
                 })?
                 .into();
         let mut functions =
@@ -293,6 +293,24 @@ fn error_chain(e: &dyn std::error::Error) -> String {
         source = s.source();
     }
     message
+}
+
+/// A binary that cannot be loaded on its own often belongs to an FMU that
+/// declares `needsExecutionTool="true"` (e.g. one exported by pythonfmu,
+/// whose binary expects the Python runtime to be loaded already): say so.
+fn with_execution_tool_hint(message: String, description: &ModelDescription) -> String {
+    if description.co_simulation.needs_execution_tool {
+        format!(
+            "{message} (the FMU declares needsExecutionTool=\"true\": its binary needs the runtime of the tool it was exported from{}, loaded into this process)",
+            description
+                .generation_tool
+                .as_deref()
+                .map(|t| format!(", {t}"))
+                .unwrap_or_default()
+        )
+    } else {
+        message
+    }
 }
 
 /// A C string returned by the FMU, or "" for null.

@@ -1,0 +1,258 @@
+//! FMUs that fail mid-run: BeltOscillator (a C FMU written by hand, see
+//! tests/c/belt_oscillator) coupled with the repository's LuGre.fmu, told
+//! to fail at its 10th fmi2DoStep with fmi2Discard, fmi2Error or fmi2Fatal.
+//! The run stops, the rows of the completed communication points are kept,
+//! and the report names the instance, the call and the status; a discarded
+//! step also says how far the FMU got (fmi2LastSuccessfulTime) and whether
+//! it asks to end (fmi2Terminated); after fmi2Fatal the FMU is never called
+//! again, not even by fmi2FreeInstance. The same through `fricsim cosim`.
+
+mod belt;
+mod common;
+
+use belt::Counters;
+use fricsim::master::{gauss_seidel::GaussSeidel, jacobi::Jacobi, simulate, MasterAlgorithm, Run};
+use fricsim::system::System;
+use fricsim::FmuError;
+use std::path::{Path, PathBuf};
+use tempfile::TempDir;
+
+/// 2^-10 s: communication points and half steps are exact binary numbers.
+const H: f64 = 1.0 / 1024.0;
+/// The call of fmi2DoStep that fails; the 9 steps before it complete.
+const FAULT_STEP: usize = 10;
+
+struct Rig {
+    _dir: TempDir,
+    belt: PathBuf,
+    lugre: PathBuf,
+}
+
+fn rig() -> Rig {
+    let dir = tempfile::tempdir().unwrap();
+    let belt = belt::build_fmu(dir.path());
+    Rig {
+        _dir: dir,
+        belt,
+        lugre: common::lugre_fmu(),
+    }
+}
+
+/// rig = BeltOscillator, friction = LuGre, coupled through the slip
+/// velocity and the friction force; the rig fails as `fault` says.
+fn coupled(rig: &Rig, fault: i32, terminates: bool) -> System {
+    let components = [
+        ("rig".to_string(), rig.belt.as_path()),
+        ("friction".to_string(), rig.lugre.as_path()),
+    ];
+    let parameters = [
+        ("rig.fault".to_string(), fault as f64),
+        ("rig.fault_step".to_string(), FAULT_STEP as f64),
+        ("rig.fault_terminates".to_string(), terminates as i32 as f64),
+        // start sliding: the body at rest on the moving belt
+        ("rig.v0".to_string(), 0.0),
+    ];
+    let connections = [
+        ("rig.v".to_string(), "friction.v".to_string()),
+        ("friction.F".to_string(), "rig.F".to_string()),
+    ];
+    System::build(&components, &parameters, &connections).unwrap()
+}
+
+/// The run stopped in the step from t = 9·H, keeping the rows at 0, H, …, 9·H.
+fn assert_stopped_at_the_fault(run: &Run) -> &str {
+    let error = run.error.as_deref().expect("the run must stop");
+    assert_eq!(run.rows.len(), FAULT_STEP, "{error}");
+    assert_eq!(run.time.len(), FAULT_STEP);
+    assert_eq!(*run.time.last().unwrap(), (FAULT_STEP - 1) as f64 * H);
+    assert!(
+        error.starts_with(&format!("at t = {}: ", (FAULT_STEP - 1) as f64 * H)),
+        "{error}"
+    );
+    // the rows kept are real results: the belt drags the body along
+    let kv = run.columns.iter().position(|c| c == "rig.v").unwrap();
+    let kf = run.columns.iter().position(|c| c == "friction.F").unwrap();
+    let last = run.rows.last().unwrap();
+    assert!(last.iter().all(|x| x.is_finite()), "{last:?}");
+    assert!(last[kv] < 0.0 && last[kf] < 0.0, "{last:?}");
+    error
+}
+
+fn masters() -> [Box<dyn MasterAlgorithm>; 3] {
+    [
+        Box::new(Jacobi::default()),
+        Box::new(GaussSeidel::new(false)),
+        Box::new(GaussSeidel::new(true)),
+    ]
+}
+
+#[test]
+fn a_discarded_step_says_how_far_the_fmu_got_and_whether_it_asks_to_end() {
+    let rig = rig();
+    for terminates in [true, false] {
+        for mut master in masters() {
+            let mut system = coupled(&rig, belt::DISCARD, terminates);
+            let run = simulate(&mut system, master.as_mut(), H, 1.0).unwrap();
+            let error = assert_stopped_at_the_fault(&run);
+            let t = (FAULT_STEP - 1) as f64 * H;
+            let mut expected = vec![
+                "fmi2DoStep failed for instance \"rig\" with fmi2Discard".to_string(),
+                format!("fault injected at step {FAULT_STEP}"),
+                format!(
+                    "the FMU completed the step only up to t = {} (fmi2LastSuccessfulTime)",
+                    t + H / 2.0
+                ),
+            ];
+            expected.push(if terminates {
+                "it asks to end the simulation (fmi2Terminated = true)".to_string()
+            } else {
+                "it does not ask to end the simulation (fmi2Terminated = false)".to_string()
+            });
+            for part in &expected {
+                assert!(error.contains(part.as_str()), "{}: {error}", master.name());
+            }
+            assert!(!error.contains("friction"), "{error}");
+            // a discard is not fatal: the instance is freed with the system
+            let counters = Counters::of(&system.components[0].fmu);
+            assert_eq!(counters.live_instances(), 1);
+            drop(system);
+            assert_eq!(counters.live_instances(), 0);
+            assert_eq!(counters.calls_after_fatal(), 0);
+        }
+    }
+}
+
+#[test]
+fn an_error_mid_run_stops_the_run_and_the_instance_is_still_freed() {
+    let rig = rig();
+    for mut master in masters() {
+        let mut system = coupled(&rig, belt::ERROR, false);
+        let run = simulate(&mut system, master.as_mut(), H, 1.0).unwrap();
+        let error = assert_stopped_at_the_fault(&run);
+        for part in [
+            "fmi2DoStep failed for instance \"rig\" with fmi2Error",
+            "fault injected at step 10",
+        ] {
+            assert!(error.contains(part), "{}: {error}", master.name());
+        }
+        assert!(!error.contains("fmi2LastSuccessfulTime"), "{error}");
+        let counters = Counters::of(&system.components[0].fmu);
+        drop(system);
+        assert_eq!(counters.live_instances(), 0);
+    }
+}
+
+#[test]
+fn after_fatal_the_fmu_is_not_called_again_not_even_to_free_it() {
+    let rig = rig();
+    for mut master in masters() {
+        let mut system = coupled(&rig, belt::FATAL, false);
+        let counters = Counters::of(&system.components[0].fmu);
+        let live_before = counters.live_instances();
+        let run = simulate(&mut system, master.as_mut(), H, 1.0).unwrap();
+        let error = assert_stopped_at_the_fault(&run);
+        for part in [
+            "fmi2DoStep failed for instance \"rig\" with fmi2Fatal",
+            "fault injected at step 10",
+        ] {
+            assert!(error.contains(part), "{}: {error}", master.name());
+        }
+        // the host refuses further calls itself
+        let e = system.components[0]
+            .instance
+            .get_real(&[belt::X], &mut [0.0])
+            .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                FmuError::AfterFatal {
+                    function: "fmi2GetReal",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // the other component is unaffected
+        let mut f = [f64::NAN];
+        let lugre_f = system.components[1]
+            .fmu
+            .variable("F")
+            .unwrap()
+            .value_reference;
+        system.components[1]
+            .instance
+            .get_real(&[lugre_f], &mut f)
+            .unwrap();
+        assert!(f[0].is_finite());
+        drop(system);
+        assert_eq!(counters.calls_after_fatal(), 0, "{}", master.name());
+        // never freed: the FMU may not be called after fmi2Fatal
+        assert_eq!(counters.live_instances(), live_before, "{}", master.name());
+    }
+}
+
+/// `fricsim cosim` with the rig failing: exit status 1, the message on
+/// stderr, the CSV with the rows so far.
+fn cosim(rig: &Rig, fault: i32, out: &Path) -> (Option<i32>, String) {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_fricsim"))
+        .arg("cosim")
+        .arg("--fmu")
+        .arg(format!("rig={}", rig.belt.display()))
+        .arg("--fmu")
+        .arg(format!("friction={}", rig.lugre.display()))
+        .args([
+            "--connect",
+            "rig.v->friction.v",
+            "--connect",
+            "friction.F->rig.F",
+        ])
+        .args(["--set", &format!("rig.fault={fault}")])
+        .args(["--set", &format!("rig.fault_step={FAULT_STEP}")])
+        .args(["--set", "rig.fault_terminates=true", "--set", "rig.v0=0"])
+        .args(["--step", &H.to_string(), "--stop", "0.5"])
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    (
+        output.status.code(),
+        String::from_utf8(output.stderr).unwrap(),
+    )
+}
+
+#[test]
+fn fricsim_cosim_exits_nonzero_names_the_failure_and_keeps_the_rows_so_far() {
+    let rig = rig();
+    let dir = tempfile::tempdir().unwrap();
+    for (fault, status, extra) in [
+        (belt::DISCARD, "fmi2Discard", "fmi2LastSuccessfulTime"),
+        (belt::ERROR, "fmi2Error", "fault injected at step 10"),
+        (belt::FATAL, "fmi2Fatal", "fault injected at step 10"),
+    ] {
+        let out = dir.path().join(format!("fault{fault}.csv"));
+        let (code, stderr) = cosim(&rig, fault, &out);
+        assert_eq!(code, Some(1), "{stderr}");
+        for part in [
+            "run INCOMPLETE",
+            &format!("fmi2DoStep failed for instance \"rig\" with {status}"),
+            extra,
+            out.to_str().unwrap(),
+        ] {
+            assert!(stderr.contains(part), "missing {part:?} in {stderr}");
+        }
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        // the FMU prints "FMI VIOLATION" if it is called after fmi2Fatal
+        assert!(!stderr.contains("FMI VIOLATION"), "{stderr}");
+
+        let csv = std::fs::read_to_string(&out).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "time,rig.x,rig.v,rig.a,friction.F,friction.z");
+        assert_eq!(lines.len(), 1 + FAULT_STEP, "{csv}");
+        let last: Vec<f64> = lines[FAULT_STEP]
+            .split(',')
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert_eq!(last[0], (FAULT_STEP - 1) as f64 * H);
+        assert!(last.iter().all(|x| x.is_finite()), "{csv}");
+    }
+}
