@@ -162,6 +162,17 @@ pub enum FmuError {
         what: &'static str,
     },
 
+    #[error("strong coupling did not converge at t = {time} (step {step}) after {iterations} iterations: {connection} still differs by {mismatch:e} (input {input:e}, output {output:e})")]
+    NotConverged {
+        time: f64,
+        step: f64,
+        iterations: usize,
+        connection: String,
+        mismatch: f64,
+        input: f64,
+        output: f64,
+    },
+
     #[error("{what} must not contain a NUL character: {value:?}")]
     NulInString { what: &'static str, value: String },
 }

@@ -1,7 +1,7 @@
 //! `fricsim cosim`: connect FMUs given on the command line, co-simulate
 //! with a fixed macro step, write a CSV and a plot, print a summary.
 
-use fricsim::master::{gauss_seidel::GaussSeidel, jacobi::Jacobi, simulate, MasterAlgorithm};
+use fricsim::master::simulate;
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
 
@@ -16,7 +16,8 @@ pub struct CosimArgs {
     /// A connection: component.output->component.input (repeat).
     #[arg(long = "connect")]
     pub connections: Vec<String>,
-    /// Master algorithm: jacobi, gauss-seidel, gauss-seidel-interpolated.
+    /// Master algorithm: jacobi, gauss-seidel, gauss-seidel-interpolated,
+    /// newton (strong coupling), fixed-point (strong coupling, for comparison).
     #[arg(long, default_value = "jacobi")]
     pub master: String,
     /// Macro step in seconds.
@@ -80,16 +81,7 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
         components.iter().map(|(n, p)| (n.clone(), *p)).collect();
     let mut system =
         System::build(&components, &parameters, &connections).map_err(|e| e.to_string())?;
-    let mut master: Box<dyn MasterAlgorithm> = match a.master.as_str() {
-        "jacobi" => Box::new(Jacobi::default()),
-        "gauss-seidel" => Box::new(GaussSeidel::new(false)),
-        "gauss-seidel-interpolated" => Box::new(GaussSeidel::new(true)),
-        other => {
-            return Err(format!(
-                "unknown --master {other} (jacobi, gauss-seidel, gauss-seidel-interpolated)"
-            ))
-        }
-    };
+    let mut master = fricsim::master::by_name(&a.master)?;
     let started = std::time::Instant::now();
     let run = simulate(&mut system, master.as_mut(), a.step, a.stop).map_err(|e| e.to_string())?;
     let elapsed = started.elapsed();
@@ -123,6 +115,9 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
                 (l.min(r[k]), h.max(r[k]))
             });
         println!("  {c:<24} min {lo:>12.5e}  max {hi:>12.5e}");
+    }
+    if let Some(report) = master.report() {
+        print!("{report}");
     }
     println!("wrote {}", a.out.display());
     if let Some(p) = &a.plot {

@@ -2,6 +2,7 @@
 
 pub mod gauss_seidel;
 pub mod jacobi;
+pub mod strong;
 
 use crate::system::System;
 use crate::FmuError;
@@ -10,6 +11,40 @@ pub trait MasterAlgorithm {
     fn name(&self) -> &'static str;
     /// Advance every component from `t` to `t + h`.
     fn step(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError>;
+    /// What the algorithm has to say after a run (iterations, rejections).
+    fn report(&self) -> Option<String> {
+        None
+    }
+}
+
+/// The master algorithms by their command-line names.
+pub const NAMES: &[&str] = &[
+    "jacobi",
+    "gauss-seidel",
+    "gauss-seidel-interpolated",
+    "newton",
+    "fixed-point",
+];
+
+/// A master algorithm by its command-line name (see [`NAMES`]).
+pub fn by_name(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
+    use strong::{JacobianSource, StrongCoupling, Update};
+    Ok(match name {
+        "jacobi" => Box::new(jacobi::Jacobi::default()),
+        "gauss-seidel" => Box::new(gauss_seidel::GaussSeidel::new(false)),
+        "gauss-seidel-interpolated" => Box::new(gauss_seidel::GaussSeidel::new(true)),
+        "newton" => Box::new(StrongCoupling::new(Update::Newton, JacobianSource::Auto)),
+        "fixed-point" => Box::new(StrongCoupling::new(
+            Update::FixedPoint,
+            JacobianSource::Auto,
+        )),
+        other => {
+            return Err(format!(
+                "unknown master algorithm `{other}` (known: {})",
+                NAMES.join(", ")
+            ))
+        }
+    })
 }
 
 /// Result of a run: column names and one row per communication point, and

@@ -1,0 +1,231 @@
+//! Strong coupling (Newton on the interface with state rollback) against
+//! the two failure modes of loose coupling: a stiff contact at a large macro
+//! step (the 1995 LuGre stick-slip benchmark), and a direct-feedthrough loop
+//! (seed 000's quasi-static rig, m = 0, against the bristle law), where
+//! fixed-point iteration diverges because the loop gain σ/k ≈ 120.
+
+use fricsim::master::strong::{JacobianSource, StrongCoupling, Update};
+use fricsim::master::{jacobi::Jacobi, simulate, MasterAlgorithm, Run};
+use fricsim::system::System;
+use fricsim::FmuError;
+use std::path::{Path, PathBuf};
+
+fn dist(name: &str) -> PathBuf {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../dist")
+        .join(name);
+    assert!(p.exists(), "{} is missing: run ./build-fmu.sh", p.display());
+    p
+}
+
+fn build(friction: &str, parameters: &[(&str, f64)], connections: &[(&str, &str)]) -> System {
+    let paths = [
+        ("rig".to_string(), dist("Rig1D.fmu")),
+        ("friction".to_string(), dist(friction)),
+    ];
+    let components: Vec<(String, &Path)> = paths
+        .iter()
+        .map(|(n, p)| (n.clone(), p.as_path()))
+        .collect();
+    let parameters: Vec<(String, f64)> = parameters
+        .iter()
+        .map(|(k, v)| (k.to_string(), *v))
+        .collect();
+    let connections: Vec<(String, String)> = connections
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+    System::build(&components, &parameters, &connections).unwrap()
+}
+
+fn stick_slip() -> System {
+    build(
+        "LuGre.fmu",
+        &[],
+        &[("rig.v", "friction.v"), ("friction.F", "rig.F")],
+    )
+}
+
+/// Seed 000's piezo push: quasi-static rig (m = c = 0), k = 116.04e3 N/m,
+/// actuator at 8.25e-8 m/s, bristles of the 0.352 kg block.
+const K_PIEZO: f64 = 116.04e3;
+const V_PIEZO: f64 = 8.25e-8;
+
+fn piezo_push() -> System {
+    build(
+        "Bristle.fmu",
+        &[
+            ("rig.m", 0.0),
+            ("rig.c", 0.0),
+            ("rig.k", K_PIEZO),
+            ("rig.v_a", V_PIEZO),
+        ],
+        &[("rig.x", "friction.x"), ("friction.F", "rig.F")],
+    )
+}
+
+fn column(run: &Run, name: &str) -> Vec<f64> {
+    let k = run.columns.iter().position(|c| c == name).unwrap();
+    run.rows.iter().map(|r| r[k]).collect()
+}
+
+fn max(xs: &[f64]) -> f64 {
+    xs.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+}
+
+fn min(xs: &[f64]) -> f64 {
+    xs.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+fn newton() -> StrongCoupling {
+    StrongCoupling::new(Update::Newton, JacobianSource::Auto)
+}
+
+#[test]
+fn newton_reproduces_the_stick_slip_benchmark_at_a_millisecond_step() {
+    let mut system = stick_slip();
+    let mut master = newton();
+    let run = simulate(&mut system, &mut master, 1e-3, 12.0).unwrap();
+    assert!(run.error.is_none(), "{:?}", run.error);
+    // MODELS.md reference results (Radau IIA, rtol 1e-10), within 0.5 %.
+    let peak_force = max(&column(&run, "friction.F"));
+    let peak_velocity = max(&column(&run, "rig.v"));
+    assert!(
+        (peak_force / 1.4766 - 1.0).abs() < 5e-3,
+        "peak friction {peak_force}"
+    );
+    assert!(
+        (peak_velocity / 0.3698 - 1.0).abs() < 5e-3,
+        "peak velocity {peak_velocity}"
+    );
+    let report = master.convergence();
+    assert_eq!(report.steps, 12_000);
+    assert_eq!(report.histogram.iter().sum::<usize>(), report.steps);
+    assert!(report.worst_accepted <= 1.0);
+    let text = master.report().unwrap();
+    assert!(text.contains("12000 steps"), "{text}");
+    assert!(
+        text.contains(
+            "Jacobian of friction: directional derivatives (checked against finite differences)"
+        ),
+        "{text}"
+    );
+}
+
+#[test]
+fn newton_stays_physical_at_a_step_where_jacobi_does_not() {
+    // h = 1e-2 s against a contact of σ0 = 1e5 N/m on 1 kg (period 20 ms).
+    let mut jacobi_system = stick_slip();
+    let jacobi = simulate(&mut jacobi_system, &mut Jacobi::default(), 1e-2, 20.0).unwrap();
+    let mut newton_system = stick_slip();
+    let strong = simulate(&mut newton_system, &mut newton(), 1e-2, 20.0).unwrap();
+    assert!(strong.error.is_none(), "{:?}", strong.error);
+    // The pulled block never moves backwards far nor is pushed by friction.
+    let (fj, fn_) = (column(&jacobi, "friction.F"), column(&strong, "friction.F"));
+    assert!(
+        min(&fj) < -0.5,
+        "Jacobi unexpectedly stable: min F {}",
+        min(&fj)
+    );
+    assert!(min(&fn_) > -1e-3, "Newton: min F {}", min(&fn_));
+    assert!(max(&fn_) < 1.5, "Newton: max F {} above Fs", max(&fn_));
+    assert!(min(&column(&strong, "rig.v")) > -1e-3);
+}
+
+#[test]
+fn difference_and_directional_jacobians_give_the_same_run() {
+    let mut a = stick_slip();
+    let mut b = stick_slip();
+    let mut dd = StrongCoupling::new(Update::Newton, JacobianSource::Directional);
+    let mut fd = StrongCoupling::new(Update::Newton, JacobianSource::FiniteDifference);
+    let ra = simulate(&mut a, &mut dd, 1e-3, 9.0).unwrap();
+    let rb = simulate(&mut b, &mut fd, 1e-3, 9.0).unwrap();
+    assert!(fd.convergence().difference_steps > 0);
+    assert_eq!(dd.convergence().difference_steps, 0);
+    for name in ["friction.F", "rig.v", "rig.x"] {
+        let (x, y) = (column(&ra, name), column(&rb, name));
+        let scale = max(&x.iter().map(|v| v.abs()).collect::<Vec<_>>());
+        let worst = x
+            .iter()
+            .zip(&y)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
+        // both converge to the same interface within rtol 1e-8
+        assert!(worst <= 1e-6 * scale, "{name}: {worst:e} of {scale:e}");
+    }
+}
+
+#[test]
+fn newton_solves_the_quasi_static_feedthrough_loop() {
+    let mut system = piezo_push();
+    let mut master = newton();
+    // 30 s: past break-away (about F/k + 2·δmax ≈ 1.9e-6 m of actuator travel).
+    let run = simulate(&mut system, &mut master, 1e-2, 30.0).unwrap();
+    assert!(run.error.is_none(), "{:?}", run.error);
+    let (x, f, xa) = (
+        column(&run, "rig.x"),
+        column(&run, "friction.F"),
+        column(&run, "rig.x_act"),
+    );
+    // Force balance 0 = k·(x_a − x) − F holds with the friction block's own
+    // output F (not only the rig's input): the loop is closed at every step.
+    for i in 0..run.rows.len() {
+        let balance = K_PIEZO * (xa[i] - x[i]) - f[i];
+        assert!(
+            balance.abs() <= 1e-7 * f[i].abs().max(1e-3),
+            "t = {}: k(x_a − x) − F = {balance:e}",
+            run.time[i]
+        );
+    }
+    // Sliding at μc·m·g = 0.0633·3.45312 N (seed 000, within 1 %).
+    let level = 0.0633 * 3.45312;
+    let f_end = *f.last().unwrap();
+    assert!((f_end / level - 1.0).abs() < 1e-2, "final force {f_end}");
+    assert!(master.convergence().max_iterations <= 10);
+}
+
+#[test]
+fn fixed_point_iteration_diverges_on_the_feedthrough_loop_and_says_where() {
+    let mut system = piezo_push();
+    let mut master = StrongCoupling::new(Update::FixedPoint, JacobianSource::Auto);
+    let run = simulate(&mut system, &mut master, 1e-2, 1.0).unwrap();
+    let error = run.error.expect("fixed-point iteration cannot converge");
+    assert!(
+        error.contains("did not converge") && error.contains("friction.F -> rig.F")
+            || error.contains("rig.x -> friction.x"),
+        "{error}"
+    );
+    assert_eq!(run.rows.len(), 1, "only the initial point is kept");
+}
+
+#[test]
+fn jacobi_on_the_feedthrough_loop_breaks_the_force_balance() {
+    let mut system = piezo_push();
+    let run = simulate(&mut system, &mut Jacobi::default(), 1e-2, 1.0).unwrap();
+    let (x, f, xa) = (
+        column(&run, "rig.x"),
+        column(&run, "friction.F"),
+        column(&run, "rig.x_act"),
+    );
+    let worst = (0..run.rows.len())
+        .map(|i| (K_PIEZO * (xa[i] - x[i]) - f[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(worst > 0.1, "lagged loop balanced to {worst:e} N");
+}
+
+#[test]
+fn not_converged_is_an_error_with_the_values() {
+    let e = FmuError::NotConverged {
+        time: 0.5,
+        step: 0.01,
+        iterations: 30,
+        connection: "a.y -> b.u".into(),
+        mismatch: 2.0,
+        input: 1.0,
+        output: 3.0,
+    };
+    let text = e.to_string();
+    for part in ["t = 0.5", "30 iterations", "a.y -> b.u", "2e0"] {
+        assert!(text.contains(part), "{text}");
+    }
+}
