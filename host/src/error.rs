@@ -31,6 +31,8 @@ pub enum ArchiveProblem {
     TooManyEntries { count: usize, limit: usize },
     #[error("the archive has no modelDescription.xml at its root")]
     MissingModelDescription,
+    #[error("the archive has no {name} at its root")]
+    MissingRootEntry { name: String },
     #[error("cannot read the entry: {0}")]
     Corrupt(String),
     #[error("cannot write the entry: {0}")]

@@ -25,9 +25,11 @@
 
 pub mod error;
 pub mod fmu;
+pub mod inputs;
 pub mod master;
 pub mod plot;
 pub mod results;
+pub mod ssp;
 pub mod system;
 
 pub use error::{ArchiveProblem, FmuError};

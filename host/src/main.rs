@@ -28,6 +28,17 @@ enum Command {
     /// Connect FMUs and co-simulate them with a fixed macro step (Jacobi),
     /// writing a CSV (time first, component.variable columns) and a plot.
     Cosim(cli::cosim::CosimArgs),
+    /// Co-simulate a system file (SSP 1.0: an .ssp archive or a .ssd) with
+    /// a fixed macro step, writing a CSV, a plot and a summary.
+    Run(cli::run::RunArgs),
+    /// Pack a .ssd and the files its sources point at (FMUs, .ssv) into a
+    /// self-contained .ssp archive (sources become resources/<file name>).
+    Pack {
+        /// The system file (.ssd).
+        ssd: PathBuf,
+        /// The archive to write (.ssp).
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -35,6 +46,10 @@ fn main() -> ExitCode {
     let result = match args.command {
         Command::Info { fmu } => cli::info::run(&fmu).map_err(|e| e.to_string()),
         Command::Cosim(args) => cli::cosim::run(&args),
+        Command::Run(args) => cli::run::run(&args),
+        Command::Pack { ssd, out } => fricsim::ssp::pack(&ssd, &out)
+            .map(|()| println!("wrote {}", out.display()))
+            .map_err(|e| e.to_string()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,9 +1,31 @@
-//! Plots of chosen signals against time, one panel per signal, as SVG.
+//! Plots of chosen signals against time, one panel per signal, as PNG
+//! (plotters' bitmap backend) or SVG, chosen by the file's extension.
+//!
+//! Text is drawn with DejaVu Sans, compiled into the binary
+//! (`host/assets/DejaVuSans.ttf`, Bitstream Vera licence beside it) and
+//! registered with plotters' pure-Rust `ab_glyph` renderer, so a plot looks
+//! the same on every machine and needs no system font library.
 
 use crate::master::Run;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
+use std::sync::OnceLock;
 
+const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+
+/// Register the font under "sans-serif" once per process.
+fn register_font() -> Result<(), String> {
+    static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+                .map_err(|_| "the compiled-in font DejaVu Sans could not be read".to_string())
+        })
+        .clone()
+}
+
+/// Plot `signals` (column names of `run`) into `path` (`.png` or `.svg`).
 pub fn plot_signals(run: &Run, signals: &[String], path: &Path, title: &str) -> Result<(), String> {
     let mut series = Vec::new();
     for s in signals {
@@ -18,44 +40,69 @@ pub fn plot_signals(run: &Run, signals: &[String], path: &Path, title: &str) -> 
             run.rows.iter().map(|r| r[k]).collect::<Vec<f64>>(),
         ));
     }
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(extension.as_deref(), Some("png" | "svg")) {
+        return Err(format!(
+            "plot {}: the file name must end in .png or .svg",
+            path.display()
+        ));
+    }
+    register_font()?;
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     }
-    let height = 260 * series.len().max(1) as u32 + 40;
-    let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
+    let size = (1000, 260 * series.len().max(1) as u32 + 40);
     let fail = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
-    root.fill(&WHITE).map_err(|e| fail(&e))?;
-    let root = root
-        .titled(title, ("sans-serif", 22))
-        .map_err(|e| fail(&e))?;
+    if extension.as_deref() == Some("png") {
+        let root = BitMapBackend::new(path, size).into_drawing_area();
+        draw(&root, run, &series, title).map_err(|e| fail(&e))?;
+        root.present().map_err(|e| fail(&e))
+    } else {
+        let root = SVGBackend::new(path, size).into_drawing_area();
+        draw(&root, run, &series, title).map_err(|e| fail(&e))?;
+        root.present().map_err(|e| fail(&e))
+    }
+}
+
+type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    run: &Run,
+    series: &[(&str, Vec<f64>)],
+    title: &str,
+) -> DrawResult<DB> {
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 22))?;
     let panels = root.split_evenly((series.len().max(1), 1));
     let t0 = *run.time.first().unwrap_or(&0.0);
     let t1 = *run.time.last().unwrap_or(&1.0);
     for ((name, ys), panel) in series.iter().zip(panels.iter()) {
         let (lo, hi) = ys
             .iter()
+            .filter(|y| y.is_finite())
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
                 (a.min(*y), b.max(*y))
             });
+        let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
         let pad = ((hi - lo) * 0.05).max(1e-12);
         let mut chart = ChartBuilder::on(panel)
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(70)
-            .build_cartesian_2d(t0..t1.max(t0 + 1e-12), (lo - pad)..(hi + pad))
-            .map_err(|e| fail(&e))?;
+            .build_cartesian_2d(t0..t1.max(t0 + 1e-12), (lo - pad)..(hi + pad))?;
         chart
             .configure_mesh()
             .x_desc("time [s]")
             .y_desc(*name)
-            .draw()
-            .map_err(|e| fail(&e))?;
-        chart
-            .draw_series(LineSeries::new(
-                run.time.iter().copied().zip(ys.iter().copied()),
-                &BLUE,
-            ))
-            .map_err(|e| fail(&e))?;
+            .draw()?;
+        chart.draw_series(LineSeries::new(
+            run.time.iter().copied().zip(ys.iter().copied()),
+            &BLUE,
+        ))?;
     }
-    root.present().map_err(|e| fail(&e))
+    Ok(())
 }

@@ -1,5 +1,7 @@
 //! Result files: CSV with `time` first and `component.variable` columns
 //! (FMPy's convention), numbers written so that they parse back exactly.
+//! A run that stopped early keeps its rows and ends with a comment line
+//! `# INCOMPLETE: …` (CSV readers such as numpy's skip `#` lines).
 
 use crate::master::Run;
 use std::io::Write;
@@ -17,6 +19,10 @@ pub fn write_csv(run: &Run, path: &Path) -> std::io::Result<()> {
             write!(out, ",{x:?}")?;
         }
         writeln!(out)?;
+    }
+    if let Some(e) = &run.error {
+        let one_line = e.replace(['\n', '\r'], " ");
+        writeln!(out, "# INCOMPLETE: the run stopped early: {one_line}")?;
     }
     out.flush()
 }

@@ -68,23 +68,53 @@ fn split_port(port: &str) -> Result<(&str, &str), SystemError> {
     })
 }
 
+/// A value for [`System::from_fmus`]: a number is converted to the
+/// variable's type (Real as is, Integer rounded toward zero, Boolean
+/// non-zero = true); text sets a String variable.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParameterValue {
+    Number(f64),
+    Text(String),
+}
+
 impl System {
     /// Open and instantiate each `(name, fmu path)`, set the parameters
-    /// (`component.variable`, value), connect `(output port, input port)`.
+    /// (`component.variable`, value), connect `(output port, input port)`;
+    /// the experiment starts at t = 0.
     pub fn build(
         components: &[(String, &Path)],
         parameters: &[(String, f64)],
         connections: &[(String, String)],
     ) -> Result<System, SystemError> {
-        let mut list: Vec<Component> = Vec::new();
+        let mut fmus = Vec::with_capacity(components.len());
         for (name, path) in components {
-            if list.iter().any(|c| &c.name == name) {
+            fmus.push((name.clone(), Fmu::open(path)?));
+        }
+        let parameters: Vec<(String, ParameterValue)> = parameters
+            .iter()
+            .map(|(k, v)| (k.clone(), ParameterValue::Number(*v)))
+            .collect();
+        System::from_fmus(fmus, &parameters, connections, 0.0)
+    }
+
+    /// Instantiate already opened FMUs `(name, fmu)`, connect
+    /// `(output port, input port)`, set up the experiment at `start`, enter
+    /// initialization mode and set the parameters (`component.variable`,
+    /// value) there, in order (a later value for the same variable wins).
+    pub fn from_fmus(
+        fmus: Vec<(String, Fmu)>,
+        parameters: &[(String, ParameterValue)],
+        connections: &[(String, String)],
+        start: f64,
+    ) -> Result<System, SystemError> {
+        let mut list: Vec<Component> = Vec::new();
+        for (name, fmu) in fmus {
+            if list.iter().any(|c| c.name == name) {
                 return Err(SystemError::Invalid(format!(
                     "component name `{name}` is used twice"
                 )));
             }
-            let fmu = Fmu::open(path)?;
-            let instance = fmu.instantiate(name)?;
+            let instance = fmu.instantiate(&name)?;
             let outputs = fmu
                 .description()
                 .variables
@@ -95,7 +125,7 @@ impl System {
                 .map(|v| (v.name.clone(), v.value_reference))
                 .collect();
             list.push(Component {
-                name: name.clone(),
+                name,
                 fmu,
                 instance,
                 outputs,
@@ -164,7 +194,7 @@ impl System {
             });
         }
         for c in &mut system.components {
-            c.instance.setup_experiment(0.0, None)?;
+            c.instance.setup_experiment(start, None)?;
             c.instance.enter_initialization_mode()?;
         }
         for (port, value) in parameters {
@@ -174,13 +204,24 @@ impl System {
                 SystemError::Invalid(format!("`{port}`: `{}` has no variable `{v}`", c.name))
             })?;
             let vr = var.value_reference;
-            match var.kind {
-                VariableKind::Real { .. } => c.instance.set_real(&[vr], &[*value])?,
-                VariableKind::Integer { .. } => c.instance.set_integer(&[vr], &[*value as i32])?,
-                VariableKind::Boolean { .. } => c.instance.set_boolean(&[vr], &[*value != 0.0])?,
-                _ => {
+            match (&var.kind, value) {
+                (VariableKind::Real { .. }, ParameterValue::Number(x)) => {
+                    c.instance.set_real(&[vr], &[*x])?
+                }
+                (
+                    VariableKind::Integer { .. } | VariableKind::Enumeration { .. },
+                    ParameterValue::Number(x),
+                ) => c.instance.set_integer(&[vr], &[*x as i32])?,
+                (VariableKind::Boolean { .. }, ParameterValue::Number(x)) => {
+                    c.instance.set_boolean(&[vr], &[*x != 0.0])?
+                }
+                (VariableKind::String { .. }, ParameterValue::Text(text)) => {
+                    c.instance.set_string(&[vr], &[text.as_str()])?
+                }
+                (kind, _) => {
                     return Err(SystemError::Invalid(format!(
-                        "`{port}` is not a Real, Integer or Boolean variable"
+                        "`{port}` is a {} variable; it cannot be set to {value:?}",
+                        kind.type_name()
                     )))
                 }
             };
@@ -203,6 +244,57 @@ impl System {
                 .set_real(&[c.to.1], &[buffer[k]])?;
         }
         Ok(())
+    }
+
+    /// Record the Real variable `component.variable` too (an input, a
+    /// parameter, a local), after the component's outputs; recording one
+    /// that is already recorded changes nothing.
+    pub fn record(&mut self, port: &str) -> Result<(), SystemError> {
+        let (c, v) = split_port(port)?;
+        let names: Vec<&str> = self.components.iter().map(|x| x.name.as_str()).collect();
+        let Some(i) = self.components.iter().position(|x| x.name == c) else {
+            return Err(SystemError::Invalid(format!(
+                "cannot record `{port}`: no component `{c}` (components: {})",
+                names.join(", ")
+            )));
+        };
+        let component = &mut self.components[i];
+        let var = component.fmu.variable(v).map_err(|_| {
+            SystemError::Invalid(format!(
+                "cannot record `{port}`: `{c}` has no variable `{v}`"
+            ))
+        })?;
+        if !matches!(var.kind, VariableKind::Real { .. }) {
+            return Err(SystemError::Invalid(format!(
+                "cannot record `{port}`: it is a {} variable; only Real variables are recorded",
+                var.kind.type_name()
+            )));
+        }
+        if !component.outputs.iter().any(|(n, _)| n == v) {
+            component.outputs.push((v.to_string(), var.value_reference));
+        }
+        Ok(())
+    }
+
+    /// The component index and the variable of `component.variable`.
+    pub fn port(&self, port: &str) -> Result<(usize, &crate::fmu::ScalarVariable), SystemError> {
+        let (c, v) = split_port(port)?;
+        let i = self
+            .components
+            .iter()
+            .position(|x| x.name == c)
+            .ok_or_else(|| {
+                let names: Vec<&str> = self.components.iter().map(|x| x.name.as_str()).collect();
+                SystemError::Invalid(format!(
+                    "`{port}`: no component `{c}` (components: {})",
+                    names.join(", ")
+                ))
+            })?;
+        let var = self.components[i]
+            .fmu
+            .variable(v)
+            .map_err(|_| SystemError::Invalid(format!("`{port}`: `{c}` has no variable `{v}`")))?;
+        Ok((i, var))
     }
 
     /// Column names `component.output`, in recording order.

@@ -2,3 +2,4 @@
 
 pub mod cosim;
 pub mod info;
+pub mod run;

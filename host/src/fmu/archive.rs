@@ -51,6 +51,17 @@ impl Default for UnpackOptions {
 /// Unpack the FMU at `path` into a new temporary directory, which is removed
 /// when the returned [`TempDir`] is dropped (or at once if unpacking fails).
 pub fn unpack(path: &Path, options: &UnpackOptions) -> Result<TempDir, FmuError> {
+    unpack_requiring(path, options, "modelDescription.xml")
+}
+
+/// [`unpack`] for any zip-based package (an FMU, an SSP): the same checks,
+/// with `required` the file that must be at the archive's root
+/// (`modelDescription.xml`, `SystemStructure.ssd`).
+pub fn unpack_requiring(
+    path: &Path,
+    options: &UnpackOptions,
+    required: &str,
+) -> Result<TempDir, FmuError> {
     let refuse = |entry: Option<&str>, problem: ArchiveProblem| FmuError::Archive {
         path: path.to_path_buf(),
         entry: entry.map(str::to_string),
@@ -120,8 +131,17 @@ pub fn unpack(path: &Path, options: &UnpackOptions) -> Result<TempDir, FmuError>
         }
         plan.push((index, name, relative, entry.is_dir()));
     }
-    if !seen.contains(Path::new("modelDescription.xml")) {
-        return Err(refuse(None, ArchiveProblem::MissingModelDescription));
+    if !seen.contains(Path::new(required)) {
+        return Err(refuse(
+            None,
+            if required == "modelDescription.xml" {
+                ArchiveProblem::MissingModelDescription
+            } else {
+                ArchiveProblem::MissingRootEntry {
+                    name: required.to_string(),
+                }
+            },
+        ));
     }
 
     let mut builder = tempfile::Builder::new();

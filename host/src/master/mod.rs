@@ -56,23 +56,67 @@ pub struct Run {
     pub error: Option<String>,
 }
 
-/// Initialise, then step with a fixed macro step `h` to `stop`; time is
-/// counted (t = n·h), never summed. An FMU error stops the run and is
-/// reported with the results so far.
+/// Something the run consults at each communication point: external
+/// inputs to set before the step, progress to show after it.
+pub trait Observer {
+    /// Called at `t` before `exitInitializationMode` (`initializing`) and
+    /// before every step from `t`: set whatever inputs come from outside.
+    fn before_step(
+        &mut self,
+        _system: &mut System,
+        _t: f64,
+        _initializing: bool,
+    ) -> Result<(), FmuError> {
+        Ok(())
+    }
+    /// Called after step `done` of `total` (1-based).
+    fn after_step(&mut self, _done: usize, _total: usize) {}
+}
+
+/// An observer that does nothing.
+pub struct NoObserver;
+impl Observer for NoObserver {}
+
+/// Initialise, then step with a fixed macro step `h` from 0 to `stop`;
+/// time is counted (t = n·h), never summed. An FMU error stops the run and
+/// is reported with the results so far.
 pub fn simulate(
     system: &mut System,
     master: &mut dyn MasterAlgorithm,
     h: f64,
     stop: f64,
 ) -> Result<Run, FmuError> {
+    simulate_with(system, master, 0.0, h, stop, &mut NoObserver)
+}
+
+/// Number of macro steps of `h` from `start` to `stop`: the nearest whole
+/// number, so that a stop time that is a multiple of the step up to rounding
+/// (20 / 1e-4) is reached exactly.
+pub fn step_count(start: f64, h: f64, stop: f64) -> usize {
+    ((stop - start) / h).round().max(0.0) as usize
+}
+
+/// [`simulate`] from `start` (t = start + n·h; the system must have been
+/// set up at `start`), with `observer` consulted at each communication
+/// point: as FMPy does, external inputs are applied at the start time in
+/// initialization mode, then at each communication point before the step.
+pub fn simulate_with(
+    system: &mut System,
+    master: &mut dyn MasterAlgorithm,
+    start: f64,
+    h: f64,
+    stop: f64,
+    observer: &mut dyn Observer,
+) -> Result<Run, FmuError> {
     let mut buffer = vec![0.0; system.connections.len()];
+    observer.before_step(system, start, true)?;
     system.propagate(&mut buffer)?;
     for c in &mut system.components {
         c.instance.exit_initialization_mode()?;
     }
     system.propagate(&mut buffer)?;
     let columns = system.columns();
-    let n = (stop / h).round() as usize;
+    let n = step_count(start, h, stop);
     let mut run = Run {
         columns,
         time: Vec::with_capacity(n + 1),
@@ -81,19 +125,26 @@ pub fn simulate(
     };
     let mut row = Vec::with_capacity(run.columns.len());
     system.sample(&mut row)?;
-    run.time.push(0.0);
+    run.time.push(start);
     run.rows.push(row);
     for i in 0..n {
-        let t = i as f64 * h;
-        let t_next = (i + 1) as f64 * h;
-        if let Err(e) = master.step(system, t, t_next - t) {
+        let t = start + i as f64 * h;
+        let t_next = start + (i + 1) as f64 * h;
+        let stepped = observer
+            .before_step(system, t, false)
+            .and_then(|()| master.step(system, t, t_next - t));
+        if let Err(e) = stepped {
             run.error = Some(format!("at t = {t}: {e}"));
             break;
         }
         let mut row = Vec::with_capacity(run.columns.len());
-        system.sample(&mut row)?;
+        if let Err(e) = system.sample(&mut row) {
+            run.error = Some(format!("at t = {t_next}: {e}"));
+            break;
+        }
         run.time.push(t_next);
         run.rows.push(row);
+        observer.after_step(i + 1, n);
     }
     Ok(run)
 }

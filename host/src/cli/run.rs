@@ -1,0 +1,253 @@
+//! `fricsim run SYSTEM.ssp|SYSTEM.ssd`: read a system file (SSP 1.0,
+//! [`fricsim::ssp`]), check it against its FMUs, co-simulate it with a
+//! fixed macro step, write a CSV and optionally a plot, print a summary.
+//! Settings come from the command line, else from the file
+//! (`DefaultExperiment`, our annotation), else from defaults.
+
+use fricsim::inputs::{ExternalInputs, InputTable};
+use fricsim::master::{by_name, simulate_with, step_count, Observer, Run};
+use fricsim::ssp::SystemFile;
+use fricsim::system::System;
+use fricsim::FmuError;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct RunArgs {
+    /// The system: an .ssp archive or a SystemStructure .ssd file.
+    pub system: PathBuf,
+    /// Start time in seconds [default: DefaultExperiment startTime, else 0].
+    #[arg(long)]
+    pub start: Option<f64>,
+    /// Stop time in seconds [default: DefaultExperiment stopTime].
+    #[arg(long)]
+    pub stop: Option<f64>,
+    /// Macro step in seconds [default: the file's stepSize annotation].
+    #[arg(long)]
+    pub step: Option<f64>,
+    /// Master algorithm: jacobi, gauss-seidel, gauss-seidel-interpolated,
+    /// newton, fixed-point [default: the file's annotation, else jacobi].
+    #[arg(long)]
+    pub master: Option<String>,
+    /// Result CSV [default: out/<file name>.csv].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Plot of the chosen signals (.png or .svg).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// A signal to plot, component.variable (repeat) [default: the file's
+    /// Plot annotation, else every recorded column].
+    #[arg(long = "plot-signal")]
+    pub plot_signals: Vec<String>,
+    /// Record a Real variable besides the outputs, component.variable
+    /// (repeat): e.g. a connected input.
+    #[arg(long = "record")]
+    pub record: Vec<String>,
+    /// External inputs: CSV with `time` first, then component.variable
+    /// columns for unconnected inputs (bare names for a one-component
+    /// system), interpolated linearly in time as FMPy does.
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// The progress bar and the external inputs, consulted by the run.
+struct Watch {
+    inputs: Option<ExternalInputs>,
+    bar: ProgressBar,
+}
+
+impl Observer for Watch {
+    fn before_step(&mut self, system: &mut System, t: f64, init: bool) -> Result<(), FmuError> {
+        match &mut self.inputs {
+            Some(i) => i.before_step(system, t, init),
+            None => Ok(()),
+        }
+    }
+
+    fn after_step(&mut self, done: usize, total: usize) {
+        // drawing is rate-limited by indicatif; updating every 256 steps
+        // keeps even the bookkeeping out of the step loop's cost
+        if done % 256 == 0 || done == total {
+            self.bar.set_position(done as u64);
+        }
+    }
+}
+
+fn positive(name: &str, x: f64) -> Result<f64, String> {
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        Err(format!("{name} must be a positive number, got {x}"))
+    }
+}
+
+pub fn run(a: &RunArgs) -> Result<(), String> {
+    let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
+    let start = match a.start {
+        Some(s) if !s.is_finite() => return Err(format!("--start must be finite, got {s}")),
+        Some(s) => s,
+        None => file.start_time.unwrap_or(0.0),
+    };
+    let stop = a.stop.or(file.stop_time).ok_or_else(|| {
+        format!(
+            "{}: no stop time: give --stop or <ssd:DefaultExperiment stopTime=\"…\">",
+            file.ssd
+        )
+    })?;
+    if !(stop.is_finite() && stop > start) {
+        return Err(format!(
+            "the stop time {stop} must be after the start time {start}"
+        ));
+    }
+    let step = match a.step.or(file.settings.step_size) {
+        Some(h) => positive("--step", h)?,
+        None => {
+            return Err(format!(
+                "{}: no step size: give --step or the stepSize of the fricsim annotation (see README, \"Writing a system file\")",
+                file.ssd
+            ))
+        }
+    };
+    let master_name = a
+        .master
+        .clone()
+        .or(file.settings.master.clone())
+        .unwrap_or_else(|| "jacobi".to_string());
+    let mut master = by_name(&master_name)?;
+
+    let mut system = file.build(start).map_err(|e| e.to_string())?;
+    let plot_signals = if !a.plot_signals.is_empty() {
+        a.plot_signals.clone()
+    } else {
+        file.settings.plot.clone()
+    };
+    for s in a.record.iter().chain(&plot_signals) {
+        system.record(s).map_err(|e| e.to_string())?;
+    }
+    let inputs = match &a.input {
+        Some(path) => Some(ExternalInputs::bind(InputTable::read(path)?, &system)?),
+        None => None,
+    };
+
+    let n = step_count(start, step, stop);
+    let bar = if a.quiet || !std::io::stderr().is_terminal() {
+        ProgressBar::hidden()
+    } else {
+        let bar = ProgressBar::with_draw_target(Some(n as u64), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} steps, {elapsed} elapsed, {eta} left",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        bar
+    };
+    let mut watch = Watch { inputs, bar };
+    let started = std::time::Instant::now();
+    let run = simulate_with(&mut system, master.as_mut(), start, step, stop, &mut watch)
+        .map_err(|e| format!("initialization failed: {e}"))?;
+    let elapsed = started.elapsed();
+    watch.bar.finish_and_clear();
+
+    let out = a.out.clone().unwrap_or_else(|| {
+        let stem = a
+            .system
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "result".to_string());
+        PathBuf::from("out").join(format!("{stem}.csv"))
+    });
+    fricsim::results::write_csv(&run, &out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let mut plot_error = None;
+    if let Some(plot) = &a.plot {
+        let signals = if plot_signals.is_empty() {
+            run.columns.clone()
+        } else {
+            plot_signals
+        };
+        let title = format!(
+            "{} ({})",
+            if file.name.is_empty() {
+                "system"
+            } else {
+                &file.name
+            },
+            master.name()
+        );
+        // a plot that cannot be drawn does not hide the summary
+        plot_error = fricsim::plot::plot_signals(&run, &signals, plot, &title).err();
+    }
+
+    print!(
+        "{}",
+        summary(&file, &run, n, step, master.name(), elapsed.as_secs_f64())
+    );
+    if let Some(report) = master.report() {
+        println!("{report}");
+    }
+    println!("wrote {}", out.display());
+    if let (Some(p), None) = (&a.plot, &plot_error) {
+        println!("wrote {}", p.display());
+    }
+    if let Some(e) = run.error {
+        return Err(format!(
+            "run INCOMPLETE (the {} rows up to the failure are in {}): {e}",
+            run.rows.len(),
+            out.display()
+        ));
+    }
+    match plot_error {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// The summary: what ran, how long, each column's min/max/final value,
+/// and whether the run completed.
+fn summary(file: &SystemFile, run: &Run, n: usize, step: f64, master: &str, wall: f64) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let done = run.rows.len().saturating_sub(1);
+    let _ = writeln!(
+        s,
+        "{}: {} components, {} connections, {} parameter values",
+        file.ssd,
+        file.components.len(),
+        file.connections.len(),
+        file.parameters.len()
+    );
+    let _ = writeln!(
+        s,
+        "{done} of {n} macro steps of {step} s with {master} ({} to {} s), {wall:.3} s wall time: {}",
+        run.time.first().copied().unwrap_or(0.0),
+        run.time.last().copied().unwrap_or(0.0),
+        if run.error.is_none() { "completed" } else { "INCOMPLETE" }
+    );
+    let width = run
+        .columns
+        .iter()
+        .map(|c| c.len())
+        .max()
+        .unwrap_or(6)
+        .max(6);
+    let _ = writeln!(
+        s,
+        "  {:<width$} {:>13} {:>13} {:>13}",
+        "signal", "min", "max", "final"
+    );
+    for (k, c) in run.columns.iter().enumerate() {
+        let (lo, hi) = run
+            .rows
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), r| {
+                (l.min(r[k]), h.max(r[k]))
+            });
+        let last = run.rows.last().map_or(f64::NAN, |r| r[k]);
+        let _ = writeln!(s, "  {c:<width$} {lo:>13.5e} {hi:>13.5e} {last:>13.5e}");
+    }
+    s
+}

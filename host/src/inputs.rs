@@ -1,0 +1,287 @@
+//! External inputs from a CSV file: a `time` column, then one column per
+//! input, named `component.variable` (or the bare variable name when the
+//! system has one component). Values are applied the way FMPy's `Input`
+//! class applies them in `simulate_fmu` (FMPy 0.3.32,
+//! `fmpy/simulation.py`): at the start time in initialization mode and at
+//! each communication point `t` before the step from `t`, held over the
+//! step. Continuous Real inputs are interpolated linearly in time; before
+//! the first sample the first value holds, after the last the last. At a
+//! repeated time (an event: two rows with the same time) the value after
+//! the event is taken from that time on. Inputs of variability `discrete`
+//! take the last sample at or before `t` (FMPy's discrete rule).
+//!
+//! Unlike FMPy with an FMU that can vary its step, fricsim does not add the
+//! times of events between communication points to the grid: put events on
+//! the grid (multiples of the step) to reproduce FMPy exactly.
+
+use crate::fmu::model_description::{Causality, Variability, VariableKind};
+use crate::fmu::ValueReference;
+use crate::master::Observer;
+use crate::system::System;
+use crate::FmuError;
+use std::path::{Path, PathBuf};
+
+/// The table of an input CSV file.
+#[derive(Clone, Debug)]
+pub struct InputTable {
+    pub path: PathBuf,
+    pub time: Vec<f64>,
+    /// Column name and values, one per row.
+    pub columns: Vec<(String, Vec<f64>)>,
+}
+
+impl InputTable {
+    /// Read and check the file: a header with `time` first and distinct
+    /// names, at least one row, finite numbers, every row as long as the
+    /// header, non-decreasing time.
+    pub fn read(path: &Path) -> Result<InputTable, String> {
+        let shown = path.display();
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .trim(csv::Trim::All)
+            .comment(Some(b'#'))
+            .from_path(path)
+            .map_err(|e| format!("{shown}: {e}"))?;
+        let header: Vec<String> = reader
+            .headers()
+            .map_err(|e| format!("{shown}: line 1: {e}"))?
+            .iter()
+            .map(|h| h.trim_start_matches('\u{feff}').to_string())
+            .collect();
+        if header.first().map(String::as_str) != Some("time") {
+            return Err(format!(
+                "{shown}: line 1: the first column must be `time`, found `{}`",
+                header.first().map(String::as_str).unwrap_or("")
+            ));
+        }
+        if header.len() < 2 {
+            return Err(format!("{shown}: line 1: no input columns after `time`"));
+        }
+        for (k, h) in header.iter().enumerate() {
+            if h.is_empty() {
+                return Err(format!("{shown}: line 1: column {} has no name", k + 1));
+            }
+            if header[..k].contains(h) {
+                return Err(format!("{shown}: line 1: column `{h}` occurs twice"));
+            }
+        }
+        let mut table = InputTable {
+            path: path.to_path_buf(),
+            time: Vec::new(),
+            columns: header[1..]
+                .iter()
+                .map(|h| (h.clone(), Vec::new()))
+                .collect(),
+        };
+        for record in reader.records() {
+            let record = record.map_err(|e| format!("{shown}: {e}"))?;
+            let line = record.position().map_or(0, |p| p.line());
+            if record.len() != header.len() {
+                return Err(format!(
+                    "{shown}: line {line}: {} values, the header has {} columns",
+                    record.len(),
+                    header.len()
+                ));
+            }
+            let mut row = Vec::with_capacity(record.len());
+            for (k, field) in record.iter().enumerate() {
+                let x = field
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| {
+                        format!(
+                            "{shown}: line {line}: column `{}`: `{field}` is not a finite number",
+                            header[k]
+                        )
+                    })?;
+                row.push(x);
+            }
+            if let Some(&last) = table.time.last() {
+                if row[0] < last {
+                    return Err(format!(
+                        "{shown}: line {line}: time {} is before the previous row's {last}: time must not decrease",
+                        row[0]
+                    ));
+                }
+            }
+            table.time.push(row[0]);
+            for (column, x) in table.columns.iter_mut().zip(&row[1..]) {
+                column.1.push(*x);
+            }
+        }
+        if table.time.is_empty() {
+            return Err(format!("{shown}: no rows after the header"));
+        }
+        Ok(table)
+    }
+}
+
+/// `math.isclose(a, b)` of Python with its defaults (rel_tol = 1e-9), as
+/// FMPy uses it to recognise events.
+fn isclose(a: f64, b: f64) -> bool {
+    a == b || (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
+}
+
+/// The value at `time` of the samples `(t, v)`: FMPy's
+/// `Input.interpolate(..., after_event=True)`, operation for operation, so
+/// that the result is bit-identical.
+pub fn interpolate(time: f64, t: &[f64], v: &[f64], discrete: bool) -> f64 {
+    let n = t.len();
+    if n < 2 {
+        return v[0];
+    }
+    // numpy.searchsorted(t, time), side "left"
+    let mut i0 = t.partition_point(|&x| x < time);
+    if i0 == 0 {
+        return v[0];
+    }
+    if i0 == n {
+        return v[n - 1];
+    }
+    if discrete {
+        let mut i = i0 - 1;
+        while i + 1 < n && (t[i + 1] < time || isclose(time, t[i + 1])) {
+            i += 1;
+        }
+        return v[i];
+    }
+    if isclose(time, t[i0]) && i0 < n - 1 && isclose(t[i0], t[i0 + 1]) {
+        while i0 < n - 1 && isclose(t[i0], t[i0 + 1]) {
+            i0 += 1;
+        }
+        return v[i0];
+    }
+    let (i0, i1) = (i0 - 1, i0);
+    let (t0, t1) = (t[i0], t[i1]);
+    let w0 = (t1 - time) / (t1 - t0);
+    let w1 = 1.0 - w0;
+    w0 * v[i0] + w1 * v[i1]
+}
+
+struct Binding {
+    component: usize,
+    vr: ValueReference,
+    column: usize,
+    discrete: bool,
+}
+
+/// The inputs of a table bound to the system's unconnected Real inputs.
+pub struct ExternalInputs {
+    table: InputTable,
+    bindings: Vec<Binding>,
+}
+
+impl ExternalInputs {
+    /// Bind every column of `table` to an input of `system`: the column
+    /// names a Real input that no connection drives.
+    pub fn bind(table: InputTable, system: &System) -> Result<ExternalInputs, String> {
+        let shown = table.path.display().to_string();
+        let mut bindings = Vec::new();
+        for (k, (name, _)) in table.columns.iter().enumerate() {
+            let port = if name.contains('.') || system.components.len() != 1 {
+                name.clone()
+            } else {
+                format!("{}.{name}", system.components[0].name)
+            };
+            let (i, var) = system.port(&port).map_err(|e| {
+                format!(
+                    "{shown}: column `{name}`: {e}{}",
+                    unconnected_inputs(system)
+                )
+            })?;
+            if var.causality != Causality::Input {
+                return Err(format!(
+                    "{shown}: column `{name}`: `{port}` has causality \"{}\", not an input{}",
+                    var.causality,
+                    unconnected_inputs(system)
+                ));
+            }
+            if !matches!(var.kind, VariableKind::Real { .. }) {
+                return Err(format!(
+                    "{shown}: column `{name}`: `{port}` is a {} input; only Real inputs can be read from a CSV",
+                    var.kind.type_name()
+                ));
+            }
+            let vr = var.value_reference;
+            let discrete = var.variability == Variability::Discrete;
+            if let Some(c) = system.connections.iter().find(|c| c.to == (i, vr)) {
+                return Err(format!(
+                    "{shown}: column `{name}`: `{port}` is driven by the connection {}; an input has one source",
+                    c.label
+                ));
+            }
+            bindings.push(Binding {
+                component: i,
+                vr,
+                column: k,
+                discrete,
+            });
+        }
+        Ok(ExternalInputs { table, bindings })
+    }
+
+    /// Set every bound input to its value at `t`.
+    pub fn apply(&self, system: &mut System, t: f64) -> Result<(), FmuError> {
+        for b in &self.bindings {
+            let x = interpolate(
+                t,
+                &self.table.time,
+                &self.table.columns[b.column].1,
+                b.discrete,
+            );
+            system.components[b.component]
+                .instance
+                .set_real(&[b.vr], &[x])?;
+        }
+        Ok(())
+    }
+}
+
+/// `; unconnected inputs: a.b, c.d` for messages.
+fn unconnected_inputs(system: &System) -> String {
+    let mut names = Vec::new();
+    for (i, c) in system.components.iter().enumerate() {
+        for v in &c.fmu.description().variables {
+            if v.causality == Causality::Input
+                && !system
+                    .connections
+                    .iter()
+                    .any(|k| k.to == (i, v.value_reference))
+            {
+                names.push(format!("{}.{}", c.name, v.name));
+            }
+        }
+    }
+    if names.is_empty() {
+        "; the system has no unconnected inputs".to_string()
+    } else {
+        format!("; unconnected inputs: {}", names.join(", "))
+    }
+}
+
+impl Observer for ExternalInputs {
+    fn before_step(&mut self, system: &mut System, t: f64, _: bool) -> Result<(), FmuError> {
+        self.apply(system, t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolation_follows_fmpy() {
+        let t = [0.0, 1.0, 2.0, 2.0, 3.0];
+        let v = [0.0, 10.0, 20.0, 5.0, 6.0];
+        assert_eq!(interpolate(-1.0, &t, &v, false), 0.0); // hold first
+        assert_eq!(interpolate(0.5, &t, &v, false), 5.0);
+        assert_eq!(interpolate(1.0, &t, &v, false), 10.0);
+        assert_eq!(interpolate(2.0, &t, &v, false), 5.0); // after the event
+        assert_eq!(interpolate(2.5, &t, &v, false), 5.5);
+        assert_eq!(interpolate(9.0, &t, &v, false), 6.0); // hold last
+        assert_eq!(interpolate(1.5, &t, &v, true), 10.0); // discrete: last sample
+        assert_eq!(interpolate(2.0, &t, &v, true), 5.0);
+        assert_eq!(interpolate(7.0, &[1.0], &[3.0], false), 3.0);
+    }
+}
