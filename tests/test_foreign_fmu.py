@@ -255,6 +255,7 @@ def test_a_discarded_step_ends_the_run_where_fmpy_ends_it(belt, tmp_path):
         assert part in process.stderr, process.stderr
     reached = float(re.search(r"up to t = (\S+) \(fmi2LastSuccessfulTime\)", process.stderr).group(1))
     assert len(ours) == 50 and ours[-1, 0] == 49 * step
+    assert out.read_text().splitlines()[-1].startswith("# INCOMPLETE: the run stopped early: at t = 0.049: ")
 
     start_values = {k.split(".", 1)[1]: v for k, v in parameters.items()}
     result = simulate_fmu(str(belt), fmi_type="CoSimulation", stop_time=stop, output_interval=step,

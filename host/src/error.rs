@@ -49,6 +49,15 @@ pub enum FmuError {
         source: std::io::Error,
     },
 
+    /// The `.fmu` at `path` was unpacked, but its model description or its
+    /// binary was refused for the reason in `source`.
+    #[error("{}: {source}", path.display())]
+    InFmu {
+        path: PathBuf,
+        #[source]
+        source: Box<FmuError>,
+    },
+
     /// An archive was refused; `entry` names the offending entry if there is one.
     #[error("{path}: {}{problem}", entry.as_ref().map(|e| format!("entry \"{e}\": ")).unwrap_or_default())]
     Archive {

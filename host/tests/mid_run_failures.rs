@@ -5,7 +5,8 @@
 //! and the report names the instance, the call and the status; a discarded
 //! step also says how far the FMU got (fmi2LastSuccessfulTime) and whether
 //! it asks to end (fmi2Terminated); after fmi2Fatal the FMU is never called
-//! again, not even by fmi2FreeInstance. The same through `fricsim cosim`.
+//! again, not even by fmi2FreeInstance. The same through `fricsim cosim`,
+//! whose CSV keeps the rows so far and ends with an `# INCOMPLETE` line.
 
 mod belt;
 mod common;
@@ -244,10 +245,17 @@ fn fricsim_cosim_exits_nonzero_names_the_failure_and_keeps_the_rows_so_far() {
         // the FMU prints "FMI VIOLATION" if it is called after fmi2Fatal
         assert!(!stderr.contains("FMI VIOLATION"), "{stderr}");
 
+        // header, the rows so far, and a comment that marks the file
         let csv = std::fs::read_to_string(&out).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines[0], "time,rig.x,rig.v,rig.a,friction.F,friction.z");
-        assert_eq!(lines.len(), 1 + FAULT_STEP, "{csv}");
+        assert_eq!(lines.len(), 1 + FAULT_STEP + 1, "{csv}");
+        let marker = lines[FAULT_STEP + 1];
+        assert!(
+            marker.starts_with("# INCOMPLETE: the run stopped early: at t = 0.0087890625: ")
+                && marker.contains(&format!("\"rig\" with {status}")),
+            "{marker}"
+        );
         let last: Vec<f64> = lines[FAULT_STEP]
             .split(',')
             .map(|x| x.parse().unwrap())

@@ -85,10 +85,15 @@ impl Fmu {
         Fmu::open_with(path, &UnpackOptions::default())
     }
 
-    /// [`Fmu::open`] with explicit unpacking limits.
+    /// [`Fmu::open`] with explicit unpacking limits. A refused model
+    /// description or binary is reported as [`FmuError::InFmu`], naming
+    /// the archive (archive errors name it already).
     pub fn open_with(path: impl AsRef<Path>, options: &UnpackOptions) -> Result<Fmu, FmuError> {
         let dir = unpack(path.as_ref(), options)?;
-        Fmu::load(FmuDir::Temporary(dir))
+        Fmu::load(FmuDir::Temporary(dir)).map_err(|e| FmuError::InFmu {
+            path: path.as_ref().to_path_buf(),
+            source: Box::new(e),
+        })
     }
 
     /// An FMU already unpacked in `dir` (not removed on drop).
