@@ -38,6 +38,7 @@ impl InputTable {
         let shown = path.display();
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)
+            .flexible(true) // rows of the wrong length get our message below
             .trim(csv::Trim::All)
             .comment(Some(b'#'))
             .from_path(path)

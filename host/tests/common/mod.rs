@@ -2,7 +2,6 @@
 //! `cc` at test time), zipping a directory, and the repository's LuGre.fmu.
 #![allow(dead_code)]
 
-use fricsim::FmuError;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -128,8 +127,8 @@ pub fn lugre_fmu() -> PathBuf {
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Assert that `error`'s message contains every one of `parts`.
-pub fn assert_message(error: &FmuError, parts: &[&str]) {
+/// Assert that `error`'s message (an error or any text) contains every one of `parts`.
+pub fn assert_message(error: &dyn std::fmt::Display, parts: &[&str]) {
     let message = error.to_string();
     for part in parts {
         assert!(
