@@ -4,19 +4,25 @@
 use crate::variables::{Causality, Initial, ModelInfo, VarType, Variability, LOG_CATEGORIES};
 use std::fmt::Write;
 
-/// SI base-unit exponents (kg, m, s) of the units our models use.
-const UNITS: &[(&str, [i32; 3])] = &[
-    ("kg", [1, 0, 0]),
-    ("1/N", [-1, -1, 2]),
-    ("m", [0, 1, 0]),
-    ("s", [0, 0, 1]),
-    ("1/m", [0, -1, 0]),
-    ("m/s", [0, 1, -1]),
-    ("m/s2", [0, 1, -2]),
-    ("s/m", [0, -1, 1]),
-    ("N", [1, 1, -2]),
-    ("N/m", [1, 0, -2]),
-    ("N.s/m", [1, 0, -1]),
+/// SI base-unit exponents (kg, m, s, A) of the units our models use.
+const UNITS: &[(&str, [i32; 4])] = &[
+    ("kg", [1, 0, 0, 0]),
+    ("1/N", [-1, -1, 2, 0]),
+    ("m", [0, 1, 0, 0]),
+    ("s", [0, 0, 1, 0]),
+    ("1/m", [0, -1, 0, 0]),
+    ("m/s", [0, 1, -1, 0]),
+    ("m/s2", [0, 1, -2, 0]),
+    ("s/m", [0, -1, 1, 0]),
+    ("N", [1, 1, -2, 0]),
+    ("N/m", [1, 0, -2, 0]),
+    ("N.s/m", [1, 0, -1, 0]),
+    ("Hz", [0, 0, -1, 0]),
+    // a drive command in volts (the rig controller; EMPS: vir) and its gains
+    ("V", [1, 2, -3, -1]),
+    ("V/m", [1, 1, -3, -1]),
+    ("V.s/m", [1, 1, -2, -1]),
+    ("N/V", [0, -1, 1, 1]),
 ];
 
 fn escape(s: &str) -> String {
@@ -87,7 +93,7 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     if !used.is_empty() {
         let _ = writeln!(w, "  <UnitDefinitions>");
         for unit in used {
-            let (_, [kg, m, s]) =
+            let (_, [kg, m, s, a]) =
                 UNITS
                     .iter()
                     .find(|(name, _)| *name == unit)
@@ -98,7 +104,7 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
                         )
                     })?;
             let mut base = String::new();
-            for (name, e) in [("kg", kg), ("m", m), ("s", s)] {
+            for (name, e) in [("kg", kg), ("m", m), ("s", s), ("A", a)] {
                 if *e != 0 {
                     let _ = write!(base, r#" {name}="{e}""#);
                 }

@@ -1,32 +1,254 @@
 //! One-degree-of-freedom rig (MODELS.md, "Rigs in the seeds"): a mass `m`
 //! with viscous damping `c` to ground, a spring `k` to an actuator point
-//! `x_a(t)`, an external force, and the friction force applied as −F:
+//! `x_a(t)`, an external force, a built-in drive force, an optional built-in
+//! controller, and the friction force applied as −F:
 //!
-//! m·ẍ = k·(x_a(t) − x) − c·ẋ + F_ext − F,  slip velocity v = ẋ − v_surface.
+//! m·ẍ = k·(x_a(t) − x) − c·ẋ + F_ext − F + F_d(t) + F_ctrl,
 //!
-//! The actuator point is prescribed: `x_a(t) = x_a0 + v_a·t` (the spring
-//! pulled at constant speed of the 1995 stick-slip benchmark, the piezo ramp
-//! of seed 000). F and F_ext vary linearly over a step (first-order input
-//! interpolation). Integration: 2-stage Gauss–Legendre (order 4, A-stable),
-//! sub-stepped so that ω·h_sub ≤ 0.02 (ω² = k/m + (c/2m)²), which makes the
-//! error per natural period far below 1e-10 relative.
+//! with the slip velocity v = ẋ − v_s(t) and relative displacement
+//! x − x_s(t) over a moving surface x_s(t) = v_surface·t + A_s·sin(2π f_s t)
+//! (belt speed plus dither; seed 004's dither d = A·sin(ωt)).
+//!
+//! - **Actuator point** ([`Actuator`]): `Prescribed`: x_a(t) = x_a0 + v_a·t +
+//!   A_a·sin(2π f_a t) (the pulled spring of the 1995 benchmark, the piezo
+//!   ramp of seed 000, seed 002's imposed sinusoidal displacement); `Input`:
+//!   x_a = the input `x_act_in`, linear over a step with its slope (seed
+//!   000's piezo staircase of 0.825e-9 m every 10 ms).
+//! - **Drive force** ([`DriveForce`]): F_d(t) = F_step·[t ≥ t_step] +
+//!   A_d·sin(2π f_d t) (seed 001's step forces 0.5–1.5 N; seed 003's 1 Hz
+//!   sine drive), added to the input F_ext. A step inside a communication
+//!   step splits the integration there, so it is taken exactly.
+//! - **Controller** ([`Controller`], needs m > 0):
+//!   u = Kp·(x_ref − x) + Kd·(β·v_ref − ẋ) + Ki·ξ,  ξ̇ = v_ref − ẋ, ξ(0) = 0,
+//!   F_ctrl = G·sat(u, ±u_max) (u_max = 0: no saturation). The reference is
+//!   built in, v_ref = v_r0 + V·sin(2π f_r t) and x_ref = x_r0 + v_r0·t +
+//!   (V/ω_r)(1 − cos ω_r t) (seed 001's velocity trials ±1e-3·sin(t/k) m/s:
+//!   V = 1e-3, f_r = 1/(2πk)), or taken from the inputs `x_ref`, `v_ref`.
+//!   Position PD: Ki = 0, β = 1. Velocity PI: Kp = 0, β = 1 (Kd is the
+//!   proportional and Ki the integral gain on the velocity error). The EMPS
+//!   loop of `shared/data/README.md`, force = gtau·sat(kv·(kp·(qg − qm) − q̇m),
+//!   ±10 V), is Kp = kv·kp, Kd = kv, Ki = 0, β = 0, G = gtau, u_max = 10,
+//!   reference from the input x_ref = qg.
+//!   ξ is integrated exactly: over any interval ξ changes by ∫v_ref − Δx.
+//!   There is no anti-windup: ξ integrates the error also while saturated.
+//!
+//! Integration: 2-stage Gauss–Legendre (order 4, A-stable), sub-stepped so
+//! that ω·h_sub ≤ 0.02, with ω = √(K/m + (C/2m)²) + C/2m from the effective
+//! stiffness K = k + G·(Kp + Ki) and damping C = c + G·Kd of the unsaturated
+//! loop, and ω at least every active forcing frequency. Gauss–Legendre has
+//! no amplitude error on an undamped oscillator; its phase error at the
+//! bound ω·h_sub = 0.02 is 1.4e-9 of a radian per natural period (∝ (ω·h)⁴:
+//! 9e-11 at ω·h = 0.01, and one sub-step of h is used when ω·h ≤ 0.02).
+//! Inputs (F, F_ext, x_act_in, x_ref, v_ref) move linearly over a step
+//! with their slopes (first-order input interpolation).
+//!
+//! **Saturation** is handled piecewise and exactly up to event location:
+//! sat(u) is continuous, and on each side of ±u_max the closed loop is
+//! affine (linear: F_ctrl = G·u; saturated: F_ctrl = ±G·u_max, constant).
+//! Each sub-step is integrated with the piece in which u lies at its start;
+//! if u at its end lies in another piece, the crossing time θ of u = ±u_max
+//! is located (Illinois regula falsi on the Gauss–Legendre solution over
+//! [0, θ], to 1e-12 of the sub-step), the sub-step is advanced to θ, and the
+//! rest is integrated with the other piece (at most 8 switches per
+//! sub-step; two crossings inside one sub-step, which ω·h_sub ≤ 0.02 makes
+//! negligible, are not resolved).
 //!
 //! m = 0 selects the quasi-static force balance of seed 000:
-//! 0 = k·(x_a − x) − c·ẋ + F_ext − F; with c = 0 the position follows the
-//! forces directly, x = x_a + (F_ext − F)/k (direct feedthrough from F).
+//! 0 = k·(x_a − x) − c·ẋ + F_ext − F + F_d. With c = 0 the position follows
+//! the forces directly, x = x_a + (F_ext − F + F_d)/k (direct feedthrough
+//! from F); with c > 0 it is first order, c·ẋ = k·(x_a − x) + F_ext − F + F_d.
+//! In this mode ẋ is its value at the end of the last step with the inputs
+//! and slopes of that step (before the first step: with zero inputs), and
+//! the acceleration output is 0.
+//!
+//! Defaults: the 1995 stick-slip benchmark (m = 1 kg, k = 2 N/m, pulled at
+//! 0.1 m/s, everything else off); in that mode the arithmetic is the one of
+//! the first version of this file, bit for bit.
+
+use crate::gauss_legendre::{stage_derivatives, C};
+use crate::signals::Sinusoid;
+use crate::{check_finite, check_non_negative};
+
+/// Sub-step rule ω·h_sub ≤ this.
+const OMEGA_H_MAX: f64 = 0.02;
+/// Most saturation switches located inside one sub-step.
+const MAX_SWITCHES: usize = 8;
+
+/// Where the actuator point (the far end of the spring) comes from;
+/// parameter `actuator`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Actuator {
+    /// 0: x_a(t) = x_a0 + v_a·t + act_amp·sin(2π·act_freq·t).
+    Prescribed,
+    /// 1: x_a = input `x_act_in` (with its interpolation slope).
+    Input,
+}
+
+impl Actuator {
+    pub fn from_code(code: i32) -> Result<Self, String> {
+        match code {
+            0 => Ok(Actuator::Prescribed),
+            1 => Ok(Actuator::Input),
+            _ => Err(format!(
+                "invalid parameter actuator = {code}: must be 0 (prescribed ramp + sinusoid) or 1 (input x_act_in)"
+            )),
+        }
+    }
+
+    pub fn code(self) -> i32 {
+        match self {
+            Actuator::Prescribed => 0,
+            Actuator::Input => 1,
+        }
+    }
+}
+
+/// Which controller runs; parameter `control`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Control {
+    /// 0: no controller.
+    Off,
+    /// 1: on, built-in reference v_ref = ref_v0 + ref_v_amp·sin(2π·ref_freq·t).
+    BuiltIn,
+    /// 2: on, reference from the inputs `x_ref` and `v_ref`.
+    Input,
+}
+
+impl Control {
+    pub fn from_code(code: i32) -> Result<Self, String> {
+        match code {
+            0 => Ok(Control::Off),
+            1 => Ok(Control::BuiltIn),
+            2 => Ok(Control::Input),
+            _ => Err(format!(
+                "invalid parameter control = {code}: must be 0 (off), 1 (built-in sinusoidal reference) or 2 (reference from inputs x_ref, v_ref)"
+            )),
+        }
+    }
+
+    pub fn code(self) -> i32 {
+        match self {
+            Control::Off => 0,
+            Control::BuiltIn => 1,
+            Control::Input => 2,
+        }
+    }
+}
+
+/// Built-in drive force F_d(t) = f_step·[t ≥ t_step] + sine(t).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DriveForce {
+    pub f_step: f64,
+    pub t_step: f64,
+    pub sine: Sinusoid,
+}
+
+impl DriveForce {
+    pub fn value(&self, t: f64) -> f64 {
+        let step = if self.f_step != 0.0 && t >= self.t_step {
+            self.f_step
+        } else {
+            0.0
+        };
+        step + self.sine.value(t)
+    }
+
+    /// dF_d/dt away from the step instant.
+    pub fn rate(&self, t: f64) -> f64 {
+        self.sine.rate(t)
+    }
+}
+
+/// Built-in reference: v_ref = v0 + sine(t), x_ref = x0 + v0·t + ∫sine.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Reference {
+    pub x0: f64,
+    pub v0: f64,
+    pub sine: Sinusoid,
+}
+
+/// u = kp·(x_ref − x) + kd·(ff·v_ref − ẋ) + ki·ξ; F_ctrl = gain·sat(u, ±u_max).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Controller {
+    pub mode: Control,
+    /// Position gain (V/m with the command in volts).
+    pub kp: f64,
+    /// Velocity gain (V·s/m).
+    pub kd: f64,
+    /// Gain on ξ = ∫(v_ref − ẋ) dt (V/m).
+    pub ki: f64,
+    /// Velocity feed-forward weight β in kd·(β·v_ref − ẋ), 0..1.
+    pub ff: f64,
+    /// Drive gain G (N/V).
+    pub gain: f64,
+    /// Saturation of the command |u| ≤ u_max (V); 0 = none.
+    pub u_max: f64,
+    pub reference: Reference,
+}
+
+impl Default for Controller {
+    fn default() -> Self {
+        Controller {
+            mode: Control::Off,
+            kp: 0.0,
+            kd: 0.0,
+            ki: 0.0,
+            ff: 1.0,
+            gain: 1.0,
+            u_max: 0.0,
+            reference: Reference::default(),
+        }
+    }
+}
+
+impl Controller {
+    fn on(&self) -> bool {
+        self.mode != Control::Off
+    }
+
+    fn saturates(&self) -> bool {
+        self.on() && self.u_max > 0.0
+    }
+
+    /// sat(u, ±u_max).
+    fn saturate(&self, u: f64) -> f64 {
+        if self.u_max > 0.0 {
+            u.clamp(-self.u_max, self.u_max)
+        } else {
+            u
+        }
+    }
+
+    /// Piece of sat(·) in which u lies: −1, 0 (|u| ≤ u_max, or no
+    /// saturation), +1.
+    fn piece(&self, u: f64) -> i8 {
+        if !self.saturates() || u.abs() <= self.u_max {
+            0
+        } else if u > 0.0 {
+            1
+        } else {
+            -1
+        }
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rig1DParams {
     pub m: f64,
     pub c: f64,
     pub k: f64,
-    /// Actuator point at t = 0 and its speed.
+    pub actuator: Actuator,
+    /// Prescribed actuator point at t = 0, its speed and its sinusoid.
     pub x_a0: f64,
     pub v_a: f64,
-    /// Belt (surface) speed: the slip velocity is ẋ − v_surface.
+    pub act_sine: Sinusoid,
+    /// Belt (surface) speed and dither: x_s(t) = v_surface·t + dither(t).
     pub v_surface: f64,
+    pub dither: Sinusoid,
     pub x0: f64,
     pub v0: f64,
+    pub drive: DriveForce,
+    pub control: Controller,
 }
 
 impl Default for Rig1DParams {
@@ -36,38 +258,62 @@ impl Default for Rig1DParams {
             m: 1.0,
             c: 0.0,
             k: 2.0,
+            actuator: Actuator::Prescribed,
             x_a0: 0.0,
             v_a: 0.1,
+            act_sine: Sinusoid::OFF,
             v_surface: 0.0,
+            dither: Sinusoid::OFF,
             x0: 0.0,
             v0: 0.0,
+            drive: DriveForce::default(),
+            control: Controller::default(),
         }
     }
 }
 
 impl Rig1DParams {
+    /// Every value finite, physical ranges, consistent modes; the error
+    /// names the parameter (as the FMU calls it) and its value.
     pub fn validate(&self) -> Result<(), String> {
-        let named = [
-            ("m", self.m),
-            ("c", self.c),
-            ("k", self.k),
+        for (name, value) in [("m", self.m), ("c", self.c), ("k", self.k)] {
+            check_non_negative(name, value)?;
+        }
+        for (name, value) in [
             ("x_a0", self.x_a0),
             ("v_a", self.v_a),
             ("v_surface", self.v_surface),
             ("x0", self.x0),
             ("v0", self.v0),
-        ];
-        for (name, value) in named {
-            if !value.is_finite() {
-                return Err(format!(
-                    "invalid parameter {name} = {value}: must be finite"
-                ));
-            }
+            ("F_step", self.drive.f_step),
+            ("t_step", self.drive.t_step),
+            ("ref_x0", self.control.reference.x0),
+            ("ref_v0", self.control.reference.v0),
+        ] {
+            check_finite(name, value)?;
         }
-        for (name, value) in [("m", self.m), ("c", self.c), ("k", self.k)] {
-            if value < 0.0 {
-                return Err(format!("invalid parameter {name} = {value}: must be >= 0"));
-            }
+        self.act_sine.validate("act_amp", "act_freq")?;
+        self.dither.validate("dither_amp", "dither_freq")?;
+        self.drive.sine.validate("drive_amp", "drive_freq")?;
+        self.control
+            .reference
+            .sine
+            .validate("ref_v_amp", "ref_freq")?;
+        let ctrl = &self.control;
+        for (name, value) in [
+            ("ctrl_kp", ctrl.kp),
+            ("ctrl_kd", ctrl.kd),
+            ("ctrl_ki", ctrl.ki),
+            ("ctrl_gain", ctrl.gain),
+            ("ctrl_u_max", ctrl.u_max),
+        ] {
+            check_non_negative(name, value)?;
+        }
+        if !(0.0..=1.0).contains(&ctrl.ff) {
+            return Err(format!(
+                "invalid parameter ctrl_ff = {}: must be in 0..1",
+                ctrl.ff
+            ));
         }
         if self.m == 0.0 && self.k == 0.0 && self.c == 0.0 {
             return Err(
@@ -75,286 +321,525 @@ impl Rig1DParams {
                     .into(),
             );
         }
+        if ctrl.on() && self.m == 0.0 {
+            return Err(format!(
+                "invalid parameter control = {}: the built-in controller needs m > 0, but m = 0 (quasi-static mode)",
+                ctrl.mode.code()
+            ));
+        }
         Ok(())
     }
+}
+
+/// The rig's inputs at one instant (or their slopes d/dt over a step).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rig1DInputs {
+    /// Friction force F, applied as −F.
+    pub friction: f64,
+    pub f_ext: f64,
+    /// Actuator point when `Actuator::Input`.
+    pub x_act: f64,
+    /// Reference position and velocity when `Control::Input`.
+    pub x_ref: f64,
+    pub v_ref: f64,
+}
+
+impl Rig1DInputs {
+    /// u + du·τ.
+    pub fn at(&self, du: &Rig1DInputs, tau: f64) -> Rig1DInputs {
+        Rig1DInputs {
+            friction: self.friction + du.friction * tau,
+            f_ext: self.f_ext + du.f_ext * tau,
+            x_act: self.x_act + du.x_act * tau,
+            x_ref: self.x_ref + du.x_ref * tau,
+            v_ref: self.v_ref + du.v_ref * tau,
+        }
+    }
+}
+
+/// The state at one instant: position, velocity, velocity-error integral.
+#[derive(Clone, Copy, Debug)]
+struct Point {
+    x: f64,
+    xd: f64,
+    xi: f64,
 }
 
 #[derive(Clone, Debug)]
 pub struct Rig1D {
     p: Rig1DParams,
-    /// Time since the start (the actuator law depends on it).
+    /// Time since the start (the prescribed signals depend on it).
     t: f64,
     x: f64,
     xd: f64,
+    /// ξ = ∫(v_ref − ẋ) dt of the controller (0 when it is off).
+    xi: f64,
 }
 
 impl Rig1D {
     pub fn new(p: Rig1DParams) -> Result<Self, String> {
         p.validate()?;
-        Ok(Rig1D {
+        let mut rig = Rig1D {
             p,
             t: 0.0,
             x: p.x0,
             xd: p.v0,
-        })
+            xi: 0.0,
+        };
+        if p.m == 0.0 {
+            rig.xd = rig.quasi_static_velocity(&Rig1DInputs::default(), &Rig1DInputs::default());
+        }
+        Ok(rig)
     }
 
     pub fn params(&self) -> &Rig1DParams {
         &self.p
     }
 
-    pub fn actuator_position(&self, t: f64) -> f64 {
-        self.p.x_a0 + self.p.v_a * t
+    pub fn time(&self) -> f64 {
+        self.t
     }
 
-    /// Position; in the quasi-static mode with c = 0 it follows the forces.
-    pub fn position(&self, friction: f64, f_ext: f64) -> f64 {
+    // ---- prescribed signals -------------------------------------------
+
+    /// x_a at absolute time t; `x_act_in` is the input's value then.
+    fn actuator_at(&self, t: f64, x_act_in: f64) -> f64 {
+        match self.p.actuator {
+            Actuator::Prescribed => self.p.x_a0 + self.p.v_a * t + self.p.act_sine.value(t),
+            Actuator::Input => x_act_in,
+        }
+    }
+
+    fn actuator_rate(&self, t: f64, x_act_slope: f64) -> f64 {
+        match self.p.actuator {
+            Actuator::Prescribed => self.p.v_a + self.p.act_sine.rate(t),
+            Actuator::Input => x_act_slope,
+        }
+    }
+
+    /// Surface position x_s(t) = v_surface·t + A_s·sin(2π f_s t).
+    pub fn surface_position(&self, t: f64) -> f64 {
+        self.p.v_surface * t + self.p.dither.value(t)
+    }
+
+    /// Surface velocity v_s(t) = v_surface + 2π f_s·A_s·cos(2π f_s t).
+    pub fn surface_velocity(&self, t: f64) -> f64 {
+        self.p.v_surface + self.p.dither.rate(t)
+    }
+
+    /// (x_ref, v_ref, R) at absolute time t = self.t + tau with inputs
+    /// u + du·tau; R is an antiderivative of v_ref in time (differences of R
+    /// are ∫v_ref).
+    fn reference(&self, t: f64, tau: f64, u: &Rig1DInputs, du: &Rig1DInputs) -> (f64, f64, f64) {
+        let r = &self.p.control.reference;
+        match self.p.control.mode {
+            Control::Off => (0.0, 0.0, 0.0),
+            Control::BuiltIn => {
+                let x_ref = r.x0 + r.v0 * t + r.sine.integral(t);
+                (x_ref, r.v0 + r.sine.value(t), x_ref)
+            }
+            Control::Input => (
+                u.x_ref + du.x_ref * tau,
+                u.v_ref + du.v_ref * tau,
+                u.v_ref * tau + 0.5 * du.v_ref * tau * tau,
+            ),
+        }
+    }
+
+    /// Unsaturated command u = Kp·(x_ref − x) + Kd·(β·v_ref − ẋ) + Ki·ξ.
+    fn command(&self, s: &Point, x_ref: f64, v_ref: f64) -> f64 {
+        let g = &self.p.control;
+        g.kp * (x_ref - s.x) + g.kd * (g.ff * v_ref - s.xd) + g.ki * s.xi
+    }
+
+    fn command_at(&self, s: &Point, tau: f64, u: &Rig1DInputs, du: &Rig1DInputs) -> f64 {
+        let (x_ref, v_ref, _) = self.reference(self.t + tau, tau, u, du);
+        self.command(s, x_ref, v_ref)
+    }
+
+    fn here(&self) -> Point {
+        Point {
+            x: self.x,
+            xd: self.xd,
+            xi: self.xi,
+        }
+    }
+
+    // ---- outputs at the current time, with the current inputs ----------
+
+    /// Position; in the quasi-static mode with c = 0 it follows the forces,
+    /// x = x_a + (F_ext − F + F_d)/k.
+    pub fn position(&self, u: &Rig1DInputs) -> f64 {
         if self.p.m == 0.0 && self.p.c == 0.0 {
-            self.actuator_position(self.t) + (f_ext - friction) / self.p.k
+            self.actuator_at(self.t, u.x_act)
+                + (u.f_ext - u.friction + self.p.drive.value(self.t)) / self.p.k
         } else {
             self.x
         }
     }
 
-    /// Body velocity ẋ (quasi-static with c = 0: the actuator speed plus the
-    /// rate of the force balance, which needs force rates: `df`, `dfe`).
-    pub fn velocity(&self, friction_rate: f64, f_ext_rate: f64) -> f64 {
-        if self.p.m == 0.0 && self.p.c == 0.0 {
-            self.p.v_a + (f_ext_rate - friction_rate) / self.p.k
+    /// Body velocity ẋ.
+    pub fn velocity(&self) -> f64 {
+        self.xd
+    }
+
+    /// Slip velocity v = ẋ − v_s(t).
+    pub fn slip_velocity(&self) -> f64 {
+        self.xd - self.surface_velocity(self.t)
+    }
+
+    /// Relative displacement x − x_s(t).
+    pub fn relative_displacement(&self, u: &Rig1DInputs) -> f64 {
+        self.position(u) - self.surface_position(self.t)
+    }
+
+    pub fn actuator_position(&self, u: &Rig1DInputs) -> f64 {
+        self.actuator_at(self.t, u.x_act)
+    }
+
+    /// Spring force on the body, k·(x_a − x).
+    pub fn spring_force(&self, u: &Rig1DInputs) -> f64 {
+        self.p.k * (self.actuator_position(u) - self.position(u))
+    }
+
+    pub fn drive_force(&self) -> f64 {
+        self.p.drive.value(self.t)
+    }
+
+    /// Saturated command sat(u, ±u_max) (0 when the controller is off).
+    pub fn control_command(&self, u: &Rig1DInputs) -> f64 {
+        if !self.p.control.on() {
+            return 0.0;
+        }
+        let raw = self.command_at(&self.here(), 0.0, u, &Rig1DInputs::default());
+        self.p.control.saturate(raw)
+    }
+
+    /// Control force G·sat(u, ±u_max).
+    pub fn control_force(&self, u: &Rig1DInputs) -> f64 {
+        if !self.p.control.on() {
+            return 0.0;
+        }
+        self.p.control.gain * self.control_command(u)
+    }
+
+    pub fn acceleration(&self, u: &Rig1DInputs) -> f64 {
+        if self.p.m == 0.0 {
+            return 0.0;
+        }
+        (self.spring_force(u) - self.p.c * self.xd + u.f_ext - u.friction
+            + self.drive_force()
+            + self.control_force(u))
+            / self.p.m
+    }
+
+    /// dx/dt now, the inputs moving at `du`: ẋ (m > 0), or the rate of the
+    /// quasi-static balance.
+    pub fn position_rate(&self, u: &Rig1DInputs, du: &Rig1DInputs) -> f64 {
+        if self.p.m == 0.0 {
+            self.quasi_static_velocity(u, du)
         } else {
             self.xd
         }
     }
 
-    pub fn slip_velocity(&self, friction_rate: f64, f_ext_rate: f64) -> f64 {
-        self.velocity(friction_rate, f_ext_rate) - self.p.v_surface
+    /// d²x_s/dt² of the surface.
+    pub fn surface_acceleration(&self) -> f64 {
+        self.p.dither.acceleration(self.t)
     }
 
-    /// Spring force on the body, k·(x_a − x).
-    pub fn spring_force(&self, friction: f64, f_ext: f64) -> f64 {
-        self.p.k * (self.actuator_position(self.t) - self.position(friction, f_ext))
+    pub fn actuator_velocity(&self, du: &Rig1DInputs) -> f64 {
+        self.actuator_rate(self.t, du.x_act)
     }
 
-    pub fn acceleration(&self, friction: f64, f_ext: f64) -> f64 {
-        if self.p.m == 0.0 {
-            return 0.0;
+    pub fn drive_force_rate(&self) -> f64 {
+        self.p.drive.rate(self.t)
+    }
+
+    /// Quasi-static ẋ at the current time with inputs u moving at du:
+    /// c = 0: ẋ_a + (Ḟ_ext − Ḟ + Ḟ_d)/k; c > 0: (k·(x_a − x) + F_ext − F + F_d)/c.
+    fn quasi_static_velocity(&self, u: &Rig1DInputs, du: &Rig1DInputs) -> f64 {
+        let p = &self.p;
+        if p.c == 0.0 {
+            self.actuator_rate(self.t, du.x_act)
+                + (du.f_ext - du.friction + p.drive.rate(self.t)) / p.k
+        } else {
+            (p.k * (self.actuator_at(self.t, u.x_act) - self.x) + u.f_ext - u.friction
+                + p.drive.value(self.t))
+                / p.c
         }
-        (self.spring_force(friction, f_ext) - self.p.c * self.xd + f_ext - friction) / self.p.m
     }
 
-    pub fn time(&self) -> f64 {
-        self.t
-    }
+    // ---- stepping --------------------------------------------------------
 
-    /// Advance by `h` with friction F(τ) = f0 + df·τ and F_ext(τ) = e0 + de·τ.
-    pub fn step(&mut self, f0: f64, df: f64, e0: f64, de: f64, h: f64) {
+    /// Advance by `h` with inputs u(τ) = u + du·τ, τ ∈ [0, h].
+    pub fn step(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
         let p = self.p;
-        if p.m == 0.0 {
-            if p.c == 0.0 {
-                // pure force balance: nothing to integrate
-            } else {
-                // c·ẋ = k(x_a − x) + F_ext − F: linear first order, exact
-                // integration by sub-stepped Gauss–Legendre as below.
-                self.integrate(
-                    h,
-                    |t, x, _xd, tau| {
-                        let rhs =
-                            p.k * (p.x_a0 + p.v_a * t - x) + (e0 + de * tau) - (f0 + df * tau);
-                        (rhs / p.c, 0.0)
-                    },
-                    true,
-                );
-            }
+        if p.m == 0.0 && p.c == 0.0 {
+            // pure force balance: nothing to integrate
             self.t += h;
+            self.xd = self.quasi_static_velocity(&u.at(du, h), du);
             return;
         }
-        self.integrate(
-            h,
-            |t, x, xd, tau| {
-                let force =
-                    p.k * (p.x_a0 + p.v_a * t - x) - p.c * xd + (e0 + de * tau) - (f0 + df * tau);
-                (xd, force / p.m)
-            },
-            false,
-        );
+        let first_order = p.m == 0.0;
+        // F_step·[t ≥ t_step] jumps inside this step: integrate up to it and on.
+        let d = &p.drive;
+        if d.f_step != 0.0 && d.t_step > self.t && d.t_step < self.t + h {
+            let tau = d.t_step - self.t;
+            self.integrate(0.0, tau, u, du, first_order);
+            self.integrate(tau, h - tau, u, du, first_order);
+        } else {
+            self.integrate(0.0, h, u, du, first_order);
+        }
         self.t += h;
+        if first_order {
+            self.xd = self.quasi_static_velocity(&u.at(du, h), du);
+        }
     }
 
-    /// Gauss–Legendre 2-stage on (x, ẋ) for a linear right-hand side `f`,
-    /// solved exactly (the stage equations are linear: solved by a fixed
-    /// number of Newton-free iterations would lose A-stability, so we solve
-    /// the 4×4 stage system directly from the linear map's columns).
-    fn integrate(
-        &mut self,
-        h: f64,
-        f: impl Fn(f64, f64, f64, f64) -> (f64, f64),
-        first_order: bool,
-    ) {
-        let p = self.p;
+    /// Largest angular frequency the sub-steps must resolve.
+    fn substep_omega(&self, first_order: bool) -> f64 {
+        let p = &self.p;
+        let g = &p.control;
+        let mut forcing = p.drive.sine.active_omega();
+        if p.actuator == Actuator::Prescribed {
+            forcing = forcing.max(p.act_sine.active_omega());
+        }
+        if g.mode == Control::BuiltIn {
+            forcing = forcing.max(g.reference.sine.active_omega());
+        }
         let omega = if first_order {
             p.k / p.c.max(f64::MIN_POSITIVE)
         } else {
-            (p.k / p.m + (p.c / (2.0 * p.m)).powi(2)).sqrt() + p.c / (2.0 * p.m)
-        };
-        let n = ((omega * h / 0.02).ceil() as usize).clamp(1, 1_000_000);
-        let hs = h / n as f64;
-        let s3 = 3f64.sqrt() / 6.0;
-        let (c1, c2) = (0.5 - s3, 0.5 + s3);
-        let a = [[0.25, 0.25 - s3], [0.25 + s3, 0.25]];
-        for i in 0..n {
-            let tau0 = i as f64 * hs;
-            let t0 = self.t + tau0;
-            let (x, xd) = (self.x, self.xd);
-            // Stage derivatives K = (k1x, k1v, k2x, k2v) solve K = f(stage(K)):
-            // f is affine in the stage values, so K = b + M·K; build b and M
-            // by evaluating f, then solve (I − M)K = b.
-            let stage = |kv: &[f64; 4], j: usize| -> (f64, f64) {
-                let sx = x + hs * (a[j][0] * kv[0] + a[j][1] * kv[2]);
-                let sv = xd + hs * (a[j][0] * kv[1] + a[j][1] * kv[3]);
-                let cj = if j == 0 { c1 } else { c2 };
-                f(t0 + cj * hs, sx, sv, tau0 + cj * hs)
-            };
-            let eval = |kv: &[f64; 4]| -> [f64; 4] {
-                let (a0, a1) = stage(kv, 0);
-                let (b0, b1) = stage(kv, 1);
-                [a0, a1, b0, b1]
-            };
-            let b = eval(&[0.0; 4]);
-            let mut m = [[0.0; 4]; 4];
-            for col in 0..4 {
-                let mut e = [0.0; 4];
-                e[col] = 1.0;
-                let fe = eval(&e);
-                for row in 0..4 {
-                    m[row][col] = fe[row] - b[row];
-                }
-            }
-            let mut lhs = [[0.0; 4]; 4];
-            for r in 0..4 {
-                for c in 0..4 {
-                    lhs[r][c] = if r == c { 1.0 } else { 0.0 } - m[r][c];
-                }
-            }
-            let kv = solve4(lhs, b);
-            self.x = x + hs * 0.5 * (kv[0] + kv[2]);
-            self.xd = if first_order {
-                0.5 * (kv[0] + kv[2])
+            let (k, c) = if g.on() {
+                (p.k + g.gain * (g.kp + g.ki), p.c + g.gain * g.kd)
             } else {
-                xd + hs * 0.5 * (kv[1] + kv[3])
+                (p.k, p.c)
             };
+            (k / p.m + (c / (2.0 * p.m)).powi(2)).sqrt() + c / (2.0 * p.m)
+        };
+        omega.max(forcing)
+    }
+
+    /// Integrate over τ ∈ [tau_start, tau_start + len] of the current step.
+    fn integrate(
+        &mut self,
+        tau_start: f64,
+        len: f64,
+        u: &Rig1DInputs,
+        du: &Rig1DInputs,
+        first_order: bool,
+    ) {
+        let omega = self.substep_omega(first_order);
+        let n = ((omega * len / OMEGA_H_MAX).ceil() as usize).clamp(1, 1_000_000);
+        let hs = len / n as f64;
+        for i in 0..n {
+            let tau0 = tau_start + i as f64 * hs;
+            self.substep(tau0, hs, u, du, first_order);
+        }
+    }
+
+    /// One sub-step, split where the command crosses ±u_max (see the module
+    /// documentation).
+    fn substep(
+        &mut self,
+        tau0: f64,
+        hs: f64,
+        u: &Rig1DInputs,
+        du: &Rig1DInputs,
+        first_order: bool,
+    ) {
+        let ctrl = self.p.control;
+        if !ctrl.saturates() {
+            let end = self.segment(tau0, hs, 0, u, du, first_order);
+            self.set(end);
+            return;
+        }
+        let (mut tau, mut remaining) = (tau0, hs);
+        let mut piece = ctrl.piece(self.command_at(&self.here(), tau, u, du));
+        for switches in 0..=MAX_SWITCHES {
+            let end = self.segment(tau, remaining, piece, u, du, first_order);
+            let u_end = self.command_at(&end, tau + remaining, u, du);
+            let piece_end = ctrl.piece(u_end);
+            if piece_end == piece || switches == MAX_SWITCHES {
+                self.set(end);
+                return;
+            }
+            // the boundary u = ±u_max that the trajectory leaves `piece` through
+            let side = if piece == 0 { piece_end } else { piece };
+            let boundary = f64::from(side) * ctrl.u_max;
+            let g0 = self.command_at(&self.here(), tau, u, du) - boundary;
+            let theta = find_crossing(
+                |th| {
+                    let s = self.segment(tau, th, piece, u, du, first_order);
+                    self.command_at(&s, tau + th, u, du) - boundary
+                },
+                g0,
+                u_end - boundary,
+                remaining,
+            );
+            if theta >= remaining {
+                self.set(end);
+                return;
+            }
+            if theta > 0.0 {
+                let mid = self.segment(tau, theta, piece, u, du, first_order);
+                self.set(mid);
+            }
+            tau += theta;
+            remaining -= theta;
+            piece = if piece == 0 { piece_end } else { 0 };
+        }
+    }
+
+    fn set(&mut self, s: Point) {
+        (self.x, self.xd, self.xi) = (s.x, s.xd, s.xi);
+    }
+
+    /// One Gauss–Legendre step of length `len` from the current state at
+    /// τ = tau0 of the step, with sat(·) replaced by its piece `piece`
+    /// (0: linear, ±1: ±u_max). Returns the state at its end.
+    fn segment(
+        &self,
+        tau0: f64,
+        len: f64,
+        piece: i8,
+        u: &Rig1DInputs,
+        du: &Rig1DInputs,
+        first_order: bool,
+    ) -> Point {
+        let p = &self.p;
+        let ctrl = &p.control;
+        let (x, xd, xi) = (self.x, self.xd, self.xi);
+        let t0 = self.t + tau0;
+        let r0 = self.reference(t0, tau0, u, du).2;
+        // The time-dependent part at each stage time t0 + c_j·len.
+        let stages = C.map(|cj| {
+            let (t, tau) = (t0 + cj * len, tau0 + cj * len);
+            let (x_ref, v_ref, r) = self.reference(t, tau, u, du);
+            Stage {
+                xa: self.actuator_at(t, u.x_act + du.x_act * tau),
+                ext: u.f_ext + du.f_ext * tau,
+                fr: u.friction + du.friction * tau,
+                drive: p.drive.value(t),
+                x_ref,
+                v_ref,
+                // ξ at the stage is xi_base − x_stage (exact: ξ̇ = v_ref − ẋ)
+                xi_base: xi + (r - r0) + x,
+            }
+        });
+        // F_ctrl at stage j for the stage state (x, ẋ): affine in both.
+        let control = |s: &Stage, sx: f64, sv: f64| -> f64 {
+            match (ctrl.on(), piece) {
+                (false, _) => 0.0,
+                (true, 0) => {
+                    ctrl.gain
+                        * (ctrl.kp * (s.x_ref - sx)
+                            + ctrl.kd * (ctrl.ff * s.v_ref - sv)
+                            + ctrl.ki * (s.xi_base - sx))
+                }
+                (true, side) => ctrl.gain * f64::from(side) * ctrl.u_max,
+            }
+        };
+        let kv = if first_order {
+            // c·ẋ = k(x_a − x) + F_ext − F + F_d (quasi-static, seed 000)
+            stage_derivatives(x, xd, len, |j, sx, _| {
+                let s = &stages[j];
+                let rhs = p.k * (s.xa - sx) + s.ext - s.fr + s.drive;
+                (rhs / p.c, 0.0)
+            })
+        } else {
+            // m·ẍ = k(x_a − x) − c·ẋ + F_ext − F + F_d + F_ctrl
+            stage_derivatives(x, xd, len, |j, sx, sv| {
+                let s = &stages[j];
+                let force =
+                    p.k * (s.xa - sx) - p.c * sv + s.ext - s.fr + s.drive + control(s, sx, sv);
+                (sv, force / p.m)
+            })
+        };
+        let x_new = x + len * 0.5 * (kv[0] + kv[2]);
+        let xd_new = if first_order {
+            0.5 * (kv[0] + kv[2])
+        } else {
+            xd + len * 0.5 * (kv[1] + kv[3])
+        };
+        let xi_new = if ctrl.on() {
+            let r1 = self.reference(t0 + len, tau0 + len, u, du).2;
+            xi + (r1 - r0) - (x_new - x)
+        } else {
+            xi
+        };
+        Point {
+            x: x_new,
+            xd: xd_new,
+            xi: xi_new,
         }
     }
 
     pub fn state_to_vec(&self) -> Vec<f64> {
-        vec![self.t, self.x, self.xd]
+        vec![self.t, self.x, self.xd, self.xi]
     }
 
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
         match s {
-            [t, x, xd] if t.is_finite() && x.is_finite() && xd.is_finite() => {
-                (self.t, self.x, self.xd) = (*t, *x, *xd);
+            [t, x, xd, xi] if s.iter().all(|v| v.is_finite()) => {
+                (self.t, self.x, self.xd, self.xi) = (*t, *x, *xd, *xi);
                 Ok(())
             }
-            _ => Err(format!("Rig1D state must be 3 finite numbers, got {s:?}")),
+            _ => Err(format!("Rig1D state must be 4 finite numbers, got {s:?}")),
         }
     }
 }
 
-/// Gaussian elimination with partial pivoting for a 4×4 system.
-fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> [f64; 4] {
-    for col in 0..4 {
-        let pivot = (col..4)
-            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
-            .unwrap();
-        a.swap(col, pivot);
-        b.swap(col, pivot);
-        for row in col + 1..4 {
-            let f = a[row][col] / a[col][col];
-            let pivot_row = a[col];
-            for (target, source) in a[row][col..].iter_mut().zip(&pivot_row[col..]) {
-                *target -= f * source;
+/// Forcing of one Gauss–Legendre stage.
+struct Stage {
+    xa: f64,
+    ext: f64,
+    fr: f64,
+    drive: f64,
+    x_ref: f64,
+    v_ref: f64,
+    xi_base: f64,
+}
+
+/// θ ∈ [0, len] where g changes sign, g(0) = g0, g(len) = g_len (Illinois
+/// regula falsi, to 1e-12·len). Returns the end of the final bracket on
+/// the far side of the crossing; 0 when g0 already has the far side's sign
+/// (the piece was read at the boundary itself).
+fn find_crossing(g: impl Fn(f64) -> f64, g0: f64, g_len: f64, len: f64) -> f64 {
+    if g0 == 0.0 || (g0 > 0.0) == (g_len > 0.0) {
+        return 0.0;
+    }
+    let (mut a, mut b, mut ga, mut gb) = (0.0, len, g0, g_len);
+    let mut kept = 0i8;
+    for _ in 0..200 {
+        if b - a <= 1e-12 * len {
+            break;
+        }
+        let mut c = (a * gb - b * ga) / (gb - ga);
+        if !(c > a && c < b) {
+            c = 0.5 * (a + b);
+        }
+        let gc = g(c);
+        if gc == 0.0 {
+            return c;
+        }
+        if (gc > 0.0) == (gb > 0.0) {
+            (b, gb) = (c, gc);
+            if kept == -1 {
+                ga *= 0.5;
             }
-            b[row] -= f * b[col];
+            kept = -1;
+        } else {
+            (a, ga) = (c, gc);
+            if kept == 1 {
+                gb *= 0.5;
+            }
+            kept = 1;
         }
     }
-    let mut x = [0.0; 4];
-    for row in (0..4).rev() {
-        let s: f64 = (row + 1..4).map(|c| a[row][c] * x[c]).sum();
-        x[row] = (b[row] - s) / a[row][row];
-    }
-    x
+    b
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Free damped oscillator from x0, no friction, actuator at rest:
-    /// x(t) = e^(−ζωn t)(x0 cos ωd t + (ζωn x0/ωd) sin ωd t).
-    #[test]
-    fn damped_oscillator_matches_the_closed_form() {
-        let p = Rig1DParams {
-            m: 0.5,
-            c: 0.3,
-            k: 20.0,
-            x_a0: 0.0,
-            v_a: 0.0,
-            x0: 0.01,
-            ..Default::default()
-        };
-        let wn = (p.k / p.m).sqrt();
-        let zeta = p.c / (2.0 * (p.k * p.m).sqrt());
-        let wd = wn * (1.0 - zeta * zeta).sqrt();
-        for h in [1e-4f64, 1e-3, 1e-2, 0.1] {
-            let mut rig = Rig1D::new(p).unwrap();
-            let n = (5.0 / h).round() as usize;
-            let mut worst: f64 = 0.0;
-            for i in 1..=n {
-                rig.step(0.0, 0.0, 0.0, 0.0, h);
-                let t = i as f64 * h;
-                let exact = (-zeta * wn * t).exp()
-                    * (p.x0 * (wd * t).cos() + zeta * wn * p.x0 / wd * (wd * t).sin());
-                worst = worst.max((rig.position(0.0, 0.0) - exact).abs());
-            }
-            assert!(worst <= 1e-8 * p.x0, "h = {h}: worst error {worst:e}");
-        }
-    }
-
-    /// Spring pulled at constant speed, no friction, from rest:
-    /// x(t) = v_a·(t − sin(ωt)/ω).
-    #[test]
-    fn ramp_response_matches_the_closed_form() {
-        let p = Rig1DParams::default();
-        let w = (p.k / p.m).sqrt();
-        let mut rig = Rig1D::new(p).unwrap();
-        let h = 1e-3;
-        for i in 1..=10_000 {
-            rig.step(0.0, 0.0, 0.0, 0.0, h);
-            let t = i as f64 * h;
-            let exact = p.v_a * (t - (w * t).sin() / w);
-            assert!(
-                (rig.position(0.0, 0.0) - exact).abs() <= 1e-8 * exact.abs().max(1e-3),
-                "t = {t}"
-            );
-        }
-    }
-
-    #[test]
-    fn quasi_static_force_balance_and_validation() {
-        let p = Rig1DParams {
-            m: 0.0,
-            c: 0.0,
-            k: 116.04e3,
-            v_a: 8.25e-8,
-            ..Default::default()
-        };
-        let mut rig = Rig1D::new(p).unwrap();
-        rig.step(0.0, 0.0, 0.0, 0.0, 1.0);
-        assert_eq!(rig.position(0.1, 0.0), 8.25e-8 - 0.1 / 116.04e3);
-        let bad = Rig1DParams {
-            m: -1.0,
-            ..Default::default()
-        };
-        assert!(Rig1D::new(bad).unwrap_err().contains("m = -1"));
-    }
-}
+mod tests;

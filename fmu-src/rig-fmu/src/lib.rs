@@ -1,22 +1,49 @@
 //! The rig FMUs: the mechanical side of the seed scenarios, on the same FMI
 //! layer as the friction FMUs. `Rig1D.fmu`: mass, damper, spring to a
-//! prescribed actuator point, moving surface, external force, friction input.
+//! prescribed or input actuator point, drive force, PD/PI controller,
+//! moving and dithered surface, external force, friction input.
+//! `Rig2D.fmu`: the planar oscillator of seed 004 with surface dither.
 #![forbid(unsafe_code)]
 
 pub mod rig1d;
+pub mod rig2d;
 
-use fmi2_cs::{ModelFactory, ModelInfo};
+use fmi2_cs::{Model, ModelFactory, ModelInfo};
 use std::sync::LazyLock;
 
-pub static REGISTRY: LazyLock<[ModelFactory; 1]> = LazyLock::new(|| {
-    [ModelFactory {
-        info: &rig1d::INFO,
-        create: || Box::new(rig1d::Rig1DFmu::default()),
-    }]
+pub static REGISTRY: LazyLock<[ModelFactory; 2]> = LazyLock::new(|| {
+    [
+        ModelFactory {
+            info: &rig1d::INFO,
+            create: || Box::new(rig1d::Rig1DFmu::default()),
+        },
+        ModelFactory {
+            info: &rig2d::INFO,
+            create: || Box::new(rig2d::Rig2DFmu::default()),
+        },
+    ]
 });
 
 pub fn models() -> Vec<&'static ModelInfo> {
     REGISTRY.iter().map(|f| f.info).collect()
 }
 
+/// A fresh model by name (for in-process runs that bypass the C ABI).
+pub fn create(model_name: &str) -> Option<Box<dyn Model>> {
+    REGISTRY
+        .iter()
+        .find(|f| f.info.model_name == model_name)
+        .map(|f| (f.create)())
+}
+
 pub const GENERATION_TOOL: &str = concat!("rig-fmu ", env!("CARGO_PKG_VERSION"));
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_variable_table_is_consistent() {
+        for info in super::models() {
+            info.check().unwrap();
+        }
+    }
+}

@@ -1,9 +1,17 @@
-//! `Rig1D.fmu`: m·ẍ = k·(x_a(t) − x) − c·ẋ + F_ext − F (see
-//! `rig_dynamics::rig1d`). The friction force F is an input, applied as −F;
-//! the slip velocity v = ẋ − v_surface is the output a friction FMU takes.
+//! `Rig1D.fmu`: m·ẍ = k·(x_a(t) − x) − c·ẋ + F_ext − F + F_d(t) + F_ctrl
+//! (see `rig_dynamics::rig1d` for the modes and formulas). The friction
+//! force F is an input, applied as −F; the slip velocity v = ẋ − v_s(t) is
+//! the output a velocity-driven friction FMU takes, x_rel = x − x_s(t) the
+//! one a displacement-driven law (Bristle) takes.
+//!
+//! Value references 0–14 are those of the first version (ramp actuator
+//! only); the modes' variables follow.
 
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
-use rig_dynamics::rig1d::{Rig1D, Rig1DParams};
+use rig_dynamics::rig1d::{
+    Actuator, Control, Controller, DriveForce, Reference, Rig1D, Rig1DInputs, Rig1DParams,
+};
+use rig_dynamics::signals::Sinusoid;
 
 pub mod vr {
     pub const F: u32 = 0;
@@ -21,11 +29,48 @@ pub mod vr {
     pub const V_SURFACE: u32 = 12;
     pub const X0: u32 = 13;
     pub const V0: u32 = 14;
+    pub const X_ACT_IN: u32 = 15;
+    pub const X_REF: u32 = 16;
+    pub const V_REF: u32 = 17;
+    pub const X_REL: u32 = 18;
+    pub const V_BODY: u32 = 19;
+    pub const F_DRIVE: u32 = 20;
+    pub const U_CTRL: u32 = 21;
+    pub const F_CTRL: u32 = 22;
+    pub const ACTUATOR: u32 = 23;
+    pub const ACT_AMP: u32 = 24;
+    pub const ACT_FREQ: u32 = 25;
+    pub const DITHER_AMP: u32 = 26;
+    pub const DITHER_FREQ: u32 = 27;
+    pub const F_STEP: u32 = 28;
+    pub const T_STEP: u32 = 29;
+    pub const DRIVE_AMP: u32 = 30;
+    pub const DRIVE_FREQ: u32 = 31;
+    pub const CONTROL: u32 = 32;
+    pub const REF_X0: u32 = 33;
+    pub const REF_V0: u32 = 34;
+    pub const REF_V_AMP: u32 = 35;
+    pub const REF_FREQ: u32 = 36;
+    pub const CTRL_KP: u32 = 37;
+    pub const CTRL_KD: u32 = 38;
+    pub const CTRL_KI: u32 = 39;
+    pub const CTRL_FF: u32 = 40;
+    pub const CTRL_GAIN: u32 = 41;
+    pub const CTRL_U_MAX: u32 = 42;
 }
 
-const FORCES: &[u32] = &[vr::F, vr::F_EXT];
+/// Direct feedthrough, over every mode (a dependency that is zero in the
+/// selected mode is allowed; a missing one is not):
+/// the position follows F, F_ext and x_act_in in the quasi-static mode;
+const POSITION_DEPS: &[u32] = &[vr::F, vr::F_EXT, vr::X_ACT_IN];
+/// the acceleration takes every force, the spring (x_act_in) and the
+/// controller's reference;
+const ALL_INPUTS: &[u32] = &[vr::F, vr::F_EXT, vr::X_ACT_IN, vr::X_REF, vr::V_REF];
+/// the command takes the reference inputs. The slip velocity v is a state
+/// (quasi-static: its value at the end of the last step): no feedthrough.
+const REFERENCE_INPUTS: &[u32] = &[vr::X_REF, vr::V_REF];
 
-static VARIABLES: [Variable; 15] = [
+static VARIABLES: [Variable; 43] = [
     Variable::input(
         vr::F,
         "F",
@@ -46,25 +91,37 @@ static VARIABLES: [Variable; 15] = [
         vr::X,
         "x",
         "m",
-        "Body position (quasi-static mode m = c = 0: x = x_act + (F_ext - F)/k)",
-        FORCES,
+        "Body position (quasi-static mode m = c = 0: x = x_act + (F_ext - F + F_drive)/k)",
+        POSITION_DEPS,
     ),
     Variable::output(
         vr::V,
         "v",
         "m/s",
-        "Slip velocity: body velocity minus surface speed",
+        "Slip velocity: body velocity minus surface velocity, v_body - v_s(t)",
         &[],
     ),
-    Variable::output(vr::A, "a", "m/s2", "Body acceleration", FORCES),
+    Variable::output(
+        vr::A,
+        "a",
+        "m/s2",
+        "Body acceleration (0 in the quasi-static mode)",
+        ALL_INPUTS,
+    ),
     Variable::output(
         vr::F_SPRING,
         "F_spring",
         "N",
         "Actuator (spring) force on the body k*(x_act - x)",
-        FORCES,
+        POSITION_DEPS,
     ),
-    Variable::output(vr::X_ACT, "x_act", "m", "Actuator point x_a0 + v_a*t", &[]),
+    Variable::output(
+        vr::X_ACT,
+        "x_act",
+        "m",
+        "Actuator point: x_a0 + v_a*t + act_amp*sin(2*pi*act_freq*t), or x_act_in",
+        &[vr::X_ACT_IN],
+    ),
     Variable::parameter(
         vr::M,
         "m",
@@ -82,7 +139,13 @@ static VARIABLES: [Variable; 15] = [
         "Spring stiffness to the actuator point",
     )
     .with_min(0.0),
-    Variable::parameter(vr::X_A0, "x_a0", 0.0, "m", "Actuator point at t = 0"),
+    Variable::parameter(
+        vr::X_A0,
+        "x_a0",
+        0.0,
+        "m",
+        "Actuator point at t = 0 (actuator = 0)",
+    ),
     Variable::parameter(
         vr::V_A,
         "v_a",
@@ -95,18 +158,230 @@ static VARIABLES: [Variable; 15] = [
         "v_surface",
         0.0,
         "m/s",
-        "Surface (belt) speed",
+        "Surface (belt) speed; surface x_s(t) = v_surface*t + dither_amp*sin(2*pi*dither_freq*t)",
     ),
-    Variable::parameter(vr::X0, "x0", 0.0, "m", "Initial position"),
-    Variable::parameter(vr::V0, "v0", 0.0, "m/s", "Initial velocity"),
+    Variable::parameter(
+        vr::X0,
+        "x0",
+        0.0,
+        "m",
+        "Initial position (unused when m = c = 0)",
+    ),
+    Variable::parameter(
+        vr::V0,
+        "v0",
+        0.0,
+        "m/s",
+        "Initial body velocity (unused when m = 0)",
+    ),
+    Variable::input(
+        vr::X_ACT_IN,
+        "x_act_in",
+        0.0,
+        "m",
+        1e-3,
+        "Actuator point when actuator = 1 (interpolation slope honoured)",
+    ),
+    Variable::input(
+        vr::X_REF,
+        "x_ref",
+        0.0,
+        "m",
+        1e-2,
+        "Reference position of the controller when control = 2 (EMPS: qg)",
+    ),
+    Variable::input(
+        vr::V_REF,
+        "v_ref",
+        0.0,
+        "m/s",
+        1e-3,
+        "Reference velocity of the controller when control = 2",
+    ),
+    Variable::output(
+        vr::X_REL,
+        "x_rel",
+        "m",
+        "Displacement relative to the surface x - x_s(t), for displacement-driven friction laws",
+        POSITION_DEPS,
+    ),
+    Variable::output(vr::V_BODY, "v_body", "m/s", "Body velocity dx/dt", &[]),
+    Variable::output(
+        vr::F_DRIVE,
+        "F_drive",
+        "N",
+        "Built-in drive force F_step*[t >= t_step] + drive_amp*sin(2*pi*drive_freq*t)",
+        &[],
+    ),
+    Variable::output(
+        vr::U_CTRL,
+        "u_ctrl",
+        "V",
+        "Controller command after saturation, sat(u, +-ctrl_u_max) (EMPS: vir); 0 when control = 0",
+        REFERENCE_INPUTS,
+    ),
+    Variable::output(
+        vr::F_CTRL,
+        "F_ctrl",
+        "N",
+        "Controller force on the body ctrl_gain*u_ctrl",
+        REFERENCE_INPUTS,
+    ),
+    Variable::integer_parameter(
+        vr::ACTUATOR,
+        "actuator",
+        0,
+        "Actuator point: 0 = prescribed x_a0 + v_a*t + act_amp*sin(2*pi*act_freq*t); 1 = input x_act_in",
+    )
+    .with_min(0.0)
+    .with_max(1.0),
+    Variable::parameter(
+        vr::ACT_AMP,
+        "act_amp",
+        0.0,
+        "m",
+        "Amplitude of the actuator sinusoid (actuator = 0)",
+    ),
+    Variable::parameter(
+        vr::ACT_FREQ,
+        "act_freq",
+        0.0,
+        "Hz",
+        "Frequency of the actuator sinusoid",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::DITHER_AMP,
+        "dither_amp",
+        0.0,
+        "m",
+        "Amplitude of the surface dither displacement (seed 004: d = A*sin(omega*t))",
+    ),
+    Variable::parameter(
+        vr::DITHER_FREQ,
+        "dither_freq",
+        0.0,
+        "Hz",
+        "Frequency of the surface dither",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::F_STEP,
+        "F_step",
+        0.0,
+        "N",
+        "Drive force step, applied from t_step on (seed 001: 0.5 to 1.5 N)",
+    ),
+    Variable::parameter(vr::T_STEP, "t_step", 0.0, "s", "Time of the drive force step"),
+    Variable::parameter(
+        vr::DRIVE_AMP,
+        "drive_amp",
+        0.0,
+        "N",
+        "Amplitude of the sinusoidal drive force",
+    ),
+    Variable::parameter(
+        vr::DRIVE_FREQ,
+        "drive_freq",
+        0.0,
+        "Hz",
+        "Frequency of the sinusoidal drive force (seed 003: 1 Hz)",
+    )
+    .with_min(0.0),
+    Variable::integer_parameter(
+        vr::CONTROL,
+        "control",
+        0,
+        "Controller u = ctrl_kp*(x_ref - x) + ctrl_kd*(ctrl_ff*v_ref - v_body) + ctrl_ki*integral(v_ref - v_body): 0 = off; 1 = built-in reference (ref_*); 2 = reference from inputs x_ref, v_ref. Needs m > 0",
+    )
+    .with_min(0.0)
+    .with_max(2.0),
+    Variable::parameter(
+        vr::REF_X0,
+        "ref_x0",
+        0.0,
+        "m",
+        "Built-in reference position at t = 0: x_ref = ref_x0 + ref_v0*t + integral of the sinusoid",
+    ),
+    Variable::parameter(
+        vr::REF_V0,
+        "ref_v0",
+        0.0,
+        "m/s",
+        "Built-in reference velocity, constant part (seed 001: 2 to 5.5 mm/s)",
+    ),
+    Variable::parameter(
+        vr::REF_V_AMP,
+        "ref_v_amp",
+        0.0,
+        "m/s",
+        "Built-in reference velocity amplitude: v_ref = ref_v0 + ref_v_amp*sin(2*pi*ref_freq*t) (seed 001: 1e-3)",
+    ),
+    Variable::parameter(
+        vr::REF_FREQ,
+        "ref_freq",
+        0.0,
+        "Hz",
+        "Built-in reference frequency (seed 001's sin(t/k): 1/(2*pi*k))",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::CTRL_KP,
+        "ctrl_kp",
+        0.0,
+        "V/m",
+        "Position gain (EMPS: kv*kp = 243.45*160.18)",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::CTRL_KD,
+        "ctrl_kd",
+        0.0,
+        "V.s/m",
+        "Velocity gain (EMPS: kv = 243.45); the P gain of a velocity PI",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::CTRL_KI,
+        "ctrl_ki",
+        0.0,
+        "V/m",
+        "Gain on the integral of the velocity error; the I gain of a velocity PI (no anti-windup)",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::CTRL_FF,
+        "ctrl_ff",
+        1.0,
+        "",
+        "Velocity feed-forward weight in ctrl_kd*(ctrl_ff*v_ref - v_body): 1 = derivative of the error, 0 = of the measurement (EMPS)",
+    )
+    .with_min(0.0)
+    .with_max(1.0),
+    Variable::parameter(
+        vr::CTRL_GAIN,
+        "ctrl_gain",
+        1.0,
+        "N/V",
+        "Drive gain: control force = ctrl_gain*u_ctrl (EMPS: gtau = 35.15065188)",
+    )
+    .with_min(0.0),
+    Variable::parameter(
+        vr::CTRL_U_MAX,
+        "ctrl_u_max",
+        0.0,
+        "V",
+        "Saturation |u_ctrl| <= ctrl_u_max (EMPS: 10 V); 0 = no saturation",
+    )
+    .with_min(0.0),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
     model_name: "Rig1D",
     model_identifier: "Rig1D",
     guid: "{f9254f7d-c408-47bd-a8a6-d02748805905}",
-    description: "One-degree-of-freedom rig: m*x'' = k*(x_a(t) - x) - c*x' + F_ext - F, slip velocity v = x' - v_surface; 2-stage Gauss-Legendre, sub-stepped. Defaults: the 1995 stick-slip benchmark (m = 1, k = 2, pulled at 0.1 m/s).",
-    source: "MODELS.md, Rigs in the seeds (1995 benchmark; seed 000 piezo push, quasi-static).",
+    description: "One-degree-of-freedom rig: m*x'' = k*(x_a(t) - x) - c*x' + F_ext - F + F_drive(t) + F_ctrl, slip velocity v = x' - v_s(t). Actuator point prescribed (ramp + sinusoid) or from an input; drive force step + sinusoid; PD/PI controller with saturation on a built-in or input reference; moving surface with dither; quasi-static mode m = 0. 2-stage Gauss-Legendre, sub-stepped, saturation switches located. Defaults: the 1995 stick-slip benchmark (m = 1, k = 2, pulled at 0.1 m/s).",
+    source: "MODELS.md, Rigs in the seeds (1995 benchmark; seed 000 piezo push, quasi-static; seed 001 step forces and velocity trials; seed 003 sine drive; EMPS control loop, shared/data/README.md).",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 20.0, step_size: 1e-4 },
     capabilities: Capabilities::FULL,
@@ -125,44 +400,102 @@ impl Default for Rig1DFmu {
     }
 }
 
+impl Rig1DFmu {
+    pub fn params(v: &Values) -> Result<Rig1DParams, String> {
+        Ok(Rig1DParams {
+            m: v.real(vr::M),
+            c: v.real(vr::C),
+            k: v.real(vr::K),
+            actuator: Actuator::from_code(v.integer(vr::ACTUATOR))?,
+            x_a0: v.real(vr::X_A0),
+            v_a: v.real(vr::V_A),
+            act_sine: Sinusoid::new(v.real(vr::ACT_AMP), v.real(vr::ACT_FREQ)),
+            v_surface: v.real(vr::V_SURFACE),
+            dither: Sinusoid::new(v.real(vr::DITHER_AMP), v.real(vr::DITHER_FREQ)),
+            x0: v.real(vr::X0),
+            v0: v.real(vr::V0),
+            drive: DriveForce {
+                f_step: v.real(vr::F_STEP),
+                t_step: v.real(vr::T_STEP),
+                sine: Sinusoid::new(v.real(vr::DRIVE_AMP), v.real(vr::DRIVE_FREQ)),
+            },
+            control: Controller {
+                mode: Control::from_code(v.integer(vr::CONTROL))?,
+                kp: v.real(vr::CTRL_KP),
+                kd: v.real(vr::CTRL_KD),
+                ki: v.real(vr::CTRL_KI),
+                ff: v.real(vr::CTRL_FF),
+                gain: v.real(vr::CTRL_GAIN),
+                u_max: v.real(vr::CTRL_U_MAX),
+                reference: Reference {
+                    x0: v.real(vr::REF_X0),
+                    v0: v.real(vr::REF_V0),
+                    sine: Sinusoid::new(v.real(vr::REF_V_AMP), v.real(vr::REF_FREQ)),
+                },
+            },
+        })
+    }
+}
+
+/// The rig's inputs read from `values` (or their slopes from `slopes`).
+fn inputs(at: impl Fn(u32) -> f64) -> Rig1DInputs {
+    Rig1DInputs {
+        friction: at(vr::F),
+        f_ext: at(vr::F_EXT),
+        x_act: at(vr::X_ACT_IN),
+        x_ref: at(vr::X_REF),
+        v_ref: at(vr::V_REF),
+    }
+}
+
 impl Model for Rig1DFmu {
     fn info(&self) -> &'static ModelInfo {
         &INFO
     }
 
     fn initialize(&mut self, v: &Values) -> Result<(), String> {
-        let p = Rig1DParams {
-            m: v.real(vr::M),
-            c: v.real(vr::C),
-            k: v.real(vr::K),
-            x_a0: v.real(vr::X_A0),
-            v_a: v.real(vr::V_A),
-            v_surface: v.real(vr::V_SURFACE),
-            x0: v.real(vr::X0),
-            v0: v.real(vr::V0),
-        };
-        self.rig = Rig1D::new(p)?;
+        self.rig = Rig1D::new(Self::params(v)?)?;
         Ok(())
     }
 
     fn compute_outputs(&self, v: &mut Values) {
-        let (f, fe) = (v.real(vr::F), v.real(vr::F_EXT));
-        v.set(vr::X, self.rig.position(f, fe));
-        v.set(vr::V, self.rig.slip_velocity(0.0, 0.0));
-        v.set(vr::A, self.rig.acceleration(f, fe));
-        v.set(vr::F_SPRING, self.rig.spring_force(f, fe));
-        v.set(vr::X_ACT, self.rig.actuator_position(self.rig.time()));
+        let u = inputs(|r| v.real(r));
+        let rig = &self.rig;
+        v.set(vr::X, rig.position(&u));
+        v.set(vr::V, rig.slip_velocity());
+        v.set(vr::A, rig.acceleration(&u));
+        v.set(vr::F_SPRING, rig.spring_force(&u));
+        v.set(vr::X_ACT, rig.actuator_position(&u));
+        v.set(vr::X_REL, rig.relative_displacement(&u));
+        v.set(vr::V_BODY, rig.velocity());
+        v.set(vr::F_DRIVE, rig.drive_force());
+        v.set(vr::U_CTRL, rig.control_command(&u));
+        v.set(vr::F_CTRL, rig.control_force(&u));
     }
 
     fn do_step(&mut self, v: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        self.rig.step(
-            v.real(vr::F),
-            slopes[vr::F as usize],
-            v.real(vr::F_EXT),
-            slopes[vr::F_EXT as usize],
-            h,
-        );
+        let u = inputs(|r| v.real(r));
+        let du = inputs(|r| slopes[r as usize]);
+        self.rig.step(&u, &du, h);
         Ok(())
+    }
+
+    /// dx/dt, dx_rel/dt, dx_act/dt, dF_drive/dt always; dv/dt and
+    /// dv_body/dt when m > 0 (the quasi-static velocity has no rate here).
+    fn output_derivative(&self, v: &Values, slopes: &[f64], output: u32) -> Option<f64> {
+        let u = inputs(|r| v.real(r));
+        let du = inputs(|r| slopes[r as usize]);
+        let rig = &self.rig;
+        let massive = rig.params().m > 0.0;
+        match output {
+            vr::X => Some(rig.position_rate(&u, &du)),
+            vr::X_REL => Some(rig.position_rate(&u, &du) - rig.surface_velocity(rig.time())),
+            vr::X_ACT => Some(rig.actuator_velocity(&du)),
+            vr::F_DRIVE => Some(rig.drive_force_rate()),
+            vr::V_BODY if massive => Some(rig.acceleration(&u)),
+            vr::V if massive => Some(rig.acceleration(&u) - rig.surface_acceleration()),
+            _ => None,
+        }
     }
 
     fmi2_cs::delegate_state!(rig);

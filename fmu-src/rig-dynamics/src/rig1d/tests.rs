@@ -1,0 +1,860 @@
+//! Rig1D against closed forms (no friction: the rig is linear), the first
+//! version's arithmetic in the default mode, and parameter validation.
+
+use super::*;
+use crate::closed_form::{constant_force_on_damped_mass, peak, worst, Forced};
+use std::f64::consts::PI;
+
+/// Rel. tolerance of the closed-form comparisons (of the signal's peak).
+const TOL: f64 = 1e-8;
+
+fn no_inputs() -> Rig1DInputs {
+    Rig1DInputs::default()
+}
+
+/// Run `rig` with inputs from `inputs(t)` (value, slope) for `n` steps of
+/// `h`; returns (times, x, ẋ) after each step.
+fn run(
+    rig: &mut Rig1D,
+    h: f64,
+    n: usize,
+    inputs: impl Fn(f64) -> (Rig1DInputs, Rig1DInputs),
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let (mut ts, mut xs, mut vs) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..n {
+        let (u, du) = inputs(i as f64 * h);
+        rig.step(&u, &du, h);
+        let t = (i + 1) as f64 * h;
+        ts.push(t);
+        xs.push(rig.position(&u.at(&du, h)));
+        vs.push(rig.velocity());
+    }
+    (ts, xs, vs)
+}
+
+/// x and ẋ of a run against a closed form `exact(t) -> (x, ẋ)`, each to TOL
+/// of its peak.
+fn assert_matches(
+    what: &str,
+    (ts, xs, vs): &(Vec<f64>, Vec<f64>, Vec<f64>),
+    exact: impl Fn(f64) -> (f64, f64),
+) {
+    let (ex, ev): (Vec<f64>, Vec<f64>) = ts.iter().map(|t| exact(*t)).unzip();
+    let (ix, iv) = (worst(xs, &ex), worst(vs, &ev));
+    assert!(
+        ix <= TOL * peak(&ex),
+        "{what}: x error {ix:e}, peak {:e}",
+        peak(&ex)
+    );
+    assert!(
+        iv <= TOL * peak(&ev),
+        "{what}: v error {iv:e}, peak {:e}",
+        peak(&ev)
+    );
+}
+
+/// Free damped oscillator from x0, no friction, actuator at rest:
+/// x(t) = e^(−ζωn t)(x0 cos ωd t + (ζωn x0/ωd) sin ωd t).
+#[test]
+fn damped_oscillator_matches_the_closed_form() {
+    let p = Rig1DParams {
+        m: 0.5,
+        c: 0.3,
+        k: 20.0,
+        x_a0: 0.0,
+        v_a: 0.0,
+        x0: 0.01,
+        ..Default::default()
+    };
+    let wn = (p.k / p.m).sqrt();
+    let zeta = p.c / (2.0 * (p.k * p.m).sqrt());
+    let wd = wn * (1.0 - zeta * zeta).sqrt();
+    for h in [1e-4f64, 1e-3, 1e-2, 0.1] {
+        let mut rig = Rig1D::new(p).unwrap();
+        let n = (5.0 / h).round() as usize;
+        let mut worst: f64 = 0.0;
+        for i in 1..=n {
+            rig.step(&no_inputs(), &no_inputs(), h);
+            let t = i as f64 * h;
+            let exact = (-zeta * wn * t).exp()
+                * (p.x0 * (wd * t).cos() + zeta * wn * p.x0 / wd * (wd * t).sin());
+            worst = worst.max((rig.position(&no_inputs()) - exact).abs());
+        }
+        assert!(worst <= 1e-8 * p.x0, "h = {h}: worst error {worst:e}");
+    }
+}
+
+/// Spring pulled at constant speed, no friction, from rest:
+/// x(t) = v_a·(t − sin(ωt)/ω).
+#[test]
+fn ramp_response_matches_the_closed_form() {
+    let p = Rig1DParams::default();
+    let w = (p.k / p.m).sqrt();
+    let mut rig = Rig1D::new(p).unwrap();
+    let h = 1e-3;
+    for i in 1..=10_000 {
+        rig.step(&no_inputs(), &no_inputs(), h);
+        let t = i as f64 * h;
+        let exact = p.v_a * (t - (w * t).sin() / w);
+        assert!(
+            (rig.position(&no_inputs()) - exact).abs() <= 1e-8 * exact.abs().max(1e-3),
+            "t = {t}"
+        );
+    }
+}
+
+/// In the default mode (prescribed ramp, no drive, controller or dither)
+/// the rig computes exactly what the first version of this file did (bits
+/// recorded from it, commit 6271953): other tests compare against runs of
+/// the stick-slip benchmark.
+#[test]
+fn default_mode_is_bit_identical_to_the_first_version() {
+    const BENCHMARK: [[u64; 5]; 5] = [
+        [
+            0xbfb02339506cc1fb,
+            0xbfc0d10f90f8a059,
+            0x3fdd62c3fc0167ea,
+            0x3fcf7f62462f515a,
+            0xbfc0d10f90f8a059,
+        ],
+        [
+            0xbfb849b9acbd0b80,
+            0xbfb893b5e76fb2b2,
+            0xbfd2621447e7c3be,
+            0x3fdb8105cc2114d0,
+            0xbfb893b5e76fb2b2,
+        ],
+        [
+            0xbfb7b0d6d6bf60c6,
+            0x3fc8f4bacc89087c,
+            0x3fd9124c9cd73282,
+            0x3fe171546e01c31a,
+            0x3fc8f4bacc89087c,
+        ],
+        [
+            0x3fa584c41d1bd0aa,
+            0x3fd3c710268204ff,
+            0x3fe66b175fff1382,
+            0x3fd95720e43e2866,
+            0x3fd3c710268204ff,
+        ],
+        [
+            0x3fd1ee9e38c6a752,
+            0x3fd332a6d3088999,
+            0xbfe56f3eba5bb552,
+            0x3fa4494fa6c8a560,
+            0x3fd332a6d3088999,
+        ],
+    ];
+    const DAMPED: [[u64; 5]; 5] = [
+        [
+            0x3fbac5c517999da1,
+            0xbfbfbc7d00e10625,
+            0xc00a01a28ddd5f63,
+            0xbff177365d800505,
+            0xbfc125ec94eb645a,
+        ],
+        [
+            0x3fc85c4bcc1b43ef,
+            0xbfd75e3e0fa09fb5,
+            0xc0124277339f44e8,
+            0xbffd38a90362e264,
+            0xbfd8021519de1059,
+        ],
+        [
+            0x3fcbbd18cd6df5f8,
+            0xbfe54aaafa0fab08,
+            0xc00f379960782728,
+            0xbff5fc950bd05786,
+            0xbfe59c967f2e635a,
+        ],
+        [
+            0x3fcde8930ebdc0ac,
+            0xbfea0cce7385c91a,
+            0xbfffb34eb63ae406,
+            0xbfe77664686d14a1,
+            0xbfea5eb9f8a4816c,
+        ],
+        [
+            0x3fcc21fc2b1382f1,
+            0xbfea8a2cfce2e648,
+            0x3fe9198cf169321c,
+            0x3fe0c6b6ffa8adf3,
+            0xbfeadc1882019e9a,
+        ],
+    ];
+    let damped = Rig1DParams {
+        m: 0.5,
+        c: 0.3,
+        k: 20.0,
+        x0: 0.01,
+        v0: -0.02,
+        v_a: 0.05,
+        x_a0: 0.001,
+        v_surface: 0.01,
+        ..Default::default()
+    };
+    for (p, h, n, golden) in [
+        (Rig1DParams::default(), 1e-3, 3000usize, &BENCHMARK),
+        (damped, 7e-3, 700, &DAMPED),
+    ] {
+        let mut rig = Rig1D::new(p).unwrap();
+        let mut out = Vec::new();
+        for i in 0..n {
+            let t = i as f64 * h;
+            let u = Rig1DInputs {
+                friction: 0.5 * (7.0 * t).sin() + 0.2,
+                f_ext: 0.1 * (3.0 * t).cos(),
+                ..Default::default()
+            };
+            let du = Rig1DInputs {
+                friction: 3.5 * (7.0 * t).cos(),
+                f_ext: -0.3 * (3.0 * t).sin(),
+                ..Default::default()
+            };
+            rig.step(&u, &du, h);
+            if (i + 1) % (n / 5) == 0 {
+                let u1 = u.at(&du, h);
+                out.push(
+                    [
+                        rig.position(&u1),
+                        rig.velocity(),
+                        rig.acceleration(&u1),
+                        rig.spring_force(&u1),
+                        rig.slip_velocity(),
+                    ]
+                    .map(f64::to_bits),
+                );
+            }
+        }
+        assert_eq!(out, golden.to_vec(), "{p:?}");
+    }
+}
+
+/// Actuator x_a = x_a0 + v_a·t + A·sin(Ωt) through the spring, from a
+/// non-zero initial state: m·ẍ + c·ẋ + k·x = k·x_a(t), transient included.
+#[test]
+fn sine_actuator_forced_response_matches_the_closed_form() {
+    let p = Rig1DParams {
+        m: 0.5,
+        c: 0.4,
+        k: 20.0,
+        x_a0: 0.002,
+        v_a: 0.02,
+        act_sine: Sinusoid::new(0.01, 1.3),
+        x0: 0.003,
+        v0: -0.01,
+        ..Default::default()
+    };
+    let exact = Forced {
+        m: p.m,
+        c: p.c,
+        k: p.k,
+        f0: p.k * p.x_a0,
+        f1: p.k * p.v_a,
+        a: p.k * p.act_sine.amp,
+        b: 0.0,
+        omega: 2.0 * PI * p.act_sine.freq,
+    };
+    for h in [1e-3, 1e-2, 0.1] {
+        let mut rig = Rig1D::new(p).unwrap();
+        let r = run(&mut rig, h, (8.0 / h).round() as usize, |_| {
+            (no_inputs(), no_inputs())
+        });
+        assert_matches(&format!("h = {h}"), &r, |t| exact.at(p.x0, p.v0, t));
+    }
+}
+
+/// The same oscillator driven by the actuator from the input x_act_in,
+/// given at each communication point with its slope: the interpolation
+/// slopes are honoured (a held input would lag by half a step).
+#[test]
+fn actuator_input_with_slopes_matches_the_closed_form() {
+    let p = Rig1DParams {
+        m: 0.5,
+        c: 0.4,
+        k: 20.0,
+        actuator: Actuator::Input,
+        ..Default::default()
+    };
+    let (x_a0, v_a) = (0.002, 0.03);
+    let exact = Forced {
+        m: p.m,
+        c: p.c,
+        k: p.k,
+        f0: p.k * x_a0,
+        f1: p.k * v_a,
+        ..Default::default()
+    };
+    let mut rig = Rig1D::new(p).unwrap();
+    let r = run(&mut rig, 1e-2, 500, |t| {
+        let u = Rig1DInputs {
+            x_act: x_a0 + v_a * t,
+            ..Default::default()
+        };
+        let du = Rig1DInputs {
+            x_act: v_a,
+            ..Default::default()
+        };
+        (u, du)
+    });
+    assert_matches("x_act_in", &r, |t| exact.at(0.0, 0.0, t));
+}
+
+/// Drive force: a step F_step at t_step inside a communication step, plus
+/// a sine, plus a constant F_ext input. Before t_step: the free response;
+/// from t_step on: the forced response from the state reached then.
+#[test]
+fn drive_step_and_sine_match_the_closed_form() {
+    let p = Rig1DParams {
+        m: 1.0,
+        c: 0.5,
+        k: 30.0,
+        v_a: 0.0,
+        x0: 0.01,
+        drive: DriveForce {
+            f_step: 1.5,
+            t_step: 0.234_567,
+            sine: Sinusoid::new(0.4, 0.9),
+        },
+        ..Default::default()
+    };
+    let f_ext = -0.25;
+    let omega = 2.0 * PI * p.drive.sine.freq;
+    let before = Forced {
+        m: p.m,
+        c: p.c,
+        k: p.k,
+        f0: f_ext,
+        a: p.drive.sine.amp,
+        omega,
+        ..Default::default()
+    };
+    let ts = p.drive.t_step;
+    let (xs, vs) = before.at(p.x0, 0.0, ts);
+    // after the step, in time τ = t − t_step: the sine is shifted by t_step
+    let after = Forced {
+        f0: f_ext + p.drive.f_step,
+        a: p.drive.sine.amp * (omega * ts).cos(),
+        b: p.drive.sine.amp * (omega * ts).sin(),
+        ..before
+    };
+    let exact = |t: f64| {
+        if t < ts {
+            before.at(p.x0, 0.0, t)
+        } else {
+            after.at(xs, vs, t - ts)
+        }
+    };
+    for h in [1e-3, 1e-2, 0.1] {
+        let mut rig = Rig1D::new(p).unwrap();
+        let r = run(&mut rig, h, (6.0 / h).round() as usize, |_| {
+            (
+                Rig1DInputs {
+                    f_ext,
+                    ..Default::default()
+                },
+                no_inputs(),
+            )
+        });
+        assert_matches(&format!("h = {h}"), &r, exact);
+        assert_eq!(
+            rig.drive_force(),
+            p.drive.f_step + p.drive.sine.value(rig.time())
+        );
+    }
+}
+
+/// Built-in reference v_ref = v_r0 + V·sin(Ωt), x_ref its integral from
+/// x_r0, on the plant m·ẍ + c·ẋ + k·x: the closed loop is linear,
+/// m·ẍ + (c + G·Kd)·ẋ + (k + G·(Kp + Ki))·x = G·[(Kp + Ki)·x_ref + Kd·β·v_ref
+/// − Ki·(x_r0 − x0)] (ξ = x_ref − x_r0 − (x − x0)), solved in closed form.
+/// Position PD, velocity PI (seed 001's ±1e-3·sin(t/k) trial, k = 2) and
+/// both together.
+#[test]
+fn controller_with_builtin_reference_matches_the_closed_form() {
+    let base = Rig1DParams {
+        m: 1.0,
+        c: 2.0,
+        k: 0.0,
+        v_a: 0.0,
+        ..Default::default()
+    };
+    let pd = Rig1DParams {
+        control: Controller {
+            mode: Control::BuiltIn,
+            kp: 400.0,
+            kd: 10.0,
+            reference: Reference {
+                x0: 0.0,
+                v0: 2e-3,
+                sine: Sinusoid::new(1e-3, 0.5),
+            },
+            ..Default::default()
+        },
+        ..base
+    };
+    let pi = Rig1DParams {
+        control: Controller {
+            mode: Control::BuiltIn,
+            kd: 20.0,
+            ki: 900.0,
+            reference: Reference {
+                sine: Sinusoid::new(1e-3, 1.0 / (2.0 * PI * 2.0)),
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+        ..base
+    };
+    let mixed = Rig1DParams {
+        m: 1.5,
+        c: 1.0,
+        k: 5.0,
+        x0: 0.001,
+        v0: -0.002,
+        control: Controller {
+            mode: Control::BuiltIn,
+            kp: 300.0,
+            kd: 15.0,
+            ki: 200.0,
+            ff: 0.7,
+            gain: 2.0,
+            u_max: 0.0,
+            reference: Reference {
+                x0: 0.003,
+                v0: 0.002,
+                sine: Sinusoid::new(0.004, 0.8),
+            },
+        },
+        ..base
+    };
+    for (name, p) in [("PD", pd), ("PI", pi), ("PID", mixed)] {
+        let g = p.control;
+        let r = g.reference;
+        let w = r.sine.omega();
+        let kk = g.kp + g.ki;
+        let exact = Forced {
+            m: p.m,
+            c: p.c + g.gain * g.kd,
+            k: p.k + g.gain * kk,
+            f0: g.gain * (kk * (r.x0 + r.sine.amp / w) + g.kd * g.ff * r.v0 - g.ki * (r.x0 - p.x0)),
+            f1: g.gain * kk * r.v0,
+            a: g.gain * g.kd * g.ff * r.sine.amp,
+            b: -g.gain * kk * r.sine.amp / w,
+            omega: w,
+        };
+        for h in [1e-3, 2e-2] {
+            let mut rig = Rig1D::new(p).unwrap();
+            let res = run(&mut rig, h, (10.0 / h).round() as usize, |_| {
+                (no_inputs(), no_inputs())
+            });
+            assert_matches(&format!("{name}, h = {h}"), &res, |t| {
+                exact.at(p.x0, p.v0, t)
+            });
+        }
+    }
+}
+
+/// The EMPS loop (shared/data/README.md): force = gtau·sat(kv·(kp·(qg − qm)
+/// − q̇m), ±10 V) on M·q̈ + Fv·q̇ = force (the benchmark's rigid-body model
+/// without Coulomb friction and offset), Kp = kv·kp, Kd = kv, β = 0.
+fn emps(u_max: f64) -> Rig1DParams {
+    let (kp, kv) = (160.18, 243.45);
+    Rig1DParams {
+        m: 95.11,
+        c: 203.5,
+        k: 0.0,
+        v_a: 0.0,
+        control: Controller {
+            mode: Control::Input,
+            kp: kv * kp,
+            kd: kv,
+            ki: 0.0,
+            ff: 0.0,
+            gain: 35.150_651_88,
+            u_max,
+            reference: Reference::default(),
+        },
+        ..Default::default()
+    }
+}
+
+/// EMPS loop tracking a reference ramp qg = r·t given through x_ref with its
+/// slope, unsaturated: M·q̈ + (Fv + G·Kd)·q̇ + G·Kp·q = G·Kp·r·t.
+#[test]
+fn emps_loop_tracking_a_ramp_matches_the_closed_form() {
+    let p = emps(10.0);
+    let g = p.control;
+    let r = 5e-3;
+    let exact = Forced {
+        m: p.m,
+        c: p.c + g.gain * g.kd,
+        k: g.gain * g.kp,
+        f1: g.gain * g.kp * r,
+        ..Default::default()
+    };
+    let h = 1e-3;
+    let inputs = |t: f64| {
+        let u = Rig1DInputs {
+            x_ref: r * t,
+            ..Default::default()
+        };
+        let du = Rig1DInputs {
+            x_ref: r,
+            ..Default::default()
+        };
+        (u, du)
+    };
+    let mut rig = Rig1D::new(p).unwrap();
+    let res = run(&mut rig, h, 1000, inputs);
+    // the case stays unsaturated: the largest command along the same run
+    let mut rig = Rig1D::new(p).unwrap();
+    let mut command: f64 = 0.0;
+    for i in 0..1000 {
+        let (u, du) = inputs(i as f64 * h);
+        rig.step(&u, &du, h);
+        command = command.max(rig.control_command(&u.at(&du, h)).abs());
+    }
+    assert!(command > 0.1 && command < 10.0, "command {command} V");
+    assert_matches("EMPS ramp", &res, |t| exact.at(0.0, 0.0, t));
+}
+
+/// EMPS loop, step of the reference large enough to saturate the drive
+/// (kv·kp·0.01 m = 390 V ≫ 10 V): against an independent piecewise closed
+/// form — saturated: M·q̈ + Fv·q̇ = ±gtau·10; linear: the closed loop —
+/// with the switching instants found by bisection on the closed forms.
+#[test]
+fn emps_loop_saturated_step_matches_the_piecewise_closed_form() {
+    let p = emps(10.0);
+    let g = p.control;
+    let target = 0.01;
+    let u_of = |x: f64, v: f64| g.kp * (target - x) - g.kd * v;
+    let piece_of = |u: f64| -> i8 {
+        if u > g.u_max {
+            1
+        } else if u < -g.u_max {
+            -1
+        } else {
+            0
+        }
+    };
+    let linear = Forced {
+        m: p.m,
+        c: p.c + g.gain * g.kd,
+        k: g.gain * g.kp,
+        f0: g.gain * g.kp * target,
+        ..Default::default()
+    };
+    let traj = |piece: i8, x0: f64, v0: f64, tau: f64| -> (f64, f64) {
+        if piece == 0 {
+            linear.at(x0, v0, tau)
+        } else {
+            let f = f64::from(piece) * g.gain * g.u_max;
+            constant_force_on_damped_mass(p.m, p.c, f, x0, v0, tau)
+        }
+    };
+    // the reference: pieces and their start (t0, x0, v0)
+    let t_end = 1.0;
+    let mut pieces = vec![(0.0, 0.0, 0.0, piece_of(u_of(0.0, 0.0)))];
+    loop {
+        let &(t0, x0, v0, piece) = pieces.last().unwrap();
+        let scan = 1e-5;
+        let mut tau = 0.0;
+        let mut hit = None;
+        while t0 + tau < t_end {
+            let next = tau + scan;
+            let (x, v) = traj(piece, x0, v0, next);
+            let q = piece_of(u_of(x, v));
+            if q != piece {
+                hit = Some((tau, next, q));
+                break;
+            }
+            tau = next;
+        }
+        let Some((mut a, mut b, q)) = hit else { break };
+        let side = if piece == 0 { q } else { piece };
+        let boundary = f64::from(side) * g.u_max;
+        let g_at = |tau: f64| {
+            let (x, v) = traj(piece, x0, v0, tau);
+            u_of(x, v) - boundary
+        };
+        let ga = g_at(a);
+        for _ in 0..200 {
+            let c = 0.5 * (a + b);
+            if (g_at(c) > 0.0) == (ga > 0.0) {
+                a = c;
+            } else {
+                b = c;
+            }
+        }
+        let (x, v) = traj(piece, x0, v0, b);
+        pieces.push((t0 + b, x, v, if piece == 0 { q } else { 0 }));
+    }
+    assert!(
+        pieces.len() >= 2,
+        "the step must saturate and come out: {pieces:?}"
+    );
+    let exact = |t: f64| {
+        let &(t0, x0, v0, piece) = pieces.iter().rev().find(|s| s.0 <= t).unwrap();
+        traj(piece, x0, v0, t - t0)
+    };
+    for h in [1e-3, 1e-2] {
+        let mut rig = Rig1D::new(p).unwrap();
+        let res = run(&mut rig, h, (t_end / h).round() as usize, |_| {
+            (
+                Rig1DInputs {
+                    x_ref: target,
+                    ..Default::default()
+                },
+                no_inputs(),
+            )
+        });
+        assert_matches(&format!("EMPS saturated step, h = {h}"), &res, exact);
+    }
+}
+
+/// Moving, dithered surface x_s = v_surface·t + A·sin(Ωt): the body (no
+/// friction) oscillates freely, and the outputs are v = ẋ − v_s(t) and
+/// x − x_s(t) with v_s = v_surface + AΩ·cos(Ωt).
+#[test]
+fn surface_dither_gives_slip_velocity_and_relative_displacement() {
+    let p = Rig1DParams {
+        m: 0.5,
+        c: 0.3,
+        k: 20.0,
+        v_a: 0.0,
+        x0: 0.01,
+        v_surface: 0.03,
+        dither: Sinusoid::new(1e-3, 25.0),
+        ..Default::default()
+    };
+    let free = Forced {
+        m: p.m,
+        c: p.c,
+        k: p.k,
+        ..Default::default()
+    };
+    let w = 2.0 * PI * p.dither.freq;
+    let h = 1e-3;
+    let mut rig = Rig1D::new(p).unwrap();
+    let (mut slip, mut slip_exact, mut rel, mut rel_exact) = (vec![], vec![], vec![], vec![]);
+    for i in 1..=2000 {
+        rig.step(&no_inputs(), &no_inputs(), h);
+        let t = i as f64 * h;
+        let (x, v) = free.at(p.x0, p.v0, t);
+        slip.push(rig.slip_velocity());
+        slip_exact.push(v - (p.v_surface + p.dither.amp * w * (w * t).cos()));
+        rel.push(rig.relative_displacement(&no_inputs()));
+        rel_exact.push(x - (p.v_surface * t + p.dither.amp * (w * t).sin()));
+        // exactly the difference of the body and surface velocities
+        assert_eq!(
+            rig.slip_velocity(),
+            rig.velocity() - rig.surface_velocity(rig.time())
+        );
+    }
+    assert!(worst(&slip, &slip_exact) <= TOL * peak(&slip_exact));
+    assert!(worst(&rel, &rel_exact) <= TOL * peak(&rel_exact));
+}
+
+#[test]
+fn quasi_static_force_balance_and_feedthrough() {
+    let p = Rig1DParams {
+        m: 0.0,
+        c: 0.0,
+        k: 116.04e3,
+        v_a: 8.25e-8,
+        ..Default::default()
+    };
+    let mut rig = Rig1D::new(p).unwrap();
+    rig.step(&no_inputs(), &no_inputs(), 1.0);
+    let f = |friction| Rig1DInputs {
+        friction,
+        ..Default::default()
+    };
+    assert_eq!(rig.position(&f(0.1)), 8.25e-8 - 0.1 / 116.04e3);
+    assert_eq!(rig.velocity(), 8.25e-8);
+
+    // seed 000's piezo staircase from the input, a drive step, F_ext:
+    // x = x_act_in + (F_ext − F + F_d)/k; ẋ from the slopes of the last step
+    let p = Rig1DParams {
+        m: 0.0,
+        c: 0.0,
+        k: 116.04e3,
+        actuator: Actuator::Input,
+        drive: DriveForce {
+            f_step: 0.05,
+            t_step: 0.5,
+            sine: Sinusoid::OFF,
+        },
+        ..Default::default()
+    };
+    let mut rig = Rig1D::new(p).unwrap();
+    let (mut x_act, h) = (0.0, 1e-2);
+    for i in 0..100 {
+        x_act += 0.825e-9;
+        let u = Rig1DInputs {
+            friction: 0.02,
+            f_ext: 0.01,
+            x_act,
+            ..Default::default()
+        };
+        let du = Rig1DInputs {
+            friction: 0.3,
+            ..Default::default()
+        };
+        rig.step(&u, &du, h);
+        let t = (i + 1) as f64 * h;
+        let drive = if t >= 0.5 { 0.05 } else { 0.0 };
+        let u1 = u.at(&du, h);
+        let expected = x_act + (0.01 - u1.friction + drive) / p.k;
+        assert!((rig.position(&u1) - expected).abs() <= 1e-15 * expected.abs().max(1e-9));
+        assert!((rig.velocity() - (-0.3 / p.k)).abs() <= 1e-15);
+    }
+}
+
+/// Quasi-static with damping, c·ẋ + k·x = k·v_a·t − F (F constant):
+/// x = v_a·(t − c/k) − F/k + (x0 + F/k + v_a·c/k)·e^(−kt/c).
+#[test]
+fn quasi_static_damped_matches_the_closed_form() {
+    let p = Rig1DParams {
+        m: 0.0,
+        c: 2.0,
+        k: 50.0,
+        v_a: 0.01,
+        x0: 0.002,
+        ..Default::default()
+    };
+    let friction = 0.3;
+    let exact = |t: f64| {
+        let e = (-p.k * t / p.c).exp();
+        let x = p.v_a * (t - p.c / p.k) - friction / p.k
+            + (p.x0 + friction / p.k + p.v_a * p.c / p.k) * e;
+        let v = p.v_a - p.k / p.c * (p.x0 + friction / p.k + p.v_a * p.c / p.k) * e;
+        (x, v)
+    };
+    for h in [1e-3, 0.1] {
+        let mut rig = Rig1D::new(p).unwrap();
+        let r = run(&mut rig, h, (2.0 / h).round() as usize, |_| {
+            (
+                Rig1DInputs {
+                    friction,
+                    ..Default::default()
+                },
+                no_inputs(),
+            )
+        });
+        assert_matches(&format!("h = {h}"), &r, exact);
+    }
+}
+
+#[test]
+fn state_round_trip_reproduces_the_run_bit_for_bit() {
+    let mut p = emps(10.0);
+    p.dither = Sinusoid::new(1e-4, 3.0);
+    p.drive.sine = Sinusoid::new(5.0, 2.0);
+    let mut a = Rig1D::new(p).unwrap();
+    let u = Rig1DInputs {
+        x_ref: 0.01,
+        friction: 20.0,
+        ..Default::default()
+    };
+    for _ in 0..50 {
+        a.step(&u, &no_inputs(), 1e-3);
+    }
+    let saved = a.state_to_vec();
+    let mut b = Rig1D::new(p).unwrap();
+    b.state_from_slice(&saved).unwrap();
+    for _ in 0..200 {
+        a.step(&u, &no_inputs(), 1e-3);
+        b.step(&u, &no_inputs(), 1e-3);
+        assert_eq!(a.state_to_vec(), b.state_to_vec());
+    }
+    assert!(b.state_from_slice(&[0.0, 1.0, f64::NAN, 0.0]).is_err());
+    assert!(b.state_from_slice(&[0.0, 1.0]).is_err());
+}
+
+#[test]
+fn invalid_parameters_are_refused_with_name_and_value() {
+    let d = Rig1DParams::default();
+    let cases: Vec<(Rig1DParams, &str)> = vec![
+        (Rig1DParams { m: -1.0, ..d }, "m = -1"),
+        (Rig1DParams { m: f64::NAN, ..d }, "m = NaN"),
+        (Rig1DParams { k: -2.0, ..d }, "k = -2"),
+        (
+            Rig1DParams {
+                v_a: f64::INFINITY,
+                ..d
+            },
+            "v_a = inf",
+        ),
+        (
+            Rig1DParams {
+                dither: Sinusoid::new(1e-3, -5.0),
+                ..d
+            },
+            "dither_freq = -5",
+        ),
+        (
+            Rig1DParams {
+                drive: DriveForce {
+                    t_step: f64::NAN,
+                    ..d.drive
+                },
+                ..d
+            },
+            "t_step = NaN",
+        ),
+        (
+            Rig1DParams {
+                control: Controller {
+                    kd: -3.0,
+                    ..d.control
+                },
+                ..d
+            },
+            "ctrl_kd = -3",
+        ),
+        (
+            Rig1DParams {
+                control: Controller {
+                    ff: 2.0,
+                    ..d.control
+                },
+                ..d
+            },
+            "ctrl_ff = 2",
+        ),
+        (
+            Rig1DParams {
+                m: 0.0,
+                control: Controller {
+                    mode: Control::BuiltIn,
+                    ..d.control
+                },
+                ..d
+            },
+            "control = 1",
+        ),
+        (
+            Rig1DParams {
+                m: 0.0,
+                k: 0.0,
+                ..d
+            },
+            "m = 0, k = 0, c = 0",
+        ),
+    ];
+    for (p, needle) in cases {
+        let e = Rig1D::new(p).unwrap_err();
+        assert!(e.contains(needle), "{needle}: {e}");
+    }
+    assert!(Actuator::from_code(2).unwrap_err().contains("actuator = 2"));
+    assert!(Control::from_code(-1).unwrap_err().contains("control = -1"));
+    for code in 0..2 {
+        assert_eq!(Actuator::from_code(code).unwrap().code(), code);
+    }
+    for code in 0..3 {
+        assert_eq!(Control::from_code(code).unwrap().code(), code);
+    }
+}
