@@ -1,6 +1,7 @@
 //! FMUs that fail mid-run: BeltOscillator (a C FMU written by hand, see
 //! tests/c/belt_oscillator) coupled with the repository's LuGre.fmu, told
-//! to fail at its 10th fmi2DoStep with fmi2Discard, fmi2Error or fmi2Fatal.
+//! to fail at its 10th fmi2DoStep with fmi2Discard, fmi2Error or fmi2Fatal,
+//! or to return fmi2OK with a NaN state.
 //! The run stops, the rows of the completed communication points are kept,
 //! and the report names the instance, the call and the status; a discarded
 //! step also says how far the FMU got (fmi2LastSuccessfulTime) and whether
@@ -192,6 +193,23 @@ fn after_fatal_the_fmu_is_not_called_again_not_even_to_free_it() {
     }
 }
 
+#[test]
+fn a_nan_output_stops_the_run_and_names_the_fmu_that_produced_it() {
+    // fault 1: the 10th step returns fmi2OK, but the rig's state is NaN.
+    // Without the host's check the NaN would reach LuGre's input, and the
+    // run would fail there, blaming the friction FMU.
+    let rig = rig();
+    let mut system = coupled(&rig, belt::NAN_STATE, false);
+    let run = simulate(&mut system, &mut Jacobi::default(), H, 1.0).unwrap();
+    let error = assert_stopped_at_the_fault(&run);
+    let expected = format!(
+        "non-finite outputs from instance \"rig\" (rig.x = NaN, rig.v = NaN, rig.a = NaN) after fmi2DoStep to t = {}",
+        FAULT_STEP as f64 * H
+    );
+    assert!(error.contains(&expected), "{error}");
+    assert!(!error.contains("friction"), "{error}");
+}
+
 /// `fricsim cosim` with the rig failing: exit status 1, the message on
 /// stderr, the CSV with the rows so far.
 fn cosim(rig: &Rig, fault: i32, out: &Path) -> (Option<i32>, String) {
@@ -229,16 +247,21 @@ fn fricsim_cosim_exits_nonzero_names_the_failure_and_keeps_the_rows_so_far() {
         (belt::DISCARD, "fmi2Discard", "fmi2LastSuccessfulTime"),
         (belt::ERROR, "fmi2Error", "fault injected at step 10"),
         (belt::FATAL, "fmi2Fatal", "fault injected at step 10"),
+        (
+            belt::NAN_STATE,
+            "",
+            "non-finite outputs from instance \"rig\" (rig.x = NaN",
+        ),
     ] {
         let out = dir.path().join(format!("fault{fault}.csv"));
         let (code, stderr) = cosim(&rig, fault, &out);
         assert_eq!(code, Some(1), "{stderr}");
-        for part in [
-            "run INCOMPLETE",
-            &format!("fmi2DoStep failed for instance \"rig\" with {status}"),
-            extra,
-            out.to_str().unwrap(),
-        ] {
+        let failed = if status.is_empty() {
+            "after fmi2DoStep to t = 0.009765625".to_string()
+        } else {
+            format!("fmi2DoStep failed for instance \"rig\" with {status}")
+        };
+        for part in ["run INCOMPLETE", &failed, extra, out.to_str().unwrap()] {
             assert!(stderr.contains(part), "missing {part:?} in {stderr}");
         }
         assert!(!stderr.contains("panicked"), "{stderr}");
@@ -253,7 +276,7 @@ fn fricsim_cosim_exits_nonzero_names_the_failure_and_keeps_the_rows_so_far() {
         let marker = lines[FAULT_STEP + 1];
         assert!(
             marker.starts_with("# INCOMPLETE: the run stopped early: at t = 0.0087890625: ")
-                && marker.contains(&format!("\"rig\" with {status}")),
+                && marker.contains(&failed),
             "{marker}"
         );
         let last: Vec<f64> = lines[FAULT_STEP]

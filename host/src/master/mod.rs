@@ -77,9 +77,41 @@ pub trait Observer {
 pub struct NoObserver;
 impl Observer for NoObserver {}
 
+/// If `row` (as [`System::sample`] writes it) holds a NaN or an infinity:
+/// which instances and outputs. Such a value would travel on to the
+/// connected inputs and make the run fail later in another FMU, or not at
+/// all; the run stops here instead, naming the FMU that produced it.
+fn non_finite(system: &System, row: &[f64]) -> Option<String> {
+    let mut instances = Vec::new();
+    let mut values = Vec::new();
+    let mut k = 0;
+    for c in &system.components {
+        let before = values.len();
+        for (name, _) in &c.outputs {
+            let x = row.get(k).copied().unwrap_or(f64::NAN);
+            k += 1;
+            if !x.is_finite() {
+                values.push(format!("{}.{name} = {x}", c.name));
+            }
+        }
+        if values.len() > before {
+            instances.push(format!("\"{}\"", c.name));
+        }
+    }
+    if values.is_empty() {
+        return None;
+    }
+    Some(format!(
+        "non-finite outputs from instance {} ({})",
+        instances.join(", "),
+        values.join(", ")
+    ))
+}
+
 /// Initialise, then step with a fixed macro step `h` from 0 to `stop`;
-/// time is counted (t = n·h), never summed. An FMU error stops the run and
-/// is reported with the results so far.
+/// time is counted (t = n·h), never summed. An FMU error, or a NaN or
+/// infinite output after a step, stops the run and is reported with the
+/// results so far (the rows of the communication points before it).
 pub fn simulate(
     system: &mut System,
     master: &mut dyn MasterAlgorithm,
@@ -140,6 +172,10 @@ pub fn simulate_with(
         let mut row = Vec::with_capacity(run.columns.len());
         if let Err(e) = system.sample(&mut row) {
             run.error = Some(format!("at t = {t_next}: {e}"));
+            break;
+        }
+        if let Some(e) = non_finite(system, &row) {
+            run.error = Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
             break;
         }
         run.time.push(t_next);
