@@ -844,7 +844,7 @@ fn junk_is_refused_without_a_panic() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("junk.ssd");
         std::fs::write(&path, junk).unwrap();
-        let err = SystemFile::open(&path).err().expect("junk must be refused");
+        let err = SystemFile::open(&path).expect_err("junk must be refused");
         assert_message(&err, &["junk.ssd"]);
     }
     let dir = tempfile::tempdir().unwrap();

@@ -71,7 +71,7 @@ impl Observer for Watch {
     fn after_step(&mut self, done: usize, total: usize) {
         // drawing is rate-limited by indicatif; updating every 256 steps
         // keeps even the bookkeeping out of the step loop's cost
-        if done % 256 == 0 || done == total {
+        if done.is_multiple_of(256) || done == total {
             self.bar.set_position(done as u64);
         }
     }

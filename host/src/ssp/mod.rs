@@ -661,16 +661,14 @@ impl SystemFile {
             .flat_map(|e| e.annotations)
             .chain(raw.annotations)
             .flat_map(|a| a.list);
-        let mut k_all = 0usize;
         let mut found: Option<(String, xml::RawSimulation)> = None;
-        for a in annotations {
+        for (k_all, a) in annotations.enumerate() {
             // annotations are numbered in document order; DefaultExperiment precedes the root's
             let location = at(
                 "Annotation",
                 k_all,
                 element("ssc:Annotation", &[("type", &a.kind)]),
             );
-            k_all += 1;
             if a.kind.as_deref() != Some(ANNOTATION_TYPE) {
                 continue; // another tool's annotation
             }
@@ -930,14 +928,15 @@ impl SystemFile {
         }
         let decoded = percent_decode(source).ok_or("a `%` escape is not two hex digits")?;
         let relative = Path::new(&decoded);
-        if self.in_archive {
-            if relative.is_absolute()
-                || relative
-                    .components()
-                    .any(|c| matches!(c, PathPart::ParentDir))
-            {
-                return Err("a source inside an .ssp must stay inside the archive (no absolute path, no `..`)".to_string());
-            }
+        let escapes = relative.is_absolute()
+            || relative
+                .components()
+                .any(|c| matches!(c, PathPart::ParentDir));
+        if self.in_archive && escapes {
+            return Err(
+                "a source inside an .ssp must stay inside the archive (no absolute path, no `..`)"
+                    .to_string(),
+            );
         }
         Ok(self.base.join(relative))
     }

@@ -35,49 +35,50 @@ pub fn pack(ssd: &Path, out: &Path) -> Result<(), SspError> {
         let event = reader
             .read_event()
             .map_err(|e| error(&shown, format!("cannot re-read the XML: {e}")))?;
-        let rewrite =
-            |e: &BytesStart,
-             files: &mut Vec<(String, PathBuf)>|
-             -> Result<BytesStart<'static>, SspError> {
-                let name = e.name().as_ref().to_string();
-                let mut copy = BytesStart::new(name);
-                for a in e.attributes() {
-                    let a = a.map_err(|err| error(&shown, err.to_string()))?;
-                    let key = a.key.as_ref().to_string();
-                    let value = a
-                        .normalized_value(quick_xml::XmlVersion::Implicit1_0)
-                        .map_err(|err| error(&shown, err.to_string()))?
-                        .into_owned();
-                    if key == "source" {
-                        let path = file
-                            .resolve(&value)
-                            .map_err(|m| error(&shown, format!("source=\"{value}\": {m}")))?;
-                        let base = path
-                            .file_name()
-                            .map(|n| n.to_string_lossy().into_owned())
-                            .ok_or_else(|| {
-                                error(&shown, format!("source=\"{value}\" names no file"))
-                            })?;
-                        let entry = format!("resources/{base}");
-                        match files.iter().find(|(n, _)| *n == entry) {
-                            Some((_, p)) if *p != path => return Err(error(
+        let rewrite = |e: &BytesStart,
+                       files: &mut Vec<(String, PathBuf)>|
+         -> Result<BytesStart<'static>, SspError> {
+            let name = e.name().as_ref().to_string();
+            let mut copy = BytesStart::new(name);
+            for a in e.attributes() {
+                let a = a.map_err(|err| error(&shown, err.to_string()))?;
+                let key = a.key.as_ref().to_string();
+                let value = a
+                    .normalized_value(quick_xml::XmlVersion::Implicit1_0)
+                    .map_err(|err| error(&shown, err.to_string()))?
+                    .into_owned();
+                if key == "source" {
+                    let path = file
+                        .resolve(&value)
+                        .map_err(|m| error(&shown, format!("source=\"{value}\": {m}")))?;
+                    let base = path
+                        .file_name()
+                        .map(|n| n.to_string_lossy().into_owned())
+                        .ok_or_else(|| {
+                            error(&shown, format!("source=\"{value}\" names no file"))
+                        })?;
+                    let entry = format!("resources/{base}");
+                    match files.iter().find(|(n, _)| *n == entry) {
+                        Some((_, p)) if *p != path => {
+                            return Err(error(
                                 &shown,
                                 format!(
                                     "sources {} and {} have the same file name {base}; rename one",
                                     p.display(),
                                     path.display()
                                 ),
-                            )),
-                            Some(_) => {}
-                            None => files.push((entry.clone(), path)),
+                            ))
                         }
-                        copy.push_attribute(("source", entry.as_str()));
-                    } else {
-                        copy.push_attribute((key.as_str(), value.as_str()));
+                        Some(_) => {}
+                        None => files.push((entry.clone(), path)),
                     }
+                    copy.push_attribute(("source", entry.as_str()));
+                } else {
+                    copy.push_attribute((key.as_str(), value.as_str()));
                 }
-                Ok(copy)
-            };
+            }
+            Ok(copy)
+        };
         let written = match event {
             Event::Eof => break,
             Event::Start(e) => writer.write_event(Event::Start(rewrite(&e, &mut files)?)),
