@@ -1,0 +1,272 @@
+// A small safe driver over the exported FMI 2.0 C functions of an FMU
+// library, for tests that go through the real C ABI in process. Included
+// (`include!`) by a test's `common` module, which first generates the
+// exports with `fmi2_cs::export_fmi2!`, re-exports them (`pub use
+// fmi2_exports::*`) and defines `fn models() -> Vec<&'static ModelInfo>`.
+
+use fmi2_cs::ffi::*;
+use fmi2_cs::{VarType, Variable};
+use std::cell::RefCell;
+use std::ffi::{c_void, CStr, CString};
+use std::os::raw::{c_char, c_int};
+use std::ptr::{null, null_mut};
+
+thread_local! {
+    pub static LOG: RefCell<Vec<(i32, String)>> = const { RefCell::new(Vec::new()) };
+}
+
+extern "C" fn record(
+    _e: *mut c_void,
+    _n: *const c_char,
+    status: c_int,
+    _c: *const c_char,
+    message: *const c_char,
+) {
+    // SAFETY: the FMU passes NUL-terminated strings.
+    let m = unsafe { CStr::from_ptr(message) }
+        .to_string_lossy()
+        .into_owned();
+    LOG.with(|l| l.borrow_mut().push((status, m)));
+}
+
+pub fn last_error() -> String {
+    LOG.with(|l| {
+        l.borrow()
+            .iter()
+            .rev()
+            .find(|(s, _)| *s >= 3)
+            .map(|(_, m)| m.clone())
+            .unwrap_or_default()
+    })
+}
+
+fn callbacks() -> &'static fmi2CallbackFunctions {
+    // SAFETY: a five-argument non-variadic function called through the
+    // variadic pointer type with no variadic arguments (as ctypes importers do).
+    let logger = unsafe {
+        std::mem::transmute::<
+            *const (),
+            unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...),
+        >(record as *const ())
+    };
+    Box::leak(Box::new(fmi2CallbackFunctions {
+        logger: Some(logger),
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: null_mut(),
+    }))
+}
+
+pub struct Fmu {
+    pub c: fmi2Component,
+    pub model: &'static str,
+    pub variables: &'static [Variable],
+    pub t: f64,
+}
+
+pub const OK: fmi2Status = fmi2Status::fmi2OK;
+
+impl Fmu {
+    /// Instantiate `model`, set `params` (by name; booleans and integers as
+    /// f64) and leave it in initialization mode.
+    pub fn instantiated(model: &'static str, params: &[(&str, f64)]) -> Fmu {
+        let info = models()
+            .into_iter()
+            .find(|m| m.model_name == model)
+            .expect("model");
+        let guid = CString::new(info.guid).unwrap();
+        let c = unsafe {
+            fmi2Instantiate(
+                c"test".as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                null(),
+                callbacks(),
+                0,
+                0,
+            )
+        };
+        assert!(!c.is_null());
+        let fmu = Fmu {
+            c,
+            model,
+            variables: info.variables,
+            t: 0.0,
+        };
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+            assert_eq!(fmi2EnterInitializationMode(c), OK);
+        }
+        for (name, value) in params {
+            assert_eq!(
+                fmu.set_any(name, *value),
+                OK,
+                "{model}.{name} = {value}: {}",
+                last_error()
+            );
+        }
+        fmu
+    }
+
+    pub fn new(model: &'static str, params: &[(&str, f64)]) -> Fmu {
+        let fmu = Fmu::instantiated(model, params);
+        assert_eq!(
+            unsafe { fmi2ExitInitializationMode(fmu.c) },
+            OK,
+            "{}",
+            last_error()
+        );
+        fmu
+    }
+
+    pub fn var(&self, name: &str) -> &'static Variable {
+        self.variables
+            .iter()
+            .find(|v| v.name == name)
+            .unwrap_or_else(|| panic!("{} has no {name}", self.model))
+    }
+
+    pub fn set_any(&self, name: &str, value: f64) -> fmi2Status {
+        let v = self.var(name);
+        unsafe {
+            match v.var_type {
+                VarType::Real => fmi2SetReal(self.c, &v.vr, 1, &value),
+                VarType::Integer => fmi2SetInteger(self.c, &v.vr, 1, &(value as i32)),
+                VarType::Boolean => fmi2SetBoolean(self.c, &v.vr, 1, &((value != 0.0) as i32)),
+            }
+        }
+    }
+
+    pub fn set(&self, name: &str, value: f64) {
+        assert_eq!(self.set_any(name, value), OK, "{}", last_error());
+    }
+
+    pub fn get(&self, name: &str) -> f64 {
+        let v = self.var(name);
+        let mut x = f64::NAN;
+        assert_eq!(
+            unsafe { fmi2GetReal(self.c, &v.vr, 1, &mut x) },
+            OK,
+            "{}",
+            last_error()
+        );
+        x
+    }
+
+    pub fn set_slope(&self, name: &str, slope: f64) {
+        let v = self.var(name);
+        assert_eq!(
+            unsafe { fmi2SetRealInputDerivatives(self.c, &v.vr, 1, &1, &slope) },
+            OK,
+            "{}",
+            last_error()
+        );
+    }
+
+    pub fn step(&mut self, h: f64) {
+        assert_eq!(
+            unsafe { fmi2DoStep(self.c, self.t, h, 0) },
+            OK,
+            "{}",
+            last_error()
+        );
+        self.t += h;
+    }
+
+    pub fn state(&self) -> fmi2FMUstate {
+        let mut s = null_mut();
+        assert_eq!(unsafe { fmi2GetFMUstate(self.c, &mut s) }, OK);
+        s
+    }
+
+    pub fn restore(&mut self, s: fmi2FMUstate, t: f64) {
+        assert_eq!(
+            unsafe { fmi2SetFMUstate(self.c, s) },
+            OK,
+            "{}",
+            last_error()
+        );
+        self.t = t;
+    }
+
+    pub fn serialize(&self, s: fmi2FMUstate) -> Vec<c_char> {
+        let mut size = 0;
+        unsafe {
+            assert_eq!(fmi2SerializedFMUstateSize(self.c, s, &mut size), OK);
+            let mut bytes = vec![0 as c_char; size];
+            assert_eq!(
+                fmi2SerializeFMUstate(self.c, s, bytes.as_mut_ptr(), size),
+                OK
+            );
+            bytes
+        }
+    }
+
+    pub fn deserialize(&self, bytes: &[c_char]) -> fmi2FMUstate {
+        let mut s = null_mut();
+        assert_eq!(
+            unsafe { fmi2DeSerializeFMUstate(self.c, bytes.as_ptr(), bytes.len(), &mut s) },
+            OK,
+            "{}",
+            last_error()
+        );
+        s
+    }
+
+    pub fn directional_derivative(&self, output: &str, input: &str) -> f64 {
+        let (o, i) = (self.var(output).vr, self.var(input).vr);
+        let mut d = f64::NAN;
+        assert_eq!(
+            unsafe { fmi2GetDirectionalDerivative(self.c, &o, 1, &i, 1, &1.0, &mut d) },
+            OK,
+            "{}",
+            last_error()
+        );
+        d
+    }
+
+    /// From the current state: (J, FD) for a step of `h` with `input` held
+    /// at its current value. J is the FMU's ∂output/∂input right after that
+    /// step; FD the central difference computed outside the FMU by rolling
+    /// back with fmi2SetFMUstate, δ = 1e-5·max(|u|, nominal). Leaves the FMU
+    /// after the unperturbed step.
+    pub fn step_sensitivity(&mut self, output: &str, input: &str, h: f64) -> (f64, f64) {
+        let (t0, s0) = (self.t, self.state());
+        let u0 = self.get(input);
+        let delta = 1e-5 * u0.abs().max(self.var(input).nominal.unwrap_or(1.0));
+        let mut f_at = |u: f64| {
+            self.restore(s0, t0);
+            self.set(input, u);
+            self.step(h);
+            self.get(output)
+        };
+        let fd = (f_at(u0 + delta) - f_at(u0 - delta)) / (2.0 * delta);
+        self.restore(s0, t0);
+        self.set(input, u0);
+        self.step(h);
+        (self.directional_derivative(output, input), fd)
+    }
+
+    pub fn output_derivative(&self, output: &str) -> f64 {
+        let o = self.var(output).vr;
+        let mut d = f64::NAN;
+        assert_eq!(
+            unsafe { fmi2GetRealOutputDerivatives(self.c, &o, 1, &1, &mut d) },
+            OK,
+            "{}",
+            last_error()
+        );
+        d
+    }
+
+    pub fn exit_initialization(&self) -> fmi2Status {
+        unsafe { fmi2ExitInitializationMode(self.c) }
+    }
+}
+
+impl Drop for Fmu {
+    fn drop(&mut self) {
+        unsafe { fmi2FreeInstance(self.c) };
+    }
+}

@@ -1,0 +1,363 @@
+//! The rig FMUs through the C ABI: directional derivatives of the outputs
+//! with respect to the friction input against finite differences by state
+//! rollback, FMU states that reproduce a run bit for bit (in memory and
+//! serialized, in a fresh instance), output derivatives, the EMPS loop's
+//! command, Rig2D's free oscillation, and invalid parameters.
+
+mod common;
+use common::{last_error, Fmu};
+use std::f64::consts::PI;
+
+/// Directional derivatives against finite differences: the rigs are
+/// linear in F, so both are exact up to rounding, and they must agree to
+/// `tol` relative plus the rounding of the differences: an output y is
+/// differenced over a perturbation of 1e-6·max(|u|, nominal) inside the
+/// FMU (1e-5 in the test), which loses ~ε·|y|/δ; the bound allows ten
+/// times that. `tol` = 1e-6 except for the stiff EMPS loop (below).
+fn assert_close(what: &str, (j, fd, y, delta): (f64, f64, f64, f64), tol: f64) {
+    let rounding = 10.0 * f64::EPSILON * y.abs() / delta;
+    assert!(
+        (j - fd).abs() <= tol * fd.abs() + rounding,
+        "{what}: FMU {j:e}, finite differences {fd:e} (output {y:e})"
+    );
+}
+
+/// (J, FD, output, FMU's perturbation) for `output`/`input` after 200
+/// warm-up steps of `h` with the inputs `warmup`.
+fn sensitivity(
+    model: &'static str,
+    params: &[(&str, f64)],
+    warmup: &[(&str, f64)],
+    output: &str,
+    input: &str,
+    h: f64,
+) -> (f64, f64, f64, f64) {
+    let mut fmu = Fmu::new(model, params);
+    for _ in 0..200 {
+        for (name, value) in warmup {
+            fmu.set(name, *value);
+        }
+        fmu.step(h);
+    }
+    with_scale(&mut fmu, output, input, h)
+}
+
+/// `Fmu::step_sensitivity` with the output's value and the FMU's
+/// perturbation size.
+fn with_scale(fmu: &mut Fmu, output: &str, input: &str, h: f64) -> (f64, f64, f64, f64) {
+    let delta = 1e-6 * fmu.get(input).abs().max(fmu.var(input).nominal.unwrap());
+    let (j, fd) = fmu.step_sensitivity(output, input, h);
+    (j, fd, fmu.get(output), delta)
+}
+
+const EMPS: &[(&str, f64)] = &[
+    ("m", 95.11),
+    ("c", 203.5),
+    ("k", 0.0),
+    ("v_a", 0.0),
+    ("control", 2.0),
+    ("ctrl_kp", 243.45 * 160.18),
+    ("ctrl_kd", 243.45),
+    ("ctrl_ff", 0.0),
+    ("ctrl_gain", 35.15065188),
+    ("ctrl_u_max", 10.0),
+];
+
+#[test]
+fn step_sensitivities_to_the_friction_force_agree_with_finite_differences() {
+    let friction = [("F", 0.3), ("F_ext", 0.1)];
+    for h in [1e-3, 5e-2] {
+        // the stick-slip benchmark rig: ∂v/∂F ≈ −h/m, ∂x/∂F ≈ −h²/2m
+        for output in ["v", "x", "x_rel", "a"] {
+            let r = sensitivity("Rig1D", &[], &friction, output, "F", h);
+            assert_close(&format!("Rig1D d{output}/dF, h = {h}"), r, 1e-6);
+        }
+        let (j, ..) = sensitivity("Rig1D", &[], &friction, "v", "F", h);
+        assert!((j + h).abs() <= 1e-3 * h, "dv/dF = {j:e}, about -h/m");
+        // the EMPS loop, tracking a small step (in the linear band) and, at
+        // h = 1e-3, 0.2 s into a 1 m step (saturated: the command sits at
+        // -10 V, no feedback). Its stiffness G·Kp = 1.4e6 N/m on 95 kg makes
+        // the step's own rounding (forces ~ G·Kp·|x|) the limit: 1e-4.
+        for (target, command) in [(1e-4, None), (-1.0, Some(-10.0))] {
+            if command.is_some() && h > 1e-3 {
+                continue;
+            }
+            let warm = [("F", 20.0), ("F_ext", 0.1), ("x_ref", target)];
+            for output in ["v", "x"] {
+                let mut fmu = Fmu::new("Rig1D", EMPS);
+                for _ in 0..200 {
+                    for (name, value) in warm {
+                        fmu.set(name, value);
+                    }
+                    fmu.step(h);
+                }
+                let u = fmu.get("u_ctrl");
+                match command {
+                    Some(c) => assert_eq!(u, c),
+                    None => assert!(u.abs() < 10.0, "u_ctrl = {u}"),
+                }
+                let r = with_scale(&mut fmu, output, "F", h);
+                assert_close(&format!("EMPS d{output}/dF, x_ref = {target}"), r, 1e-4);
+            }
+        }
+        // Rig2D: each axis feels its own friction component only
+        let forces = [("F1", 0.2), ("F2", -0.1)];
+        for (output, input) in [("v1", "F1"), ("x2", "F2"), ("a2", "F2"), ("x1_rel", "F1")] {
+            let r = sensitivity("Rig2D", &[], &forces, output, input, h);
+            assert_close(&format!("Rig2D d{output}/d{input}"), r, 1e-6);
+        }
+        let (j, fd, ..) = sensitivity("Rig2D", &[], &forces, "v1", "F2", h);
+        assert_eq!((j, fd), (0.0, 0.0));
+    }
+}
+
+/// Quasi-static mode (seed 000): x = x_act + (F_ext − F)/k, so ∂x/∂F = −1/k
+/// at every instant — before any step (feedthrough only) and after one.
+#[test]
+fn quasi_static_position_feeds_through_minus_one_over_k() {
+    let k = 116.04e3;
+    let params = [("m", 0.0), ("c", 0.0), ("k", k), ("v_a", 8.25e-8)];
+    let mut fmu = Fmu::new("Rig1D", &params);
+    fmu.set("F", 0.05);
+    let before = fmu.directional_derivative("x", "F");
+    assert!(
+        (before + 1.0 / k).abs() <= 1e-6 / k,
+        "before a step: {before:e}"
+    );
+    for _ in 0..10 {
+        fmu.step(1e-2);
+    }
+    let r = with_scale(&mut fmu, "x", "F", 1e-2);
+    assert_close("quasi-static dx/dF", r, 1e-6);
+    let j = r.0;
+    assert!((j + 1.0 / k).abs() <= 1e-6 / k, "after a step: {j:e}");
+    assert_eq!(fmu.directional_derivative("v", "F"), 0.0);
+    // damped quasi-static: c·ẋ = k(x_a − x) − F; over h, ∂x/∂F = −(1 − e^(−kh/c))/k
+    let (k, c, h) = (50.0, 2.0, 1e-2);
+    let r = sensitivity(
+        "Rig1D",
+        &[("m", 0.0), ("c", c), ("k", k)],
+        &[("F", 0.3)],
+        "x",
+        "F",
+        h,
+    );
+    assert_close("damped quasi-static dx/dF", r, 1e-6);
+    let j = r.0;
+    let exact = -(1.0 - (-k * h / c).exp()) / k;
+    assert!(
+        (j - exact).abs() <= 1e-8 * exact.abs(),
+        "{j:e} vs {exact:e}"
+    );
+}
+
+/// Run with time-varying inputs (interpolated), recording every output.
+fn run(fmu: &mut Fmu, steps: usize, h: f64, record: &mut Vec<u64>) {
+    let (inputs, outputs): (&[&str], &[&str]) = if fmu.model == "Rig1D" {
+        (
+            &["F", "F_ext", "x_act_in", "x_ref"],
+            &[
+                "x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl",
+                "F_ctrl",
+            ],
+        )
+    } else {
+        (
+            &["F1", "F2", "F_ext1", "F_ext2"],
+            &["v1", "v2", "x1", "x2", "x1_rel", "x2_rel", "a1", "a2"],
+        )
+    };
+    for _ in 0..steps {
+        for (i, name) in inputs.iter().enumerate() {
+            let w = 2.0 * PI * (1.0 + i as f64);
+            let u = |t: f64| 0.1 * (w * t).sin() + 0.01 * i as f64;
+            fmu.set(name, u(fmu.t));
+            fmu.set_slope(name, (u(fmu.t + h) - u(fmu.t)) / h);
+        }
+        fmu.step(h);
+        for o in outputs {
+            record.push(fmu.get(o).to_bits());
+        }
+    }
+}
+
+#[test]
+fn restored_states_reproduce_the_run_bit_for_bit() {
+    let rig1d = [
+        ("m", 2.0),
+        ("c", 30.0),
+        ("k", 100.0),
+        ("actuator", 1.0),
+        ("dither_amp", 1e-3),
+        ("dither_freq", 15.0),
+        ("F_step", 0.8),
+        ("t_step", 0.4123),
+        ("drive_amp", 0.5),
+        ("drive_freq", 1.0),
+        ("control", 2.0),
+        ("ctrl_kp", 400.0),
+        ("ctrl_kd", 20.0),
+        ("ctrl_ki", 100.0),
+        ("ctrl_u_max", 0.05),
+    ];
+    let rig2d = [
+        ("c1", 0.3),
+        ("vs2", 0.01),
+        ("dither_amp2", 1e-3),
+        ("dither_freq2", 20.0),
+    ];
+    for (model, params) in [("Rig1D", &rig1d[..]), ("Rig2D", &rig2d[..])] {
+        let mut a = Fmu::new(model, params);
+        let mut ignored = Vec::new();
+        run(&mut a, 300, 1e-3, &mut ignored);
+        let t_saved = a.t;
+        let saved = a.state();
+        let bytes = a.serialize(saved);
+        let mut original = Vec::new();
+        run(&mut a, 500, 1e-3, &mut original);
+
+        a.restore(saved, t_saved);
+        let mut again = Vec::new();
+        run(&mut a, 500, 1e-3, &mut again);
+        assert_eq!(original, again, "{model}: in-memory state");
+
+        let mut b = Fmu::new(model, params);
+        let s = b.deserialize(&bytes);
+        b.restore(s, t_saved);
+        let mut fresh = Vec::new();
+        run(&mut b, 500, 1e-3, &mut fresh);
+        assert_eq!(
+            original, fresh,
+            "{model}: serialized state in a new instance"
+        );
+        assert!(
+            original.windows(2).any(|w| w[0] != w[1]),
+            "{model}: nothing changed"
+        );
+    }
+}
+
+/// Output derivatives against a short step with the declared input slopes.
+#[test]
+fn output_derivatives_agree_with_a_short_step() {
+    let cases: [(&str, &[(&str, f64)], &str); 7] = [
+        ("Rig1D", &[("dither_amp", 1e-3), ("dither_freq", 5.0)], "x"),
+        ("Rig1D", &[("dither_amp", 1e-3), ("dither_freq", 5.0)], "v"),
+        (
+            "Rig1D",
+            &[("dither_amp", 1e-3), ("dither_freq", 5.0)],
+            "x_rel",
+        ),
+        (
+            "Rig1D",
+            &[("drive_amp", 1.0), ("drive_freq", 2.0)],
+            "F_drive",
+        ),
+        ("Rig1D", &[("m", 0.0), ("k", 50.0)], "x"),
+        (
+            "Rig2D",
+            &[("dither_amp1", 1e-3), ("dither_freq1", 5.0)],
+            "v1",
+        ),
+        ("Rig2D", &[], "x2_rel"),
+    ];
+    for (model, params, output) in cases {
+        let mut fmu = Fmu::new(model, params);
+        let input = if model == "Rig1D" { "F" } else { "F1" };
+        for _ in 0..5 {
+            fmu.set(input, 0.2);
+            fmu.step(1e-3);
+        }
+        fmu.set(input, 0.2);
+        fmu.set_slope(input, 3.0);
+        let rate = fmu.output_derivative(output);
+        let y0 = fmu.get(output);
+        let dt = 1e-7;
+        fmu.step(dt);
+        let fd = (fmu.get(output) - y0) / dt;
+        assert!(
+            (rate - fd).abs() <= 1e-4 * fd.abs().max(1e-9),
+            "{model}.{output}: rate {rate:e}, short step {fd:e}"
+        );
+    }
+}
+
+/// The EMPS loop through the FMU: u_ctrl is the benchmark's control law
+/// vir = sat(kv·(kp·(qg − qm) − q̇m), ±10 V) of the outputs x = qm and
+/// v_body = q̇m, and F_ctrl = gtau·vir.
+#[test]
+fn emps_command_is_the_benchmark_control_law() {
+    let mut fmu = Fmu::new("Rig1D", EMPS);
+    let (kp, kv, gtau) = (160.18, 243.45, 35.15065188);
+    let mut saturated = 0;
+    for n in 0..2000 {
+        let t = n as f64 * 1e-3;
+        let qg = 0.02 * (2.0 * PI * t).sin();
+        fmu.set("x_ref", qg);
+        fmu.set("F", 20.39 * fmu.get("v_body").signum());
+        let vir = fmu.get("u_ctrl");
+        let law = (kv * (kp * (qg - fmu.get("x")) - fmu.get("v_body"))).clamp(-10.0, 10.0);
+        assert!((vir - law).abs() <= 1e-12 * 10.0, "t = {t}: {vir} vs {law}");
+        assert!((fmu.get("F_ctrl") - gtau * vir).abs() <= 1e-12 * gtau * 10.0);
+        saturated += usize::from(vir.abs() == 10.0);
+        fmu.step(1e-3);
+    }
+    assert!(saturated > 0, "the case should reach the saturation");
+}
+
+/// Seed 004's oscillator without friction through the FMU: x_i(t) =
+/// x_i(0)·cos ωt + v_i(0)/ω·sin ωt, ω = 10 rad/s, in both axes.
+#[test]
+fn rig2d_free_oscillation_through_the_fmu() {
+    let mut fmu = Fmu::new("Rig2D", &[]);
+    let w = 10.0;
+    for _ in 0..1000 {
+        fmu.step(1e-3);
+    }
+    let t = fmu.t;
+    for (x, v0) in [("x1", -0.8), ("x2", 0.8)] {
+        let exact = 0.08 * (w * t).cos() + v0 / w * (w * t).sin();
+        assert!(
+            (fmu.get(x) - exact).abs() <= 1e-8 * 0.113,
+            "{x}: {} vs {exact}",
+            fmu.get(x)
+        );
+    }
+}
+
+#[test]
+fn invalid_parameters_are_refused_with_name_and_value() {
+    let cases: &[(&str, &[(&str, f64)], &str)] = &[
+        ("Rig1D", &[("m", -1.0)], "m = -1"),
+        ("Rig1D", &[("actuator", 3.0)], "actuator = 3"),
+        ("Rig1D", &[("control", 5.0)], "control = 5"),
+        ("Rig1D", &[("m", 0.0), ("control", 1.0)], "control = 1"),
+        ("Rig1D", &[("ctrl_ff", 1.5)], "ctrl_ff = 1.5"),
+        ("Rig1D", &[("ctrl_u_max", -10.0)], "ctrl_u_max = -10"),
+        ("Rig1D", &[("dither_freq", -1.0)], "dither_freq = -1"),
+        ("Rig2D", &[("m", 0.0)], "m = 0"),
+        ("Rig2D", &[("k1", -5.0)], "k1 = -5"),
+        ("Rig2D", &[("dither_freq2", -3.0)], "dither_freq2 = -3"),
+    ];
+    for (model, bad, needle) in cases {
+        let fmu = Fmu::instantiated(model, bad);
+        assert_eq!(
+            fmu.exit_initialization(),
+            fmi2_cs::ffi::fmi2Status::fmi2Error,
+            "{model} {bad:?}"
+        );
+        let m = last_error();
+        assert!(
+            m.contains("fmi2ExitInitializationMode") && m.contains(needle),
+            "{model}: {m}"
+        );
+        // fixed and called again, the instance initialises
+        fmu.set_any(bad[0].0, 0.0);
+        fmu.set("m", 1.0);
+        assert_eq!(fmu.exit_initialization(), common::OK, "{}", last_error());
+    }
+    // NaN never reaches the model: fmi2SetReal refuses it, naming the value
+    let fmu = Fmu::instantiated("Rig1D", &[]);
+    assert_ne!(fmu.set_any("k", f64::NAN), common::OK);
+    assert!(last_error().contains("NaN"), "{}", last_error());
+}
