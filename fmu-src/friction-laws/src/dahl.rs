@@ -71,6 +71,24 @@ impl Dahl {
         self.f / self.p.sigma
     }
 
+    /// The right-hand side of the law in time for any force `f`:
+    /// `dF/dt = σ·|1 − (F/Fc)·sgn v|^α·sgn(1 − (F/Fc)·sgn v)·v` (seed 001
+    /// eq. 2–3; MODELS.md "Dahl"). A pure function, for integrating the law
+    /// together with other equations (the monolithic reference solutions);
+    /// [`Dahl::step`] integrates it exactly in displacement instead.
+    pub fn force_rate(&self, f: f64, v: f64) -> f64 {
+        if v == 0.0 {
+            return 0.0;
+        }
+        let y = 1.0 - f / self.p.fc * v.signum();
+        let shape = if self.p.alpha == 1.0 {
+            y
+        } else {
+            y.abs().powf(self.p.alpha) * y.signum()
+        };
+        self.p.sigma * shape * v
+    }
+
     /// `true` when moving (`v ≠ 0`) with `sgn(v)·F ≥ 0.99·Fc`.
     pub fn sliding(&self, v: f64) -> bool {
         v != 0.0 && v.signum() * self.f >= 0.99 * self.p.fc
@@ -315,6 +333,45 @@ mod tests {
         // Unloading is stiffer (slope σ(1 + F/Fc) > σ(1 − F/Fc)), so the same
         // distance back overshoots below zero: hysteresis.
         assert!(e.force() < 0.0, "hysteresis: {}", e.force());
+    }
+
+    #[test]
+    fn force_rate_is_the_derivative_of_the_exact_update() {
+        // α = 1 and motion from rest: F = Fc(1 − e^(−σx/Fc)), so
+        // dF/dt = v·σ·e^(−σx/Fc) = σ·(1 − F/Fc)·v.
+        let p = DahlParams::default();
+        let d = Dahl::new(p).unwrap();
+        for &x in &[0.0, 1e-6, 2e-5, 1e-4] {
+            let f = closed_form(&p, x);
+            let v = 3e-3;
+            let expect = v * p.sigma * (-p.sigma * x / p.fc).exp();
+            assert!(rel(d.force_rate(f, v), expect) < 1e-12, "x {x}");
+        }
+        assert_eq!(d.force_rate(0.5, 0.0), 0.0);
+        // Every α, both directions, loading and unloading (y > 1), and
+        // beyond Fc (y < 0): a tiny exact step moves F by the rate·h.
+        for &alpha in &[0.5, 1.0, 2.5] {
+            let p = DahlParams {
+                alpha,
+                ..DahlParams::default()
+            };
+            let mut d = Dahl::new(p).unwrap();
+            for &(f, v) in &[(0.3, 1e-3), (0.3, -1e-3), (-1.5, 2e-3), (1.9, -5e-4)] {
+                d.state_from_slice(&[f]).unwrap();
+                let rate = d.force_rate(f, v);
+                let h = 1e-9;
+                d.step(Ramp::constant(v), h);
+                let fd = (d.force() - f) / h;
+                assert!(
+                    (fd - rate).abs() <= 1e-5 * rate.abs(),
+                    "alpha {alpha}, F {f}, v {v}: {fd} vs {rate}"
+                );
+            }
+        }
+        // Beyond the Coulomb level (reachable only by setting the state),
+        // the rate pulls F back: sgn(1 − F/Fc·sgn v) < 0.
+        let d = Dahl::new(p).unwrap();
+        assert!(d.force_rate(2.5 * p.fc, 1e-3) < 0.0);
     }
 
     #[test]

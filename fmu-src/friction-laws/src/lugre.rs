@@ -342,11 +342,20 @@ impl LuGre {
     /// `ż = v − σ0·|v|·z/g(v)` at the current state (independent of `Fn`:
     /// the ratio σ0/g is per unit normal force).
     pub fn z_dot(&self, v: f64, x: f64, fn_: f64) -> f64 {
+        self.z_rate(self.z, v, x, fn_)
+    }
+
+    /// The right-hand side of the state equation for any deflection `z`:
+    /// `ż = v − σ0·|v|·z/g(v)` (seed 001 eq. 9–10; MODELS.md "LuGre"), with
+    /// the direction and position scaling of `g`; independent of `Fn`. A
+    /// pure function, for integrating the law together with other
+    /// equations (the monolithic reference solutions).
+    pub fn z_rate(&self, z: f64, v: f64, x: f64, fn_: f64) -> f64 {
         let _ = fn_;
         if v == 0.0 {
             return 0.0;
         }
-        v - self.p.sigma0 * v.abs() * self.z / self.g_unit(v.abs(), v, x)
+        v - self.p.sigma0 * v.abs() * z / self.g_unit(v.abs(), v, x)
     }
 
     /// Micro-damping `σ1(v) = σ1·exp(−(v/vd)²)`, constant when `vd = 0`.
@@ -363,8 +372,15 @@ impl LuGre {
     /// instantaneous inputs (direct feedthrough of `v`; seed 001 eq. 11,
     /// seed 002 eq. 1).
     pub fn force(&self, v: f64, x: f64, fn_: f64) -> f64 {
-        let zd = self.z_dot(v, x, fn_);
-        (self.p.sigma0 * self.z + self.sigma1_at(v) * zd + self.p.sigma2 * v) * self.fn_factor(fn_)
+        self.force_of(self.z, v, x, fn_)
+    }
+
+    /// The output equation for any deflection `z`:
+    /// `F = (σ0·z + σ1(v)·ż + σ2·v)·[Fn]` with `ż` from [`LuGre::z_rate`]
+    /// (seed 001 eq. 11, seed 002 eq. 1). Pure, like [`LuGre::z_rate`].
+    pub fn force_of(&self, z: f64, v: f64, x: f64, fn_: f64) -> f64 {
+        let zd = self.z_rate(z, v, x, fn_);
+        (self.p.sigma0 * z + self.sigma1_at(v) * zd + self.p.sigma2 * v) * self.fn_factor(fn_)
     }
 
     /// `true` when moving with the bristles at the sliding level:
@@ -761,6 +777,63 @@ mod tests {
         let v = 2e-3;
         let expect = p.sigma1 * (-4.0f64).exp() * v + p.sigma2 * v;
         assert!(rel(l.force(v, 0.0, 1.0), expect) < 1e-14);
+    }
+
+    #[test]
+    fn pure_right_hand_side_matches_the_state_methods_and_the_stepper() {
+        let mut p = LuGreParams {
+            direction_dependent: true,
+            fc_neg: 0.7,
+            fs_neg: 1.2,
+            position_dependent: true,
+            n_table: 3,
+            vd: 2e-3,
+            normal_force_form: true,
+            ..LuGreParams::default()
+        };
+        p.x_table[..3].copy_from_slice(&[0.0, 0.1, 0.3]);
+        p.scale_pos[..3].copy_from_slice(&[1.0, 2.0, 0.5]);
+        p.scale_neg[..3].copy_from_slice(&[1.5, 1.0, 1.0]);
+        let mut l = LuGre::new(p).unwrap();
+        for &(z, v, x, fn_) in &[
+            (3e-6, 1e-3, 0.05, 2.0),
+            (-1e-5, -4e-3, 0.2, 1.0),
+            (1e-5, 0.3, -1.0, 0.5),
+            (2e-6, 0.0, 0.1, 3.0),
+        ] {
+            l.set_z(z);
+            assert_eq!(
+                l.z_rate(z, v, x, fn_).to_bits(),
+                l.z_dot(v, x, fn_).to_bits()
+            );
+            assert_eq!(
+                l.force_of(z, v, x, fn_).to_bits(),
+                l.force(v, x, fn_).to_bits()
+            );
+            // ż = v − σ0|v|z/g, written out.
+            let g = l.g(v, x, 1.0);
+            let expect = if v == 0.0 {
+                0.0
+            } else {
+                v - p.sigma0 * v.abs() * z / g
+            };
+            assert!((l.z_rate(z, v, x, fn_) - expect).abs() <= 1e-15 * v.abs().max(1e-12));
+            // The exact stepper over a tiny step moves z by ż·h to first order.
+            let h = 1e-9;
+            let inp = LuGreInputs {
+                v: Ramp::constant(v),
+                x: Ramp::constant(x),
+                fn_: Ramp::constant(fn_),
+            };
+            let mut m = l.clone();
+            m.step(&inp, h);
+            let fd = (m.z() - z) / h;
+            let rate = l.z_rate(z, v, x, fn_);
+            assert!(
+                (fd - rate).abs() <= 1e-5 * rate.abs().max(1e-9),
+                "v {v}: {fd} vs {rate}"
+            );
+        }
     }
 
     #[test]

@@ -1,0 +1,4 @@
+//! Monolithic reference solutions for the friction co-simulations.
+#![forbid(unsafe_code)]
+
+pub mod radau;
