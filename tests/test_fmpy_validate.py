@@ -7,6 +7,9 @@ from fmpy.validation import validate_fmu
 
 from conftest import MODELS, fmu_path
 
+# the rig FMUs (the mechanical side), validated like the friction laws
+RIGS = ["Rig1D", "Rig2D"]
+
 EXPECTED = {
     "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma", "Fc", "alpha"}},
     "LuGre": {"input": {"v", "x", "Fn"}, "output": {"F", "z", "sliding"},
@@ -18,15 +21,25 @@ EXPECTED = {
                 "parameter": {"sigma_ini", "delta_max", "x_rel", "n_bristles", "c", "mu_c", "Fn", "seed"}},
     "Bristle2D": {"input": {"v1", "v2"}, "output": {"F1", "F2", "z1", "z2", "sliding"},
                   "parameter": {"sigma01", "sigma02", "sigma11", "sigma12", "a1", "a2", "z0", "av"}},
+    "Rig1D": {"input": {"F", "F_ext", "x_act_in", "x_ref", "v_ref"},
+              "output": {"x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl"},
+              "parameter": {"m", "c", "k", "x_a0", "v_a", "v_surface", "x0", "v0", "actuator", "act_amp",
+                            "act_freq", "dither_amp", "dither_freq", "F_step", "t_step", "drive_amp",
+                            "drive_freq", "control", "ref_x0", "ref_v0", "ref_v_amp", "ref_freq", "ctrl_kp",
+                            "ctrl_kd", "ctrl_ki", "ctrl_ff", "ctrl_gain", "ctrl_u_max"}},
+    "Rig2D": {"input": {"F1", "F2", "F_ext1", "F_ext2"},
+              "output": {"v1", "v2", "x1", "x2", "x1_rel", "x2_rel", "a1", "a2"},
+              "parameter": {"m", "k1", "k2", "c1", "c2", "x1_0", "x2_0", "v1_0", "v2_0", "vs1", "vs2",
+                            "dither_amp1", "dither_freq1", "dither_amp2", "dither_freq2"}},
 }
 
 
-@pytest.mark.parametrize("name", MODELS)
+@pytest.mark.parametrize("name", MODELS + RIGS)
 def test_validate_fmu_reports_no_problems(name):
     assert validate_fmu(str(fmu_path(name))) == []
 
 
-@pytest.mark.parametrize("name", MODELS)
+@pytest.mark.parametrize("name", MODELS + RIGS)
 def test_declared_variables_and_capabilities(name):
     md = read_model_description(str(fmu_path(name)))
     by_causality = {}
@@ -47,5 +60,5 @@ def test_declared_variables_and_capabilities(name):
         assert sum(1 for v in md.modelVariables if v.name.startswith("x_table[")) >= 16
     for v in md.modelVariables:
         if v.type == "Real" and v.causality in ("input", "output", "parameter") and v.name not in (
-                "alpha", "a", "a1", "a2", "stribeck_exponent", "mu_c") and not v.name.startswith("scale_"):
+                "alpha", "a", "a1", "a2", "stribeck_exponent", "mu_c", "ctrl_ff") and not v.name.startswith("scale_"):
             assert v.unit, f"{name}.{v.name} has no unit"

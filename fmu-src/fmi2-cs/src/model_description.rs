@@ -162,11 +162,16 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
         if let Some(n) = v.nominal {
             let _ = write!(attrs, r#" nominal="{}""#, number(n));
         }
+        // bounds in the variable's own type (an Integer's min is "0", not "0.0")
+        let bound = |b: f64| match v.var_type {
+            VarType::Integer => format!("{}", b as i64),
+            _ => number(b),
+        };
         if let Some(m) = v.min {
-            let _ = write!(attrs, r#" min="{}""#, number(m));
+            let _ = write!(attrs, r#" min="{}""#, bound(m));
         }
         if let Some(m) = v.max {
-            let _ = write!(attrs, r#" max="{}""#, number(m));
+            let _ = write!(attrs, r#" max="{}""#, bound(m));
         }
         let (tag, start) = match v.var_type {
             VarType::Real => ("Real", v.start.map(number)),
