@@ -20,12 +20,15 @@ import subprocess
 import sys
 import sysconfig
 import zipfile
+from ctypes import byref
 from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
-from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free, printLogMessage)
+from fmpy.logging import addLoggerProxy
 from fmpy.validation import validate_fmu
 
 from conftest import ROOT, fmu_path
@@ -69,6 +72,30 @@ def python_runtime():
     if not sysconfig.get_config_var("Py_ENABLE_SHARED") or not libpython.is_file():
         pytest.skip(f"this Python has no shared libpython ({libpython}) to preload")
     return dict(os.environ, LD_PRELOAD=str(libpython))
+
+
+# FMPy's logging proxy keeps one logger for the whole process (a static in
+# fmpy/logging), set by the latest addLoggerProxy call: after a test whose
+# logger is gone, an FMU logging through FMPy's default callbacks would call
+# freed memory. A test that makes an FMU log passes its own logger and then
+# leaves this one, which lives as long as the module, in place.
+_LASTING = fmi2CallbackFunctions()
+_LASTING.logger = fmi2CallbackLoggerTYPE(printLogMessage)
+_LASTING.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+_LASTING.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+
+
+def simulate_logged(fmu, **kwargs):
+    """simulate_fmu with the FMU's log messages collected: (result, messages)."""
+    messages = []
+
+    def logger(env, instance, status, category, message):
+        messages.append((status, category.decode(), message.decode()))
+
+    try:
+        return simulate_fmu(str(fmu), logger=logger, **kwargs), messages
+    finally:
+        addLoggerProxy(byref(_LASTING))
 
 
 def fricsim(*args, env=None):
@@ -258,8 +285,10 @@ def test_a_discarded_step_ends_the_run_where_fmpy_ends_it(belt, tmp_path):
     assert out.read_text().splitlines()[-1].startswith("# INCOMPLETE: the run stopped early: at t = 0.049: ")
 
     start_values = {k.split(".", 1)[1]: v for k, v in parameters.items()}
-    result = simulate_fmu(str(belt), fmi_type="CoSimulation", stop_time=stop, output_interval=step,
-                          start_values=start_values)
+    result, messages = simulate_logged(belt, fmi_type="CoSimulation", stop_time=stop, output_interval=step,
+                                       start_values=start_values)
+    assert [(s, c) for s, c, _ in messages] == [(2, "logStatusDiscard")], messages
+    assert "fault injected at step 50" in messages[0][2]
     theirs = np.column_stack([result[n] for n in ("time", "x", "v", "a")])
     assert len(theirs) == 51
     assert theirs[-1, 0] == reached == pytest.approx(0.0495, rel=1e-12)
