@@ -8,7 +8,7 @@
 pub mod rig1d;
 pub mod rig2d;
 
-use fmi2_cs::{Model, ModelFactory, ModelInfo};
+use fmi2_cs::{ModelFactory, ModelInfo};
 use std::sync::LazyLock;
 
 pub static REGISTRY: LazyLock<[ModelFactory; 2]> = LazyLock::new(|| {
@@ -26,14 +26,6 @@ pub static REGISTRY: LazyLock<[ModelFactory; 2]> = LazyLock::new(|| {
 
 pub fn models() -> Vec<&'static ModelInfo> {
     REGISTRY.iter().map(|f| f.info).collect()
-}
-
-/// A fresh model by name (for in-process runs that bypass the C ABI).
-pub fn create(model_name: &str) -> Option<Box<dyn Model>> {
-    REGISTRY
-        .iter()
-        .find(|f| f.info.model_name == model_name)
-        .map(|f| (f.create)())
 }
 
 pub const GENERATION_TOOL: &str = concat!("rig-fmu ", env!("CARGO_PKG_VERSION"));

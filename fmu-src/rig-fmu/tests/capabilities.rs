@@ -8,6 +8,10 @@ mod common;
 use common::{last_error, Fmu};
 use std::f64::consts::PI;
 
+/// A case: model, parameter assignments (by name), and an output name or
+/// the text an error message must contain.
+type Case<'a> = (&'a str, &'a [(&'a str, f64)], &'a str);
+
 /// Directional derivatives against finite differences: the rigs are
 /// linear in F, so both are exact up to rounding, and they must agree to
 /// `tol` relative plus the rounding of the differences: an output y is
@@ -240,7 +244,7 @@ fn restored_states_reproduce_the_run_bit_for_bit() {
 /// Output derivatives against a short step with the declared input slopes.
 #[test]
 fn output_derivatives_agree_with_a_short_step() {
-    let cases: [(&str, &[(&str, f64)], &str); 7] = [
+    let cases: [Case; 7] = [
         ("Rig1D", &[("dither_amp", 1e-3), ("dither_freq", 5.0)], "x"),
         ("Rig1D", &[("dither_amp", 1e-3), ("dither_freq", 5.0)], "v"),
         (
@@ -327,7 +331,7 @@ fn rig2d_free_oscillation_through_the_fmu() {
 
 #[test]
 fn invalid_parameters_are_refused_with_name_and_value() {
-    let cases: &[(&str, &[(&str, f64)], &str)] = &[
+    let cases: &[Case] = &[
         ("Rig1D", &[("m", -1.0)], "m = -1"),
         ("Rig1D", &[("actuator", 3.0)], "actuator = 3"),
         ("Rig1D", &[("control", 5.0)], "control = 5"),
