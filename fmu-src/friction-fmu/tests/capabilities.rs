@@ -5,7 +5,7 @@
 //! derivatives, and invalid parameters (issue 2).
 
 mod common;
-use common::{last_error, Fmu};
+use common::Fmu;
 use std::f64::consts::PI;
 
 /// An input signal: its name and its value at time t.
@@ -75,36 +75,7 @@ fn run(fmu: &mut Fmu, steps: usize, h: f64, record: &mut Vec<u64>) {
 #[test]
 fn restored_states_reproduce_the_run_bit_for_bit() {
     for model in MODELS {
-        let mut a = Fmu::new(model, params(model));
-        let mut ignored = Vec::new();
-        run(&mut a, 300, 1e-3, &mut ignored);
-        let t_saved = a.t;
-        let saved = a.state();
-        let bytes = a.serialize(saved);
-        let mut original = Vec::new();
-        run(&mut a, 500, 1e-3, &mut original);
-
-        // same instance, in-memory state
-        a.restore(saved, t_saved);
-        let mut again = Vec::new();
-        run(&mut a, 500, 1e-3, &mut again);
-        assert_eq!(original, again, "{model}: in-memory state");
-
-        // fresh instance, serialized state
-        let mut b = Fmu::new(model, params(model));
-        let s = b.deserialize(&bytes);
-        b.restore(s, t_saved);
-        let mut fresh = Vec::new();
-        run(&mut b, 500, 1e-3, &mut fresh);
-        assert_eq!(
-            original, fresh,
-            "{model}: serialized state in a new instance"
-        );
-        // the continuation really moves
-        assert!(
-            original.windows(2).any(|w| w[0] != w[1]),
-            "{model}: nothing changed"
-        );
+        common::assert_state_round_trip(model, params(model), run);
     }
 }
 
@@ -308,16 +279,6 @@ fn invalid_parameters_are_refused_with_name_and_value() {
         ("Bristle2D", &[("sigma11", -1.0)], "sigma11 = -1"),
     ];
     for (model, bad, needle) in cases {
-        let fmu = Fmu::instantiated(model, bad);
-        assert_eq!(
-            fmu.exit_initialization(),
-            fmi2_cs::ffi::fmi2Status::fmi2Error,
-            "{model} {bad:?}"
-        );
-        let m = last_error();
-        assert!(
-            m.contains("fmi2ExitInitializationMode") && m.contains(needle),
-            "{model}: {m}"
-        );
+        common::refused_at_initialization(model, bad, needle);
     }
 }

@@ -210,35 +210,8 @@ fn restored_states_reproduce_the_run_bit_for_bit() {
         ("dither_amp2", 1e-3),
         ("dither_freq2", 20.0),
     ];
-    for (model, params) in [("Rig1D", &rig1d[..]), ("Rig2D", &rig2d[..])] {
-        let mut a = Fmu::new(model, params);
-        let mut ignored = Vec::new();
-        run(&mut a, 300, 1e-3, &mut ignored);
-        let t_saved = a.t;
-        let saved = a.state();
-        let bytes = a.serialize(saved);
-        let mut original = Vec::new();
-        run(&mut a, 500, 1e-3, &mut original);
-
-        a.restore(saved, t_saved);
-        let mut again = Vec::new();
-        run(&mut a, 500, 1e-3, &mut again);
-        assert_eq!(original, again, "{model}: in-memory state");
-
-        let mut b = Fmu::new(model, params);
-        let s = b.deserialize(&bytes);
-        b.restore(s, t_saved);
-        let mut fresh = Vec::new();
-        run(&mut b, 500, 1e-3, &mut fresh);
-        assert_eq!(
-            original, fresh,
-            "{model}: serialized state in a new instance"
-        );
-        assert!(
-            original.windows(2).any(|w| w[0] != w[1]),
-            "{model}: nothing changed"
-        );
-    }
+    common::assert_state_round_trip("Rig1D", &rig1d, run);
+    common::assert_state_round_trip("Rig2D", &rig2d, run);
 }
 
 /// Output derivatives against a short step with the declared input slopes.
@@ -344,17 +317,7 @@ fn invalid_parameters_are_refused_with_name_and_value() {
         ("Rig2D", &[("dither_freq2", -3.0)], "dither_freq2 = -3"),
     ];
     for (model, bad, needle) in cases {
-        let fmu = Fmu::instantiated(model, bad);
-        assert_eq!(
-            fmu.exit_initialization(),
-            fmi2_cs::ffi::fmi2Status::fmi2Error,
-            "{model} {bad:?}"
-        );
-        let m = last_error();
-        assert!(
-            m.contains("fmi2ExitInitializationMode") && m.contains(needle),
-            "{model}: {m}"
-        );
+        let fmu = common::refused_at_initialization(model, bad, needle);
         // fixed and called again, the instance initialises
         fmu.set_any(bad[0].0, 0.0);
         fmu.set("m", 1.0);

@@ -270,3 +270,61 @@ impl Drop for Fmu {
         unsafe { fmi2FreeInstance(self.c) };
     }
 }
+
+/// `run(fmu, steps, h, record)` drives a model and appends output bits.
+pub type Recorder = fn(&mut Fmu, usize, f64, &mut Vec<u64>);
+
+/// Run 300 steps of 1e-3, save the FMU state (in memory and serialized),
+/// run 500 more recording every output bit; the run again from the
+/// restored state in the same instance, and from the deserialized state in
+/// a fresh instance, must record the same bits, and the run must move.
+pub fn assert_state_round_trip(model: &'static str, params: &[(&str, f64)], run: Recorder) {
+    let mut a = Fmu::new(model, params);
+    run(&mut a, 300, 1e-3, &mut Vec::new());
+    let t_saved = a.t;
+    let saved = a.state();
+    let bytes = a.serialize(saved);
+    let mut original = Vec::new();
+    run(&mut a, 500, 1e-3, &mut original);
+
+    // same instance, in-memory state
+    a.restore(saved, t_saved);
+    let mut again = Vec::new();
+    run(&mut a, 500, 1e-3, &mut again);
+    assert_eq!(original, again, "{model}: in-memory state");
+
+    // fresh instance, serialized state
+    let mut b = Fmu::new(model, params);
+    let s = b.deserialize(&bytes);
+    b.restore(s, t_saved);
+    let mut fresh = Vec::new();
+    run(&mut b, 500, 1e-3, &mut fresh);
+    assert_eq!(
+        original, fresh,
+        "{model}: serialized state in a new instance"
+    );
+    // the continuation really moves
+    assert!(
+        original.windows(2).any(|w| w[0] != w[1]),
+        "{model}: nothing changed"
+    );
+}
+
+/// Instantiate `model` with the invalid parameters `bad`:
+/// fmi2ExitInitializationMode must return fmi2Error and log a message
+/// naming itself and containing `needle` (the parameter and its value).
+/// Returns the instance, still in initialization mode.
+pub fn refused_at_initialization(model: &'static str, bad: &[(&str, f64)], needle: &str) -> Fmu {
+    let fmu = Fmu::instantiated(model, bad);
+    assert_eq!(
+        fmu.exit_initialization(),
+        fmi2Status::fmi2Error,
+        "{model} {bad:?}"
+    );
+    let m = last_error();
+    assert!(
+        m.contains("fmi2ExitInitializationMode") && m.contains(needle),
+        "{model}: {m}"
+    );
+    fmu
+}
