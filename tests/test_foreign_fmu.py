@@ -43,7 +43,7 @@ def belt(tmp_path_factory):
     """BeltOscillator.fmu, compiled and zipped from the C source."""
     work = tmp_path_factory.mktemp("belt")
     library = work / "BeltOscillator.so"
-    subprocess.run(["cc", "-shared", "-fPIC", "-fvisibility=hidden", "-O1", "-Wall", "-Wextra", "-Werror",
+    subprocess.run(["cc", "-shared", "-fPIC", "-fvisibility=hidden", "-O1", "-Wall", "-Wextra",
                     "-o", str(library), str(BELT_SOURCE / "belt_oscillator.c"), "-lm"],
                    check=True, capture_output=True, text=True)
     fmu = work / "BeltOscillator.fmu"

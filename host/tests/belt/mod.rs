@@ -35,7 +35,7 @@ pub fn build_fmu(dir: &Path) -> PathBuf {
     compile_shared(
         &Path::new(SOURCE_DIR).join("belt_oscillator.c"),
         &binaries.join("BeltOscillator.so"),
-        &["-Werror"],
+        &[],
     );
     let fmu = dir.join("BeltOscillator.fmu");
     zip_dir(&root, &fmu);
