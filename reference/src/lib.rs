@@ -252,7 +252,7 @@ impl ReferenceModel {
                         .map_err(|e| law_err(e.to_string()))?;
                     let normal_force = fc.vr("Fn").map_or(1.0, |vr| fc.values.real(vr));
                     DynamicLaw::LuGre {
-                        law: l,
+                        law: Box::new(l),
                         normal_force,
                     }
                 } else {
@@ -384,7 +384,14 @@ impl ReferenceModel {
                         }
                     };
                     let law_state = [y[3]];
-                    let r = self.row(&[tau, y[0], y[1], y[2]], c.force, &law_state, c.v, c.x);
+                    let r = self.row(
+                        &[tau, y[0], y[1], y[2]],
+                        c.force,
+                        &law_state,
+                        c.v,
+                        c.x,
+                        false,
+                    );
                     self.push(&mut table, start + tau, r, &mut failure);
                 })?;
                 Some(stats)
@@ -400,6 +407,7 @@ impl ReferenceModel {
                         &b.state_to_vec(),
                         f64::NAN,
                         p.xi,
+                        p.held,
                     );
                     self.push(&mut table, start + p.tau, r, &mut failure);
                 });
@@ -429,7 +437,9 @@ impl ReferenceModel {
     }
 
     /// Every output column at one state: the rig's state and friction
-    /// input `force`, the law's state and its inputs `v`, `x`.
+    /// input `force`, the law's state and its inputs `v`, `x`. `held`: the
+    /// bristle law is held at a reversal, where its force is the balance
+    /// value `force` rather than the law's branch value.
     fn row(
         &mut self,
         rig_state: &[f64],
@@ -437,6 +447,7 @@ impl ReferenceModel {
         law_state: &[f64],
         v: f64,
         x: f64,
+        held: bool,
     ) -> Result<Vec<f64>, String> {
         let mut friction_inputs = Vec::new();
         if let Some(vr) = self.friction_v_vr {
@@ -448,9 +459,14 @@ impl ReferenceModel {
         let rig_vals = self.components[self.rig]
             .outputs(rig_state, &[(self.rig_force_vr, force)])
             .map_err(|e| format!("{}: {e}", self.components[self.rig].name))?;
-        let fr_vals = self.components[self.friction]
+        let mut fr_vals = self.components[self.friction]
             .outputs(law_state, &friction_inputs)
             .map_err(|e| format!("{}: {e}", self.components[self.friction].name))?;
+        if held {
+            if let Some(vr) = self.components[self.friction].vr("F") {
+                fr_vals.set(vr, force);
+            }
+        }
         let mut row = Vec::new();
         for (i, c) in self.components.iter().enumerate() {
             let vals = if i == self.rig { &rig_vals } else { &fr_vals };

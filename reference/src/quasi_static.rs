@@ -29,8 +29,9 @@
 //!
 //! At a reversal the disconnected bristles reconnect with a force drop (the
 //! seed's relaxation), so `F` jumps at the turning point and the balance
-//! may have no root beyond it: the body then stays where it is (the force is
-//! set-valued there, and `R` has to travel through the jump first).
+//! may have no root beyond it: the body then stays where it is until `R`
+//! has travelled through the jump, the friction force being set-valued
+//! there; it is reported as the balance value `k·(R − ξ)`, inside the jump.
 //!
 //! Velocity: differentiating the balance, `ξ' = R'/(1 + K/k)` (0 while held
 //! at a reversal), and the body's `ẋ = ξ' + x_s'(t)` for `x_rel`.
@@ -68,8 +69,11 @@ pub struct QuasiStaticPoint {
     /// Body position and velocity.
     pub x: f64,
     pub xd: f64,
-    /// Friction force F(ξ).
+    /// Friction force: `F(ξ)`, or while held at a reversal the balance
+    /// value `k·(R − ξ)`, which then lies inside the jump of `F`.
     pub force: f64,
+    /// Held at a reversal (the balance has no root beyond the jump).
+    pub held: bool,
 }
 
 impl QuasiStaticBristle {
@@ -155,24 +159,34 @@ impl QuasiStaticBristle {
     }
 
     /// Moves the bristle to the root of `ξ + F(ξ)/k = r` beyond its current
-    /// position (see the module documentation).
-    pub fn settle(&self, b: &mut Bristle, r: f64) {
+    /// position (see the module documentation); `true` when there is none
+    /// because `r` lies in the jump at a reversal, and the bristle stays.
+    pub fn settle(&self, b: &mut Bristle, r: f64) -> bool {
         let k = self.rig.params().k;
         let x0 = b.position();
         let residual = |x: f64, f: f64| r - x - f / k;
         let g0 = residual(x0, b.force());
         if g0 == 0.0 || !g0.is_finite() {
-            return;
+            return false;
         }
         let s = g0.signum();
         // A probe just beyond the current position shows the branch the
         // move starts on (with the reconnection jump after a reversal).
         let eps = (1e-9 * b.params().delta_max).max(8.0 * f64::EPSILON * x0.abs());
         let probe = x0 + s * eps;
-        let gp = residual(probe, b.force_at(probe));
+        let fp = b.force_at(probe);
+        let gp = residual(probe, fp);
         if gp * s <= 0.0 {
-            // The root lies in the jump: the body stays.
-            return;
+            let slope = b.stiffness_at(probe);
+            let jump = fp - b.force() - slope * (probe - x0);
+            if jump.abs() > 1e-9 * b.sliding_level() {
+                // The root lies in the jump: the body stays.
+                return true;
+            }
+            // No jump: the root lies within the probe distance, on the
+            // first linear piece.
+            b.move_to(x0 + g0 / (1.0 + slope / k));
+            return false;
         }
         let mut x = probe;
         let mut gx = gp;
@@ -189,6 +203,7 @@ impl QuasiStaticBristle {
             }
         }
         b.move_to(x);
+        false
     }
 
     /// Velocity `ξ'` at the settled state for the current `R'`.
@@ -234,7 +249,8 @@ impl QuasiStaticBristle {
             for t in visits {
                 self.settle(&mut b, self.free_position(t));
             }
-            self.settle(&mut b, self.free_position(tau));
+            let r = self.free_position(tau);
+            let held = self.settle(&mut b, r);
             let rig = self.rig_at(tau);
             let (xs, vs) = self.surface(&rig, tau);
             let xi = b.position();
@@ -243,7 +259,12 @@ impl QuasiStaticBristle {
                 xi,
                 x: xi + xs,
                 xd: self.xi_rate(&b, self.free_rate(tau)) + vs,
-                force: b.force(),
+                force: if held {
+                    self.rig.params().k * (r - xi)
+                } else {
+                    b.force()
+                },
+                held,
             };
             out(&point, &b);
             prev = tau;

@@ -36,7 +36,7 @@ use rig_dynamics::rig1d::{Control, Rig1D, Rig1DInputs};
 pub enum DynamicLaw {
     /// LuGre with its (constant) normal force input `Fn`.
     LuGre {
-        law: LuGre,
+        law: Box<LuGre>,
         normal_force: f64,
     },
     Dahl(Dahl),
