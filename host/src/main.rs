@@ -39,6 +39,13 @@ enum Command {
         /// The archive to write (.ssp).
         out: PathBuf,
     },
+    /// Co-simulation error of a result CSV against a reference CSV: relative
+    /// RMS and largest absolute error per common signal.
+    Compare(cli::compare::CompareArgs),
+    /// Monolithic reference solution of a system of this project's FMUs
+    /// (Rig1D with LuGre, Dahl or Bristle): the same equations in one
+    /// process at tight tolerance, written as the same CSV as `run`.
+    Reference(cli::reference::ReferenceArgs),
 }
 
 fn main() -> ExitCode {
@@ -50,6 +57,8 @@ fn main() -> ExitCode {
         Command::Pack { ssd, out } => fricsim::ssp::pack(&ssd, &out)
             .map(|()| println!("wrote {}", out.display()))
             .map_err(|e| e.to_string()),
+        Command::Compare(args) => cli::compare::run(&args),
+        Command::Reference(args) => cli::reference::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -327,17 +327,31 @@ impl ReferenceModel {
         &self.description
     }
 
-    /// `component.output` for every Real output, components in the order
-    /// of the system: the columns of `fricsim run`.
+    /// `component.output` for every Real output (and recorded variable),
+    /// components in the order of the system: the columns of `fricsim run`.
     pub fn columns(&self) -> Vec<String> {
         self.components
             .iter()
             .flat_map(|c| {
-                c.real_outputs()
-                    .into_iter()
+                c.columns
+                    .iter()
                     .map(move |(n, _)| format!("{}.{n}", c.name))
             })
             .collect()
+    }
+
+    /// Records the Real variable `component.variable` besides the outputs
+    /// (after its component's outputs), as `fricsim run --record` does.
+    pub fn record(&mut self, port: &str) -> Result<(), MapError> {
+        let (c, v) = split(port)?;
+        let names: Vec<&str> = self.components.iter().map(|x| x.name.as_str()).collect();
+        let Some(i) = self.components.iter().position(|x| x.name == c) else {
+            return Err(MapError(format!(
+                "cannot record `{port}`: no component `{c}` (components: {})",
+                names.join(", ")
+            )));
+        };
+        self.components[i].record(v)
     }
 
     /// The solution at the absolute times `times` (increasing, the first
@@ -470,7 +484,7 @@ impl ReferenceModel {
         let mut row = Vec::new();
         for (i, c) in self.components.iter().enumerate() {
             let vals = if i == self.rig { &rig_vals } else { &fr_vals };
-            row.extend(c.real_outputs().iter().map(|&(_, vr)| vals.real(vr)));
+            row.extend(c.columns.iter().map(|&(_, vr)| vals.real(vr)));
         }
         Ok(row)
     }

@@ -117,6 +117,9 @@ pub(crate) struct Component {
     pub info: &'static ModelInfo,
     pub values: Values,
     pub model: Box<dyn Model>,
+    /// The recorded variables (name, value reference): the Real outputs in
+    /// variable-table order, then any recorded besides them.
+    pub columns: Vec<(&'static str, u32)>,
 }
 
 impl Component {
@@ -175,11 +178,18 @@ impl Component {
         model
             .initialize(&values)
             .map_err(|e| MapError(format!("component `{name}` ({}): {e}", info.model_name)))?;
+        let columns = info
+            .variables
+            .iter()
+            .filter(|v| v.causality == Causality::Output && v.var_type == VarType::Real)
+            .map(|v| (v.name, v.vr))
+            .collect();
         Ok(Component {
             name: name.clone(),
             info,
             values,
             model,
+            columns,
         })
     }
 
@@ -192,15 +202,25 @@ impl Component {
             .map(|v| v.vr)
     }
 
-    /// The Real outputs in variable-table order: the columns `fricsim run`
-    /// records for this component.
-    pub fn real_outputs(&self) -> Vec<(&'static str, u32)> {
-        self.info
-            .variables
-            .iter()
-            .filter(|v| v.causality == Causality::Output && v.var_type == VarType::Real)
-            .map(|v| (v.name, v.vr))
-            .collect()
+    /// Records the Real variable `variable` (an input, a parameter) after
+    /// the outputs, as `fricsim run --record` does.
+    pub fn record(&mut self, variable: &str) -> Result<(), MapError> {
+        let Some(var) = self.info.variables.iter().find(|v| v.name == variable) else {
+            return Err(MapError(format!(
+                "cannot record `{}.{variable}`: {} has no variable `{variable}`",
+                self.name, self.info.model_name
+            )));
+        };
+        if var.var_type != VarType::Real {
+            return Err(MapError(format!(
+                "cannot record `{}.{variable}`: it is a {:?} variable; only Real variables are recorded",
+                self.name, var.var_type
+            )));
+        }
+        if !self.columns.iter().any(|(n, _)| *n == variable) {
+            self.columns.push((var.name, var.vr));
+        }
+        Ok(())
     }
 
     /// Outputs for a state and input values: restores `state` into the

@@ -180,3 +180,30 @@ fn dahl_reference_equals_the_exact_update_along_its_own_path() {
         .zip(&f)
         .all(|(z, f)| (z * 87_750.0 - f).abs() < 1e-12));
 }
+
+#[test]
+fn recorded_inputs_and_parameters_follow_the_outputs_they_are_connected_to() {
+    let mut m = ReferenceModel::from_spec(&system(lugre_1995())).unwrap();
+    m.record("friction.v").unwrap();
+    m.record("rig.F").unwrap();
+    m.record("friction.sigma0").unwrap();
+    m.record("friction.v").unwrap(); // twice: once
+    let e = m.record("friction.sliding").unwrap_err().0;
+    assert!(e.contains("only Real variables"), "{e}");
+    let e = m.record("friction.nothing").unwrap_err().0;
+    assert!(e.contains("no variable `nothing`"), "{e}");
+    let e = m.record("belt.v").unwrap_err().0;
+    assert!(e.contains("no component `belt`"), "{e}");
+    let cols = m.columns();
+    let k = cols.iter().position(|c| c == "rig.F").unwrap();
+    assert_eq!(cols[k - 1], "rig.F_ctrl", "after the rig's outputs");
+    assert_eq!(
+        &cols[cols.len() - 4..],
+        ["friction.F", "friction.z", "friction.v", "friction.sigma0"]
+    );
+    let times: Vec<f64> = (0..=900).map(|i| i as f64 * 0.01).collect();
+    let t = m.solve(0.0, &times, RTOL).unwrap().0;
+    assert_eq!(col(&t, "friction.v"), col(&t, "rig.v"));
+    assert_eq!(col(&t, "rig.F"), col(&t, "friction.F"));
+    assert!(col(&t, "friction.sigma0").iter().all(|&s| s == 1e5));
+}

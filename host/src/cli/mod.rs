@@ -1,5 +1,7 @@
 //! The subcommands of the `fricsim` binary (not part of the library).
 
+pub mod compare;
 pub mod cosim;
 pub mod info;
+pub mod reference;
 pub mod run;
