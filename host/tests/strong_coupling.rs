@@ -4,7 +4,7 @@
 //! (seed 000's quasi-static rig, m = 0, against the bristle law), where
 //! fixed-point iteration diverges because the loop gain σ/k ≈ 120.
 
-use fricsim::master::strong::{JacobianSource, StrongCoupling, Update};
+use fricsim::master::strong::{JacobianSource, StepControl, StrongCoupling, Update};
 use fricsim::master::{jacobi::Jacobi, simulate, MasterAlgorithm, Run};
 use fricsim::system::System;
 use fricsim::FmuError;
@@ -228,4 +228,51 @@ fn not_converged_is_an_error_with_the_values() {
     for part in ["t = 0.5", "30 iterations", "a.y -> b.u", "2e0"] {
         assert!(text.contains(part), "{text}");
     }
+}
+
+fn adaptive(rtol: f64) -> StrongCoupling {
+    let mut master = newton();
+    master.step_control = Some(StepControl {
+        rtol,
+        atol: 1e-6,
+        h_min: 1e-9,
+    });
+    master
+}
+
+#[test]
+fn adaptive_steps_meet_the_benchmark_on_a_coarse_output_grid() {
+    // Communication points every 0.1 s; the macro steps inside are chosen
+    // by the hold-error estimate and rolled back when too large.
+    let mut errors = Vec::new();
+    for rtol in [1e-2, 1e-3] {
+        let mut system = stick_slip();
+        let mut master = adaptive(rtol);
+        let run = simulate(&mut system, &mut master, 0.1, 12.0).unwrap();
+        assert!(run.error.is_none(), "{:?}", run.error);
+        assert_eq!(run.rows.len(), 121, "the output grid stays at 0.1 s");
+        let report = master.convergence();
+        assert!(report.accepted > 0 && report.rejected > 0, "{report:?}");
+        assert!(report.largest_step <= 0.1 * (1.0 + 1e-12) && report.smallest_step >= 1e-9);
+        let peak_force = max(&column(&run, "friction.F"));
+        let peak_velocity = max(&column(&run, "rig.v"));
+        errors.push(
+            (peak_force / 1.4766 - 1.0)
+                .abs()
+                .max((peak_velocity / 0.3698 - 1.0).abs()),
+        );
+        if rtol == 1e-3 {
+            assert!(errors[1] < 5e-3, "peaks off by {:e}", errors[1]);
+            // fewer macro steps than Jacobi needs for the same figures
+            // (1e-4 s: 120 000). Not fewer than Newton at a fixed 1e-3 s
+            // (12 000): the hold-error estimate is pessimistic while the
+            // interface is still small (before the first slip).
+            assert!(report.accepted < 60_000, "{report:?}");
+            assert!(master.report().unwrap().contains("accepted"));
+        }
+    }
+    assert!(
+        errors[1] < errors[0],
+        "tighter tolerance, larger error: {errors:?}"
+    );
 }

@@ -24,6 +24,7 @@ pub const NAMES: &[&str] = &[
     "gauss-seidel-interpolated",
     "newton",
     "fixed-point",
+    "adaptive",
 ];
 
 /// A master algorithm by its command-line name (see [`NAMES`]).
@@ -34,6 +35,15 @@ pub fn by_name(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
         "gauss-seidel" => Box::new(gauss_seidel::GaussSeidel::new(false)),
         "gauss-seidel-interpolated" => Box::new(gauss_seidel::GaussSeidel::new(true)),
         "newton" => Box::new(StrongCoupling::new(Update::Newton, JacobianSource::Auto)),
+        "adaptive" => {
+            let mut master = StrongCoupling::new(Update::Newton, JacobianSource::Auto);
+            master.step_control = Some(strong::StepControl {
+                rtol: 1e-3,
+                atol: 1e-6,
+                h_min: 1e-9,
+            });
+            Box::new(master)
+        }
         "fixed-point" => Box::new(StrongCoupling::new(
             Update::FixedPoint,
             JacobianSource::Auto,

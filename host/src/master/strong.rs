@@ -61,6 +61,19 @@ pub enum JacobianSource {
     Auto,
 }
 
+/// Error control of the macro step (see [`StrongCoupling::step_control`]):
+/// a step is accepted when the estimated hold error of every connection is
+/// at most `atol·nominal + rtol·max|U|` (the largest magnitude of that
+/// connection so far); the next step is h·clamp(0.9/err,
+/// 0.2, 2) (the estimate is first order in h), never below `h_min` nor
+/// above the communication interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepControl {
+    pub rtol: f64,
+    pub atol: f64,
+    pub h_min: f64,
+}
+
 /// Counters of a strongly coupled run, for the convergence report.
 #[derive(Clone, Debug, Default)]
 pub struct ConvergenceReport {
@@ -78,8 +91,13 @@ pub struct ConvergenceReport {
     pub difference_steps: usize,
     /// Newton steps shortened because the residual did not decrease.
     pub backtracks: usize,
-    /// Steps (or half steps) rolled back and split in two after Newton failed.
+    /// Steps rolled back: split in two after Newton failed (fixed steps),
+    /// or retried smaller (adaptive steps: error too large or Newton failed).
     pub rejected: usize,
+    /// Adaptive steps accepted, and the smallest and largest of them.
+    pub accepted: usize,
+    pub smallest_step: f64,
+    pub largest_step: f64,
     /// Largest `|R_k| / tolerance_k` of an accepted step (≤ 1).
     pub worst_accepted: f64,
     /// Per component: how its Jacobian columns were obtained.
@@ -108,6 +126,13 @@ impl std::fmt::Display for ConvergenceReport {
             })
             .collect();
         writeln!(f, "  iterations per step: {}", bins.join(", "))?;
+        if self.accepted > 0 {
+            writeln!(
+                f,
+                "  adaptive macro steps: {} accepted, {} rejected, from {:.3e} s to {:.3e} s",
+                self.accepted, self.rejected, self.smallest_step, self.largest_step
+            )?;
+        }
         writeln!(
             f,
             "  largest accepted mismatch: {:.3} of the tolerance",
@@ -143,6 +168,12 @@ pub struct StrongCoupling {
     variable_steps: bool,
     /// U at the start of the step being solved (restored on a split).
     accepted: Vec<f64>,
+    /// Adaptive macro steps inside each communication interval, if set.
+    pub step_control: Option<StepControl>,
+    /// The step the controller proposes next.
+    h_next: Option<f64>,
+    /// Largest |U_k| so far, per connection (scale of the error control).
+    range: Vec<f64>,
     report: ConvergenceReport,
     ports: Vec<Ports>,
     states: Vec<Option<FmuState>>,
@@ -165,7 +196,13 @@ impl StrongCoupling {
             max_splits: 10,
             variable_steps: false,
             accepted: Vec::new(),
-            report: ConvergenceReport::default(),
+            step_control: None,
+            h_next: None,
+            range: Vec::new(),
+            report: ConvergenceReport {
+                smallest_step: f64::INFINITY,
+                ..Default::default()
+            },
             ports: Vec::new(),
             states: Vec::new(),
             nominal: Vec::new(),
@@ -239,6 +276,7 @@ impl StrongCoupling {
                 .can_handle_variable_communication_step_size
         });
         self.u = vec![0.0; n];
+        self.range = vec![0.0; n];
         self.started = false;
         self.y = vec![0.0; n];
         self.report.jacobian_of = system
@@ -436,7 +474,12 @@ impl MasterAlgorithm for StrongCoupling {
         if self.ports.len() != system.components.len() {
             self.prepare(system);
         }
-        self.step_or_split(system, t, h, 0)
+        match self.step_control {
+            Some(control) if !system.connections.is_empty() => {
+                self.adaptive_step(system, t, h, control)
+            }
+            _ => self.step_or_split(system, t, h, 0),
+        }
     }
 
     fn report(&self) -> Option<String> {
@@ -445,6 +488,110 @@ impl MasterAlgorithm for StrongCoupling {
 }
 
 impl StrongCoupling {
+    /// Cover the communication interval `[t, t + big_h]` with macro steps
+    /// chosen by the error estimate of [`StepControl`]; the last one ends
+    /// exactly at `t + big_h`.
+    fn adaptive_step(
+        &mut self,
+        system: &mut System,
+        t: f64,
+        big_h: f64,
+        control: StepControl,
+    ) -> Result<(), FmuError> {
+        if !control.h_min.is_finite() || control.h_min <= 0.0 {
+            return Err(FmuError::NotConverged {
+                time: t,
+                step: control.h_min,
+                iterations: 0,
+                connection: "(step control: h_min must be > 0)".into(),
+                mismatch: f64::NAN,
+                input: f64::NAN,
+                output: f64::NAN,
+            });
+        }
+        let end = t + big_h;
+        let mut now = t;
+        let mut h = self.h_next.unwrap_or(big_h).min(big_h);
+        self.ensure_started(system)?;
+        while now < end {
+            // Take the rest if it is within reach, never leave a sliver.
+            let rest = end - now;
+            let last = h >= rest || rest - h < control.h_min;
+            let step = if last { rest } else { h };
+            let start = self.u.clone();
+            let solved = self.solve(system, now, step);
+            let estimate = match &solved {
+                Ok(()) => Some(self.hold_error(&start, control)),
+                Err(FmuError::NotConverged { .. }) => None,
+                Err(_) => return solved,
+            };
+            match estimate {
+                Some(error) if error <= 1.0 || step <= control.h_min => {
+                    self.report.accepted += 1;
+                    self.report.smallest_step = self.report.smallest_step.min(step);
+                    self.report.largest_step = self.report.largest_step.max(step);
+                    now = if last { end } else { now + step };
+                    // first-order estimate: error ∝ h
+                    let grow = if error > 0.0 { 0.9 / error } else { 2.0 };
+                    if !last || step >= h {
+                        h = (step * grow.clamp(0.2, 1.5)).clamp(control.h_min, big_h);
+                    }
+                }
+                _ => {
+                    // Rejected (too large an error, or Newton failed): roll
+                    // back to `now` and retry with a smaller step.
+                    if step <= control.h_min {
+                        return solved;
+                    }
+                    self.report.rejected += 1;
+                    for c in 0..system.components.len() {
+                        self.restore(system, c)?;
+                    }
+                    self.u.copy_from_slice(&start);
+                    let shrink = match estimate {
+                        Some(error) => (0.9 / error).clamp(0.2, 0.5),
+                        None => 0.25,
+                    };
+                    h = (step * shrink).max(control.h_min);
+                }
+            }
+        }
+        self.h_next = Some(h);
+        Ok(())
+    }
+
+    /// Local error of holding the interface over the step: the held value
+    /// U(t + h) differs from the interface's true course, which moves from
+    /// U(t) to U(t + h), by half the change on average. Scaled by the
+    /// tolerance of [`StepControl`], largest over the connections.
+    ///
+    /// The relative part is taken of the largest magnitude the connection
+    /// has had so far (`range`), not of its current value: a slip velocity
+    /// passing through zero at a stick would otherwise ask for steps of
+    /// nanoseconds.
+    fn hold_error(&mut self, start: &[f64], control: StepControl) -> f64 {
+        let mut worst: f64 = 0.0;
+        for k in 0..self.u.len() {
+            self.range[k] = self.range[k].max(self.u[k].abs()).max(start[k].abs());
+            let tolerance = control.atol * self.nominal[k] + control.rtol * self.range[k];
+            let error = 0.5 * (self.u[k] - start[k]).abs() / tolerance;
+            if error.is_nan() || error > worst {
+                worst = error;
+            }
+        }
+        worst
+    }
+
+    fn ensure_started(&mut self, system: &mut System) -> Result<(), FmuError> {
+        if !self.started {
+            for c in 0..system.components.len() {
+                Self::read_outputs(system, c, &self.ports[c], &mut self.u)?;
+            }
+            self.started = true;
+        }
+        Ok(())
+    }
+
     /// Solve the step; if Newton fails, roll back and cover `[t, t + h]`
     /// with two half steps (recursively, at most `max_splits` times deep).
     /// The communication grid of the run is unchanged: the halves happen
@@ -489,12 +636,7 @@ impl StrongCoupling {
         // accepted U; at the first step, the outputs at t). Not the outputs:
         // a hysteretic law reads an input a rounding error below its last
         // one as a reversal.
-        if !self.started {
-            for c in 0..system.components.len() {
-                Self::read_outputs(system, c, &self.ports[c], &mut self.u)?;
-            }
-            self.started = true;
-        }
+        self.ensure_started(system)?;
         self.accepted.clone_from(&self.u);
         // Damped Newton: from the base point `base` (where the Jacobian was
         // taken) try U = base + λ·direction, halving λ while the scaled
