@@ -43,8 +43,9 @@ enum Command {
     /// RMS and largest absolute error per common signal.
     Compare(cli::compare::CompareArgs),
     /// Monolithic reference solution of a system of this project's FMUs
-    /// (Rig1D with LuGre, Dahl or Bristle): the same equations in one
-    /// process at tight tolerance, written as the same CSV as `run`.
+    /// (Rig1D with LuGre, Dahl or Bristle; Rig2D with Bristle2D): the same
+    /// equations in one process at tight tolerance, written as the same
+    /// CSV as `run`.
     Reference(cli::reference::ReferenceArgs),
 }
 

@@ -9,6 +9,8 @@
 //! - [`rig_friction`]: Rig1D (m > 0) with LuGre or Dahl as one ODE system;
 //! - [`quasi_static`]: the quasi-static Rig1D (m = 0) with the bristle
 //!   model, solved exactly at each output time;
+//! - [`planar`]: Rig2D with the 2-D bristle law, a hybrid ODE system
+//!   (stick and slide modes);
 //! - [`spec`]: a system as plain data (components with model names, GUIDs
 //!   and parameter values; connections), and [`ReferenceModel`], which
 //!   recognises one of the couplings above in it;
@@ -21,21 +23,27 @@
 #![forbid(unsafe_code)]
 
 pub mod metrics;
+pub mod planar;
 pub mod quasi_static;
 pub mod radau;
 pub mod rig_friction;
 pub mod spec;
 
 use friction_fmu::bristle::BristleFmu;
+use friction_fmu::bristle2d::Bristle2DFmu;
 use friction_fmu::dahl::DahlFmu;
 use friction_fmu::lugre::LuGreFmu;
 use friction_laws::bristle::Bristle;
+use friction_laws::bristle2d::Bristle2D;
 use friction_laws::dahl::Dahl;
 use friction_laws::lugre::LuGre;
+use planar::PlanarBristle;
 use quasi_static::{BristleInput, QuasiStaticBristle};
 use radau::{RadauError, RadauStats};
 use rig_dynamics::rig1d::{Rig1D, Rig1DInputs};
+use rig_dynamics::rig2d::Rig2D;
 use rig_fmu::rig1d::Rig1DFmu;
+use rig_fmu::rig2d::Rig2DFmu;
 use rig_friction::{DynamicLaw, PositionSource, RigWithFriction, VelocitySource};
 use spec::Component;
 pub use spec::{ComponentSpec, MapError, SystemSpec, Value};
@@ -115,6 +123,7 @@ impl From<RadauError> for ReferenceError {
 enum Coupled {
     Dynamic(RigWithFriction),
     QuasiStatic(QuasiStaticBristle),
+    Planar(Box<PlanarBristle>),
 }
 
 /// A system of this project's FMUs mapped onto one monolithic model.
@@ -123,11 +132,62 @@ pub struct ReferenceModel {
     rig: usize,
     friction: usize,
     coupled: Coupled,
-    /// Inputs set from the solution when outputs are evaluated.
-    rig_force_vr: u32,
-    friction_v_vr: Option<u32>,
-    friction_x_vr: Option<u32>,
+    /// Value references of the connected inputs, set from the solution
+    /// when outputs are evaluated: the rig's friction force input(s), the
+    /// law's velocity input(s) and position input, and the law's force
+    /// output(s) (overridden where the law's own evaluation from its state
+    /// would not see the mode).
+    rig_force: Vec<u32>,
+    law_velocity: Vec<u32>,
+    law_position: Option<u32>,
+    law_force: Vec<u32>,
     description: String,
+}
+
+/// One connection a coupling knows: into the rig (`to_rig`) or into the
+/// law, the input's name, the outputs it may come from, and whether the
+/// coupling needs it.
+struct Link {
+    to_rig: bool,
+    input: &'static str,
+    sources: &'static [&'static str],
+    required: bool,
+}
+
+const fn link(
+    to_rig: bool,
+    input: &'static str,
+    sources: &'static [&'static str],
+    required: bool,
+) -> Link {
+    Link {
+        to_rig,
+        input,
+        sources,
+        required,
+    }
+}
+
+/// The connections of each coupling with a reference.
+fn links(rig: &str, law: &str) -> Option<&'static [Link]> {
+    const FORCE: Link = link(true, "F", &["F"], true);
+    const VELOCITY: Link = link(false, "v", &["v", "v_body"], true);
+    static LUGRE: [Link; 3] = [FORCE, VELOCITY, link(false, "x", &["x", "x_rel"], false)];
+    static DAHL: [Link; 2] = [FORCE, VELOCITY];
+    static BRISTLE: [Link; 2] = [FORCE, link(false, "x", &["x", "x_rel"], true)];
+    static PLANAR: [Link; 4] = [
+        link(true, "F1", &["F1"], true),
+        link(true, "F2", &["F2"], true),
+        link(false, "v1", &["v1"], true),
+        link(false, "v2", &["v2"], true),
+    ];
+    Some(match (rig, law) {
+        ("Rig1D", "LuGre") => &LUGRE,
+        ("Rig1D", "Dahl") => &DAHL,
+        ("Rig1D", "Bristle") => &BRISTLE,
+        ("Rig2D", "Bristle2D") => &PLANAR,
+        _ => return None,
+    })
 }
 
 /// `component.variable` split at the first dot.
@@ -138,11 +198,14 @@ fn split(port: &str) -> Result<(&str, &str), MapError> {
 }
 
 impl ReferenceModel {
-    /// Recognises the coupling: two components, a `Rig1D` and a friction
-    /// law, connected `friction.F → rig.F` and
-    /// - LuGre or Dahl (rig m > 0): `rig.v` (or `rig.v_body`) → `friction.v`,
-    ///   and for LuGre optionally `rig.x` (or `rig.x_rel`) → `friction.x`;
-    /// - Bristle (rig m = 0, c = 0): `rig.x` (or `rig.x_rel`) → `friction.x`.
+    /// Recognises the coupling: two components, a rig and a friction law:
+    /// - `Rig1D` (m > 0) with LuGre or Dahl: `friction.F → rig.F`,
+    ///   `rig.v` (or `rig.v_body`) → `friction.v`, and for LuGre optionally
+    ///   `rig.x` (or `rig.x_rel`) → `friction.x`;
+    /// - `Rig1D` (m = 0, c = 0) with Bristle: `friction.F → rig.F`,
+    ///   `rig.x` (or `rig.x_rel`) → `friction.x`;
+    /// - `Rig2D` with Bristle2D: `friction.F1, F2 → rig.F1, F2`,
+    ///   `rig.v1, v2 → friction.v1, v2`.
     ///
     /// Unconnected inputs keep their start values. Anything else is refused
     /// with a message naming the component or connection.
@@ -150,7 +213,7 @@ impl ReferenceModel {
         let names: Vec<&str> = spec.components.iter().map(|c| c.name.as_str()).collect();
         if spec.components.len() != 2 {
             return Err(MapError(format!(
-                "a reference exists for a Rig1D and one friction law (2 components); this system has {}: {}",
+                "a reference exists for a rig and one friction law (2 components); this system has {}: {}",
                 names.len(),
                 names.join(", ")
             )));
@@ -160,164 +223,189 @@ impl ReferenceModel {
             .iter()
             .map(Component::from_spec)
             .collect::<Result<Vec<_>, _>>()?;
-        let rigs: Vec<usize> = (0..2)
-            .filter(|&i| components[i].info.model_name == "Rig1D")
-            .collect();
-        let (rig, friction) = match rigs.as_slice() {
-            [r] => (*r, 1 - *r),
+        let is_rig = |i: usize| matches!(components[i].info.model_name, "Rig1D" | "Rig2D");
+        let (rig, friction) = match (is_rig(0), is_rig(1)) {
+            (true, false) => (0, 1),
+            (false, true) => (1, 0),
             _ => {
                 return Err(MapError(format!(
-                    "a reference needs one Rig1D and one friction law; components {} are {} and {}",
+                    "a reference needs one rig (Rig1D or Rig2D) and one friction law; components {} are {} and {}",
                     names.join(", "),
                     components[0].info.model_name,
                     components[1].info.model_name
                 )))
             }
         };
+        let rig_model = components[rig].info.model_name;
         let law = components[friction].info.model_name;
         let (rig_name, fr_name) = (&components[rig].name, &components[friction].name);
+        let Some(table) = links(rig_model, law) else {
+            return Err(MapError(format!(
+                "component `{fr_name}` ({law}) with {rig_model} `{rig_name}`: no monolithic reference for this pair (supported: Rig1D with LuGre, Dahl or Bristle; Rig2D with Bristle2D)"
+            )));
+        };
+        let expected = expected(table, rig_name, fr_name);
 
-        // Connections.
-        let mut force = false;
-        let mut v_from: Option<String> = None;
-        let mut x_from: Option<String> = None;
+        // Connections: each onto a link of the table, each input once.
+        let mut sources: Vec<Option<String>> = vec![None; table.len()];
         for (from, to) in &spec.connections {
             let (fc, fv) = split(from)?;
             let (tc, tv) = split(to)?;
-            let known = if fc == fr_name && tc == rig_name {
-                fv == "F" && tv == "F"
-            } else if fc == rig_name && tc == fr_name {
-                match (law, tv) {
-                    ("LuGre" | "Dahl", "v") => matches!(fv, "v" | "v_body"),
-                    ("LuGre" | "Bristle", "x") => matches!(fv, "x" | "x_rel"),
-                    _ => false,
-                }
-            } else {
-                false
-            };
-            if !known {
+            let to_rig = fc == fr_name && tc == rig_name;
+            let to_law = fc == rig_name && tc == fr_name;
+            let k = table.iter().position(|l| {
+                (to_rig || to_law) && l.to_rig == to_rig && l.input == tv && l.sources.contains(&fv)
+            });
+            let Some(k) = k else {
                 return Err(MapError(format!(
-                    "connection {from} → {to}: not part of a coupling the reference knows (Rig1D + {law}: {})",
-                    expected(law, rig_name, fr_name)
+                    "connection {from} → {to}: not part of a coupling the reference knows ({rig_model} + {law}: {expected})"
                 )));
-            }
-            let slot = match tv {
-                "F" => {
-                    let seen = force;
-                    force = true;
-                    seen
-                }
-                "v" => v_from.replace(fv.to_string()).is_some(),
-                _ => x_from.replace(fv.to_string()).is_some(),
             };
-            if slot {
+            if sources[k].replace(fv.to_string()).is_some() {
                 return Err(MapError(format!("input {to} is connected twice")));
             }
         }
-        let needs_v = law != "Bristle";
-        let needs_x = law == "Bristle";
-        if !force || (needs_v && v_from.is_none()) || (needs_x && x_from.is_none()) {
+        if table
+            .iter()
+            .zip(&sources)
+            .any(|(l, s)| l.required && s.is_none())
+        {
             return Err(MapError(format!(
-                "components `{rig_name}` (Rig1D) and `{fr_name}` ({law}) are not coupled as the reference needs: {}",
-                expected(law, rig_name, fr_name)
+                "components `{rig_name}` ({rig_model}) and `{fr_name}` ({law}) are not coupled as the reference needs: {expected}"
             )));
         }
+        let source = |input: &str| {
+            table
+                .iter()
+                .zip(&sources)
+                .find(|(l, _)| l.input == input && !l.to_rig)
+                .and_then(|(_, s)| s.as_deref())
+        };
+        let (v_from, x_from) = (source("v"), source("x"));
 
         // Physics objects from the FMU adapters' parameter semantics.
         let rc = &components[rig];
-        let rig_params = Rig1DFmu::params(&rc.values)
-            .map_err(|e| MapError(format!("component `{rig_name}` (Rig1D): {e}")))?;
-        let rig_obj = Rig1D::new(rig_params)
-            .map_err(|e| MapError(format!("component `{rig_name}` (Rig1D): {e}")))?;
-        let input = |name: &str| rc.vr(name).map_or(0.0, |vr| rc.values.real(vr));
-        let inputs = Rig1DInputs {
-            friction: 0.0,
-            f_ext: input("F_ext"),
-            x_act: input("x_act_in"),
-            x_ref: input("x_ref"),
-            v_ref: input("v_ref"),
-        };
         let fc = &components[friction];
+        let rig_err = |e: String| MapError(format!("component `{rig_name}` ({rig_model}): {e}"));
         let law_err = |e: String| MapError(format!("component `{fr_name}` ({law}): {e}"));
-        let (m, c) = (rig_params.m, rig_params.c);
-        let coupled = match law {
-            "LuGre" | "Dahl" => {
-                if m <= 0.0 {
-                    return Err(MapError(format!(
-                        "component `{rig_name}` (Rig1D): m = {m}: the quasi-static rig has a reference only with the Bristle law; {law} needs m > 0"
-                    )));
-                }
-                let dynamic = if law == "LuGre" {
-                    let l = LuGre::new(LuGreFmu::params(&fc.values))
-                        .map_err(|e| law_err(e.to_string()))?;
-                    let normal_force = fc.vr("Fn").map_or(1.0, |vr| fc.values.real(vr));
-                    DynamicLaw::LuGre {
-                        law: Box::new(l),
-                        normal_force,
+        let input = |name: &str| rc.vr(name).map_or(0.0, |vr| rc.values.real(vr));
+        let (coupled, description) = if rig_model == "Rig2D" {
+            let rig_obj = Rig2D::new(Rig2DFmu::params(&rc.values)).map_err(rig_err)?;
+            let b = Bristle2D::new(Bristle2DFmu::params(&fc.values))
+                .map_err(|e| law_err(e.to_string()))?;
+            (
+                Coupled::Planar(Box::new(PlanarBristle {
+                    rig: rig_obj,
+                    law: b,
+                    f_ext: [input("F_ext1"), input("F_ext2")],
+                })),
+                format!(
+                    "Rig2D `{rig_name}` + Bristle2D `{fr_name}`: hybrid ODE system (stick and slide modes), Radau IIA"
+                ),
+            )
+        } else {
+            let rig_params = Rig1DFmu::params(&rc.values).map_err(rig_err)?;
+            let rig_obj = Rig1D::new(rig_params).map_err(rig_err)?;
+            let inputs = Rig1DInputs {
+                friction: 0.0,
+                f_ext: input("F_ext"),
+                x_act: input("x_act_in"),
+                x_ref: input("x_ref"),
+                v_ref: input("v_ref"),
+            };
+            let (m, c) = (rig_params.m, rig_params.c);
+            match law {
+                "LuGre" | "Dahl" => {
+                    if m <= 0.0 {
+                        return Err(MapError(format!(
+                            "component `{rig_name}` (Rig1D): m = {m}: the quasi-static rig has a reference only with the Bristle law; {law} needs m > 0"
+                        )));
                     }
-                } else {
-                    DynamicLaw::Dahl(
-                        Dahl::new(DahlFmu::params(&fc.values))
-                            .map_err(|e| law_err(e.to_string()))?,
+                    let dynamic = if law == "LuGre" {
+                        let l = LuGre::new(LuGreFmu::params(&fc.values))
+                            .map_err(|e| law_err(e.to_string()))?;
+                        let normal_force = fc.vr("Fn").map_or(1.0, |vr| fc.values.real(vr));
+                        DynamicLaw::LuGre {
+                            law: Box::new(l),
+                            normal_force,
+                        }
+                    } else {
+                        DynamicLaw::Dahl(
+                            Dahl::new(DahlFmu::params(&fc.values))
+                                .map_err(|e| law_err(e.to_string()))?,
+                        )
+                    };
+                    let velocity = match v_from {
+                        Some("v_body") => VelocitySource::Body,
+                        _ => VelocitySource::Slip,
+                    };
+                    let position = match x_from {
+                        Some("x") => PositionSource::Position,
+                        Some(_) => PositionSource::Relative,
+                        None => PositionSource::Constant(
+                            fc.vr("x").map_or(0.0, |vr| fc.values.real(vr)),
+                        ),
+                    };
+                    (
+                        Coupled::Dynamic(RigWithFriction {
+                            rig: rig_obj,
+                            law: dynamic,
+                            inputs,
+                            velocity,
+                            position,
+                        }),
+                        format!(
+                            "Rig1D `{rig_name}` (m = {m}) + {law} `{fr_name}`: one ODE system, Radau IIA"
+                        ),
                     )
-                };
-                let velocity = match v_from.as_deref() {
-                    Some("v_body") => VelocitySource::Body,
-                    _ => VelocitySource::Slip,
-                };
-                let position = match x_from.as_deref() {
-                    Some("x") => PositionSource::Position,
-                    Some(_) => PositionSource::Relative,
-                    None => {
-                        PositionSource::Constant(fc.vr("x").map_or(0.0, |vr| fc.values.real(vr)))
-                    }
-                };
-                Coupled::Dynamic(RigWithFriction {
-                    rig: rig_obj,
-                    law: dynamic,
-                    inputs,
-                    velocity,
-                    position,
-                })
-            }
-            _ => {
-                if m != 0.0 || c != 0.0 {
-                    return Err(MapError(format!(
-                        "component `{fr_name}` (Bristle): the reference solves the bristle law only with the quasi-static rig (m = 0, c = 0), but `{rig_name}` has m = {m}, c = {c}"
-                    )));
                 }
-                let b = Bristle::new(BristleFmu::params(&fc.values).map_err(law_err)?)
-                    .map_err(|e| law_err(e.to_string()))?;
-                Coupled::QuasiStatic(QuasiStaticBristle {
-                    rig: rig_obj,
-                    bristle: b,
-                    inputs,
-                    input: match x_from.as_deref() {
-                        Some("x") => BristleInput::Position,
-                        _ => BristleInput::Relative,
-                    },
-                })
+                _ => {
+                    if m != 0.0 || c != 0.0 {
+                        return Err(MapError(format!(
+                            "component `{fr_name}` (Bristle): the reference solves the bristle law only with the quasi-static rig (m = 0, c = 0), but `{rig_name}` has m = {m}, c = {c}"
+                        )));
+                    }
+                    let b = Bristle::new(BristleFmu::params(&fc.values).map_err(law_err)?)
+                        .map_err(|e| law_err(e.to_string()))?;
+                    (
+                        Coupled::QuasiStatic(QuasiStaticBristle {
+                            rig: rig_obj,
+                            bristle: b,
+                            inputs,
+                            input: match x_from {
+                                Some("x") => BristleInput::Position,
+                                _ => BristleInput::Relative,
+                            },
+                        }),
+                        format!(
+                            "Rig1D `{rig_name}` (quasi-static, m = 0) + Bristle `{fr_name}`: exact root of the force balance at each output time"
+                        ),
+                    )
+                }
             }
         };
-        let description = match &coupled {
-            Coupled::Dynamic(_) => format!(
-                "Rig1D `{rig_name}` (m = {m}) + {law} `{fr_name}`: one ODE system, Radau IIA"
-            ),
-            Coupled::QuasiStatic(_) => format!(
-                "Rig1D `{rig_name}` (quasi-static, m = 0) + Bristle `{fr_name}`: exact root of the force balance at each output time"
-            ),
+        let vrs = |c: &Component, names: &[&str]| -> Vec<u32> {
+            names.iter().filter_map(|n| c.vr(n)).collect()
         };
-        let rig_force_vr = components[rig].vr("F").expect("Rig1D has input F");
-        let friction_v_vr = v_from.as_ref().and_then(|_| components[friction].vr("v"));
-        let friction_x_vr = x_from.as_ref().and_then(|_| components[friction].vr("x"));
+        let planar = rig_model == "Rig2D";
+        let (forces, velocities): (&[&str], &[&str]) = if planar {
+            (&["F1", "F2"], &["v1", "v2"])
+        } else {
+            (&["F"], if v_from.is_some() { &["v"] } else { &[] })
+        };
+        let rig_force = vrs(&components[rig], forces);
+        let law_velocity = vrs(&components[friction], velocities);
+        let law_force = vrs(&components[friction], forces);
+        let law_position = x_from.and_then(|_| components[friction].vr("x"));
         Ok(ReferenceModel {
             components,
             rig,
             friction,
             coupled,
-            rig_force_vr,
-            friction_v_vr,
-            friction_x_vr,
+            rig_force,
+            law_velocity,
+            law_position,
+            law_force,
             description,
         })
     }
@@ -397,14 +485,13 @@ impl ReferenceModel {
                             return;
                         }
                     };
-                    let law_state = [y[3]];
                     let r = self.row(
                         &[tau, y[0], y[1], y[2]],
-                        c.force,
-                        &law_state,
-                        c.v,
+                        &[c.force],
+                        &[y[3]],
+                        &[c.v],
                         c.x,
-                        false,
+                        None,
                     );
                     self.push(&mut table, start + tau, r, &mut failure);
                 })?;
@@ -417,15 +504,39 @@ impl ReferenceModel {
                     }
                     let r = self.row(
                         &[p.tau, p.x, p.xd, 0.0],
-                        p.force,
+                        &[p.force],
                         &b.state_to_vec(),
-                        f64::NAN,
+                        &[],
                         p.xi,
-                        p.held,
+                        p.held.then_some(&[p.force][..]),
                     );
                     self.push(&mut table, start + p.tau, r, &mut failure);
                 });
                 None
+            }
+            Coupled::Planar(sys) => {
+                let stats = sys.solve(&taus, rtol, |tau, y, sliding| {
+                    if failure.is_some() {
+                        return;
+                    }
+                    let c = match sys.coupling(tau, y, sliding) {
+                        Ok(c) => c,
+                        Err(e) => {
+                            failure = Some(e);
+                            return;
+                        }
+                    };
+                    let r = self.row(
+                        &[tau, y[0], y[1], 0.0, tau, y[2], y[3], 0.0],
+                        &c.force,
+                        &c.z,
+                        &c.v,
+                        f64::NAN,
+                        Some(&c.force),
+                    );
+                    self.push(&mut table, start + tau, r, &mut failure);
+                })?;
+                Some(stats)
             }
         };
         match failure {
@@ -450,35 +561,46 @@ impl ReferenceModel {
         }
     }
 
-    /// Every output column at one state: the rig's state and friction
-    /// input `force`, the law's state and its inputs `v`, `x`. `held`: the
-    /// bristle law is held at a reversal, where its force is the balance
-    /// value `force` rather than the law's branch value.
+    /// Every output column at one state: the rig's state and its friction
+    /// input(s) `force`, the law's state and its inputs `v` (velocity
+    /// inputs in order) and `x` (position input, if connected).
+    /// `law_force`: the law's force output(s) as the coupled solution has
+    /// them, where the law evaluated from its state alone would not see
+    /// the mode (the bristle law held at a reversal, the 2-D law's stick or
+    /// slide mode).
     fn row(
         &mut self,
         rig_state: &[f64],
-        force: f64,
+        force: &[f64],
         law_state: &[f64],
-        v: f64,
+        v: &[f64],
         x: f64,
-        held: bool,
+        law_force: Option<&[f64]>,
     ) -> Result<Vec<f64>, String> {
-        let mut friction_inputs = Vec::new();
-        if let Some(vr) = self.friction_v_vr {
-            friction_inputs.push((vr, v));
-        }
-        if let Some(vr) = self.friction_x_vr {
-            friction_inputs.push((vr, x));
+        let rig_inputs: Vec<(u32, f64)> = self
+            .rig_force
+            .iter()
+            .copied()
+            .zip(force.iter().copied())
+            .collect();
+        let mut law_inputs: Vec<(u32, f64)> = self
+            .law_velocity
+            .iter()
+            .copied()
+            .zip(v.iter().copied())
+            .collect();
+        if let Some(vr) = self.law_position {
+            law_inputs.push((vr, x));
         }
         let rig_vals = self.components[self.rig]
-            .outputs(rig_state, &[(self.rig_force_vr, force)])
+            .outputs(rig_state, &rig_inputs)
             .map_err(|e| format!("{}: {e}", self.components[self.rig].name))?;
         let mut fr_vals = self.components[self.friction]
-            .outputs(law_state, &friction_inputs)
+            .outputs(law_state, &law_inputs)
             .map_err(|e| format!("{}: {e}", self.components[self.friction].name))?;
-        if held {
-            if let Some(vr) = self.components[self.friction].vr("F") {
-                fr_vals.set(vr, force);
+        if let Some(f) = law_force {
+            for (&vr, &value) in self.law_force.iter().zip(f) {
+                fr_vals.set(vr, value);
             }
         }
         let mut row = Vec::new();
@@ -490,13 +612,25 @@ impl ReferenceModel {
     }
 }
 
-/// The connections a coupling needs, for messages.
-fn expected(law: &str, rig: &str, fr: &str) -> String {
-    match law {
-        "LuGre" => format!(
-            "{fr}.F → {rig}.F, {rig}.v (or v_body) → {fr}.v, optionally {rig}.x (or x_rel) → {fr}.x"
-        ),
-        "Dahl" => format!("{fr}.F → {rig}.F, {rig}.v (or v_body) → {fr}.v"),
-        _ => format!("{fr}.F → {rig}.F, {rig}.x (or x_rel) → {fr}.x"),
-    }
+/// The connections a coupling needs, for messages:
+/// `friction.F → rig.F, rig.v (or v_body) → friction.v, optionally …`.
+fn expected(table: &[Link], rig: &str, fr: &str) -> String {
+    table
+        .iter()
+        .map(|l| {
+            let (from, to) = if l.to_rig { (fr, rig) } else { (rig, fr) };
+            let alternatives: Vec<String> = l.sources[1..]
+                .iter()
+                .map(|s| format!(" (or {s})"))
+                .collect();
+            format!(
+                "{}{from}.{}{} → {to}.{}",
+                if l.required { "" } else { "optionally " },
+                l.sources[0],
+                alternatives.concat(),
+                l.input
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }

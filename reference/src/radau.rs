@@ -273,10 +273,63 @@ pub fn solve_with<S: OdeSystem + ?Sized>(
             out(t0, y0);
             continue;
         }
-        run.advance_to(target)?;
+        run.advance_to(target, false)?;
         out(run.t, run.y.as_slice());
     }
     Ok(run.stats)
+}
+
+/// Where [`solve_until_switch`] stopped.
+#[derive(Clone, Debug)]
+pub struct SegmentEnd {
+    pub t: f64,
+    pub y: Vec<f64>,
+    /// Stopped on a sign change of a switching function (else at the last
+    /// output time).
+    pub switched: bool,
+    pub stats: RadauStats,
+}
+
+/// As [`solve_with`], but returns after the first step that ends on a sign
+/// change of a switching function (the outputs up to it handed to `out`),
+/// so that the caller can change the equations there (a hybrid system's
+/// mode) and continue with the remaining output times.
+pub fn solve_until_switch<S: OdeSystem + ?Sized>(
+    sys: &S,
+    t0: f64,
+    y0: &[f64],
+    t_out: &[f64],
+    opts: &RadauOptions,
+    mut out: impl FnMut(f64, &[f64]),
+) -> Result<SegmentEnd, RadauError> {
+    let n = sys.dim();
+    check_inputs(n, t0, y0, t_out, opts)?;
+    let t_end = *t_out.last().expect("checked non-empty");
+    let mut run = Run::new(sys, opts, t0, y0, t_end);
+    for &target in t_out {
+        if target == t0 {
+            out(t0, y0);
+            continue;
+        }
+        let reached = run.advance_to(target, true)?;
+        if reached {
+            out(run.t, run.y.as_slice());
+        }
+        if run.switched {
+            return Ok(SegmentEnd {
+                t: run.t,
+                y: run.y.as_slice().to_vec(),
+                switched: true,
+                stats: run.stats,
+            });
+        }
+    }
+    Ok(SegmentEnd {
+        t: run.t,
+        y: run.y.as_slice().to_vec(),
+        switched: false,
+        stats: run.stats,
+    })
 }
 
 fn check_inputs(
@@ -371,6 +424,8 @@ struct Run<'a, S: OdeSystem + ?Sized> {
     err_acc: f64,
     /// Switching functions at (t, y).
     g: Vec<f64>,
+    /// The last accepted step ended on or past a sign change of one.
+    switched: bool,
 }
 
 impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
@@ -414,6 +469,7 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
             h_acc: h,
             err_acc: 1e-2,
             g: vec![0.0; sys.switching_count()],
+            switched: false,
         };
         run.f0 = run.eval(t0, &run.y.clone());
         if !run.g.is_empty() {
@@ -495,7 +551,10 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
     }
 
     /// Advances until `t == target` exactly.
-    fn advance_to(&mut self, target: f64) -> Result<(), RadauError> {
+    /// With `stop_on_switch`, returns `false` after a step that ends on
+    /// (or just past) a sign change of a switching function before the
+    /// target, else `true` on reaching it.
+    fn advance_to(&mut self, target: f64, stop_on_switch: bool) -> Result<bool, RadauError> {
         while self.t < target {
             // Stretch by 0.01 % to land on the target rather than leave a
             // sliver (RADAU5 does the same at the end of the interval).
@@ -514,14 +573,20 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
             } else {
                 self.h = h_next;
             }
+            if stop_on_switch && self.switched && self.t < target {
+                return Ok(false);
+            }
         }
-        Ok(())
+        Ok(true)
     }
 
     /// One accepted step of size at most `h` (reduced after rejections);
     /// returns the step size taken and the proposed next one.
     fn step(&mut self, mut h: f64) -> Result<(f64, f64), RadauError> {
         let n = self.n;
+        // The step has been shortened to end on a sign change of a
+        // switching function (and not shortened further since).
+        let mut to_switch = false;
         let tab_c = self.tab.c;
         let tab_a = self.tab.a;
         loop {
@@ -641,6 +706,7 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
                 NewtonOutcome::Converged => {}
                 NewtonOutcome::TooSlow(hhfac) => {
                     h *= hhfac;
+                    to_switch = false;
                     self.reject = true;
                     self.refresh_after_failure();
                     continue;
@@ -650,6 +716,7 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
                         return Err(RadauError::NotFinite { t: self.t });
                     }
                     h *= 0.5;
+                    to_switch = false;
                     self.reject = true;
                     self.refresh_after_failure();
                     continue;
@@ -688,17 +755,20 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
                         self.stats.switches += 1;
                         h *= theta;
                         self.lu = None;
+                        to_switch = true;
                         continue;
                     }
                 }
                 self.h_acc = h;
                 self.err_acc = err.max(1e-2);
                 self.stats.accepted += 1;
-                let switched = self
-                    .g
-                    .iter()
-                    .zip(&g1)
-                    .any(|(a, b)| a * b < 0.0 || (*a != 0.0 && *b == 0.0));
+                // Ends on a sign change: past it, or shortened to it.
+                let switched = to_switch
+                    || self
+                        .g
+                        .iter()
+                        .zip(&g1)
+                        .any(|(a, b)| a * b < 0.0 || (*a != 0.0 && *b == 0.0));
                 self.g = g1;
                 self.cont = [d1, d2, d3];
                 self.h_old = h;
@@ -712,6 +782,7 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
                     // Past a kink: a fresh Jacobian for the next step.
                     self.theta = 1.0;
                 }
+                self.switched = switched;
                 h_new = h_new.min(self.h_max);
                 if self.reject {
                     h_new = h_new.min(h);
@@ -727,6 +798,7 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
             // Rejected.
             self.stats.rejected += 1;
             self.reject = true;
+            to_switch = false;
             if self.first {
                 h *= 0.1;
             } else {
@@ -772,10 +844,12 @@ impl<'a, S: OdeSystem + ?Sized> Run<'a, S> {
                 lo = mid;
             }
         }
-        // Too close to either end to be worth a separate step: a fraction
-        // 1e-6 of the step, or a thousand ulps of t.
-        let margin = (1e-6 * h).max(1e3 * f64::EPSILON * self.t.abs());
-        (hi * h > margin && (1.0 - hi) * h > margin).then_some(hi)
+        // Too close to an end to be worth a separate step: a thousand ulps
+        // of t from the end; from the start also a fraction 1e-6 of the
+        // step (the previous step was ended on this sign change, and the
+        // polynomial's root only just missed it).
+        let ulps = 1e3 * f64::EPSILON * self.t.abs().max(f64::MIN_POSITIVE);
+        (hi * h > ulps.max(1e-6 * h) && (1.0 - hi) * h > ulps).then_some(hi)
     }
 
     /// After a failed attempt: a fresh Jacobian if the current one is not,

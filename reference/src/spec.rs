@@ -106,7 +106,7 @@ pub(crate) fn known_model(model_name: &str) -> Option<(&'static ModelInfo, Box<d
 }
 
 /// Model names a reference can be built for.
-pub const SUPPORTED: [&str; 4] = ["Rig1D", "LuGre", "Dahl", "Bristle"];
+pub const SUPPORTED: [&str; 6] = ["Rig1D", "Rig2D", "LuGre", "Dahl", "Bristle", "Bristle2D"];
 
 /// A component recognised as one of our models: its parameter and input
 /// start values set as the FMU would hold them after initialisation, and an
@@ -130,7 +130,7 @@ impl Component {
         let name = &spec.name;
         let Some((info, mut model)) = known_model(&spec.model_name) else {
             return Err(MapError(format!(
-                "component `{name}`: model `{}` has no monolithic reference (supported: Rig1D with LuGre or Dahl; Rig1D with m = 0, c = 0 and Bristle)",
+                "component `{name}`: model `{}` has no monolithic reference (supported: Rig1D with LuGre or Dahl; Rig1D with m = 0, c = 0 and Bristle; Rig2D with Bristle2D)",
                 spec.model_name
             )));
         };

@@ -69,7 +69,25 @@ fn unsupported_models_and_counts_are_named() {
         ],
         connections: Vec::new(),
     };
-    assert_mentions(&refused(&two_laws), &["one Rig1D", "LuGre", "Dahl"]);
+    assert_mentions(
+        &refused(&two_laws),
+        &["one rig (Rig1D or Rig2D)", "LuGre", "Dahl"],
+    );
+    // A known rig with a law it has no reference with.
+    let mismatched = SystemSpec {
+        components: vec![
+            ComponentSpec::new("rig", "Rig2D"),
+            ComponentSpec::new("friction", "LuGre"),
+        ],
+        connections: Vec::new(),
+    };
+    assert_mentions(
+        &refused(&mismatched),
+        &[
+            "`friction` (LuGre) with Rig2D `rig`",
+            "Rig2D with Bristle2D",
+        ],
+    );
     // A foreign FMU that calls itself LuGre.
     let mut foreign = ComponentSpec::new("friction", "LuGre");
     foreign.guid = Some("{00000000-0000-0000-0000-000000000000}".into());

@@ -139,10 +139,19 @@ impl Bristle2D {
 
     /// `ż = v − [|z| ≥ z0 and z·v > 0]·(z·v)·z/|z|²` (MODELS.md, derived).
     pub fn z_dot(&self, v: [f64; 2]) -> [f64; 2] {
-        let zv = dot(self.z, v);
-        if self.on_boundary() && zv > 0.0 {
-            let c = zv / dot(self.z, self.z);
-            [v[0] - c * self.z[0], v[1] - c * self.z[1]]
+        self.z_rate(self.z, v, self.on_boundary())
+    }
+
+    /// The right-hand side for any deflection `z`, with the contact state
+    /// given: `ż = v − [on_boundary and z·v > 0]·(z·v)·z/|z|²` (MODELS.md,
+    /// derived from seed 004). A pure function, for integrating the law
+    /// with other equations (the monolithic reference solutions), which
+    /// track `on_boundary` as a mode rather than from `|z|`.
+    pub fn z_rate(&self, z: [f64; 2], v: [f64; 2], on_boundary: bool) -> [f64; 2] {
+        let zv = dot(z, v);
+        if on_boundary && zv > 0.0 {
+            let c = zv / dot(z, z);
+            [v[0] - c * z[0], v[1] - c * z[1]]
         } else {
             v
         }
@@ -151,9 +160,16 @@ impl Bristle2D {
     /// `Fi = (1 + ai(|z|))·σ0i·zi + σ1i(|v|)·żi` with `ai` only inside the
     /// disc and `σ1i(|v|) = σ1i·exp(−(|v|/av)²)`.
     pub fn force(&self, v: [f64; 2]) -> [f64; 2] {
+        self.force_of(self.z, v, self.on_boundary())
+    }
+
+    /// The output equation for any deflection `z` and contact state:
+    /// `Fi = (1 + [not on_boundary]·ai)·σ0i·zi + σ1i(|v|)·żi`, `ż` from
+    /// [`Bristle2D::z_rate`]. Pure, like it.
+    pub fn force_of(&self, z: [f64; 2], v: [f64; 2], on_boundary: bool) -> [f64; 2] {
         let p = &self.p;
-        let zd = self.z_dot(v);
-        let (g1, g2) = if self.on_boundary() {
+        let zd = self.z_rate(z, v, on_boundary);
+        let (g1, g2) = if on_boundary {
             (1.0, 1.0)
         } else {
             (1.0 + p.a1, 1.0 + p.a2)
@@ -165,8 +181,8 @@ impl Bristle2D {
             1.0
         };
         [
-            g1 * p.sigma01 * self.z[0] + p.sigma11 * damp * zd[0],
-            g2 * p.sigma02 * self.z[1] + p.sigma12 * damp * zd[1],
+            g1 * p.sigma01 * z[0] + p.sigma11 * damp * zd[0],
+            g2 * p.sigma02 * z[1] + p.sigma12 * damp * zd[1],
         ]
     }
 
@@ -637,5 +653,50 @@ mod tests {
         assert!(b.state_from_slice(&[0.0, f64::NAN]).is_err());
         b.set_z([1.0, 0.0]);
         assert_eq!(b.z(), [p.z0, 0.0]);
+    }
+
+    #[test]
+    fn pure_right_hand_side_matches_the_state_methods_and_the_exact_update() {
+        let p = Bristle2DParams {
+            sigma02: 8e3,
+            a2: 0.3,
+            ..Bristle2DParams::default()
+        };
+        let mut b = Bristle2D::new(p).unwrap();
+        let z0 = p.z0;
+        // Inside the disc, on its boundary slipping outward, and on it
+        // slipping back inward.
+        for &(z, v) in &[
+            ([3e-5, -2e-5], [1e-3, 4e-3]),
+            ([0.6 * z0, 0.8 * z0], [2e-3, 1e-3]),
+            ([0.6 * z0, 0.8 * z0], [-2e-3, -1e-3]),
+        ] {
+            b.set_z(z);
+            let on = b.on_boundary();
+            assert_eq!(b.z_rate(z, v, on), b.z_dot(v));
+            assert_eq!(b.force_of(z, v, on), b.force(v));
+            // The exact update over a tiny step moves z by ż·h.
+            let h = 1e-9;
+            let mut c = b.clone();
+            c.advance_constant(v, h);
+            let rate = b.z_rate(z, v, on);
+            for k in 0..2 {
+                let fd = (c.z()[k] - z[k]) / h;
+                assert!(
+                    (fd - rate[k]).abs() <= 1e-6 * v[0].hypot(v[1]),
+                    "{z:?} {v:?}"
+                );
+            }
+        }
+        // On the boundary the slip is tangential: z·ż = 0; the stiction
+        // gradient only acts inside.
+        let z = [0.6 * z0, 0.8 * z0];
+        let zd = b.z_rate(z, [2e-3, 1e-3], true);
+        assert!(dot(z, zd).abs() < 1e-20);
+        let v0 = [0.0, 0.0];
+        let inside = b.force_of(z, v0, false);
+        let boundary = b.force_of(z, v0, true);
+        assert!((inside[0] / boundary[0] - 1.1).abs() < 1e-12);
+        assert!((inside[1] / boundary[1] - 1.3).abs() < 1e-12);
     }
 }

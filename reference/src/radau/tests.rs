@@ -359,3 +359,55 @@ fn kinks_at_sign_changes_of_a_switching_function() {
     assert!(without > 1e-8, "{without:e}");
     assert_eq!(plain.switches, 0);
 }
+
+/// A ball dropped from 1 m (y'' = −g) bouncing with restitution e = 0.9:
+/// the integration stops at each impact (switching function y), the
+/// caller reverses the velocity and continues. Impact times in closed
+/// form: t1 = √(2/g), then flights of 2·e^k·v1/g, v1 = g·t1.
+#[test]
+fn solve_until_switch_stops_at_each_event_for_the_caller() {
+    struct Ball;
+    impl OdeSystem for Ball {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn rhs(&self, _t: f64, y: &[f64], d: &mut [f64]) {
+            d[0] = y[1];
+            d[1] = -9.81;
+        }
+        fn switching_count(&self) -> usize {
+            1
+        }
+        fn switching(&self, _t: f64, y: &[f64], g: &mut [f64]) {
+            g[0] = y[0];
+        }
+    }
+    let (g, e): (f64, f64) = (9.81, 0.9);
+    let t1 = (2.0 / g).sqrt();
+    let mut exact = vec![t1];
+    for k in 1..6 {
+        exact.push(exact[k - 1] + 2.0 * e.powi(k as i32) * g * t1 / g);
+    }
+    let t_out: Vec<f64> = (1..=60).map(|i| i as f64 * 0.1).collect();
+    let opts = RadauOptions::new(1e-10, 1e-10);
+    let (mut t, mut y) = (0.0, vec![1.0, 0.0]);
+    let mut impacts = Vec::new();
+    let mut outputs = 0;
+    while impacts.len() < 6 {
+        let rest: Vec<f64> = t_out.iter().copied().filter(|&s| s > t).collect();
+        let end = solve_until_switch(&Ball, t, &y, &rest, &opts, |_, yi| {
+            outputs += 1;
+            assert!(yi[0] > -1e-9);
+        })
+        .unwrap();
+        assert!(end.switched, "stopped at {} without an impact", end.t);
+        impacts.push(end.t);
+        (t, y) = (end.t, vec![0.0, -e * end.y[1]]);
+    }
+    for (k, (a, b)) in impacts.iter().zip(&exact).enumerate() {
+        // The flight is a parabola, which the collocation polynomial holds
+        // exactly: the impacts are exact to round-off (observed 4e-16 s).
+        assert!((a - b).abs() < 1e-12, "impact {k}: {a} vs {b}");
+    }
+    assert!(outputs > 30, "{outputs} outputs between the impacts");
+}
