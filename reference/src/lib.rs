@@ -48,8 +48,6 @@ use rig_friction::{DynamicLaw, PositionSource, RigWithFriction, VelocitySource};
 use spec::Component;
 pub use spec::{ComponentSpec, MapError, SystemSpec, Value};
 use std::fmt;
-use std::io::Write;
-use std::path::Path;
 
 /// The relative tolerance of the reference solutions (MODELS.md: "Radau
 /// IIA, rtol 1e-10").
@@ -68,25 +66,6 @@ impl Table {
     pub fn column(&self, name: &str) -> Option<Vec<f64>> {
         let k = self.columns.iter().position(|c| c == name)?;
         Some(self.rows.iter().map(|r| r[k]).collect())
-    }
-
-    /// CSV as `fricsim run` writes it: `time` first, then the columns;
-    /// numbers in Rust's shortest round-trip form, so they parse back
-    /// exactly.
-    pub fn write_csv(&self, path: &Path) -> std::io::Result<()> {
-        if let Some(dir) = path.parent() {
-            std::fs::create_dir_all(dir)?;
-        }
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-        writeln!(out, "time,{}", self.columns.join(","))?;
-        for (t, row) in self.time.iter().zip(&self.rows) {
-            write!(out, "{t:?}")?;
-            for x in row {
-                write!(out, ",{x:?}")?;
-            }
-            writeln!(out)?;
-        }
-        out.flush()
     }
 }
 

@@ -147,7 +147,7 @@ impl PlanarBristle {
             let end = radau::solve_until_switch(&mode, tau, &y, rest, &opts, |t, yi| {
                 out(t, yi, sliding)
             })?;
-            add(&mut stats, &end.stats);
+            stats.add(&end.stats);
             if !end.switched {
                 return Ok(stats);
             }
@@ -183,16 +183,6 @@ impl PlanarBristle {
         y[4] = z[0];
         y[5] = z[1];
     }
-}
-
-fn add(total: &mut RadauStats, s: &RadauStats) {
-    total.accepted += s.accepted;
-    total.rejected += s.rejected;
-    total.rhs_evaluations += s.rhs_evaluations;
-    total.jacobians += s.jacobians;
-    total.factorisations += s.factorisations;
-    total.newton_iterations += s.newton_iterations;
-    total.switches += s.switches;
 }
 
 /// The equations of one mode.

@@ -129,6 +129,19 @@ pub struct RadauStats {
     pub switches: usize,
 }
 
+impl RadauStats {
+    /// Adds the counts of another run (the segments of one solution).
+    pub fn add(&mut self, other: &RadauStats) {
+        self.accepted += other.accepted;
+        self.rejected += other.rejected;
+        self.rhs_evaluations += other.rhs_evaluations;
+        self.jacobians += other.jacobians;
+        self.factorisations += other.factorisations;
+        self.newton_iterations += other.newton_iterations;
+        self.switches += other.switches;
+    }
+}
+
 /// Why [`solve`] stopped.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RadauError {
@@ -262,21 +275,9 @@ pub fn solve_with<S: OdeSystem + ?Sized>(
     y0: &[f64],
     t_out: &[f64],
     opts: &RadauOptions,
-    mut out: impl FnMut(f64, &[f64]),
+    out: impl FnMut(f64, &[f64]),
 ) -> Result<RadauStats, RadauError> {
-    let n = sys.dim();
-    check_inputs(n, t0, y0, t_out, opts)?;
-    let t_end = *t_out.last().expect("checked non-empty");
-    let mut run = Run::new(sys, opts, t0, y0, t_end);
-    for &target in t_out {
-        if target == t0 {
-            out(t0, y0);
-            continue;
-        }
-        run.advance_to(target, false)?;
-        out(run.t, run.y.as_slice());
-    }
-    Ok(run.stats)
+    Ok(drive(sys, t0, y0, t_out, opts, out, false)?.stats)
 }
 
 /// Where [`solve_until_switch`] stopped.
@@ -300,10 +301,23 @@ pub fn solve_until_switch<S: OdeSystem + ?Sized>(
     y0: &[f64],
     t_out: &[f64],
     opts: &RadauOptions,
-    mut out: impl FnMut(f64, &[f64]),
+    out: impl FnMut(f64, &[f64]),
 ) -> Result<SegmentEnd, RadauError> {
-    let n = sys.dim();
-    check_inputs(n, t0, y0, t_out, opts)?;
+    drive(sys, t0, y0, t_out, opts, out, true)
+}
+
+/// Integrates through the output times, optionally stopping at the first
+/// step that ends on a switch.
+fn drive<S: OdeSystem + ?Sized>(
+    sys: &S,
+    t0: f64,
+    y0: &[f64],
+    t_out: &[f64],
+    opts: &RadauOptions,
+    mut out: impl FnMut(f64, &[f64]),
+    stop_on_switch: bool,
+) -> Result<SegmentEnd, RadauError> {
+    check_inputs(sys.dim(), t0, y0, t_out, opts)?;
     let t_end = *t_out.last().expect("checked non-empty");
     let mut run = Run::new(sys, opts, t0, y0, t_end);
     for &target in t_out {
@@ -311,23 +325,17 @@ pub fn solve_until_switch<S: OdeSystem + ?Sized>(
             out(t0, y0);
             continue;
         }
-        let reached = run.advance_to(target, true)?;
-        if reached {
+        if run.advance_to(target, stop_on_switch)? {
             out(run.t, run.y.as_slice());
         }
-        if run.switched {
-            return Ok(SegmentEnd {
-                t: run.t,
-                y: run.y.as_slice().to_vec(),
-                switched: true,
-                stats: run.stats,
-            });
+        if stop_on_switch && run.switched {
+            break;
         }
     }
     Ok(SegmentEnd {
         t: run.t,
         y: run.y.as_slice().to_vec(),
-        switched: false,
+        switched: stop_on_switch && run.switched,
         stats: run.stats,
     })
 }

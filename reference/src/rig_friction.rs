@@ -234,7 +234,7 @@ impl RigWithFriction {
                 k += 1;
                 last.copy_from_slice(yi);
             })?;
-            add(&mut stats, &s);
+            stats.add(&s);
             y = last;
             tau0 = if cut.is_finite() { cut } else { tau_end };
             rest = tail;
@@ -244,16 +244,6 @@ impl RigWithFriction {
         }
         Ok(stats)
     }
-}
-
-fn add(total: &mut RadauStats, s: &RadauStats) {
-    total.accepted += s.accepted;
-    total.rejected += s.rejected;
-    total.rhs_evaluations += s.rhs_evaluations;
-    total.jacobians += s.jacobians;
-    total.factorisations += s.factorisations;
-    total.newton_iterations += s.newton_iterations;
-    total.switches += s.switches;
 }
 
 impl RigWithFriction {

@@ -11,7 +11,7 @@
 //! from the file's bindings. Systems without a monolithic model are refused
 //! with a message naming the component or connection.
 
-use fricsim::master::step_count;
+use fricsim::master::{step_count, Run};
 use fricsim::ssp::{SystemFile, Value as SspValue};
 use fricsim_reference::{ComponentSpec, ReferenceModel, SystemSpec, Table, Value, RTOL};
 use std::path::PathBuf;
@@ -143,9 +143,14 @@ pub fn run(a: &ReferenceArgs) -> Result<(), String> {
             .unwrap_or_else(|| "system".to_string());
         PathBuf::from("out").join(format!("{stem}_reference.csv"))
     });
-    table
-        .write_csv(&out)
-        .map_err(|e| format!("{}: {e}", out.display()))?;
+    let run = Run {
+        columns: table.columns.clone(),
+        time: table.time.clone(),
+        rows: table.rows.clone(),
+        error: None,
+    };
+    // The writer of `fricsim run`: the same format to the digit.
+    fricsim::results::write_csv(&run, &out).map_err(|e| format!("{}: {e}", out.display()))?;
 
     println!("{}: {}", file.ssd, model.description());
     print!(
