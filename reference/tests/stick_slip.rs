@@ -12,15 +12,18 @@ use friction_laws::Ramp;
 /// The 1995 benchmark rig (m = 1 kg, k = 2 N/m, pulled at 0.1 m/s) with
 /// `law` as component `friction`, connected as in examples/stick_slip.ssd.
 fn system(law: ComponentSpec) -> SystemSpec {
+    let rig = ComponentSpec::new("rig", "Rig1D")
+        .real("m", 1.0)
+        .real("k", 2.0)
+        .real("c", 0.0)
+        .real("v_a", 0.1);
+    coupled(rig, law)
+}
+
+/// `rig` and `law` connected `rig.v → friction.v`, `friction.F → rig.F`.
+fn coupled(rig: ComponentSpec, law: ComponentSpec) -> SystemSpec {
     SystemSpec {
-        components: vec![
-            ComponentSpec::new("rig", "Rig1D")
-                .real("m", 1.0)
-                .real("k", 2.0)
-                .real("c", 0.0)
-                .real("v_a", 0.1),
-            law,
-        ],
+        components: vec![rig, law],
         connections: Vec::new(),
     }
     .connect("rig.v", "friction.v")
@@ -206,4 +209,62 @@ fn recorded_inputs_and_parameters_follow_the_outputs_they_are_connected_to() {
     assert_eq!(col(&t, "friction.v"), col(&t, "rig.v"));
     assert_eq!(col(&t, "rig.F"), col(&t, "friction.F"));
     assert!(col(&t, "friction.sigma0").iter().all(|&s| s == 1e5));
+}
+
+#[test]
+fn lugre_pre_sliding_settles_with_the_bristles_at_f_over_sigma0() {
+    // MODELS.md: with seed 001's parameters a step force below break-away
+    // settles at x = F/σ0 (14.9 µm at 1 N). At rest the LuGre force is
+    // σ0·z, so the bristle deflection z settles at F/σ0 exactly; the
+    // body's x equals it only while F ≪ Fs: on the way, ż = v − σ0·|v|·z/g
+    // lags x, and at 1 N (Fs = 2.35 N) the body settles at 21.5 µm. The
+    // step comes at t = 0.05 s, inside the run: the integration restarts
+    // there, so the jump is taken exactly.
+    let sigma0 = 66_967.231;
+    let settle = |force: f64| {
+        let rig = ComponentSpec::new("rig", "Rig1D")
+            .real("m", 1.0)
+            .real("k", 0.0)
+            .real("c", 0.0)
+            .real("v_a", 0.0)
+            .real("F_step", force)
+            .real("t_step", 0.05);
+        let law = ComponentSpec::new("friction", "LuGre")
+            .real("sigma0", sigma0)
+            .real("sigma1", 2.0 * f64::sqrt(sigma0) - 173.0)
+            .real("sigma2", 173.0)
+            .real("Fc", 1.284)
+            .real("Fs", 2.35)
+            .real("vs", 1.139_75e-3);
+        let t = run(&coupled(rig, law), 1e-3, 0.5, RTOL);
+        let (x, z, drive) = (
+            col(&t, "rig.x"),
+            col(&t, "friction.z"),
+            col(&t, "rig.F_drive"),
+        );
+        let before = (0.05f64 / 1e-3).round() as usize - 1;
+        assert_eq!(
+            (x[before], drive[before], drive[before + 1]),
+            (0.0, 0.0, force)
+        );
+        let last = x.len() - 1;
+        assert!(
+            (z[last] - force / sigma0).abs() < 1e-6 * force / sigma0,
+            "{}",
+            z[last]
+        );
+        assert!(col(&t, "rig.v")[last].abs() < 1e-9);
+        x[last]
+    };
+    // Small force: x = F/σ0 to 0.3 % (the lag is a factor 1 + F/(2·Fs)).
+    let small = settle(0.01);
+    assert!((small * sigma0 / 0.01 - 1.0).abs() < 3e-3, "{small}");
+    // 1 N: well beyond 14.9 µm (observed 21.5 µm).
+    let one = settle(1.0);
+    eprintln!(
+        small,
+        small * sigma0 / 0.01,
+        one
+    );
+    assert!(one > 1.3 / sigma0 && one < 1.6 / sigma0, "{one}");
 }
