@@ -94,10 +94,12 @@ fn draw<DB: DrawingBackend>(
             .x_label_area_size(35)
             .y_label_area_size(70)
             .build_cartesian_2d(t0..t1.max(t0 + 1e-12), (lo - pad)..(hi + pad))?;
+        let (a, b) = (lo - pad, hi + pad);
         chart
             .configure_mesh()
             .x_desc("time [s]")
             .y_desc(*name)
+            .y_label_formatter(&|y| tick_label(*y, a, b))
             .draw()?;
         chart.draw_series(LineSeries::new(
             run.time.iter().copied().zip(ys.iter().copied()),
@@ -105,4 +107,50 @@ fn draw<DB: DrawingBackend>(
         ))?;
     }
     Ok(())
+}
+
+/// A y-axis tick label that tells the ticks of the range `lo..hi` apart at
+/// any scale (plotters' default prints `0.0` for every tick of a signal in
+/// micrometres): decimals for magnitudes from 1e-3 to 1e5, scientific
+/// notation otherwise, with digits down to a twentieth of the range.
+fn tick_label(y: f64, lo: f64, hi: f64) -> String {
+    if y == 0.0 || !y.is_finite() {
+        return format!("{y}");
+    }
+    let magnitude = lo.abs().max(hi.abs());
+    let resolution = ((hi - lo).abs() / 20.0).max(magnitude * 1e-12);
+    if !(magnitude.is_finite() && resolution > 0.0) {
+        return format!("{y}");
+    }
+    let finest = resolution.log10().floor() as i32;
+    if (1e-3..1e5).contains(&magnitude) {
+        format!("{:.*}", (-finest).max(0) as usize, y)
+    } else {
+        let leading = y.abs().log10().floor() as i32;
+        format!("{:.*e}", (leading - finest).clamp(0, 12) as usize, y)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick_label;
+
+    #[test]
+    fn tick_labels_resolve_micrometres_and_newtons() {
+        // a body position in micrometres: distinct, readable labels
+        let labels: Vec<String> = (0..=6)
+            .map(|i| tick_label(i as f64 * 1e-7, 0.0, 6e-7))
+            .collect();
+        assert_eq!(
+            labels,
+            ["0", "1.0e-7", "2.0e-7", "3.0e-7", "4.0e-7", "5.0e-7", "6.0e-7"]
+        );
+        // a narrow range far from zero keeps the digits that differ
+        assert_eq!(tick_label(5.7937e-7, 5.7936e-7, 5.794e-7), "5.79370e-7");
+        // forces in newtons and large values
+        assert_eq!(tick_label(0.15, -0.22, 0.22), "0.15");
+        assert_eq!(tick_label(2.5, 0.0, 10.0), "2.5");
+        assert_eq!(tick_label(250000.0, 0.0, 1e6), "2.5e5");
+        assert_eq!(tick_label(f64::NAN, 0.0, 1.0), "NaN");
+    }
 }
