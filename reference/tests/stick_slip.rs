@@ -261,10 +261,5 @@ fn lugre_pre_sliding_settles_with_the_bristles_at_f_over_sigma0() {
     assert!((small * sigma0 / 0.01 - 1.0).abs() < 3e-3, "{small}");
     // 1 N: well beyond 14.9 µm (observed 21.5 µm).
     let one = settle(1.0);
-    eprintln!(
-        small,
-        small * sigma0 / 0.01,
-        one
-    );
     assert!(one > 1.3 / sigma0 && one < 1.6 / sigma0, "{one}");
 }
