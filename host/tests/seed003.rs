@@ -35,9 +35,12 @@ const TABLE_POINTS: usize = 32;
 /// The measured travel, mm.
 const TRAVEL: f64 = 270.0;
 
-/// The measured break-away inputs (position mm, volts) for the positive
-/// and the negative direction, in the file's order (increasing position).
-fn measured() -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+/// Measured break-away inputs of one direction: (position mm, volts).
+type Profile = Vec<(f64, f64)>;
+
+/// The measured break-away inputs for the positive and the negative
+/// direction, in the file's order (increasing position).
+fn measured() -> (Profile, Profile) {
     let path = repository().join("examples/data/slider_stiction_by_position.csv");
     let text = std::fs::read_to_string(&path).unwrap();
     let mut lines = text.lines();
