@@ -295,3 +295,34 @@ fn relaxation_grows_with_the_pre_sliding_displacement() {
         "least-squares slope: {all:.3} over all releases, {late_slope:.3} for displacements ≥ δmax/2 (seed, measured: ≈ 0.30)"
     );
 }
+
+#[test]
+#[ignore = "known failure: newton does not find the relaxed position after a release at 20, 21 and 22 s (see relaxation_grows_with_the_pre_sliding_displacement)"]
+fn newton_finds_the_relaxed_position_after_every_pre_sliding_release() {
+    // The co-simulated counterpart of the reference scan above: the same
+    // releases through the host with the newton master. The root lies
+    // about 1.1e-8 m behind the turning point, on the backward branch of
+    // stiffness σ_ini; the first Newton step uses the forward stiffness
+    // n_c·σb at the turning point (47 bristles at 20 s) and goes about
+    // 3e-8 m back. At 20, 21 and 22 s the iteration does not recover: the
+    // last iterate reported has the bristle in reverse sliding (F =
+    // −μc·m·g) with an input force of 7.3e-3 N, and halving the step does
+    // not help, since the jump of the load does not shrink with the step.
+    let push = example("seed000_piezo_push.ssd");
+    let h = settings(&push).0;
+    let pushed = run(&push);
+    let f_push = column(&pushed, "friction.F");
+    for second in 1..=22 {
+        let t = f64::from(second);
+        let i = index(t, h);
+        let mut file = example("seed000_relaxation.ssd");
+        set_real(&mut file, "rig.t_step", t);
+        set_real(&mut file, "rig.F_step", -f_push[i]);
+        // run_with requires the run to complete.
+        let run = run_with(&file, "newton", h, t + 2.0 * h);
+        let (x, f) = (column(&run, "rig.x"), column(&run, "friction.F"));
+        assert!(x[i] < x[i - 1], "release at {t} s: not pulled back");
+        let (_, s) = zero_load_position(&x, &f, i);
+        assert!((s / sigma_ini() - 1.0).abs() < 1e-4, "release at {t} s");
+    }
+}
