@@ -29,6 +29,7 @@ pub mod fmu;
 pub mod inputs;
 pub mod master;
 pub mod plot;
+pub mod reference;
 pub mod results;
 pub mod ssp;
 pub mod system;
