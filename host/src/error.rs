@@ -173,15 +173,30 @@ pub enum FmuError {
         what: &'static str,
     },
 
-    #[error("strong coupling did not converge at t = {time} (step {step}) after {iterations} iterations: {connection} still differs by {mismatch:e} (input {input:e}, output {output:e})")]
+    #[error("strong coupling did not converge at t = {time} (step {step}) after {iterations} iterations: {connection} still differs by {mismatch:e} (input {input:e}, output {output:e}; tolerance {tolerance:e}, scaled residual norm {residual:e}); the step is not accepted")]
     NotConverged {
         time: f64,
         step: f64,
         iterations: usize,
+        /// The connection with the largest mismatch relative to its tolerance.
         connection: String,
+        /// `|U_k − Y_k|` of that connection.
         mismatch: f64,
         input: f64,
         output: f64,
+        /// Its tolerance `atol·nominal + rtol·max(|U_k|, |Y_k|)`.
+        tolerance: f64,
+        /// Euclidean norm over all connections of `|U_k − Y_k| / tolerance_k`.
+        residual: f64,
+    },
+
+    #[error("{master} cannot run instance \"{instance}\" (model {model}): its FMU does not declare {capability}, which {master} needs: {reason}")]
+    MissingCapability {
+        master: &'static str,
+        instance: String,
+        model: String,
+        capability: &'static str,
+        reason: &'static str,
     },
 
     #[error("{what} must not contain a NUL character: {value:?}")]

@@ -223,9 +223,19 @@ fn not_converged_is_an_error_with_the_values() {
         mismatch: 2.0,
         input: 1.0,
         output: 3.0,
+        tolerance: 3e-8,
+        residual: 7.5e7,
     };
     let text = e.to_string();
-    for part in ["t = 0.5", "30 iterations", "a.y -> b.u", "2e0"] {
+    for part in [
+        "t = 0.5",
+        "30 iterations",
+        "a.y -> b.u",
+        "2e0",
+        "tolerance 3e-8",
+        "7.5e7",
+        "not accepted",
+    ] {
         assert!(text.contains(part), "{text}");
     }
 }
@@ -275,4 +285,55 @@ fn adaptive_steps_meet_the_benchmark_on_a_coarse_output_grid() {
         errors[1] < errors[0],
         "tighter tolerance, larger error: {errors:?}"
     );
+}
+
+/// Relative RMS error of `friction.F` of `master` on the system file
+/// against its monolithic reference, at macro step `h` up to `stop`.
+fn error_against_reference(file: &Path, master: &str, h: f64, stop: f64) -> f64 {
+    use fricsim::ssp::SystemFile;
+    use fricsim_reference::{ReferenceModel, RTOL};
+    let file = SystemFile::open(file).unwrap();
+    let n = fricsim::master::step_count(0.0, h, stop);
+    let times: Vec<f64> = (0..=n).map(|i| i as f64 * h).collect();
+    let mut model = ReferenceModel::from_spec(&fricsim::reference::spec(&file).unwrap()).unwrap();
+    let (table, _) = model.solve(0.0, &times, RTOL).unwrap();
+    let reference = table.column("friction.F").unwrap();
+    let mut system = file.build(0.0).unwrap();
+    let mut algorithm = fricsim::master::by_name(master).unwrap();
+    let run = simulate(&mut system, algorithm.as_mut(), h, stop).unwrap();
+    assert!(run.error.is_none(), "{master}, h = {h}: {:?}", run.error);
+    let result = column(&run, "friction.F");
+    assert_eq!(result.len(), reference.len());
+    let (mut diff, mut norm) = (0.0, 0.0);
+    for (y, r) in result.iter().zip(&reference) {
+        diff += (y - r) * (y - r);
+        norm += r * r;
+    }
+    (diff / norm).sqrt()
+}
+
+#[test]
+fn interpolated_inputs_make_strong_coupling_second_order_on_the_stiff_contact() {
+    // σ0 = 1e7 N/m (period 2 ms on the 1 kg mass), through the first slip
+    // and the stick after it (10.3 s). Holding U over the step is first
+    // order in h: the error falls about tenfold from 1e-3 to 1e-4 s; a ramp
+    // from the value at t to U is second order, about a hundredfold.
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/stick_slip_sigma1e7.ssd");
+    let e = |master: &str, h: f64| error_against_reference(&file, master, h, 12.0);
+    let (hold_coarse, hold_fine) = (e("newton", 1e-3), e("newton", 1e-4));
+    let (ramp_coarse, ramp_fine) = (
+        e("newton-interpolated", 1e-3),
+        e("newton-interpolated", 1e-4),
+    );
+    let hold_order = (hold_coarse / hold_fine).log10();
+    let ramp_order = (ramp_coarse / ramp_fine).log10();
+    assert!(
+        (0.5..1.5).contains(&hold_order),
+        "hold: {hold_coarse:e} → {hold_fine:e}, order {hold_order:.2}"
+    );
+    assert!(
+        ramp_order > 1.6,
+        "ramp: {ramp_coarse:e} → {ramp_fine:e}, order {ramp_order:.2}"
+    );
+    assert!(ramp_coarse < 1e-2 && ramp_coarse < 0.5 * hold_coarse);
 }

@@ -17,7 +17,9 @@ pub struct CosimArgs {
     #[arg(long = "connect")]
     pub connections: Vec<String>,
     /// Master algorithm: jacobi, gauss-seidel, gauss-seidel-interpolated,
-    /// newton (strong coupling), fixed-point (strong coupling, for comparison).
+    /// newton (strong coupling), newton-interpolated (strong coupling, inputs
+    /// ramped over the step), adaptive (strong coupling, adaptive macro
+    /// steps), fixed-point (strong coupling, for comparison).
     #[arg(long, default_value = "jacobi")]
     pub master: String,
     /// Macro step in seconds.

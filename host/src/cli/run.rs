@@ -27,7 +27,8 @@ pub struct RunArgs {
     #[arg(long)]
     pub step: Option<f64>,
     /// Master algorithm: jacobi, gauss-seidel, gauss-seidel-interpolated,
-    /// newton, fixed-point [default: the file's annotation, else jacobi].
+    /// newton, newton-interpolated, adaptive, fixed-point [default: the
+    /// file's annotation, else jacobi].
     #[arg(long)]
     pub master: Option<String>,
     /// Result CSV [default: out/<file name>.csv].

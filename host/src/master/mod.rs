@@ -23,6 +23,7 @@ pub const NAMES: &[&str] = &[
     "gauss-seidel",
     "gauss-seidel-interpolated",
     "newton",
+    "newton-interpolated",
     "fixed-point",
     "adaptive",
 ];
@@ -35,6 +36,11 @@ pub fn by_name(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
         "gauss-seidel" => Box::new(gauss_seidel::GaussSeidel::new(false)),
         "gauss-seidel-interpolated" => Box::new(gauss_seidel::GaussSeidel::new(true)),
         "newton" => Box::new(StrongCoupling::new(Update::Newton, JacobianSource::Auto)),
+        "newton-interpolated" => {
+            let mut master = StrongCoupling::new(Update::Newton, JacobianSource::Auto);
+            master.interpolate = true;
+            Box::new(master)
+        }
         "adaptive" => {
             let mut master = StrongCoupling::new(Update::Newton, JacobianSource::Auto);
             master.step_control = Some(strong::StepControl {

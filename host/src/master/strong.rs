@@ -27,8 +27,20 @@
 //! * **Fixed point**: `U ← Y(U)` (Gauss–Jacobi waveform iteration), kept for
 //!   comparison: it diverges when the loop gain |∂Y/∂U| exceeds one.
 //!
+//! * **Interpolated inputs** ([`StrongCoupling::interpolate`]): each input
+//!   ramps linearly over the step from its value at `t` to `U`
+//!   (`fmi2SetRealInputDerivatives`) instead of holding `U`: the interface
+//!   analogue of the trapezoidal rule, second order in h where the hold is
+//!   first order. The FMU's directional derivative is the sensitivity to a
+//!   held input, not to the end of a ramp, so these components are
+//!   differenced.
+//!
 //! Between iterations every component is restored to its state at `t`
-//! (`fmi2GetFMUstate` / `fmi2SetFMUstate`). A step converges when
+//! (`fmi2GetFMUstate` / `fmi2SetFMUstate`): every FMU must declare
+//! `canGetAndSetFMUstate`, and the first step refuses, naming the instance,
+//! before anything is stepped. An FMU without directional derivatives is
+//! differenced. A step that does not converge is an error carrying the
+//! residual ([`FmuError::NotConverged`]), never accepted. A step converges when
 //! `|R_k| ≤ atol_k + rtol·max(|U_k|, |Y_k|)` for every connection, with
 //! `atol_k = atol·nominal_k` from the input variable's nominal (default 1).
 
@@ -154,6 +166,11 @@ struct Ports {
     output_vrs: Vec<ValueReference>,
     /// Directional derivatives trusted (Auto: decided at the first check).
     directional: Option<bool>,
+    /// Why the component is differenced, when that is decided up front.
+    differenced: &'static str,
+    /// Inputs ramp linearly over the step from their value at `t` to `U`
+    /// (`fmi2SetRealInputDerivatives`) instead of holding `U`.
+    ramped: bool,
 }
 
 pub struct StrongCoupling {
@@ -164,6 +181,11 @@ pub struct StrongCoupling {
     pub max_iterations: usize,
     /// How many times a macro step may be halved when Newton fails.
     pub max_splits: usize,
+    /// Ramp the inputs over the step from their values at `t` to `U`
+    /// where the receiving FMU can interpolate inputs (second order in h,
+    /// like the trapezoidal rule) instead of holding `U` (first order,
+    /// like implicit Euler).
+    pub interpolate: bool,
     /// Whether every FMU accepts varying step sizes (else no halving).
     variable_steps: bool,
     /// U at the start of the step being solved (restored on a split).
@@ -194,6 +216,7 @@ impl StrongCoupling {
             atol: 1e-10,
             max_iterations: 50,
             max_splits: 10,
+            interpolate: false,
             variable_steps: false,
             accepted: Vec::new(),
             step_control: None,
@@ -217,13 +240,80 @@ impl StrongCoupling {
         &self.report
     }
 
-    fn prepare(&mut self, system: &System) {
+    /// What every component must offer, checked at the first step before
+    /// anything is stepped: the error names the instance and the capability.
+    fn check_capabilities(&self, system: &System) -> Result<(), FmuError> {
+        let refuse = |c: usize, capability, reason| {
+            let component = &system.components[c];
+            Err(FmuError::MissingCapability {
+                master: self.name(),
+                instance: component.name.clone(),
+                model: component.fmu.description().model_name.clone(),
+                capability,
+                reason,
+            })
+        };
+        if system.connections.is_empty() {
+            return Ok(()); // nothing to iterate: every step is taken once
+        }
+        for (c, component) in system.components.iter().enumerate() {
+            let cs = &component.fmu.description().co_simulation;
+            if !cs.can_get_and_set_fmu_state {
+                return refuse(
+                    c,
+                    "canGetAndSetFMUstate=\"true\"",
+                    "every macro step is iterated from the state at its start (fmi2GetFMUstate / fmi2SetFMUstate); jacobi or gauss-seidel need no rollback",
+                );
+            }
+            if self.step_control.is_some() && !cs.can_handle_variable_communication_step_size {
+                return refuse(
+                    c,
+                    "canHandleVariableCommunicationStepSize=\"true\"",
+                    "adaptive macro steps change the step size; newton keeps it fixed",
+                );
+            }
+            let has_loop_inputs = system.connections.iter().any(|k| k.to.0 == c)
+                && system.connections.iter().any(|k| k.from.0 == c);
+            if self.update == Update::Newton
+                && self.jacobian == JacobianSource::Directional
+                && has_loop_inputs
+                && !cs.provides_directional_derivative
+            {
+                return refuse(
+                    c,
+                    "providesDirectionalDerivative=\"true\"",
+                    "its Jacobian was asked for from fmi2GetDirectionalDerivative; the automatic choice differences it instead",
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn prepare(&mut self, system: &System) -> Result<(), FmuError> {
+        self.check_capabilities(system)?;
         let n = system.connections.len();
         self.ports = (0..system.components.len())
             .map(|c| {
+                let cs = &system.components[c].fmu.description().co_simulation;
                 let outputs: Vec<usize> = (0..n)
                     .filter(|&k| system.connections[k].from.0 == c)
                     .collect();
+                let ramped = self.interpolate && cs.can_interpolate_inputs;
+                let (directional, differenced) = match self.jacobian {
+                    _ if ramped => (
+                        Some(false),
+                        "finite differences (rollback): its inputs ramp over the step, and fmi2GetDirectionalDerivative gives the sensitivity to held inputs",
+                    ),
+                    JacobianSource::Directional => (Some(true), ""),
+                    JacobianSource::FiniteDifference => {
+                        (Some(false), "finite differences (rollback)")
+                    }
+                    JacobianSource::Auto if cs.provides_directional_derivative => (None, ""),
+                    JacobianSource::Auto => (
+                        Some(false),
+                        "finite differences (rollback): the FMU does not provide directional derivatives (providesDirectionalDerivative=\"false\")",
+                    ),
+                };
                 Ports {
                     inputs: (0..n)
                         .filter(|&k| system.connections[k].to.0 == c)
@@ -233,22 +323,9 @@ impl StrongCoupling {
                         .map(|&k| system.connections[k].from.1)
                         .collect(),
                     outputs,
-                    directional: match self.jacobian {
-                        JacobianSource::Directional => Some(true),
-                        JacobianSource::FiniteDifference => Some(false),
-                        JacobianSource::Auto => {
-                            if system.components[c]
-                                .fmu
-                                .description()
-                                .co_simulation
-                                .provides_directional_derivative
-                            {
-                                None
-                            } else {
-                                Some(false)
-                            }
-                        }
-                    },
+                    directional,
+                    differenced,
+                    ramped,
                 }
             })
             .collect();
@@ -284,6 +361,7 @@ impl StrongCoupling {
             .iter()
             .map(|c| (c.name.clone(), "not needed"))
             .collect();
+        Ok(())
     }
 
     fn save_states(&mut self, system: &mut System) -> Result<(), FmuError> {
@@ -304,11 +382,26 @@ impl StrongCoupling {
         Ok(())
     }
 
-    /// Set the inputs of component `c` from `u` (one value per connection).
-    fn set_inputs(system: &mut System, ports: &Ports, u: &[f64]) -> Result<(), FmuError> {
-        for &k in &ports.inputs {
+    /// Set the inputs `inputs` (connection indices) of one component from
+    /// `u` (one value per connection): held, or `ramped` from `start` at
+    /// `t` to `u` at `t + h`.
+    fn set_inputs(
+        system: &mut System,
+        inputs: &[usize],
+        ramped: bool,
+        u: &[f64],
+        start: &[f64],
+        h: f64,
+    ) -> Result<(), FmuError> {
+        for &k in inputs {
             let (comp, vr) = system.connections[k].to;
-            system.components[comp].instance.set_real(&[vr], &[u[k]])?;
+            let instance = &mut system.components[comp].instance;
+            if ramped {
+                instance.set_real(&[vr], &[start[k]])?;
+                instance.set_real_input_derivatives(&[vr], &[1], &[(u[k] - start[k]) / h])?;
+            } else {
+                instance.set_real(&[vr], &[u[k]])?;
+            }
         }
         Ok(())
     }
@@ -346,12 +439,8 @@ impl StrongCoupling {
                 self.restore(system, c)?;
                 let mut perturbed = self.u.clone();
                 perturbed[j] += delta;
-                for &k in &ports {
-                    let (comp, vr) = system.connections[k].to;
-                    system.components[comp]
-                        .instance
-                        .set_real(&[vr], &[perturbed[k]])?;
-                }
+                let ramped = self.ports[c].ramped;
+                Self::set_inputs(system, &ports, ramped, &perturbed, &self.accepted, h)?;
                 system.components[c].instance.do_step(t, h)?;
                 self.report.difference_steps += 1;
                 self.column.clone_from(&self.y);
@@ -429,7 +518,7 @@ impl StrongCoupling {
                 Some(false) => {
                     self.difference_columns(system, c, t, h, &mut jac)?;
                     if self.report.jacobian_of[c].1 == "not needed" {
-                        self.report.jacobian_of[c].1 = "finite differences (rollback)";
+                        self.report.jacobian_of[c].1 = self.ports[c].differenced;
                     }
                 }
                 None => {
@@ -464,15 +553,17 @@ impl StrongCoupling {
 
 impl MasterAlgorithm for StrongCoupling {
     fn name(&self) -> &'static str {
-        match self.update {
-            Update::Newton => "strong coupling (Newton)",
-            Update::FixedPoint => "strong coupling (fixed point)",
+        match (self.update, self.interpolate) {
+            (Update::Newton, false) => "strong coupling (Newton)",
+            (Update::Newton, true) => "strong coupling (Newton, interpolated inputs)",
+            (Update::FixedPoint, false) => "strong coupling (fixed point)",
+            (Update::FixedPoint, true) => "strong coupling (fixed point, interpolated inputs)",
         }
     }
 
     fn step(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
         if self.ports.len() != system.components.len() {
-            self.prepare(system);
+            self.prepare(system)?;
         }
         match self.step_control {
             Some(control) if !system.connections.is_empty() => {
@@ -507,6 +598,8 @@ impl StrongCoupling {
                 mismatch: f64::NAN,
                 input: f64::NAN,
                 output: f64::NAN,
+                tolerance: f64::NAN,
+                residual: f64::NAN,
             });
         }
         let end = t + big_h;
@@ -571,10 +664,10 @@ impl StrongCoupling {
     /// nanoseconds.
     fn hold_error(&mut self, start: &[f64], control: StepControl) -> f64 {
         let mut worst: f64 = 0.0;
-        for k in 0..self.u.len() {
-            self.range[k] = self.range[k].max(self.u[k].abs()).max(start[k].abs());
+        for (k, &u0) in start.iter().enumerate() {
+            self.range[k] = self.range[k].max(self.u[k].abs()).max(u0.abs());
             let tolerance = control.atol * self.nominal[k] + control.rtol * self.range[k];
-            let error = 0.5 * (self.u[k] - start[k]).abs() / tolerance;
+            let error = 0.5 * (self.u[k] - u0).abs() / tolerance;
             if error.is_nan() || error > worst {
                 worst = error;
             }
@@ -651,12 +744,21 @@ impl StrongCoupling {
         let mut direction = vec![0.0; n];
         let mut lambda = 1.0;
         let mut worst = (f64::INFINITY, 0);
+        let mut last_norm = f64::INFINITY;
         for iteration in 1..=self.max_iterations {
             for c in 0..system.components.len() {
                 if iteration > 1 {
                     self.restore(system, c)?;
                 }
-                Self::set_inputs(system, &self.ports[c], &self.u)?;
+                let ports = &self.ports[c];
+                Self::set_inputs(
+                    system,
+                    &ports.inputs,
+                    ports.ramped,
+                    &self.u,
+                    &self.accepted,
+                    h,
+                )?;
             }
             for c in &mut system.components {
                 c.instance.do_step(t, h)?;
@@ -676,6 +778,7 @@ impl StrongCoupling {
                 }
             }
             let norm = norm.sqrt();
+            last_norm = norm;
             if worst.0 <= 1.0 {
                 self.report.steps += 1;
                 self.report.iterations += iteration;
@@ -740,6 +843,9 @@ impl StrongCoupling {
             mismatch: (self.u[k] - self.y[k]).abs(),
             input: self.u[k],
             output: self.y[k],
+            tolerance: self.atol * self.nominal[k]
+                + self.rtol * self.u[k].abs().max(self.y[k].abs()),
+            residual: last_norm,
         })
     }
 }
