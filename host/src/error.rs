@@ -190,7 +190,7 @@ pub enum FmuError {
         residual: f64,
     },
 
-    #[error("{master} cannot run instance \"{instance}\" (model {model}): its FMU does not declare {capability}, which {master} needs: {reason}")]
+    #[error("{master} cannot run instance \"{instance}\" (model {model}): its FMU does not declare {capability}: {reason}")]
     MissingCapability {
         master: &'static str,
         instance: String,
