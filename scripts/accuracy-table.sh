@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# BENCHMARKS.md's accuracy table: relative RMS error of the friction force
+# against the monolithic reference (fricsim reference) for the stick-slip
+# benchmark at sigma0 = 1e5 and 1e7 N/m and seed 000's piezo push, at macro
+# steps 1e-5 ... 1e-2 s, for jacobi, gauss-seidel, newton,
+# newton-interpolated and adaptive, with the wall time of every run.
+#
+# Builds the FMUs and the examples' archives (build-fmu.sh) and the
+# accuracy-table program (host/src/bin/accuracy_table.rs), then runs it;
+# the tables are written between the markers of BENCHMARKS.md. Arguments
+# go to the program: --quick (1e-3 s only, 2 s per case), --steps,
+# --stop, --masters, --cases, --update OTHER.md; --help lists them.
+# The full table takes a few minutes; run it on an otherwise idle machine,
+# since the wall times are part of it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./build-fmu.sh >/dev/null
+cargo build --release -p fricsim --bin accuracy-table
+args=("$@")
+case " $* " in
+    *" --update "*|*" --update="*) ;;
+    *) args+=(--update BENCHMARKS.md) ;;
+esac
+ACCURACY_TABLE_COMMAND="scripts/accuracy-table.sh${*:+ $*}" \
+    exec target/release/accuracy-table "${args[@]}"
