@@ -130,6 +130,10 @@ struct Cell {
     outcome: Outcome,
     /// Wall time of the co-simulation (initialization and stepping), s.
     wall: f64,
+    /// Total variation of the friction force over the reference's (NaN
+    /// for a failed run): printed with the progress, to see how far from
+    /// [`UNSTABLE_VARIATION`] a run is.
+    variation: f64,
 }
 
 struct Row {
@@ -269,10 +273,11 @@ fn run_row(
     for name in masters {
         let cell = run_cell(file, name, start, step, stop, &reference)?;
         eprintln!(
-            "{}, h = {step:e} s, {name}: {} in {:.2} s",
+            "{}, h = {step:e} s, {name}: {} in {:.2} s (variation {:.3} times the reference's)",
             case.label,
             error_entry(&cell.outcome),
-            cell.wall
+            cell.wall,
+            cell.variation
         );
         cells.push(cell);
     }
@@ -315,6 +320,7 @@ fn run_cell(
                     reason: short_reason(&e.to_string()),
                 },
                 wall,
+                variation: f64::NAN,
             })
         }
     };
@@ -325,6 +331,7 @@ fn run_cell(
                 reason: short_reason(e),
             },
             wall,
+            variation: f64::NAN,
         });
     }
     let result = as_result_file("result", run);
@@ -337,10 +344,14 @@ fn run_cell(
             .map(|w| (w[1] - w[0]).abs())
             .sum::<f64>()
     };
-    let unstable = variation(&result) > UNSTABLE_VARIATION * variation(reference);
+    let ratio = variation(&result) / variation(reference);
     Ok(Cell {
-        outcome: Outcome::Done { error, unstable },
+        outcome: Outcome::Done {
+            error,
+            unstable: ratio > UNSTABLE_VARIATION,
+        },
         wall,
+        variation: ratio,
     })
 }
 
