@@ -468,8 +468,13 @@ fn a_truncated_file_says_so() {
         let message = refused(&text[..cut]);
         assert_message(&message, &["system.ssd:"]);
     }
-    let message = refused(&text[..text.len() / 2]);
-    assert_message(&message, &["truncated"]);
+    // wherever the cut falls: between elements, inside a tag or inside an
+    // attribute value
+    for cut in (text.len() / 4..text.len() - 20).step_by(37) {
+        if text.is_char_boundary(cut) {
+            assert_message(&refused(&text[..cut]), &["truncated"]);
+        }
+    }
     assert_message(&refused(""), &["system.ssd:", "no root element"]);
 }
 

@@ -83,7 +83,23 @@ pub fn first_pass(xml: &str, root: &str, namespace: &str) -> Result<(String, Lin
             Ok((ResolveResult::Bound(n), event)) => (n.into_inner().to_string(), event),
             Ok((_, event)) => (String::new(), event),
             Err(e) => {
-                let message = e.to_string();
+                let mut message = e.to_string();
+                // A file cut inside a tag, an attribute value or a comment
+                // fails with an "unclosed … before end of input" syntax
+                // error: say it is truncated.
+                let unclosed = matches!(
+                    &e,
+                    quick_xml::Error::Syntax(s)
+                        if !matches!(s, quick_xml::errors::SyntaxError::InvalidBangMarkup)
+                );
+                if unclosed {
+                    message = match open.last() {
+                        Some((name, line)) => format!(
+                            "{message}; the document ends inside <{name}> (opened at line {line}): the file is truncated"
+                        ),
+                        None => format!("{message}; the file is truncated"),
+                    };
+                }
                 return Err(at(reader.error_position(), message));
             }
         };
