@@ -283,17 +283,11 @@ fn fricsim_run_says_which_capability_is_missing_and_exits_nonzero() {
     std::fs::write(dir.path().join("system.ssd"), ssd).unwrap();
     assert!(lugre.starts_with(dir.path()));
     let out = dir.path().join("result.csv");
-    let output = Command::new(env!("CARGO_BIN_EXE_fricsim"))
-        .arg("run")
-        .arg(dir.path().join("system.ssd"))
-        .args([
-            "--master", "newton", "--step", "1e-3", "--stop", "0.1", "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    let stderr = failing_run(
+        &dir.path().join("system.ssd"),
+        &["--master", "newton", "--step", "1e-3", "--stop", "0.1"],
+        &out,
+    );
     common::assert_message(
         &stderr,
         &[
@@ -414,15 +408,11 @@ fn step_halving_rescues_what_three_iterations_cannot_and_says_so() {
 fn fixed_point_divergence_through_the_command_line_reports_the_residual() {
     let dir = TempDir::new().unwrap();
     let out = dir.path().join("result.csv");
-    let output = Command::new(env!("CARGO_BIN_EXE_fricsim"))
-        .arg("run")
-        .arg(common::repository().join("examples/seed000_piezo_push.ssd"))
-        .args(["--master", "fixed-point", "--stop", "1", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    let stderr = failing_run(
+        &common::repository().join("examples/seed000_piezo_push.ssd"),
+        &["--master", "fixed-point", "--stop", "1"],
+        &out,
+    );
     common::assert_message(
         &stderr,
         &[
@@ -455,4 +445,20 @@ fn interpolated_inputs_are_differenced_and_the_report_says_why() {
         &master.report().unwrap(),
         &["Jacobian of friction: finite differences (rollback): its inputs ramp over the step"],
     );
+}
+
+/// `fricsim run SYSTEM ARGS --out OUT`, which must exit with status 1;
+/// its standard error.
+fn failing_run(system: &Path, args: &[&str], out: &Path) -> String {
+    let output = Command::new(env!("CARGO_BIN_EXE_fricsim"))
+        .arg("run")
+        .arg(system)
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    stderr
 }

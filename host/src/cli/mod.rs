@@ -5,3 +5,53 @@ pub mod cosim;
 pub mod info;
 pub mod reference;
 pub mod run;
+
+use fricsim::ssp::SystemFile;
+use std::path::{Path, PathBuf};
+
+/// The time grid of a run of `file`: `--start`, `--stop` and `--step` where
+/// given, else the file's `DefaultExperiment` and stepSize annotation
+/// (start defaults to 0). Shared by `fricsim run` and `fricsim reference`,
+/// so that both produce the same times.
+pub fn time_grid(
+    file: &SystemFile,
+    start: Option<f64>,
+    stop: Option<f64>,
+    step: Option<f64>,
+) -> Result<(f64, f64, f64), String> {
+    let start = match start {
+        Some(s) if !s.is_finite() => return Err(format!("--start must be finite, got {s}")),
+        Some(s) => s,
+        None => file.start_time.unwrap_or(0.0),
+    };
+    let stop = stop.or(file.stop_time).ok_or_else(|| {
+        format!(
+            "{}: no stop time: give --stop or <ssd:DefaultExperiment stopTime=\"…\">",
+            file.ssd
+        )
+    })?;
+    if !(stop.is_finite() && stop > start) {
+        return Err(format!(
+            "the stop time {stop} must be after the start time {start}"
+        ));
+    }
+    let step = step.or(file.settings.step_size).ok_or_else(|| {
+        format!(
+            "{}: no step size: give --step or the stepSize of the fricsim annotation (see README, \"Writing a system file\")",
+            file.ssd
+        )
+    })?;
+    if !(step.is_finite() && step > 0.0) {
+        return Err(format!("--step must be a positive number, got {step}"));
+    }
+    Ok((start, stop, step))
+}
+
+/// `out/<system file stem><suffix>.csv`, the default result file.
+pub fn default_out(system: &Path, suffix: &str) -> PathBuf {
+    let stem = system
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "system".to_string());
+    PathBuf::from("out").join(format!("{stem}{suffix}.csv"))
+}

@@ -50,27 +50,7 @@ pub struct ReferenceArgs {
 
 pub fn run(a: &ReferenceArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let start = a.start.or(file.start_time).unwrap_or(0.0);
-    let stop = a.stop.or(file.stop_time).ok_or_else(|| {
-        format!(
-            "{}: no stop time: give --stop or <ssd:DefaultExperiment stopTime=\"…\">",
-            file.ssd
-        )
-    })?;
-    if !(start.is_finite() && stop.is_finite() && stop > start) {
-        return Err(format!(
-            "the stop time {stop} must be after the start time {start}, both finite"
-        ));
-    }
-    let step = a.step.or(file.settings.step_size).ok_or_else(|| {
-        format!(
-            "{}: no output interval: give --step or the stepSize of the fricsim annotation",
-            file.ssd
-        )
-    })?;
-    if !(step.is_finite() && step > 0.0) {
-        return Err(format!("--step must be a positive number, got {step}"));
-    }
+    let (start, stop, step) = super::time_grid(&file, a.start, a.stop, a.step)?;
     if !(a.rtol.is_finite() && a.rtol > 0.0 && a.rtol < 1.0) {
         return Err(format!("--rtol must be in (0, 1), got {}", a.rtol));
     }
@@ -92,14 +72,10 @@ pub fn run(a: &ReferenceArgs) -> Result<(), String> {
         .solve(start, &times, a.rtol)
         .map_err(|e| format!("{}: {e}", file.ssd))?;
     let wall = started.elapsed().as_secs_f64();
-    let out = a.out.clone().unwrap_or_else(|| {
-        let stem = a
-            .system
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "system".to_string());
-        PathBuf::from("out").join(format!("{stem}_reference.csv"))
-    });
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, "_reference"));
     let run = Run {
         columns: table.columns.clone(),
         time: table.time.clone(),

@@ -78,41 +78,9 @@ impl Observer for Watch {
     }
 }
 
-fn positive(name: &str, x: f64) -> Result<f64, String> {
-    if x.is_finite() && x > 0.0 {
-        Ok(x)
-    } else {
-        Err(format!("{name} must be a positive number, got {x}"))
-    }
-}
-
 pub fn run(a: &RunArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let start = match a.start {
-        Some(s) if !s.is_finite() => return Err(format!("--start must be finite, got {s}")),
-        Some(s) => s,
-        None => file.start_time.unwrap_or(0.0),
-    };
-    let stop = a.stop.or(file.stop_time).ok_or_else(|| {
-        format!(
-            "{}: no stop time: give --stop or <ssd:DefaultExperiment stopTime=\"…\">",
-            file.ssd
-        )
-    })?;
-    if !(stop.is_finite() && stop > start) {
-        return Err(format!(
-            "the stop time {stop} must be after the start time {start}"
-        ));
-    }
-    let step = match a.step.or(file.settings.step_size) {
-        Some(h) => positive("--step", h)?,
-        None => {
-            return Err(format!(
-                "{}: no step size: give --step or the stepSize of the fricsim annotation (see README, \"Writing a system file\")",
-                file.ssd
-            ))
-        }
-    };
+    let (start, stop, step) = super::time_grid(&file, a.start, a.stop, a.step)?;
     let master_name = a
         .master
         .clone()
@@ -154,14 +122,10 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     let elapsed = started.elapsed();
     watch.bar.finish_and_clear();
 
-    let out = a.out.clone().unwrap_or_else(|| {
-        let stem = a
-            .system
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "result".to_string());
-        PathBuf::from("out").join(format!("{stem}.csv"))
-    });
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, ""));
     fricsim::results::write_csv(&run, &out).map_err(|e| format!("{}: {e}", out.display()))?;
     let mut plot_error = None;
     if let Some(plot) = &a.plot {
