@@ -171,6 +171,8 @@ struct Binding {
 pub struct ExternalInputs {
     table: InputTable,
     bindings: Vec<Binding>,
+    /// Macro step for the slopes of [`ExternalInputs::with_slopes`].
+    slopes: Option<f64>,
 }
 
 impl ExternalInputs {
@@ -219,21 +221,43 @@ impl ExternalInputs {
                 discrete,
             });
         }
-        Ok(ExternalInputs { table, bindings })
+        Ok(ExternalInputs {
+            table,
+            bindings,
+            slopes: None,
+        })
     }
 
-    /// Set every bound input to its value at `t`.
+    /// Also give each continuous input its slope over the macro step `h`
+    /// (`fmi2SetRealInputDerivatives`, first order) when its FMU can
+    /// interpolate inputs, so that a sampled input moves linearly between
+    /// samples inside the step instead of being held (FMPy holds it; this
+    /// is for `fricsim diagnose`, which compares with the measurements).
+    pub fn with_slopes(mut self, h: f64) -> Self {
+        self.slopes = Some(h);
+        self
+    }
+
+    /// Set every bound input to its value at `t` (and its slope, see
+    /// [`ExternalInputs::with_slopes`]).
     pub fn apply(&self, system: &mut System, t: f64) -> Result<(), FmuError> {
         for b in &self.bindings {
-            let x = interpolate(
-                t,
-                &self.table.time,
-                &self.table.columns[b.column].1,
-                b.discrete,
-            );
-            system.components[b.component]
-                .instance
-                .set_real(&[b.vr], &[x])?;
+            let column = &self.table.columns[b.column].1;
+            let x = interpolate(t, &self.table.time, column, b.discrete);
+            let instance = &mut system.components[b.component].instance;
+            instance.set_real(&[b.vr], &[x])?;
+            if let Some(h) = self.slopes {
+                if !b.discrete
+                    && instance
+                        .fmu()
+                        .description()
+                        .co_simulation
+                        .can_interpolate_inputs
+                {
+                    let next = interpolate(t + h, &self.table.time, column, false);
+                    instance.set_real_input_derivatives(&[b.vr], &[1], &[(next - x) / h])?;
+                }
+            }
         }
         Ok(())
     }

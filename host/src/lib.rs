@@ -35,3 +35,4 @@ pub mod ssp;
 pub mod system;
 
 pub use error::{ArchiveProblem, FmuError};
+pub mod diagnose;

@@ -47,6 +47,12 @@ enum Command {
     /// equations in one process at tight tolerance, written as the same
     /// CSV as `run`.
     Reference(cli::reference::ReferenceArgs),
+    /// Where a system and measurements disagree: names the missing friction
+    /// effect (viscous, stribeck, presliding, position_dependent,
+    /// direction_dependent, normal_load), adds it to the LuGre FMU, refits,
+    /// and reports the error on held-out data; writes report.json,
+    /// report.md, plots and the refitted system.
+    Diagnose(cli::diagnose::DiagnoseArgs),
 }
 
 fn main() -> ExitCode {
@@ -68,6 +74,7 @@ fn main() -> ExitCode {
             .map_err(|e| e.to_string()),
         Command::Compare(args) => cli::compare::run(&args),
         Command::Reference(args) => cli::reference::run(&args),
+        Command::Diagnose(args) => cli::diagnose::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -68,6 +68,19 @@ fn split_port(port: &str) -> Result<(&str, &str), SystemError> {
     })
 }
 
+/// The component index and variable name of `component.variable`.
+fn find(list: &[Component], port: &str) -> Result<(usize, String), SystemError> {
+    let (c, v) = split_port(port)?;
+    let i = list.iter().position(|x| x.name == c).ok_or_else(|| {
+        let names: Vec<&str> = list.iter().map(|x| x.name.as_str()).collect();
+        SystemError::Invalid(format!(
+            "`{port}`: no component `{c}` (components: {})",
+            names.join(", ")
+        ))
+    })?;
+    Ok((i, v.to_string()))
+}
+
 /// A value for [`System::from_fmus`]: a number is converted to the
 /// variable's type (Real as is, Integer rounded toward zero, Boolean
 /// non-zero = true); text sets a String variable.
@@ -131,17 +144,6 @@ impl System {
                 outputs,
             });
         }
-        let find = |list: &[Component], port: &str| -> Result<(usize, String), SystemError> {
-            let (c, v) = split_port(port)?;
-            let i = list.iter().position(|x| x.name == c).ok_or_else(|| {
-                let names: Vec<&str> = list.iter().map(|x| x.name.as_str()).collect();
-                SystemError::Invalid(format!(
-                    "`{port}`: no component `{c}` (components: {})",
-                    names.join(", ")
-                ))
-            })?;
-            Ok((i, v.to_string()))
-        };
         let mut system = System {
             components: list,
             connections: Vec::new(),
@@ -197,23 +199,50 @@ impl System {
             c.instance.setup_experiment(start, None)?;
             c.instance.enter_initialization_mode()?;
         }
+        system.set_parameters(parameters)?;
+        Ok(system)
+    }
+
+    /// Start over at `start` with the same instances: `fmi2Reset` each,
+    /// set up the experiment, enter initialization mode and set the
+    /// parameters as [`System::from_fmus`] does. Cheaper than building the
+    /// system again (no unpacking, no loading); for repeated runs such as
+    /// the fits of `fricsim diagnose`.
+    pub fn restart(
+        &mut self,
+        start: f64,
+        parameters: &[(String, ParameterValue)],
+    ) -> Result<(), SystemError> {
+        for c in &mut self.components {
+            c.instance.reset()?;
+            c.instance.setup_experiment(start, None)?;
+            c.instance.enter_initialization_mode()?;
+        }
+        self.set_parameters(parameters)
+    }
+
+    /// Set `(component.variable, value)` in order, in initialization mode.
+    fn set_parameters(
+        &mut self,
+        parameters: &[(String, ParameterValue)],
+    ) -> Result<(), SystemError> {
         for (port, value) in parameters {
-            let (i, v) = find(&system.components, port)?;
-            let c = &mut system.components[i];
+            let (i, v) = find(&self.components, port)?;
+            let c = &mut self.components[i];
             let var = c.fmu.variable(&v).map_err(|_| {
                 SystemError::Invalid(format!("`{port}`: `{}` has no variable `{v}`", c.name))
             })?;
             let vr = var.value_reference;
             match (&var.kind, value) {
-                (VariableKind::Real { .. }, ParameterValue::Number(x)) => {
-                    c.instance.set_real(&[vr], &[*x])?
+                (VariableKind::Real { .. }, &ParameterValue::Number(x)) => {
+                    c.instance.set_real(&[vr], &[x])?
                 }
                 (
                     VariableKind::Integer { .. } | VariableKind::Enumeration { .. },
-                    ParameterValue::Number(x),
-                ) => c.instance.set_integer(&[vr], &[*x as i32])?,
-                (VariableKind::Boolean { .. }, ParameterValue::Number(x)) => {
-                    c.instance.set_boolean(&[vr], &[*x != 0.0])?
+                    &ParameterValue::Number(x),
+                ) => c.instance.set_integer(&[vr], &[x as i32])?,
+                (VariableKind::Boolean { .. }, &ParameterValue::Number(x)) => {
+                    c.instance.set_boolean(&[vr], &[x != 0.0])?
                 }
                 (VariableKind::String { .. }, ParameterValue::Text(text)) => {
                     c.instance.set_string(&[vr], &[text.as_str()])?
@@ -226,7 +255,7 @@ impl System {
                 }
             };
         }
-        Ok(system)
+        Ok(())
     }
 
     /// Copy every connected output to its input.

@@ -2,6 +2,7 @@
 
 pub mod compare;
 pub mod cosim;
+pub mod diagnose;
 pub mod info;
 pub mod reference;
 pub mod run;

@@ -29,7 +29,7 @@
 //! matches no variable is an error (the standard ignores it), since it is
 //! almost always a typing mistake.
 
-mod pack;
+pub mod pack;
 mod xml;
 
 pub use pack::pack;
@@ -911,7 +911,7 @@ impl SystemFile {
     /// Where a `source` attribute points: a relative reference resolved
     /// against the ssd's directory (`%XX` escapes decoded). Inside an
     /// archive it must stay inside the archive.
-    fn resolve(&self, source: &str) -> Result<PathBuf, String> {
+    pub fn resolve(&self, source: &str) -> Result<PathBuf, String> {
         let scheme = source.split_once(':').map(|(s, _)| s).filter(|s| {
             s.len() > 1
                 && s.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
@@ -939,6 +939,16 @@ impl SystemFile {
             );
         }
         Ok(self.base.join(relative))
+    }
+
+    /// The SystemStructure.ssd itself: the file given, or the one unpacked
+    /// from the archive.
+    pub fn ssd_path(&self) -> PathBuf {
+        if self.in_archive {
+            self.base.join("SystemStructure.ssd")
+        } else {
+            self.path.clone()
+        }
     }
 
     /// Open each component's FMU and check the system against the model

@@ -1,0 +1,126 @@
+//! `fricsim diagnose SYSTEM DATA.csv`: find where the system and the
+//! measurements disagree, name the missing friction effect from the
+//! library, add it, refit, and show the error on held-out data
+//! ([`fricsim::diagnose`]).
+
+use fricsim::diagnose::model::Effect;
+use fricsim::diagnose::{diagnose, report, Options};
+use fricsim::ssp::SystemFile;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct DiagnoseArgs {
+    /// The nominal system: an .ssp archive or a SystemStructure .ssd file
+    /// with one LuGre friction component.
+    pub system: PathBuf,
+    /// Measurements: CSV with `time` first, then `component.variable`
+    /// columns; unconnected inputs drive the system, outputs are compared.
+    pub data: PathBuf,
+    /// Held-out measurements (same channels) to score on [default: every
+    /// third of 30 equal time blocks of DATA, from the second on, is held
+    /// out].
+    #[arg(long)]
+    pub heldout: Option<PathBuf>,
+    /// Output directory [default: out/<system name>-diagnosis].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Candidate effects to try (repeat) [default: all: viscous, stribeck,
+    /// presliding, position_dependent, direction_dependent, normal_load].
+    #[arg(long = "candidate")]
+    pub candidates: Vec<String>,
+    /// Knots of the position table of position_dependent.
+    #[arg(long, default_value_t = fricsim::diagnose::model::DEFAULT_POSITION_KNOTS)]
+    pub position_knots: usize,
+    /// Family-wise significance level of the acceptance test.
+    #[arg(long, default_value_t = 0.01)]
+    pub alpha: f64,
+    /// Without --heldout: cut DATA into this many equal time blocks and
+    /// hold out every third (one block per independent trial, e.g. per
+    /// row of a table of break-away measurements).
+    #[arg(long, default_value_t = fricsim::diagnose::SPLIT_BLOCKS)]
+    pub blocks: usize,
+    /// Smoothing window of the measured position for the inverse dynamics (s).
+    #[arg(long, default_value_t = 0.01)]
+    pub smooth: f64,
+}
+
+pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
+    let mut options = Options {
+        position_knots: a.position_knots,
+        alpha: a.alpha,
+        smooth: a.smooth,
+        blocks: a.blocks,
+        ..Options::default()
+    };
+    if !(a.alpha > 0.0 && a.alpha < 1.0) {
+        return Err(format!("--alpha {}: must be between 0 and 1", a.alpha));
+    }
+    if !(2..=32).contains(&a.position_knots) {
+        return Err(format!(
+            "--position-knots {}: must be in 2..=32 (the LuGre table holds 32 points)",
+            a.position_knots
+        ));
+    }
+    if a.blocks < 3 {
+        return Err(format!(
+            "--blocks {}: at least 3 (every third block is held out)",
+            a.blocks
+        ));
+    }
+    if !a.candidates.is_empty() {
+        options.candidates = a
+            .candidates
+            .iter()
+            .map(|c| Effect::from_name(c))
+            .collect::<Result<_, _>>()?;
+    }
+    let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
+    let d = diagnose(&file, &a.data, a.heldout.as_deref(), &options)?;
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, "-diagnosis").with_extension(""));
+    report::write(&d, &file, &d.friction_component, &out)?;
+    let names: Vec<&str> = d.effects.iter().map(|e| e.name.name()).collect();
+    println!(
+        "{}: {}",
+        file.ssd,
+        if names.is_empty() {
+            "no missing effect found".to_string()
+        } else {
+            format!("missing {}", names.join(", then "))
+        }
+    );
+    for e in &d.effects {
+        println!(
+            "  {:<20} held-out RMS {:.5} -> {:.5} (p = {:.1e}); where: {} {}",
+            e.name.name(),
+            e.rms_before,
+            e.rms_after,
+            e.p_value,
+            e.where_.state,
+            e.where_.bin
+        );
+    }
+    println!(
+        "held-out RMS: nominal {:.5}, refitted nominal {:.5}, final {:.5}; noise floor {:.5}{}",
+        d.nominal_rms,
+        d.baseline_rms,
+        d.final_rms,
+        d.noise_floor_rms,
+        if d.unexplained {
+            format!(
+                "; UNEXPLAINED residual, largest in {}",
+                d.residual_pattern.strongest
+            )
+        } else {
+            String::new()
+        }
+    );
+    println!(
+        "{:.2} s; wrote {}/report.json, report.md, fit.png, residual.png, refitted.ssp",
+        d.wall_seconds,
+        out.display()
+    );
+    Ok(())
+}

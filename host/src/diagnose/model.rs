@@ -1,0 +1,445 @@
+//! The friction model that `fricsim diagnose` refits, and its library of
+//! candidate effects. Every effect is a feature of the LuGre FMU
+//! (`fmu-src/friction-laws/src/lugre.rs`), so adding one changes the
+//! friction FMU's parameters, not a formula on the side:
+//!
+//! | effect | LuGre feature | free parameters |
+//! | --- | --- | --- |
+//! | `viscous` | σ2·v | σ2 |
+//! | `stribeck` | g(v) = Fc + (Fs − Fc)·exp(−(v/vs)²) | Fs/Fc − 1, vs |
+//! | `presliding` | finite σ0: ż = v − σ0·|v|·z/g(v), hysteresis over Fc/σ0 | σ0 |
+//! | `position_dependent` | levels × a piecewise-linear scale of x | the scales at K knots |
+//! | `direction_dependent` | Fc_neg, Fs_neg (and scale_neg) for v < 0 | Fc_neg (or the negative scales) |
+//! | `normal_load` | normal-force form: F ∝ the input Fn | (the levels, per newton of Fn) |
+//!
+//! Parameters are fitted through transforms that keep them physical:
+//! levels, stiffness, speeds and scales are `exp(θ)` (> 0), the Stribeck
+//! excess `Fs/Fc − 1` is `exp(θ)` (Fs > Fc), σ2 is `exp(θ)` (> 0).
+
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// A physically named effect of the candidate library.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Effect {
+    Viscous,
+    Stribeck,
+    Presliding,
+    PositionDependent,
+    DirectionDependent,
+    NormalLoad,
+}
+
+impl Effect {
+    pub const ALL: [Effect; 6] = [
+        Effect::Viscous,
+        Effect::Stribeck,
+        Effect::Presliding,
+        Effect::PositionDependent,
+        Effect::DirectionDependent,
+        Effect::NormalLoad,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::Viscous => "viscous",
+            Effect::Stribeck => "stribeck",
+            Effect::Presliding => "presliding",
+            Effect::PositionDependent => "position_dependent",
+            Effect::DirectionDependent => "direction_dependent",
+            Effect::NormalLoad => "normal_load",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Result<Effect, String> {
+        Effect::ALL
+            .into_iter()
+            .find(|e| e.name() == name)
+            .ok_or_else(|| {
+                format!(
+                    "unknown effect `{name}` (known: {})",
+                    Effect::ALL.map(|e| e.name()).join(", ")
+                )
+            })
+    }
+
+    /// What the effect is, in words, for the report.
+    pub fn meaning(self) -> &'static str {
+        match self {
+            Effect::Viscous => "friction growing with speed (sigma2*v)",
+            Effect::Stribeck => "break-away above the sliding level, decaying with speed",
+            Effect::Presliding => {
+                "elastic micro-displacement and hysteresis before gross sliding (finite sigma0)"
+            }
+            Effect::PositionDependent => "friction levels varying along the travel",
+            Effect::DirectionDependent => "different friction levels for the two directions",
+            Effect::NormalLoad => "friction levels proportional to the measured normal force",
+        }
+    }
+}
+
+impl fmt::Display for Effect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A presliding distance Fc/σ0 below this is a stiff (Coulomb-like) law:
+/// the presliding effect counts as absent.
+pub const STIFF_PRESLIDING_DISTANCE: f64 = 1e-6;
+
+/// Knots of the position table when `position_dependent` is added.
+pub const DEFAULT_POSITION_KNOTS: usize = 6;
+
+/// The LuGre parameters that diagnose reads, fits and writes back (SI
+/// units; per newton of normal force in the normal-force form).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FrictionModel {
+    pub fc: f64,
+    pub fs: f64,
+    pub vs: f64,
+    pub stribeck_exponent: f64,
+    pub sigma0: f64,
+    pub sigma1: f64,
+    pub sigma2: f64,
+    pub fc_neg: f64,
+    pub fs_neg: f64,
+    pub direction_dependent: bool,
+    pub normal_force_form: bool,
+    pub position_dependent: bool,
+    /// Table positions (m) and scales (only the first `x_table.len()` are
+    /// used; empty when not position-dependent).
+    pub x_table: Vec<f64>,
+    pub scale_pos: Vec<f64>,
+    pub scale_neg: Vec<f64>,
+}
+
+/// The LuGre parameter names diagnose reads from the nominal FMU.
+pub const READ_PARAMETERS: [&str; 9] = [
+    "Fc",
+    "Fs",
+    "vs",
+    "stribeck_exponent",
+    "sigma0",
+    "sigma1",
+    "sigma2",
+    "Fc_neg",
+    "Fs_neg",
+];
+
+impl FrictionModel {
+    /// From the values of the nominal friction FMU's parameters: the Reals
+    /// of [`READ_PARAMETERS`], the flags and the table.
+    pub fn from_values(values: &BTreeMap<String, f64>) -> Result<FrictionModel, String> {
+        let get = |name: &str| {
+            values
+                .get(name)
+                .copied()
+                .ok_or_else(|| format!("the friction FMU has no parameter `{name}`"))
+        };
+        let flag = |name: &str| get(name).map(|x| x != 0.0);
+        let mut m = FrictionModel {
+            fc: get("Fc")?,
+            fs: get("Fs")?,
+            vs: get("vs")?,
+            stribeck_exponent: get("stribeck_exponent")?,
+            sigma0: get("sigma0")?,
+            sigma1: get("sigma1")?,
+            sigma2: get("sigma2")?,
+            fc_neg: get("Fc_neg")?,
+            fs_neg: get("Fs_neg")?,
+            direction_dependent: flag("direction_dependent")?,
+            normal_force_form: flag("normal_force_form")?,
+            position_dependent: flag("position_dependent")?,
+            x_table: Vec::new(),
+            scale_pos: Vec::new(),
+            scale_neg: Vec::new(),
+        };
+        if m.position_dependent {
+            let n = get("n_table")? as usize;
+            for i in 1..=n {
+                m.x_table.push(get(&format!("x_table[{i}]"))?);
+                m.scale_pos.push(get(&format!("scale_pos[{i}]"))?);
+                m.scale_neg.push(get(&format!("scale_neg[{i}]"))?);
+            }
+        }
+        if !m.direction_dependent {
+            m.fc_neg = m.fc;
+            m.fs_neg = m.fs;
+        }
+        Ok(m)
+    }
+
+    /// Whether `effect` is part of the model already.
+    pub fn has(&self, effect: Effect) -> bool {
+        match effect {
+            Effect::Viscous => self.sigma2 > 0.0,
+            Effect::Stribeck => self.fs > self.fc * (1.0 + 1e-9),
+            Effect::Presliding => self.fc / self.sigma0 >= STIFF_PRESLIDING_DISTANCE,
+            Effect::PositionDependent => self.position_dependent,
+            Effect::DirectionDependent => self.direction_dependent,
+            Effect::NormalLoad => self.normal_force_form,
+        }
+    }
+
+    /// The effects of the library the model has.
+    pub fn effects(&self) -> Vec<Effect> {
+        Effect::ALL.into_iter().filter(|e| self.has(*e)).collect()
+    }
+
+    /// The model with `effect` switched on at a neutral start (it changes
+    /// nothing yet, or very little, until fitted): σ2 small, Fs just above
+    /// Fc with vs from `context`, σ0 giving a presliding distance of a
+    /// thousandth of the travel, unit scales on knots spread over the
+    /// travel, equal levels for both directions, levels per unit of the
+    /// mean normal force.
+    pub fn with(&self, effect: Effect, context: &Context) -> FrictionModel {
+        let mut m = self.clone();
+        match effect {
+            Effect::Viscous => m.sigma2 = 1e-3 * m.fc / context.speed_scale,
+            Effect::Stribeck => {
+                m.fs = m.fc * 1.01;
+                m.fs_neg = m.fc_neg * 1.01;
+                m.vs = 0.1 * context.speed_scale;
+            }
+            Effect::Presliding => m.sigma0 = m.fc / (1e-3 * context.travel),
+            Effect::PositionDependent => {
+                let k = context.position_knots.max(2);
+                m.position_dependent = true;
+                m.x_table = (0..k)
+                    .map(|i| {
+                        context.x_min + (context.x_max - context.x_min) * i as f64 / (k - 1) as f64
+                    })
+                    .collect();
+                m.scale_pos = vec![1.0; k];
+                m.scale_neg = vec![1.0; k];
+            }
+            Effect::DirectionDependent => {
+                m.direction_dependent = true;
+                m.fc_neg = m.fc;
+                m.fs_neg = m.fs;
+                m.scale_neg = m.scale_pos.clone();
+            }
+            Effect::NormalLoad => {
+                let n = context.mean_normal_force;
+                m.normal_force_form = true;
+                for x in [
+                    &mut m.fc,
+                    &mut m.fs,
+                    &mut m.fc_neg,
+                    &mut m.fs_neg,
+                    &mut m.sigma0,
+                    &mut m.sigma1,
+                    &mut m.sigma2,
+                ] {
+                    *x /= n;
+                }
+            }
+        }
+        m
+    }
+
+    /// The free parameters of this model (the nominal levels and those of
+    /// every effect it has), as transformed coordinates θ.
+    pub fn free(&self) -> Vec<Free> {
+        let mut f = Vec::new();
+        // levels: carried by the scales when position-dependent (a common
+        // factor of Fc and the scales could not be told apart)
+        if self.position_dependent {
+            for i in 0..self.x_table.len() {
+                f.push(Free::ScalePos(i));
+                if self.direction_dependent {
+                    f.push(Free::ScaleNeg(i));
+                }
+            }
+        } else {
+            f.push(Free::Fc);
+            if self.direction_dependent {
+                f.push(Free::FcNeg);
+            }
+        }
+        if self.has(Effect::Viscous) {
+            f.push(Free::Sigma2);
+        }
+        if self.has(Effect::Stribeck) {
+            f.push(Free::StribeckExcess);
+            f.push(Free::Vs);
+        }
+        if self.has(Effect::Presliding) {
+            f.push(Free::Sigma0);
+        }
+        f
+    }
+
+    /// θ of the free parameters.
+    pub fn theta(&self, free: &[Free]) -> Vec<f64> {
+        free.iter()
+            .map(|p| match p {
+                Free::Fc => self.fc.ln(),
+                Free::FcNeg => self.fc_neg.ln(),
+                Free::Sigma2 => self.sigma2.max(1e-300).ln(),
+                Free::StribeckExcess => (self.fs / self.fc - 1.0).max(1e-12).ln(),
+                Free::Vs => self.vs.ln(),
+                Free::Sigma0 => self.sigma0.ln(),
+                Free::ScalePos(i) => self.scale_pos[*i].ln(),
+                Free::ScaleNeg(i) => self.scale_neg[*i].ln(),
+            })
+            .collect()
+    }
+
+    /// The model at θ (the Stribeck excess applies to both directions).
+    pub fn at(&self, free: &[Free], theta: &[f64]) -> FrictionModel {
+        let mut m = self.clone();
+        let excess = (self.fs / self.fc - 1.0).max(0.0);
+        let mut new_excess = excess;
+        for (p, &t) in free.iter().zip(theta) {
+            let x = t.clamp(-700.0, 700.0).exp();
+            match p {
+                Free::Fc => m.fc = x,
+                Free::FcNeg => m.fc_neg = x,
+                Free::Sigma2 => m.sigma2 = x,
+                Free::StribeckExcess => new_excess = x,
+                Free::Vs => m.vs = x,
+                Free::Sigma0 => m.sigma0 = x,
+                Free::ScalePos(i) => m.scale_pos[*i] = x,
+                Free::ScaleNeg(i) => m.scale_neg[*i] = x,
+            }
+        }
+        if !m.direction_dependent {
+            m.fc_neg = m.fc;
+        }
+        m.fs = m.fc * (1.0 + new_excess);
+        m.fs_neg = m.fc_neg * (1.0 + new_excess);
+        m
+    }
+
+    /// `(variable, value)` of the LuGre FMU for this model.
+    pub fn parameters(&self) -> Vec<(String, f64)> {
+        let mut p = vec![
+            ("Fc".to_string(), self.fc),
+            ("Fs".to_string(), self.fs),
+            ("vs".to_string(), self.vs),
+            ("stribeck_exponent".to_string(), self.stribeck_exponent),
+            ("sigma0".to_string(), self.sigma0),
+            ("sigma1".to_string(), self.sigma1),
+            ("sigma2".to_string(), self.sigma2),
+            ("Fc_neg".to_string(), self.fc_neg),
+            ("Fs_neg".to_string(), self.fs_neg),
+            (
+                "direction_dependent".to_string(),
+                f64::from(u8::from(self.direction_dependent)),
+            ),
+            (
+                "normal_force_form".to_string(),
+                f64::from(u8::from(self.normal_force_form)),
+            ),
+            (
+                "position_dependent".to_string(),
+                f64::from(u8::from(self.position_dependent)),
+            ),
+        ];
+        if self.position_dependent {
+            p.push(("n_table".to_string(), self.x_table.len() as f64));
+            for i in 0..self.x_table.len() {
+                p.push((format!("x_table[{}]", i + 1), self.x_table[i]));
+                p.push((format!("scale_pos[{}]", i + 1), self.scale_pos[i]));
+                p.push((format!("scale_neg[{}]", i + 1), self.scale_neg[i]));
+            }
+        }
+        p
+    }
+
+    /// The parameters that describe `effect` in this model, for the report
+    /// (name, value, unit).
+    pub fn effect_parameters(&self, effect: Effect) -> Vec<(String, f64, &'static str)> {
+        let level = if self.normal_force_form { "N/N" } else { "N" };
+        match effect {
+            Effect::Viscous => vec![("sigma2".into(), self.sigma2, "N.s/m")],
+            Effect::Stribeck => vec![
+                ("Fs".into(), self.fs, level),
+                ("Fs_minus_Fc".into(), self.fs - self.fc, level),
+                ("vs".into(), self.vs, "m/s"),
+            ],
+            Effect::Presliding => vec![
+                ("sigma0".into(), self.sigma0, "N/m"),
+                ("presliding_distance".into(), self.fc / self.sigma0, "m"),
+            ],
+            Effect::PositionDependent => {
+                let mut v = Vec::new();
+                for i in 0..self.x_table.len() {
+                    v.push((format!("x_table[{}]", i + 1), self.x_table[i], "m"));
+                    v.push((
+                        format!("Fc_pos_at[{}]", i + 1),
+                        self.fc * self.scale_pos[i],
+                        level,
+                    ));
+                    if self.direction_dependent {
+                        v.push((
+                            format!("Fc_neg_at[{}]", i + 1),
+                            self.fc_neg * self.scale_neg[i],
+                            level,
+                        ));
+                    }
+                }
+                v
+            }
+            Effect::DirectionDependent => vec![
+                ("Fc".into(), self.fc, level),
+                ("Fc_neg".into(), self.fc_neg, level),
+                ("Fc_neg_minus_Fc".into(), self.fc_neg - self.fc, level),
+            ],
+            Effect::NormalLoad => vec![
+                ("Fc_per_N".into(), self.fc, "N/N"),
+                ("Fc_neg_per_N".into(), self.fc_neg, "N/N"),
+            ],
+        }
+    }
+
+    /// Coulomb level for direction `positive` at position `x` (per unit Fn
+    /// in the normal-force form): Fc or Fc_neg times the table's scale.
+    pub fn level(&self, positive: bool, x: f64) -> f64 {
+        let base = if positive || !self.direction_dependent {
+            self.fc
+        } else {
+            self.fc_neg
+        };
+        if !self.position_dependent {
+            return base;
+        }
+        let scales = if positive || !self.direction_dependent {
+            &self.scale_pos
+        } else {
+            &self.scale_neg
+        };
+        base * crate::inputs::interpolate(x, &self.x_table, scales, false)
+    }
+}
+
+/// A free parameter, fitted as θ = ln(value) (or ln(Fs/Fc − 1)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Free {
+    Fc,
+    FcNeg,
+    Sigma2,
+    StribeckExcess,
+    Vs,
+    Sigma0,
+    ScalePos(usize),
+    ScaleNeg(usize),
+}
+
+/// What the neutral starts of the effects depend on: the data's ranges.
+#[derive(Clone, Debug)]
+pub struct Context {
+    /// RMS speed (m/s).
+    pub speed_scale: f64,
+    pub x_min: f64,
+    pub x_max: f64,
+    /// max(x_max − x_min, 1e-9).
+    pub travel: f64,
+    /// Mean normal force (N), 1 when not measured.
+    pub mean_normal_force: f64,
+    pub position_knots: usize,
+}

@@ -1,0 +1,619 @@
+//! What `fricsim diagnose` works on: the measurements checked against the
+//! system, the friction component, and the friction force the data imply.
+//!
+//! **Measurements** (a CSV): `time` first, then columns named
+//! `component.variable`. A column naming an unconnected input drives it
+//! (interpolated as `fricsim run --input` does); a column naming an output
+//! is a measured channel, compared with the simulation.
+//!
+//! **Friction force implied by the data**, on each sample interval
+//! `[t_k, t_k+1]`:
+//! - measured directly when `friction.F` is a column;
+//! - otherwise by inverse dynamics of the Rig1D the friction acts on
+//!   (seed 001 eq. 15; the EMPS benchmark's inverse dynamic model), from
+//!   its equation `m·ẍ = k·(x_a − x) − c·ẋ + F_ext − F + F_d(t) + F_ctrl`:
+//!   `F = k·(x_a − x) − c·ẋ + F_ext + F_d(t) + G·u_ctrl − m·ẍ`, with x
+//!   from the measured `rig.x` smoothed by a Savitzky–Golay filter (local
+//!   quadratic), ẋ its difference over the interval, ẍ the central
+//!   difference of ẋ, and the controller's effort `u_ctrl` measured.
+//!
+//! The friction law's inputs on the interval (slip velocity v, position x,
+//! normal force Fn) come from their columns, or from the smoothed position
+//! when they are connected to the rig's `v` and `x`.
+
+use super::model::{Context, FrictionModel};
+use crate::fmu::model_description::{Causality, VariableKind};
+use crate::fmu::{Fmu, Instance};
+use crate::inputs::{interpolate, InputTable};
+use crate::ssp::SystemFile;
+use crate::system::System;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Fewest samples diagnose accepts in a file.
+pub const MIN_SAMPLES: usize = 50;
+
+/// A measurement file checked against the system.
+#[derive(Clone, Debug)]
+pub struct Measured {
+    pub label: String,
+    pub time: Vec<f64>,
+    /// Columns that drive unconnected inputs.
+    pub inputs: Vec<(String, Vec<f64>)>,
+    /// Measured output channels.
+    pub outputs: Vec<(String, Vec<f64>)>,
+}
+
+impl Measured {
+    /// Read `path` and sort its columns into inputs and measured outputs of
+    /// `system`; refuse unknown columns, columns that are neither, too few
+    /// samples, a time that does not increase overall, and a file with no
+    /// output to compare.
+    pub fn read(path: &Path, system: &System) -> Result<Measured, String> {
+        let table = InputTable::read(path)?;
+        let shown = path.display().to_string();
+        if table.time.len() < MIN_SAMPLES {
+            return Err(format!(
+                "{shown}: {} samples; diagnose needs at least {MIN_SAMPLES}",
+                table.time.len()
+            ));
+        }
+        let (t0, t1) = (table.time[0], table.time[table.time.len() - 1]);
+        if t1 <= t0 {
+            return Err(format!(
+                "{shown}: time does not advance (from {t0} to {t1} s)"
+            ));
+        }
+        let mut inputs = Vec::new();
+        let mut outputs = Vec::new();
+        for (name, values) in table.columns {
+            let (i, var) = system.port(&name).map_err(|e| {
+                format!(
+                    "{shown}: column `{name}` names no variable of the system: {e}; {}",
+                    known_columns(system)
+                )
+            })?;
+            if !matches!(var.kind, VariableKind::Real { .. }) {
+                return Err(format!(
+                    "{shown}: column `{name}` is a {} variable; only Real variables can be measured or driven",
+                    var.kind.type_name()
+                ));
+            }
+            let connected = system
+                .connections
+                .iter()
+                .any(|c| c.to == (i, var.value_reference));
+            match var.causality {
+                Causality::Input if !connected => inputs.push((name, values)),
+                Causality::Output => outputs.push((name, values)),
+                Causality::Input => {
+                    return Err(format!(
+                        "{shown}: column `{name}` is an input driven by a connection; it can be neither set from the data nor compared (measure the output it comes from); {}",
+                        known_columns(system)
+                    ))
+                }
+                other => {
+                    return Err(format!(
+                        "{shown}: column `{name}` has causality \"{other}\": it cannot be compared with the simulation; {}",
+                        known_columns(system)
+                    ))
+                }
+            }
+        }
+        if outputs.is_empty() {
+            return Err(format!(
+                "{shown}: no column names an output of the system, so nothing can be compared; {}",
+                known_columns(system)
+            ));
+        }
+        Ok(Measured {
+            label: shown,
+            time: table.time,
+            inputs,
+            outputs,
+        })
+    }
+
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.inputs
+            .iter()
+            .chain(&self.outputs)
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_slice())
+    }
+
+    /// The input columns as a table for [`crate::inputs::ExternalInputs`].
+    pub fn input_table(&self) -> InputTable {
+        InputTable {
+            path: self.label.clone().into(),
+            time: self.time.clone(),
+            columns: self.inputs.clone(),
+        }
+    }
+}
+
+/// `outputs: a, b; unconnected inputs: c` for messages.
+fn known_columns(system: &System) -> String {
+    let mut outs = Vec::new();
+    let mut ins = Vec::new();
+    for (i, c) in system.components.iter().enumerate() {
+        for v in &c.fmu.description().variables {
+            if !matches!(v.kind, VariableKind::Real { .. }) {
+                continue;
+            }
+            let port = format!("{}.{}", c.name, v.name);
+            match v.causality {
+                Causality::Output => outs.push(port),
+                Causality::Input
+                    if !system
+                        .connections
+                        .iter()
+                        .any(|k| k.to == (i, v.value_reference)) =>
+                {
+                    ins.push(port)
+                }
+                _ => {}
+            }
+        }
+    }
+    format!(
+        "columns may be outputs ({}) or unconnected inputs ({})",
+        outs.join(", "),
+        if ins.is_empty() {
+            "none".to_string()
+        } else {
+            ins.join(", ")
+        }
+    )
+}
+
+/// The value of any scalar variable as a number (Booleans 0/1).
+pub fn read_value(instance: &mut Instance, fmu: &Fmu, name: &str) -> Result<f64, String> {
+    let var = fmu.variable(name).map_err(|e| e.to_string())?;
+    let vr = var.value_reference;
+    let fail = |e: crate::FmuError| format!("reading `{name}`: {e}");
+    Ok(match var.kind {
+        VariableKind::Real { .. } => {
+            let mut x = [0.0];
+            instance.get_real(&[vr], &mut x).map_err(fail)?;
+            x[0]
+        }
+        VariableKind::Integer { .. } | VariableKind::Enumeration { .. } => {
+            let mut x = [0];
+            instance.get_integer(&[vr], &mut x).map_err(fail)?;
+            x[0] as f64
+        }
+        VariableKind::Boolean { .. } => {
+            let mut x = [false];
+            instance.get_boolean(&[vr], &mut x).map_err(fail)?;
+            f64::from(u8::from(x[0]))
+        }
+        VariableKind::String { .. } => return Err(format!("`{name}` is a String")),
+    })
+}
+
+/// Where the friction law's inputs and force come from on each interval.
+#[derive(Clone, Debug)]
+pub struct FrictionData {
+    /// Interval start times and lengths (intervals of zero length, the
+    /// events of the file, are left out).
+    pub t: Vec<f64>,
+    pub h: Vec<f64>,
+    /// Index of the interval's end sample in the file.
+    pub end: Vec<usize>,
+    pub v: Vec<f64>,
+    pub x: Vec<f64>,
+    pub fn_: Vec<f64>,
+    /// Friction force implied by the data.
+    pub f: Vec<f64>,
+    /// How the force was obtained, in words.
+    pub source: String,
+    /// Whether a normal force is measured (and varies).
+    pub normal_force_measured: bool,
+}
+
+/// The system around the friction FMU.
+pub struct Setup {
+    /// Index of the friction component in the system.
+    pub friction: usize,
+    pub friction_name: String,
+    pub friction_fmu: Fmu,
+    /// Nominal friction parameters.
+    pub nominal: FrictionModel,
+    /// Rig parameters by name (empty without a rig).
+    pub rig: Option<(String, BTreeMap<String, f64>)>,
+    /// Macro step of the co-simulation.
+    pub step: f64,
+    pub master: String,
+}
+
+/// Rig1D parameters used by the inverse dynamics.
+const RIG_PARAMETERS: [&str; 17] = [
+    "m",
+    "c",
+    "k",
+    "x_a0",
+    "v_a",
+    "act_amp",
+    "act_freq",
+    "actuator",
+    "F_step",
+    "t_step",
+    "drive_amp",
+    "drive_freq",
+    "control",
+    "ctrl_gain",
+    "v_surface",
+    "dither_amp",
+    "F_ext",
+];
+
+impl Setup {
+    /// Find the friction component (the one LuGre FMU) and the rig its
+    /// force acts on, and read their parameters from a freshly built system.
+    pub fn new(
+        file: &SystemFile,
+        system: &mut System,
+        step: f64,
+        master: &str,
+    ) -> Result<Setup, String> {
+        let lugre: Vec<usize> = (0..system.components.len())
+            .filter(|&i| system.components[i].fmu.description().model_name == "LuGre")
+            .collect();
+        let friction = match lugre.as_slice() {
+            [i] => *i,
+            [] => {
+                let models: Vec<String> = system
+                    .components
+                    .iter()
+                    .map(|c| format!("{} ({})", c.name, c.fmu.description().model_name))
+                    .collect();
+                return Err(format!(
+                    "{}: diagnose refits a LuGre friction FMU (its features are the candidate effects), and the system has none: {}",
+                    file.ssd,
+                    models.join(", ")
+                ));
+            }
+            _ => {
+                return Err(format!(
+                    "{}: {} LuGre components; diagnose refits exactly one",
+                    file.ssd,
+                    lugre.len()
+                ))
+            }
+        };
+        let fmu = system.components[friction].fmu.clone();
+        let name = system.components[friction].name.clone();
+        let mut values = BTreeMap::new();
+        for v in &fmu.description().variables {
+            if v.causality == Causality::Parameter {
+                let x = read_value(&mut system.components[friction].instance, &fmu, &v.name)?;
+                values.insert(v.name.clone(), x);
+            }
+        }
+        let nominal = FrictionModel::from_values(&values)?;
+        // the rig: the component whose input F the friction force drives
+        let f_vr = fmu
+            .variable("F")
+            .map_err(|e| e.to_string())?
+            .value_reference;
+        let rig = match system
+            .connections
+            .iter()
+            .find(|c| c.from == (friction, f_vr))
+        {
+            Some(c) => {
+                let r = c.to.0;
+                let rfmu = system.components[r].fmu.clone();
+                if rfmu.description().model_name != "Rig1D" {
+                    None
+                } else {
+                    let mut p = BTreeMap::new();
+                    for n in RIG_PARAMETERS {
+                        p.insert(
+                            n.to_string(),
+                            read_value(&mut system.components[r].instance, &rfmu, n)?,
+                        );
+                    }
+                    Some((system.components[r].name.clone(), p))
+                }
+            }
+            None => None,
+        };
+        Ok(Setup {
+            friction,
+            friction_name: name,
+            friction_fmu: fmu,
+            nominal,
+            rig,
+            step,
+            master: master.to_string(),
+        })
+    }
+
+    /// The friction force and law inputs the data imply, on every interval.
+    pub fn friction_data(
+        &self,
+        system: &System,
+        data: &Measured,
+        smooth: f64,
+    ) -> Result<FrictionData, String> {
+        let f = &self.friction_name;
+        let port_source = |var: &str| -> Option<String> {
+            let vr = self.friction_fmu.variable(var).ok()?.value_reference;
+            system
+                .connections
+                .iter()
+                .find(|c| c.to == (self.friction, vr))
+                .map(|c| {
+                    let from = &system.components[c.from.0];
+                    let name = from
+                        .fmu
+                        .description()
+                        .variables
+                        .iter()
+                        .find(|v| v.value_reference == c.from.1 && v.causality == Causality::Output)
+                        .map_or("?".to_string(), |v| v.name.clone());
+                    format!("{}.{}", from.name, name)
+                })
+        };
+        let time = &data.time;
+        let n = time.len();
+        // intervals of positive length
+        let mut t = Vec::new();
+        let mut h = Vec::new();
+        let mut end = Vec::new();
+        for k in 0..n - 1 {
+            if time[k + 1] > time[k] {
+                t.push(time[k]);
+                h.push(time[k + 1] - time[k]);
+                end.push(k + 1);
+            }
+        }
+        let m = t.len();
+        let start_of = |j: usize| end[j] - 1;
+
+        // the rig's smoothed position, when measured
+        let rig_x: Option<Vec<f64>> = self.rig.as_ref().and_then(|(r, _)| {
+            data.column(&format!("{r}.x"))
+                .map(|x| savitzky_golay(x, window_half_width(time, smooth)))
+        });
+        let velocity_of = |xs: &[f64]| -> Vec<f64> {
+            (0..m)
+                .map(|j| (xs[end[j]] - xs[start_of(j)]) / h[j])
+                .collect()
+        };
+        let law_input = |var: &str| -> Result<Vec<f64>, String> {
+            let port = format!("{f}.{var}");
+            if let Some(col) = data.column(&port) {
+                return Ok((0..m).map(|j| col[start_of(j)]).collect());
+            }
+            match port_source(var) {
+                Some(src) => {
+                    let (rig, _) = self
+                        .rig
+                        .as_ref()
+                        .ok_or_else(|| format!("`{port}` comes from `{src}`, which is not a Rig1D diagnose can reconstruct"))?;
+                    let xs = rig_x.as_ref().ok_or_else(|| {
+                        format!(
+                            "`{port}` comes from `{src}`: measure `{rig}.x` (or give `{port}` as a column)"
+                        )
+                    })?;
+                    if src == format!("{rig}.v") || src == format!("{rig}.v_body") {
+                        Ok(velocity_of(xs))
+                    } else if src == format!("{rig}.x") || src == format!("{rig}.x_rel") {
+                        Ok((0..m)
+                            .map(|j| 0.5 * (xs[start_of(j)] + xs[end[j]]))
+                            .collect())
+                    } else {
+                        Err(format!("`{port}` comes from `{src}`, which diagnose cannot reconstruct from the data"))
+                    }
+                }
+                None => {
+                    let start = match &self
+                        .friction_fmu
+                        .variable(var)
+                        .map_err(|e| e.to_string())?
+                        .kind
+                    {
+                        VariableKind::Real { start, .. } => start.unwrap_or(0.0),
+                        _ => 0.0,
+                    };
+                    Ok(vec![start; m])
+                }
+            }
+        };
+        let v = law_input("v")?;
+        let x = law_input("x")?;
+        let fn_ = law_input("Fn")?;
+        let normal_force_measured = data.column(&format!("{f}.Fn")).is_some()
+            && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+                > fn_.iter().cloned().fold(f64::INFINITY, f64::min);
+
+        let (force, source) = if let Some(col) = data.column(&format!("{f}.F")) {
+            (
+                (0..m).map(|j| col[end[j]]).collect(),
+                format!("measured `{f}.F`"),
+            )
+        } else {
+            self.inverse_dynamics(data, rig_x.as_deref(), &t, &h, &end, &v)?
+        };
+        Ok(FrictionData {
+            t,
+            h,
+            end,
+            v,
+            x,
+            fn_,
+            f: force,
+            source,
+            normal_force_measured,
+        })
+    }
+
+    /// F = k·(x_a − x) − c·ẋ + F_ext + F_d(t) + G·u_ctrl − m·ẍ on each interval.
+    #[allow(clippy::too_many_arguments)]
+    fn inverse_dynamics(
+        &self,
+        data: &Measured,
+        xs: Option<&[f64]>,
+        t: &[f64],
+        h: &[f64],
+        end: &[usize],
+        v: &[f64],
+    ) -> Result<(Vec<f64>, String), String> {
+        let f = &self.friction_name;
+        let Some((rig, p)) = &self.rig else {
+            return Err(format!(
+                "cannot estimate the friction force from the data: measure `{f}.F`, or connect `{f}.F` to a Rig1D whose position is measured"
+            ));
+        };
+        let xs = xs.ok_or_else(|| {
+            format!("cannot estimate the friction force: measure `{rig}.x` (for the inverse dynamics of `{rig}`) or `{f}.F`")
+        })?;
+        if p["v_surface"] != 0.0 || p["dither_amp"] != 0.0 {
+            return Err(format!(
+                "cannot estimate the friction force: `{rig}` has a moving surface (v_surface = {}, dither_amp = {}), which diagnose's inverse dynamics does not model",
+                p["v_surface"], p["dither_amp"]
+            ));
+        }
+        let control = p["control"] != 0.0;
+        let u = if control {
+            Some(data.column(&format!("{rig}.u_ctrl")).ok_or_else(|| {
+                format!("cannot estimate the friction force: `{rig}` runs its controller (control = {}), so its effort `{rig}.u_ctrl` must be measured", p["control"])
+            })?)
+        } else {
+            None
+        };
+        let f_ext = data.column(&format!("{rig}.F_ext"));
+        let x_act_in = data.column(&format!("{rig}.x_act_in"));
+        if p["k"] != 0.0 && p["actuator"] != 0.0 && x_act_in.is_none() {
+            return Err(format!(
+                "cannot estimate the friction force: `{rig}` has a spring (k = {}) to an actuator point from its input, so `{rig}.x_act_in` must be a column",
+                p["k"]
+            ));
+        }
+        let m = t.len();
+        let mid = |col: &[f64], j: usize| 0.5 * (col[end[j] - 1] + col[end[j]]);
+        let mut force = Vec::with_capacity(m);
+        for j in 0..m {
+            let tm = t[j] + 0.5 * h[j];
+            // acceleration: central difference of the interval velocities
+            let (jl, jr) = (j.saturating_sub(1), (j + 1).min(m - 1));
+            let a = if jr > jl {
+                (v[jr] - v[jl]) / (0.5 * (h[jl] + h[jr]) * (jr - jl) as f64)
+            } else {
+                0.0
+            };
+            let x = 0.5 * (xs[end[j] - 1] + xs[end[j]]);
+            let x_a = if p["actuator"] != 0.0 {
+                x_act_in.map_or(0.0, |c| mid(c, j))
+            } else {
+                p["x_a0"]
+                    + p["v_a"] * tm
+                    + p["act_amp"] * (std::f64::consts::TAU * p["act_freq"] * tm).sin()
+            };
+            let drive = if tm >= p["t_step"] { p["F_step"] } else { 0.0 }
+                + p["drive_amp"] * (std::f64::consts::TAU * p["drive_freq"] * tm).sin();
+            let ext = f_ext.map_or(p["F_ext"], |c| mid(c, j));
+            let ctrl = u.map_or(0.0, |c| p["ctrl_gain"] * mid(c, j));
+            force.push(p["k"] * (x_a - x) - p["c"] * v[j] + ext + drive + ctrl - p["m"] * a);
+        }
+        let mut how = format!(
+            "inverse dynamics of `{rig}` (m = {} kg) from the measured `{rig}.x`",
+            p["m"]
+        );
+        if control {
+            how.push_str(&format!(
+                " and effort `{rig}.u_ctrl` (gain {} N/V)",
+                p["ctrl_gain"]
+            ));
+        }
+        Ok((force, how))
+    }
+
+    /// The ranges that set the neutral starts of the candidates.
+    pub fn context(&self, d: &FrictionData, position_knots: usize) -> Context {
+        let speed_scale = (d.v.iter().map(|v| v * v).sum::<f64>() / d.v.len() as f64)
+            .sqrt()
+            .max(1e-9);
+        let x_min = d.x.iter().cloned().fold(f64::INFINITY, f64::min);
+        let x_max = d.x.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let mean_fn = d.fn_.iter().sum::<f64>() / d.fn_.len() as f64;
+        Context {
+            speed_scale,
+            x_min,
+            x_max,
+            travel: (x_max - x_min).max(1e-9),
+            mean_normal_force: if mean_fn > 0.0 { mean_fn } else { 1.0 },
+            position_knots,
+        }
+    }
+}
+
+/// Half-width (samples) of a smoothing window of `seconds` at the file's
+/// median sample spacing.
+fn window_half_width(time: &[f64], seconds: f64) -> usize {
+    let mut dt: Vec<f64> = time
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .collect();
+    if dt.is_empty() || seconds <= 0.0 {
+        return 0;
+    }
+    dt.sort_by(f64::total_cmp);
+    let median = dt[dt.len() / 2];
+    ((0.5 * seconds / median).round() as usize).min(time.len() / 4)
+}
+
+/// Savitzky–Golay smoothing (local quadratic, window 2·w + 1), with the
+/// window shrunk symmetrically near the ends:
+/// `c_j = (3·(3w² + 3w − 1) − 15·j²) / ((2w + 1)(4w² + 4w − 3))`.
+pub fn savitzky_golay(y: &[f64], w: usize) -> Vec<f64> {
+    let n = y.len();
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let w = w.min(i).min(n - 1 - i);
+        if w == 0 {
+            out.push(y[i]);
+            continue;
+        }
+        let wf = w as f64;
+        let norm = (2.0 * wf + 1.0) * (4.0 * wf * wf + 4.0 * wf - 3.0);
+        let mut s = 0.0;
+        for j in -(w as i64)..=(w as i64) {
+            let c = (3.0 * (3.0 * wf * wf + 3.0 * wf - 1.0) - 15.0 * (j * j) as f64) / norm;
+            s += c * y[(i as i64 + j) as usize];
+        }
+        out.push(s);
+    }
+    out
+}
+
+/// The value of a measured column at time `time` (linear interpolation).
+pub fn at(time: f64, t: &[f64], v: &[f64]) -> f64 {
+    interpolate(time, t, v, false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::savitzky_golay;
+
+    #[test]
+    fn savitzky_golay_keeps_quadratics_and_averages_noise() {
+        let y: Vec<f64> = (0..50)
+            .map(|i| 0.5 * (i as f64).powi(2) - 3.0 * i as f64 + 1.0)
+            .collect();
+        let s = savitzky_golay(&y, 5);
+        for (a, b) in y.iter().zip(&s) {
+            assert!((a - b).abs() < 1e-9 * a.abs().max(1.0), "{a} {b}");
+        }
+        // alternating noise of ±1 is reduced well below 1 inside
+        let z: Vec<f64> = (0..50)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        let s = savitzky_golay(&z, 5);
+        assert!(s[10..40].iter().all(|x| x.abs() < 0.3), "{s:?}");
+    }
+}

@@ -1,0 +1,474 @@
+//! The output directory of `fricsim diagnose`: `report.json`, `report.md`,
+//! `fit.png` (measured vs nominal vs final on each measured channel, on
+//! the held-out data), `residual.png` (friction residual against the
+//! localising states, before and after) and `refitted.ssp` (the system
+//! with the refitted friction parameters, runnable by `fricsim run` and
+//! FMPy). Everything is written into a temporary sibling directory first
+//! and renamed into place at the end, so a failure leaves nothing half
+//! written.
+
+use super::model::FrictionModel;
+use super::{Diagnosis, PlotData};
+use crate::ssp::SystemFile;
+use plotters::prelude::*;
+use quick_xml::events::{BytesEnd, BytesStart, Event};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Write every output into `out` (replacing an earlier diagnose output
+/// there; refusing any other existing directory).
+pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Result<(), String> {
+    if out.exists() && !out.join("report.json").exists() {
+        return Err(format!(
+            "{}: exists and is not an earlier diagnose output (no report.json); choose another directory",
+            out.display()
+        ));
+    }
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+    let tmp = tempfile::Builder::new()
+        .prefix(".diagnose-")
+        .tempdir_in(parent)
+        .map_err(|e| {
+            format!(
+                "{}: cannot create a temporary directory: {e}",
+                parent.display()
+            )
+        })?;
+    let dir = tmp.path();
+    let json = serde_json::to_string_pretty(d).map_err(|e| e.to_string())?;
+    std::fs::write(dir.join("report.json"), json + "\n").map_err(|e| e.to_string())?;
+    std::fs::write(dir.join("report.md"), markdown(d)).map_err(|e| e.to_string())?;
+    plot_fit(&d.plots, &dir.join("fit.png"))?;
+    plot_residuals(&d.plots, &dir.join("residual.png"))?;
+    write_ssp(file, friction, &d.final_model, &dir.join("refitted.ssp"))?;
+    if out.exists() {
+        std::fs::remove_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    }
+    let kept: PathBuf = tmp.keep();
+    std::fs::rename(&kept, out).map_err(|e| format!("{}: {e}", out.display()))?;
+    Ok(())
+}
+
+fn pct(before: f64, after: f64) -> String {
+    if before > 0.0 {
+        format!("{:+.1} %", 100.0 * (after - before) / before)
+    } else {
+        "n/a".into()
+    }
+}
+
+/// The readable report.
+pub fn markdown(d: &Diagnosis) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Diagnosis of {}\n", d.system);
+    let _ = writeln!(s, "- measurements: {} ({} samples)", d.data, d.samples);
+    let _ = writeln!(
+        s,
+        "- held out: {} ({} samples compared)",
+        d.heldout, d.heldout_samples
+    );
+    let _ = writeln!(s, "- friction force from the data: {}", d.force_source);
+    let _ = writeln!(
+        s,
+        "- co-simulation: {} at {} s; {:.2} s wall time\n",
+        d.master, d.step, d.wall_seconds
+    );
+    let _ = writeln!(s, "## Result\n");
+    if d.effects.is_empty() {
+        let _ = writeln!(
+            s,
+            "No effect of the library improves the model significantly on the held-out data."
+        );
+    } else {
+        let names: Vec<&str> = d.effects.iter().map(|e| e.name.name()).collect();
+        let _ = writeln!(
+            s,
+            "Missing effect(s), in the order found: **{}**.",
+            names.join("**, **")
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nHeld-out RMS error (each channel divided by its standard deviation, then averaged in the mean square): nominal as given {:.5}, refitted nominal (baseline) {:.5}, final {:.5} ({} against the baseline). Measurement-noise floor {:.5}.",
+        d.nominal_rms,
+        d.baseline_rms,
+        d.final_rms,
+        pct(d.baseline_rms, d.final_rms),
+        d.noise_floor_rms
+    );
+    if d.unexplained {
+        let _ = writeln!(
+            s,
+            "\n**Unexplained**: the final error is more than twice the noise floor and no candidate of the library reduces it significantly. The remaining residual is largest in: {}.",
+            d.residual_pattern.strongest
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "\nThe final error is within twice the noise floor: nothing unexplained remains."
+        );
+    }
+    let _ = writeln!(s, "\n| channel | scale | nominal RMS | baseline RMS | final RMS |\n| --- | --- | --- | --- | --- |");
+    for c in &d.channels {
+        let _ = writeln!(
+            s,
+            "| `{}` | {:.4e} | {:.4e} | {:.4e} | {:.4e} |",
+            c.name, c.scale, c.nominal_rms, c.baseline_rms, c.final_rms
+        );
+    }
+    for (k, e) in d.effects.iter().enumerate() {
+        let _ = writeln!(s, "\n## {}. `{}`: {}\n", k + 1, e.name.name(), e.meaning);
+        let _ = writeln!(
+            s,
+            "Held-out RMS {:.5} → {:.5} ({}); p = {:.2e} < {:.2e}.\n",
+            e.rms_before,
+            e.rms_after,
+            pct(e.rms_before, e.rms_after),
+            e.p_value,
+            e.threshold
+        );
+        let _ = writeln!(
+            s,
+            "Where: {} {} holds {:.0} % of the improvement in {:.0} % of the samples.\n",
+            e.where_.state,
+            e.where_.bin,
+            100.0 * e.where_.share_of_improvement,
+            100.0 * e.where_.share_of_samples
+        );
+        let _ = writeln!(s, "| parameter | value |\n| --- | --- |");
+        for (n, v) in &e.parameters {
+            let _ = writeln!(s, "| {n} | {v} |");
+        }
+    }
+    let _ = writeln!(s, "\n## Candidates tried\n");
+    for (r, round) in d.rounds.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "Round {} ({} candidates; p must be below {:.2e}):\n\n| candidate | held-out RMS | drop of the mean square | p | force RMS (N, training) | fit runs |\n| --- | --- | --- | --- | --- | --- |",
+            r + 1,
+            round.len(),
+            d.alpha / round.len().max(1) as f64
+        );
+        for c in round {
+            let _ = writeln!(
+                s,
+                "| `{}` | {:.5} | {:.1} % | {:.2e} | {:.4} | {} |",
+                c.name,
+                c.heldout_rms,
+                100.0 * c.gain,
+                c.p_value,
+                c.force_rms,
+                c.fit_evaluations
+            );
+        }
+        let _ = writeln!(s);
+    }
+    let _ = writeln!(
+        s,
+        "## Where the baseline and the final model disagree with the data\n"
+    );
+    let _ = writeln!(s, "Friction residual (force the data imply minus the law's force along the measured states), held-out data.\n");
+    let _ = writeln!(s, "| state | bin | samples | baseline mean (N) | baseline RMS (N) | final mean (N) | final RMS (N) |\n| --- | --- | --- | --- | --- | --- | --- |");
+    for (b, a) in d.baseline_pattern.bins.iter().zip(&d.residual_pattern.bins) {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.0} % | {:+.4} | {:.4} | {:+.4} | {:.4} |",
+            b.state,
+            b.bin,
+            100.0 * b.share,
+            b.mean,
+            b.rms,
+            a.mean,
+            a.rms
+        );
+    }
+    let _ = writeln!(s, "\nPlots: `fit.png` (measured, nominal, final), `residual.png` (friction residual against the states). The refitted system: `refitted.ssp` (`fricsim run refitted.ssp --input <inputs.csv>`).");
+    s
+}
+
+type Fail = String;
+
+fn plot_fit(p: &PlotData, path: &Path) -> Result<(), Fail> {
+    crate::plot::register_font()?;
+    let n = p.channels.len().max(1);
+    let root = BitMapBackend::new(path, (1200, 300 * n as u32 + 40)).into_drawing_area();
+    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let root = root
+        .titled(
+            "held-out data: measured (black), nominal (red), final (blue)",
+            ("sans-serif", 20),
+        )
+        .map_err(|e| fail(&e))?;
+    let panels = root.split_evenly((n, 1));
+    let (t0, t1) = range(&p.time);
+    for ((name, meas, nom, fin), panel) in p.channels.iter().zip(panels.iter()) {
+        let (lo, hi) = range(&[meas.as_slice(), nom, fin].concat());
+        let mut chart = ChartBuilder::on(panel)
+            .margin(8)
+            .x_label_area_size(30)
+            .y_label_area_size(80)
+            .build_cartesian_2d(t0..t1, lo..hi)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("time [s]")
+            .y_desc(name.as_str())
+            .y_label_formatter(&|y| crate::plot::tick_label(*y, lo, hi))
+            .draw()
+            .map_err(|e| fail(&e))?;
+        for (series, color) in [(meas, BLACK), (nom, RED), (fin, BLUE)] {
+            chart
+                .draw_series(
+                    thin(&p.time, series)
+                        .into_iter()
+                        .map(|(t, y)| Circle::new((t, y), 1, color.filled())),
+                )
+                .map_err(|e| fail(&e))?;
+        }
+    }
+    root.present().map_err(|e| fail(&e))
+}
+
+fn plot_residuals(p: &PlotData, path: &Path) -> Result<(), Fail> {
+    crate::plot::register_font()?;
+    let mut states: Vec<(&str, &Vec<f64>)> = vec![
+        ("velocity v [m/s]", &p.v),
+        ("position x [m]", &p.x),
+        ("time since reversal [s]", &p.since_reversal),
+    ];
+    if let Some(f) = &p.fn_ {
+        states.push(("normal force Fn [N]", f));
+    }
+    let root = BitMapBackend::new(path, (1200, 280 * states.len() as u32 + 40)).into_drawing_area();
+    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let root = root
+        .titled(
+            "friction residual (data - law) on held-out data: baseline (red), final (blue)",
+            ("sans-serif", 20),
+        )
+        .map_err(|e| fail(&e))?;
+    let panels = root.split_evenly((states.len(), 1));
+    let (lo, hi) = range(&[p.residual_before.as_slice(), &p.residual_after].concat());
+    for ((label, xs), panel) in states.iter().zip(panels.iter()) {
+        let (x0, x1) = range(xs);
+        let mut chart = ChartBuilder::on(panel)
+            .margin(8)
+            .x_label_area_size(30)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, lo..hi)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc(*label)
+            .y_desc("residual [N]")
+            .x_label_formatter(&|x| crate::plot::tick_label(*x, x0, x1))
+            .y_label_formatter(&|y| crate::plot::tick_label(*y, lo, hi))
+            .draw()
+            .map_err(|e| fail(&e))?;
+        for (series, color) in [(&p.residual_before, RED), (&p.residual_after, BLUE)] {
+            chart
+                .draw_series(
+                    thin(xs, series)
+                        .into_iter()
+                        .map(|(x, y)| Circle::new((x, y), 1, color.filled())),
+                )
+                .map_err(|e| fail(&e))?;
+        }
+    }
+    root.present().map_err(|e| fail(&e))
+}
+
+/// At most 6000 evenly picked points.
+fn thin(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    let n = x.len().min(y.len());
+    let every = n.div_ceil(6000).max(1);
+    (0..n).step_by(every).map(|i| (x[i], y[i])).collect()
+}
+
+fn range(v: &[f64]) -> (f64, f64) {
+    let (lo, hi) = v
+        .iter()
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    if lo <= hi {
+        let pad = ((hi - lo) * 0.05).max(1e-12 * lo.abs().max(1.0));
+        (lo - pad, hi + pad)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+/// The refitted system: the nominal ssd with every `source` made absolute,
+/// the friction component's parameter bindings replaced by one inline set
+/// (its nominal values with the refitted ones over them), packed into a
+/// self-contained `.ssp` by [`crate::ssp::pack::pack`].
+fn write_ssp(
+    file: &SystemFile,
+    friction: &str,
+    model: &FrictionModel,
+    out: &Path,
+) -> Result<(), Fail> {
+    let ssd = file.ssd_path();
+    let text = std::fs::read_to_string(&ssd).map_err(|e| format!("{}: {e}", ssd.display()))?;
+    // values: the nominal component's, then the refitted ones
+    let mut values: Vec<(String, String, String)> = Vec::new(); // (name, type, value)
+    let mut put = |name: &str, ty: &str, value: String| {
+        values.retain(|(n, _, _)| n != name);
+        values.push((name.to_string(), ty.to_string(), value));
+    };
+    for p in file.parameters.iter().filter(|p| p.component == friction) {
+        let (ty, v) = match &p.value {
+            crate::ssp::Value::Real(x) => ("Real", format!("{x:e}")),
+            crate::ssp::Value::Integer(i) => ("Integer", i.to_string()),
+            crate::ssp::Value::Boolean(b) => ("Boolean", b.to_string()),
+            crate::ssp::Value::String(s) => ("String", s.clone()),
+        };
+        put(&p.variable, ty, v);
+    }
+    for (name, x) in model.parameters() {
+        match name.as_str() {
+            "direction_dependent" | "normal_force_form" | "position_dependent" => {
+                put(&name, "Boolean", (x != 0.0).to_string())
+            }
+            "n_table" => put(&name, "Integer", (x as i64).to_string()),
+            _ => put(&name, "Real", format!("{x:e}")),
+        }
+    }
+
+    let mut reader = quick_xml::Reader::from_str(&text);
+    let mut writer = quick_xml::Writer::new(Vec::new());
+    let fail =
+        |e: &dyn std::fmt::Display| format!("{}: rewriting for refitted.ssp: {e}", ssd.display());
+    let mut in_friction = false;
+    let mut skip_depth = 0usize;
+    let mut prefix = String::new();
+    loop {
+        let event = reader.read_event().map_err(|e| fail(&e))?;
+        if skip_depth > 0 {
+            match &event {
+                Event::Start(_) => skip_depth += 1,
+                Event::End(_) => skip_depth -= 1,
+                Event::Eof => break,
+                _ => {}
+            }
+            continue;
+        }
+        match event {
+            Event::Eof => break,
+            // the friction component's own bindings are replaced
+            Event::Start(e) if in_friction && local(e.name().as_ref()) == "ParameterBindings" => {
+                skip_depth = 1;
+            }
+            Event::Empty(e) if in_friction && local(e.name().as_ref()) == "ParameterBindings" => {}
+            Event::Start(e) => {
+                let e = absolute_source(file, &e).map_err(|m| fail(&m))?;
+                if local(e.name().as_ref()) == "Component" {
+                    let name = attr(&e, "name");
+                    in_friction = name.as_deref() == Some(friction);
+                    let full = e.name().as_ref().to_string();
+                    prefix = full.strip_suffix("Component").unwrap_or("").to_string();
+                }
+                writer.write_event(Event::Start(e)).map_err(|e| fail(&e))?;
+            }
+            Event::Empty(e) => {
+                let e = absolute_source(file, &e).map_err(|m| fail(&m))?;
+                writer.write_event(Event::Empty(e)).map_err(|e| fail(&e))?;
+            }
+            Event::End(e) => {
+                if local(e.name().as_ref()) == "Component" && in_friction {
+                    write_bindings(&mut writer, &prefix, &values).map_err(|e| fail(&e))?;
+                    in_friction = false;
+                }
+                writer.write_event(Event::End(e)).map_err(|e| fail(&e))?;
+            }
+            other => writer.write_event(other).map_err(|e| fail(&e))?,
+        }
+    }
+    let dir = out.parent().unwrap_or(Path::new("."));
+    let tmp_ssd = dir.join("refitted.ssd");
+    std::fs::write(&tmp_ssd, writer.into_inner()).map_err(|e| e.to_string())?;
+    let packed = crate::ssp::pack::pack(&tmp_ssd, out).map_err(|e| e.to_string());
+    let _ = std::fs::remove_file(&tmp_ssd);
+    packed
+}
+
+fn local(name: &str) -> &str {
+    name.rsplit(':').next().unwrap_or("")
+}
+
+fn attr(e: &BytesStart, key: &str) -> Option<String> {
+    e.attributes()
+        .flatten()
+        .find(|a| a.key.as_ref() == key)
+        .and_then(|a| {
+            a.normalized_value(quick_xml::XmlVersion::Implicit1_0)
+                .ok()
+                .map(|v| v.into_owned())
+        })
+}
+
+/// A copy of `e` with its `source` attribute resolved to an absolute path.
+fn absolute_source(file: &SystemFile, e: &BytesStart) -> Result<BytesStart<'static>, String> {
+    let name = e.name().as_ref().to_string();
+    let mut copy = BytesStart::new(name);
+    for a in e.attributes() {
+        let a = a.map_err(|err| err.to_string())?;
+        let key = a.key.as_ref().to_string();
+        let value = a
+            .normalized_value(quick_xml::XmlVersion::Implicit1_0)
+            .map_err(|err| err.to_string())?
+            .into_owned();
+        if key == "source" {
+            let path = file.resolve(&value)?;
+            let path = std::fs::canonicalize(&path).unwrap_or(path);
+            copy.push_attribute((key.as_str(), path.to_string_lossy().as_ref()));
+        } else {
+            copy.push_attribute((key.as_str(), value.as_str()));
+        }
+    }
+    Ok(copy)
+}
+
+fn write_bindings(
+    w: &mut quick_xml::Writer<Vec<u8>>,
+    prefix: &str,
+    values: &[(String, String, String)],
+) -> Result<(), quick_xml::Error> {
+    let start = |n: &str| BytesStart::new(n.to_string());
+    let tag = |n: &str| format!("{prefix}{n}");
+    w.write_event(Event::Start(start(&tag("ParameterBindings"))))?;
+    w.write_event(Event::Start(start(&tag("ParameterBinding"))))?;
+    w.write_event(Event::Start(start(&tag("ParameterValues"))))?;
+    let mut set = start("ssv:ParameterSet");
+    set.push_attribute(("version", "1.0"));
+    set.push_attribute(("name", "refitted_by_fricsim_diagnose"));
+    set.push_attribute((
+        "xmlns:ssv",
+        "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+    ));
+    w.write_event(Event::Start(set))?;
+    w.write_event(Event::Start(start("ssv:Parameters")))?;
+    for (name, ty, value) in values {
+        let mut p = start("ssv:Parameter");
+        p.push_attribute(("name", name.as_str()));
+        w.write_event(Event::Start(p))?;
+        let mut v = start(&format!("ssv:{ty}"));
+        v.push_attribute(("value", value.as_str()));
+        w.write_event(Event::Empty(v))?;
+        w.write_event(Event::End(BytesEnd::new("ssv:Parameter")))?;
+    }
+    w.write_event(Event::End(BytesEnd::new("ssv:Parameters")))?;
+    w.write_event(Event::End(BytesEnd::new("ssv:ParameterSet")))?;
+    w.write_event(Event::End(BytesEnd::new(tag("ParameterValues"))))?;
+    w.write_event(Event::End(BytesEnd::new(tag("ParameterBinding"))))?;
+    w.write_event(Event::End(BytesEnd::new(tag("ParameterBindings"))))?;
+    Ok(())
+}

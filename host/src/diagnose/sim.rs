@@ -1,0 +1,235 @@
+//! The two simulations diagnose runs, both through the FMUs:
+//!
+//! - [`FrictionSim`]: the friction FMU alone, driven along the measured
+//!   states (v, x, Fn held over each sample interval), giving the friction
+//!   force the law predicts there. This is what the fits minimise against
+//!   the force the data imply: thousands of runs, one FMU, no coupling.
+//! - [`co_simulate`]: the whole system with the measured inputs, as
+//!   `fricsim run` runs it, sampled at the measured times: the residuals on
+//!   the measured channels that the RMS figures and the significance test
+//!   use.
+
+use super::model::FrictionModel;
+use super::problem::{FrictionData, Measured, Setup};
+use crate::fmu::model_description::VariableKind;
+use crate::fmu::{Fmu, Instance, ValueReference};
+use crate::inputs::ExternalInputs;
+use crate::master::{by_name, simulate_with};
+use crate::ssp::SystemFile;
+use crate::system::{ParameterValue, System};
+
+/// A parameter's value reference and type in the friction FMU.
+#[derive(Clone, Copy)]
+enum Slot {
+    Real(ValueReference),
+    Integer(ValueReference),
+    Boolean(ValueReference),
+}
+
+/// The friction FMU driven along the data.
+pub struct FrictionSim {
+    fmu: Fmu,
+    instance: Instance,
+    inputs: [ValueReference; 3],
+    force: ValueReference,
+}
+
+impl FrictionSim {
+    pub fn new(fmu: &Fmu) -> Result<FrictionSim, String> {
+        let instance = fmu
+            .instantiate("diagnose-friction")
+            .map_err(|e| e.to_string())?;
+        let vr = |n: &str| -> Result<ValueReference, String> {
+            Ok(fmu.variable(n).map_err(|e| e.to_string())?.value_reference)
+        };
+        Ok(FrictionSim {
+            fmu: fmu.clone(),
+            instance,
+            inputs: [vr("v")?, vr("x")?, vr("Fn")?],
+            force: vr("F")?,
+        })
+    }
+
+    fn slot(&self, name: &str) -> Result<Slot, String> {
+        let v = self.fmu.variable(name).map_err(|e| e.to_string())?;
+        Ok(match v.kind {
+            VariableKind::Real { .. } => Slot::Real(v.value_reference),
+            VariableKind::Boolean { .. } => Slot::Boolean(v.value_reference),
+            _ => Slot::Integer(v.value_reference),
+        })
+    }
+
+    /// The friction force after each interval of `d` for `model`; an error
+    /// when the FMU refuses the parameters or a step.
+    pub fn run(&mut self, model: &FrictionModel, d: &FrictionData) -> Result<Vec<f64>, String> {
+        let fail = |e: crate::FmuError| e.to_string();
+        let i = &mut self.instance;
+        i.reset().map_err(fail)?;
+        let t0 = d.t.first().copied().unwrap_or(0.0);
+        i.setup_experiment(t0, None).map_err(fail)?;
+        i.enter_initialization_mode().map_err(fail)?;
+        for (name, value) in model.parameters() {
+            let slot = {
+                let v = self.fmu.variable(&name).map_err(|e| e.to_string())?;
+                match v.kind {
+                    VariableKind::Real { .. } => Slot::Real(v.value_reference),
+                    VariableKind::Boolean { .. } => Slot::Boolean(v.value_reference),
+                    _ => Slot::Integer(v.value_reference),
+                }
+            };
+            match slot {
+                Slot::Real(vr) => i.set_real(&[vr], &[value]),
+                Slot::Integer(vr) => i.set_integer(&[vr], &[value as i32]),
+                Slot::Boolean(vr) => i.set_boolean(&[vr], &[value != 0.0]),
+            }
+            .map_err(fail)?;
+        }
+        if !d.t.is_empty() {
+            i.set_real(&self.inputs, &[d.v[0], d.x[0], d.fn_[0]])
+                .map_err(fail)?;
+        }
+        i.exit_initialization_mode().map_err(fail)?;
+        let mut out = Vec::with_capacity(d.t.len());
+        let mut f = [0.0];
+        for k in 0..d.t.len() {
+            i.set_real(&self.inputs, &[d.v[k], d.x[k], d.fn_[k]])
+                .map_err(fail)?;
+            i.do_step(d.t[k], d.h[k]).map_err(fail)?;
+            i.get_real(&[self.force], &mut f).map_err(fail)?;
+            out.push(f[0]);
+        }
+        Ok(out)
+    }
+
+    /// Whether the FMU accepts this parameter name (for checks).
+    pub fn knows(&self, name: &str) -> bool {
+        self.slot(name).is_ok()
+    }
+}
+
+/// Residuals of one co-simulation on the measured channels, at the
+/// measured times (repeated times compare the first row only).
+pub struct ChannelResiduals {
+    /// Channel names.
+    pub channels: Vec<String>,
+    /// Sample indices (into the file) compared.
+    pub samples: Vec<usize>,
+    /// `values[c][s]`: simulated value of channel c at sample s.
+    pub simulated: Vec<Vec<f64>>,
+    /// `residuals[c][s]`: measured − simulated.
+    pub residuals: Vec<Vec<f64>>,
+    /// Set when the run stopped early (the samples after it are missing).
+    pub incomplete: Option<String>,
+}
+
+impl ChannelResiduals {
+    /// Per sample: mean over channels of (residual / scale)².
+    pub fn squared(&self, scales: &[f64]) -> Vec<f64> {
+        (0..self.samples.len())
+            .map(|s| {
+                self.residuals
+                    .iter()
+                    .zip(scales)
+                    .map(|(r, sc)| (r[s] / sc).powi(2))
+                    .sum::<f64>()
+                    / scales.len() as f64
+            })
+            .collect()
+    }
+}
+
+/// The parameters of the nominal system with the friction component's
+/// replaced by `model`'s.
+pub fn system_parameters(
+    file: &SystemFile,
+    setup: &Setup,
+    model: &FrictionModel,
+) -> Vec<(String, ParameterValue)> {
+    use crate::ssp::Value;
+    let mut p: Vec<(String, ParameterValue)> = file
+        .parameters
+        .iter()
+        .map(|d| {
+            let v = match &d.value {
+                Value::Real(x) => ParameterValue::Number(*x),
+                Value::Integer(i) => ParameterValue::Number(*i as f64),
+                Value::Boolean(b) => ParameterValue::Number(f64::from(u8::from(*b))),
+                Value::String(s) => ParameterValue::Text(s.clone()),
+            };
+            (format!("{}.{}", d.component, d.variable), v)
+        })
+        .collect();
+    for (name, value) in model.parameters() {
+        p.push((
+            format!("{}.{}", setup.friction_name, name),
+            ParameterValue::Number(value),
+        ));
+    }
+    p
+}
+
+/// Co-simulate `system` (restarted with `parameters`) over the file's time
+/// span with its inputs, and compare with its measured channels.
+pub fn co_simulate(
+    system: &mut System,
+    parameters: &[(String, ParameterValue)],
+    setup: &Setup,
+    data: &Measured,
+) -> Result<ChannelResiduals, String> {
+    let start = data.time[0];
+    let stop = *data.time.last().unwrap_or(&start);
+    system
+        .restart(start, parameters)
+        .map_err(|e| format!("setting up the co-simulation: {e}"))?;
+    let mut inputs = ExternalInputs::bind(data.input_table(), system)?.with_slopes(setup.step);
+    let mut master = by_name(&setup.master)?;
+    let run = simulate_with(
+        system,
+        master.as_mut(),
+        start,
+        setup.step,
+        stop,
+        &mut inputs,
+    )
+    .map_err(|e| format!("co-simulation: {e}"))?;
+    let mut samples = Vec::new();
+    for (k, &t) in data.time.iter().enumerate() {
+        let repeated = k > 0 && data.time[k - 1] == t;
+        let reached = run
+            .time
+            .last()
+            .is_some_and(|&last| t <= last + 1e-9 * setup.step);
+        if !repeated && reached {
+            samples.push(k);
+        }
+    }
+    let mut simulated = Vec::new();
+    let mut residuals = Vec::new();
+    for (name, values) in &data.outputs {
+        let col = run
+            .columns
+            .iter()
+            .position(|c| c == name)
+            .ok_or_else(|| format!("the co-simulation does not record `{name}`"))?;
+        let series: Vec<f64> = run.rows.iter().map(|r| r[col]).collect();
+        let sim: Vec<f64> = samples
+            .iter()
+            .map(|&k| crate::inputs::interpolate(data.time[k], &run.time, &series, false))
+            .collect();
+        residuals.push(
+            samples
+                .iter()
+                .zip(&sim)
+                .map(|(&k, s)| values[k] - s)
+                .collect(),
+        );
+        simulated.push(sim);
+    }
+    Ok(ChannelResiduals {
+        channels: data.outputs.iter().map(|(n, _)| n.clone()).collect(),
+        samples,
+        simulated,
+        residuals,
+        incomplete: run.error,
+    })
+}

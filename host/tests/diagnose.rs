@@ -1,0 +1,183 @@
+//! `fricsim diagnose` (host/src/diagnose/): the real-data case it must
+//! get right (EMPS) and the bad inputs it must refuse with a message,
+//! writing nothing.
+
+use fricsim::diagnose::model::Effect;
+use fricsim::diagnose::{diagnose, report, Options};
+use fricsim::ssp::SystemFile;
+use std::path::{Path, PathBuf};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// EMPS benchmark: from the symmetric Coulomb + viscous model, fitted on
+/// the training file and scored on the pulses file, the first effect named
+/// is the direction dependence and the held-out error does not get worse.
+#[test]
+fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
+    let r = repo();
+    let file = SystemFile::open(r.join("examples/emps_nominal.ssd")).unwrap();
+    let d = diagnose(
+        &file,
+        &r.join("examples/data/emps_train.csv"),
+        Some(&r.join("examples/data/emps_test_pulses.csv")),
+        &Options::default(),
+    )
+    .unwrap();
+    let names: Vec<Effect> = d.effects.iter().map(|e| e.name).collect();
+    assert_eq!(
+        names.first(),
+        Some(&Effect::DirectionDependent),
+        "{names:?}"
+    );
+    assert!(
+        d.final_rms <= d.baseline_rms,
+        "{} > {}",
+        d.final_rms,
+        d.baseline_rms
+    );
+    // the outputs: a report that parses, plots and a refitted system
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().join("emps");
+    report::write(&d, &file, &d.friction_component, &dir).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    for key in ["baseline_rms", "final_rms", "unexplained", "effects"] {
+        assert!(json.get(key).is_some(), "report.json lacks {key}");
+    }
+    let first = &json["effects"][0];
+    for key in ["name", "parameters", "rms_before", "rms_after", "where"] {
+        assert!(first.get(key).is_some(), "effect lacks {key}: {first}");
+    }
+    for f in ["report.md", "fit.png", "residual.png", "refitted.ssp"] {
+        assert!(dir.join(f).metadata().unwrap().len() > 0, "{f}");
+    }
+    // the refitted system opens, checks, and carries the fitted level
+    let refitted = SystemFile::open(dir.join("refitted.ssp")).unwrap();
+    refitted.check().unwrap();
+    let fc_neg = refitted
+        .parameters
+        .iter()
+        .rev()
+        .find(|p| p.component == "friction" && p.variable == "Fc_neg")
+        .map(|p| match p.value {
+            fricsim::ssp::Value::Real(x) => x,
+            _ => f64::NAN,
+        })
+        .unwrap();
+    assert!(
+        (fc_neg - d.final_model.fc_neg).abs() <= 1e-12 * fc_neg.abs(),
+        "{fc_neg}"
+    );
+}
+
+/// Write `text` as a CSV and diagnose the hidden-effect rig with it; the
+/// error message, and that the output directory was not created.
+fn refused(name: &str, text: &str) -> String {
+    let r = repo();
+    let file = SystemFile::open(r.join("examples/hidden_effect_rig.ssd")).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let csv = tmp.path().join(format!("{name}.csv"));
+    std::fs::write(&csv, text).unwrap();
+    let e = diagnose(&file, &csv, None, &Options::default())
+        .err()
+        .unwrap_or_else(|| panic!("{name}: accepted"));
+    assert!(!tmp.path().join("out").exists());
+    e
+}
+
+/// A well-formed file of `n` rows with the given header and a row maker.
+fn table(header: &str, n: usize, row: impl Fn(usize) -> String) -> String {
+    let mut s = format!("{header}\n");
+    for k in 0..n {
+        s.push_str(&row(k));
+        s.push('\n');
+    }
+    s
+}
+
+#[test]
+fn bad_measurement_files_are_refused_with_the_problem_named() {
+    let good = |k: usize| format!("{},0.1,0,100,0.1,0", k as f64 * 1e-3);
+    let header = "time,rig.x_ref,rig.v_ref,friction.Fn,rig.x,rig.u_ctrl";
+
+    let e = refused(
+        "unknown",
+        &table("time,rig.x_ref,rig.nonsense", 100, |k| {
+            format!("{},0.1,0", k as f64 * 1e-3)
+        }),
+    );
+    assert!(
+        e.contains("rig.nonsense") && e.contains("columns may be outputs"),
+        "{e}"
+    );
+
+    let e = refused(
+        "no_output",
+        &table("time,rig.x_ref,rig.v_ref", 100, |k| {
+            format!("{},0.1,0", k as f64 * 1e-3)
+        }),
+    );
+    assert!(e.contains("no column names an output"), "{e}");
+
+    let e = refused(
+        "connected",
+        &table("time,friction.v,rig.x", 100, |k| {
+            format!("{},0,0.1", k as f64 * 1e-3)
+        }),
+    );
+    assert!(
+        e.contains("friction.v") && e.contains("driven by a connection"),
+        "{e}"
+    );
+
+    let e = refused(
+        "parameter",
+        &table("time,rig.m,rig.x", 100, |k| {
+            format!("{},2,0.1", k as f64 * 1e-3)
+        }),
+    );
+    assert!(e.contains("rig.m") && e.contains("parameter"), "{e}");
+
+    let e = refused(
+        "backwards",
+        &table(header, 100, |k| {
+            let t = if k == 50 { 0.0 } else { k as f64 * 1e-3 };
+            format!("{t},0.1,0,100,0.1,0")
+        }),
+    );
+    assert!(
+        e.contains("time must not decrease") && e.contains("line"),
+        "{e}"
+    );
+
+    let e = refused(
+        "nan",
+        &table(header, 100, |k| {
+            if k == 7 {
+                format!("{},0.1,0,100,NaN,0", k as f64 * 1e-3)
+            } else {
+                good(k)
+            }
+        }),
+    );
+    assert!(
+        e.contains("rig.x") && e.contains("NaN") && e.contains("not a finite number"),
+        "{e}"
+    );
+
+    let e = refused("short", &table(header, 10, good));
+    assert!(e.contains("10 samples") && e.contains("at least"), "{e}");
+
+    let e = refused(
+        "missing_effort",
+        &table("time,rig.x_ref,rig.v_ref,rig.x", 100, |k| {
+            format!("{},0.1,0,0.1", k as f64 * 1e-3)
+        }),
+    );
+    assert!(
+        e.contains("rig.u_ctrl") && e.contains("must be measured"),
+        "{e}"
+    );
+}
