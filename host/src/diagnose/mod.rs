@@ -236,7 +236,7 @@ pub fn diagnose(
     };
     let step = match file.settings.step_size {
         Some(h) => h,
-        None => median_spacing(&train.time),
+        None => problem::median_spacing(&train.time),
     };
     let master = file
         .settings
@@ -541,30 +541,8 @@ struct Scored {
     q: Vec<f64>,
 }
 
-impl Clone for ChannelResiduals {
-    fn clone(&self) -> Self {
-        ChannelResiduals {
-            channels: self.channels.clone(),
-            samples: self.samples.clone(),
-            simulated: self.simulated.clone(),
-            residuals: self.residuals.clone(),
-            incomplete: self.incomplete.clone(),
-        }
-    }
-}
-
 fn mean(x: &[f64]) -> f64 {
     x.iter().sum::<f64>() / x.len().max(1) as f64
-}
-
-fn median_spacing(time: &[f64]) -> f64 {
-    let mut dt: Vec<f64> = time
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|d| *d > 0.0)
-        .collect();
-    dt.sort_by(f64::total_cmp);
-    dt[dt.len() / 2]
 }
 
 fn channel_rms(s: &Scored, c: usize) -> f64 {

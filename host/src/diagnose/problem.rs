@@ -24,7 +24,7 @@
 use super::model::{Context, FrictionModel};
 use crate::fmu::model_description::{Causality, VariableKind};
 use crate::fmu::{Fmu, Instance};
-use crate::inputs::{interpolate, InputTable};
+use crate::inputs::InputTable;
 use crate::ssp::SystemFile;
 use crate::system::System;
 use std::collections::BTreeMap;
@@ -554,17 +554,22 @@ impl Setup {
 /// Half-width (samples) of a smoothing window of `seconds` at the file's
 /// median sample spacing.
 fn window_half_width(time: &[f64], seconds: f64) -> usize {
+    if seconds <= 0.0 {
+        return 0;
+    }
+    ((0.5 * seconds / median_spacing(time)).round() as usize).min(time.len() / 4)
+}
+
+/// The median of the positive sample spacings (a file always has one:
+/// [`Measured::read`] requires time to advance).
+pub fn median_spacing(time: &[f64]) -> f64 {
     let mut dt: Vec<f64> = time
         .windows(2)
         .map(|w| w[1] - w[0])
         .filter(|d| *d > 0.0)
         .collect();
-    if dt.is_empty() || seconds <= 0.0 {
-        return 0;
-    }
     dt.sort_by(f64::total_cmp);
-    let median = dt[dt.len() / 2];
-    ((0.5 * seconds / median).round() as usize).min(time.len() / 4)
+    dt.get(dt.len() / 2).copied().unwrap_or(f64::INFINITY)
 }
 
 /// Savitzky–Golay smoothing (local quadratic, window 2·w + 1), with the
@@ -589,11 +594,6 @@ pub fn savitzky_golay(y: &[f64], w: usize) -> Vec<f64> {
         out.push(s);
     }
     out
-}
-
-/// The value of a measured column at time `time` (linear interpolation).
-pub fn at(time: f64, t: &[f64], v: &[f64]) -> f64 {
-    interpolate(time, t, v, false)
 }
 
 #[cfg(test)]

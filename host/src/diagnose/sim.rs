@@ -26,6 +26,16 @@ enum Slot {
     Boolean(ValueReference),
 }
 
+/// Where parameter `name` of `fmu` is set, and with which type.
+fn slot(fmu: &Fmu, name: &str) -> Result<Slot, String> {
+    let v = fmu.variable(name).map_err(|e| e.to_string())?;
+    Ok(match v.kind {
+        VariableKind::Real { .. } => Slot::Real(v.value_reference),
+        VariableKind::Boolean { .. } => Slot::Boolean(v.value_reference),
+        _ => Slot::Integer(v.value_reference),
+    })
+}
+
 /// The friction FMU driven along the data.
 pub struct FrictionSim {
     fmu: Fmu,
@@ -50,15 +60,6 @@ impl FrictionSim {
         })
     }
 
-    fn slot(&self, name: &str) -> Result<Slot, String> {
-        let v = self.fmu.variable(name).map_err(|e| e.to_string())?;
-        Ok(match v.kind {
-            VariableKind::Real { .. } => Slot::Real(v.value_reference),
-            VariableKind::Boolean { .. } => Slot::Boolean(v.value_reference),
-            _ => Slot::Integer(v.value_reference),
-        })
-    }
-
     /// The friction force after each interval of `d` for `model`; an error
     /// when the FMU refuses the parameters or a step.
     pub fn run(&mut self, model: &FrictionModel, d: &FrictionData) -> Result<Vec<f64>, String> {
@@ -69,15 +70,7 @@ impl FrictionSim {
         i.setup_experiment(t0, None).map_err(fail)?;
         i.enter_initialization_mode().map_err(fail)?;
         for (name, value) in model.parameters() {
-            let slot = {
-                let v = self.fmu.variable(&name).map_err(|e| e.to_string())?;
-                match v.kind {
-                    VariableKind::Real { .. } => Slot::Real(v.value_reference),
-                    VariableKind::Boolean { .. } => Slot::Boolean(v.value_reference),
-                    _ => Slot::Integer(v.value_reference),
-                }
-            };
-            match slot {
+            match slot(&self.fmu, &name)? {
                 Slot::Real(vr) => i.set_real(&[vr], &[value]),
                 Slot::Integer(vr) => i.set_integer(&[vr], &[value as i32]),
                 Slot::Boolean(vr) => i.set_boolean(&[vr], &[value != 0.0]),
@@ -100,15 +93,11 @@ impl FrictionSim {
         }
         Ok(out)
     }
-
-    /// Whether the FMU accepts this parameter name (for checks).
-    pub fn knows(&self, name: &str) -> bool {
-        self.slot(name).is_ok()
-    }
 }
 
 /// Residuals of one co-simulation on the measured channels, at the
 /// measured times (repeated times compare the first row only).
+#[derive(Clone)]
 pub struct ChannelResiduals {
     /// Channel names.
     pub channels: Vec<String>,
