@@ -42,6 +42,10 @@ pub struct DiagnoseArgs {
     /// Smoothing window of the measured position for the inverse dynamics (s).
     #[arg(long, default_value_t = 0.01)]
     pub smooth: f64,
+    /// Skip the output-error refinement of accepted models (faster; the
+    /// fitted parameters are those of the force fit).
+    #[arg(long)]
+    pub no_polish: bool,
 }
 
 pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
@@ -50,6 +54,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         alpha: a.alpha,
         smooth: a.smooth,
         blocks: a.blocks,
+        polish: !a.no_polish,
         ..Options::default()
     };
     if !(a.alpha > 0.0 && a.alpha < 1.0) {
@@ -117,6 +122,12 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             String::new()
         }
     );
+    if d.polish_cosimulations > 0 {
+        println!(
+            "refinement on the output error: {} co-simulations, {:.2} s",
+            d.polish_cosimulations, d.polish_seconds
+        );
+    }
     println!(
         "{:.2} s; wrote {}/report.json, report.md, fit.png, residual.png, refitted.ssp",
         d.wall_seconds,

@@ -1,9 +1,17 @@
-//! Fitting a friction model to the force the data imply: Levenberg–
-//! Marquardt (the `levenberg-marquardt` crate, MINPACK's algorithm) on
-//! the transformed parameters θ (see [`super::model`]), each residual a
-//! run of the friction FMU along the training intervals, the Jacobian by
-//! forward differences in θ. Starting points of the nonlinear parameters
-//! (Stribeck velocity, presliding stiffness) come from a small grid.
+//! Fitting a friction model: Levenberg–Marquardt (the `levenberg-marquardt`
+//! crate, MINPACK's algorithm) on the transformed parameters θ (see
+//! [`super::model`]), the Jacobian by forward differences in θ. Two
+//! objectives:
+//!
+//! - [`fit`]: the law's force against the force the data imply, each
+//!   residual vector one run of the friction FMU along the training
+//!   intervals (milliseconds); starting points of the nonlinear parameters
+//!   (Stribeck velocity, presliding stiffness) from a small grid;
+//! - [`polish`]: the whole system's outputs against the measured channels
+//!   on the training data (output error), each residual vector one
+//!   co-simulation; a few iterations from the force fit, for the effects
+//!   whose signature the force estimate cannot see (what happens while the
+//!   contact sticks).
 
 use super::model::{Free, FrictionModel};
 use super::problem::FrictionData;
@@ -17,46 +25,74 @@ const REFUSED: f64 = 1e3;
 /// Step of the forward differences in θ (θ is a logarithm: a relative step).
 const DIFF_STEP: f64 = 1e-5;
 
+/// Step of the forward differences of [`polish`]: larger, because a
+/// co-simulation's outputs carry the master's iteration tolerance.
+const POLISH_DIFF_STEP: f64 = 1e-3;
+
 /// The fit's result.
 pub struct Fitted {
     pub model: FrictionModel,
-    /// RMS of (law − data) force on the training intervals (N).
+    /// RMS of (law − data) force on the training intervals (N); for
+    /// [`polish`], the RMS of the normalised output residuals.
     pub rms: f64,
     pub evaluations: usize,
 }
 
-struct Problem<'a> {
+/// Residuals of a batch of models (one vector per model, `None` when it
+/// cannot be evaluated: the FMU refuses the parameters, the run fails).
+/// A batch is the columns of one forward-difference Jacobian, which an
+/// evaluator may run in parallel.
+pub type Residuals<'a> = dyn FnMut(&[FrictionModel]) -> Vec<Option<DVector<f64>>> + 'a;
+
+struct Problem<'a, 'r> {
     base: FrictionModel,
     free: Vec<Free>,
     theta: DVector<f64>,
-    sim: &'a mut FrictionSim,
-    data: &'a FrictionData,
-    train: &'a [usize],
-    scale: f64,
+    residual: &'r mut Residuals<'a>,
+    /// Length of the residual vector (for the refusal vector).
+    len: usize,
+    diff_step: f64,
     evaluations: usize,
+    /// Stop evaluating (and make LM stop) after this many.
+    budget: usize,
     residuals: Option<DVector<f64>>,
+    /// The lowest cost seen and its θ: the result, whatever LM reports.
+    best: Option<(f64, Vec<f64>)>,
 }
 
-impl Problem<'_> {
-    fn residuals_at(&mut self, theta: &[f64]) -> DVector<f64> {
-        self.evaluations += 1;
-        let model = self.base.at(&self.free, theta);
-        let norm = (self.train.len() as f64).sqrt() * self.scale;
-        match self.sim.run(&model, self.data) {
-            Ok(f) => DVector::from_iterator(
-                self.train.len(),
-                self.train.iter().map(|&j| (f[j] - self.data.f[j]) / norm),
-            ),
-            Err(_) => DVector::from_element(self.train.len(), REFUSED / norm),
+impl Problem<'_, '_> {
+    /// The residuals at each θ of `thetas` (one batch), or `None` when the
+    /// budget is spent.
+    fn residuals_at(&mut self, thetas: &[Vec<f64>]) -> Option<Vec<DVector<f64>>> {
+        if self.evaluations + thetas.len() > self.budget {
+            return None;
         }
+        self.evaluations += thetas.len();
+        let models: Vec<FrictionModel> =
+            thetas.iter().map(|t| self.base.at(&self.free, t)).collect();
+        let results = (self.residual)(&models);
+        let mut out = Vec::with_capacity(thetas.len());
+        for (theta, r) in thetas.iter().zip(results) {
+            let r = r
+                .filter(|r| r.iter().all(|x| x.is_finite()))
+                .unwrap_or_else(|| {
+                    DVector::from_element(self.len, REFUSED / (self.len as f64).sqrt())
+                });
+            let cost = r.norm_squared();
+            if self.best.as_ref().is_none_or(|(c, _)| cost < *c) {
+                self.best = Some((cost, theta.clone()));
+            }
+            out.push(r);
+        }
+        Some(out)
     }
 }
 
 /// A wrapper whose `residuals` and `jacobian` run the simulations (the
-/// crate's trait takes `&self`, the FMU needs `&mut`).
-struct Fit<'a>(std::cell::RefCell<Problem<'a>>);
+/// crate's trait takes `&self`, the simulations need `&mut`).
+struct Fit<'a, 'r>(std::cell::RefCell<Problem<'a, 'r>>);
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_> {
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_, '_> {
     type ResidualStorage = Owned<f64, Dyn>;
     type JacobianStorage = Owned<f64, Dyn, Dyn>;
     type ParameterStorage = Owned<f64, Dyn>;
@@ -75,8 +111,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_> {
         let mut p = self.0.borrow_mut();
         if p.residuals.is_none() {
             let theta: Vec<f64> = p.theta.iter().copied().collect();
-            let r = p.residuals_at(&theta);
-            p.residuals = Some(r);
+            p.residuals = p.residuals_at(&[theta]).and_then(|mut r| r.pop());
         }
         p.residuals.clone()
     }
@@ -85,16 +120,81 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_> {
         let r0 = self.residuals()?;
         let mut p = self.0.borrow_mut();
         let theta: Vec<f64> = p.theta.iter().copied().collect();
+        let steps: Vec<f64> = theta
+            .iter()
+            .map(|t| p.diff_step * t.abs().max(1.0))
+            .collect();
+        let shifted: Vec<Vec<f64>> = (0..theta.len())
+            .map(|j| {
+                let mut t = theta.clone();
+                t[j] += steps[j];
+                t
+            })
+            .collect();
+        let columns = p.residuals_at(&shifted)?;
         let mut jac = DMatrix::zeros(r0.len(), theta.len());
-        for j in 0..theta.len() {
-            let mut t = theta.clone();
-            let step = DIFF_STEP * t[j].abs().max(1.0);
-            t[j] += step;
-            let r = p.residuals_at(&t);
-            jac.set_column(j, &((r - &r0) / step));
+        for (j, r) in columns.into_iter().enumerate() {
+            jac.set_column(j, &((r - &r0) / steps[j]));
         }
         Some(jac)
     }
+}
+
+/// Minimise `residual` over the free parameters of `start` with at most
+/// `budget` evaluations; the best model seen, its cost and the count.
+fn minimise(
+    start: &FrictionModel,
+    residual: &mut Residuals<'_>,
+    diff_step: f64,
+    budget: usize,
+) -> (FrictionModel, f64, usize) {
+    let free = start.free();
+    let theta0 = start.theta(&free);
+    let mut problem = Problem {
+        theta: DVector::from_vec(theta0.clone()),
+        base: start.clone(),
+        free: free.clone(),
+        residual,
+        len: 1,
+        diff_step,
+        evaluations: 0,
+        budget,
+        residuals: None,
+        best: None,
+    };
+    match problem.residuals_at(std::slice::from_ref(&theta0)) {
+        // kept: LM asks for the start's residuals first
+        Some(mut r) => {
+            problem.len = r[0].len();
+            problem.residuals = r.pop();
+        }
+        None => return (start.clone(), f64::INFINITY, problem.evaluations),
+    }
+    let (result, _report) = LevenbergMarquardt::new()
+        .with_patience(12)
+        .with_ftol(1e-8)
+        .with_xtol(1e-8)
+        .minimize(Fit(std::cell::RefCell::new(problem)));
+    let p = result.0.into_inner();
+    let (cost, theta) = p.best.unwrap_or((f64::INFINITY, theta0));
+    (start.at(&free, &theta), cost, p.evaluations)
+}
+
+/// The force-fit residuals of `model`: (law − data) / (√n · scale) on the
+/// intervals `train`.
+fn force_residuals(
+    sim: &mut FrictionSim,
+    data: &FrictionData,
+    train: &[usize],
+    scale: f64,
+    model: &FrictionModel,
+) -> Option<DVector<f64>> {
+    let norm = (train.len() as f64).sqrt() * scale;
+    let f = sim.run(model, data).ok()?;
+    Some(DVector::from_iterator(
+        train.len(),
+        train.iter().map(|&j| (f[j] - data.f[j]) / norm),
+    ))
 }
 
 /// Fit the free parameters of `model` to `data` on the intervals `train`,
@@ -110,65 +210,38 @@ pub fn fit(
     // the best start by cost
     let mut best: Option<(f64, &FrictionModel)> = None;
     for s in starts {
-        let free = s.free();
-        let mut p = Problem {
-            base: s.clone(),
-            theta: DVector::from_vec(s.theta(&free)),
-            free,
-            sim,
-            data,
-            train,
-            scale,
-            evaluations: 0,
-            residuals: None,
-        };
-        let theta: Vec<f64> = p.theta.iter().copied().collect();
-        let cost = p.residuals_at(&theta).norm_squared();
-        evaluations += p.evaluations;
+        let cost =
+            force_residuals(sim, data, train, scale, s).map_or(f64::INFINITY, |r| r.norm_squared());
+        evaluations += 1;
         if best.is_none_or(|(c, _)| cost < c) {
             best = Some((cost, s));
         }
     }
     let start = best.map(|(_, s)| s).unwrap_or(&starts[0]).clone();
-    let free = start.free();
-    let problem = Problem {
-        theta: DVector::from_vec(start.theta(&free)),
-        base: start.clone(),
-        free: free.clone(),
-        sim,
-        data,
-        train,
-        scale,
-        evaluations: 0,
-        residuals: None,
-    };
-    let (result, report) = LevenbergMarquardt::new()
-        .with_patience(12)
-        .with_ftol(1e-8)
-        .with_xtol(1e-8)
-        .minimize(Fit(std::cell::RefCell::new(problem)));
-    let p = result.0.into_inner();
-    evaluations += p.evaluations;
-    let theta: Vec<f64> = p.theta.iter().copied().collect();
-    let model = start.at(&free, &theta);
-    let model = if report.objective_function.is_finite() {
-        model
-    } else {
-        start
-    };
-    let rms = match p.sim.run(&model, data) {
-        Ok(f) => (train
+    let mut residual = |models: &[FrictionModel]| {
+        models
             .iter()
-            .map(|&j| (f[j] - data.f[j]).powi(2))
-            .sum::<f64>()
-            / train.len().max(1) as f64)
-            .sqrt(),
-        Err(_) => f64::INFINITY,
+            .map(|m| force_residuals(sim, data, train, scale, m))
+            .collect()
     };
+    let (model, cost, n) = minimise(&start, &mut residual, DIFF_STEP, usize::MAX);
     Fitted {
         model,
-        rms,
-        evaluations: evaluations + 1,
+        // the residuals are divided by √n·scale
+        rms: cost.sqrt() * scale,
+        evaluations: evaluations + n,
+    }
+}
+
+/// Refine `start` on an output-error objective (`residual`: one
+/// co-simulation per model, already normalised), with at most `budget`
+/// co-simulations. Returns `start` itself when nothing better was found.
+pub fn polish(start: &FrictionModel, residual: &mut Residuals<'_>, budget: usize) -> Fitted {
+    let (model, cost, evaluations) = minimise(start, residual, POLISH_DIFF_STEP, budget);
+    Fitted {
+        model,
+        rms: cost.sqrt(),
+        evaluations,
     }
 }
 

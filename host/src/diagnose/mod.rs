@@ -29,6 +29,7 @@ pub mod model;
 pub mod problem;
 pub mod report;
 pub mod sim;
+pub mod suite;
 pub mod synthetic;
 
 use model::{Effect, FrictionModel};
@@ -58,6 +59,9 @@ pub struct Options {
     pub groups: usize,
     /// At most this many effects.
     pub max_effects: usize,
+    /// Refine each accepted model on the output error of the training
+    /// data ([`fit::polish`], [`POLISH_ITERATIONS`]).
+    pub polish: bool,
     /// Equal time blocks the data are cut into when no held-out file is
     /// given; every third, from the second on, is held out.
     pub blocks: usize,
@@ -73,6 +77,7 @@ impl Default for Options {
             min_gain: 0.02,
             groups: 20,
             max_effects: 4,
+            polish: true,
             blocks: SPLIT_BLOCKS,
         }
     }
@@ -83,6 +88,10 @@ impl Default for Options {
 /// [`SPLIT_BLOCKS`]), and every third block, from the second on, is held
 /// out (a third of the data, spread over the whole experiment).
 pub const SPLIT_BLOCKS: usize = 30;
+
+/// Levenberg–Marquardt iterations (one Jacobian each) of the output-error
+/// refinement of an accepted model ([`fit::polish`]).
+pub const POLISH_ITERATIONS: usize = 3;
 
 /// Whether time block `b` is held out.
 pub fn held_out_block(b: usize) -> bool {
@@ -159,6 +168,10 @@ pub struct Diagnosis {
     /// Family-wise significance level.
     pub alpha: f64,
     pub wall_seconds: f64,
+    /// Of which the output-error refinement of accepted models took this
+    /// long, in this many co-simulations.
+    pub polish_seconds: f64,
+    pub polish_cosimulations: usize,
     pub step: f64,
     pub master: String,
     #[serde(skip)]
@@ -256,14 +269,14 @@ pub fn diagnose(
     let block_of = move |t: f64| (((t - t0) / (t1 - t0) * blocks as f64) as usize).min(blocks - 1);
     let split = heldout_file.is_none();
     let train_intervals: Vec<usize> = (0..d_train.t.len())
-        .filter(|&j| !split || !held_out_block(block_of(d_train.t[j])))
+        .filter(|&j| d_train.trusted[j] && (!split || !held_out_block(block_of(d_train.t[j]))))
         .collect();
     let held = match (&heldout_file, &d_held) {
         (Some(h), Some(dh)) => HeldOut {
             data: h,
             friction: dh,
             samples: Box::new(|r: &ChannelResiduals| (0..r.samples.len()).collect()),
-            intervals: (0..dh.t.len()).collect(),
+            intervals: (0..dh.t.len()).filter(|&j| dh.trusted[j]).collect(),
         },
         _ => {
             let time = train.time.clone();
@@ -276,7 +289,7 @@ pub fn diagnose(
                         .collect()
                 }),
                 intervals: (0..d_train.t.len())
-                    .filter(|&j| held_out_block(block_of(d_train.t[j])))
+                    .filter(|&j| d_train.trusted[j] && held_out_block(block_of(d_train.t[j])))
                     .collect(),
             }
         }
@@ -323,6 +336,45 @@ pub fn diagnose(
             })
         };
 
+    // the output error on the training samples, for [`fit::polish`]
+    let train_samples: Picker = match &heldout_file {
+        Some(_) => Box::new(|r: &ChannelResiduals| (0..r.samples.len()).collect()),
+        None => {
+            let time = train.time.clone();
+            Box::new(move |r: &ChannelResiduals| {
+                (0..r.samples.len())
+                    .filter(|&s| !held_out_block(block_of(time[r.samples[s]])))
+                    .collect()
+            })
+        }
+    };
+    let polish = |model: &FrictionModel| -> fit::Fitted {
+        let train_residuals = |m: &FrictionModel| -> Option<nalgebra::DVector<f64>> {
+            // a system of its own (an FMU instance stays on its thread)
+            let mut system = file.build(0.0).ok()?;
+            let params = system_parameters(file, &setup, m);
+            let r = co_simulate(&mut system, &params, &setup, &train).ok()?;
+            if r.incomplete.is_some() {
+                return None;
+            }
+            let picked = train_samples(&r);
+            let channels = scales.len();
+            let norm = ((picked.len() * channels) as f64).sqrt();
+            Some(nalgebra::DVector::from_iterator(
+                picked.len() * channels,
+                picked.iter().flat_map(|&s| {
+                    let (r, scales) = (&r, &scales);
+                    (0..channels).map(move |c| r.residuals[c][s] / scales[c] / norm)
+                }),
+            ))
+        };
+        let mut residual = |models: &[FrictionModel]| -> Vec<Option<nalgebra::DVector<f64>>> {
+            models.par_iter().map(train_residuals).collect()
+        };
+        let budget = POLISH_ITERATIONS * (model.free().len() + 1) + 1;
+        fit::polish(model, &mut residual, budget)
+    };
+
     // nominal as given, then refitted
     let mut sim = FrictionSim::new(&setup.friction_fmu)?;
     let nominal_scored =
@@ -341,6 +393,7 @@ pub fn diagnose(
     let mut current_scored = baseline_scored.clone();
     let mut effects = Vec::new();
     let mut rounds = Vec::new();
+    let (mut polish_seconds, mut polish_runs) = (0.0, 0);
     // one round: fit and score each addition (one effect, or two at once)
     let try_round =
         |current: &FrictionModel, additions: &[Vec<Effect>]| -> Result<Vec<Tried>, String> {
@@ -426,7 +479,26 @@ pub fn diagnose(
         let Some((mut tried, k, p_value, threshold)) = accepted else {
             break;
         };
-        let t = tried.swap_remove(k);
+        let mut t = tried.swap_remove(k);
+        // refine the accepted model on the output error of the training data
+        let polish_started = Instant::now();
+        let polished = if options.polish {
+            polish(&t.model)
+        } else {
+            fit::Fitted {
+                model: t.model.clone(),
+                rms: f64::NAN,
+                evaluations: 0,
+            }
+        };
+        polish_seconds += polish_started.elapsed().as_secs_f64();
+        polish_runs += polished.evaluations;
+        if polished.evaluations > 0 && polished.model != t.model {
+            let scored = score(&mut system, &polished.model)
+                .map_err(|e| format!("the refined {}: {e}", label(&t.added)))?;
+            t.model = polished.model;
+            t.scored = scored;
+        }
         // the intermediate model of a pair: its first effect alone, as fitted in the singles round
         let mut steps: Vec<(Effect, FrictionModel, Scored)> = Vec::new();
         if t.added.len() == 2 {
@@ -511,6 +583,8 @@ pub fn diagnose(
         heldout_samples: current_scored.q.len(),
         alpha: options.alpha,
         wall_seconds: started.elapsed().as_secs_f64(),
+        polish_seconds,
+        polish_cosimulations: polish_runs,
         step,
         master,
         plots,

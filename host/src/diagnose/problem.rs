@@ -210,6 +210,16 @@ pub struct FrictionData {
     pub source: String,
     /// Whether a normal force is measured (and varies).
     pub normal_force_measured: bool,
+    /// Whether the interval's force is trusted for fitting: not within the
+    /// smoothing window of the file's ends, where the Savitzky–Golay fit
+    /// shrinks to nothing and the acceleration is one-sided, so that an
+    /// experiment that starts with a transient does not leave one estimate
+    /// of hundreds of newtons in the fit; and not where the contact sticks
+    /// (|v| below [`STICK_SPEED_FRACTION`] of the RMS speed), where the
+    /// force is whatever balances the rig, not the law's level, and a law
+    /// driven by the (noisy, near-zero) estimated velocity cannot follow it.
+    /// The co-simulation scores cover these intervals too.
+    pub trusted: Vec<bool>,
 }
 
 /// The system around the friction FMU.
@@ -430,13 +440,22 @@ impl Setup {
             && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
                 > fn_.iter().cloned().fold(f64::INFINITY, f64::min);
 
-        let (force, source) = if let Some(col) = data.column(&format!("{f}.F")) {
+        let (force, source, trusted) = if let Some(col) = data.column(&format!("{f}.F")) {
             (
                 (0..m).map(|j| col[end[j]]).collect(),
                 format!("measured `{f}.F`"),
+                vec![true; m],
             )
         } else {
-            self.inverse_dynamics(data, rig_x.as_deref(), &t, &h, &end, &v)?
+            let (force, source) =
+                self.inverse_dynamics(data, rig_x.as_deref(), &t, &h, &end, &v)?;
+            // one more sample for the central difference of the velocities
+            let edge = window_half_width(time, smooth) + 1;
+            let stuck = STICK_SPEED_FRACTION * rms(&v);
+            let trusted = (0..m)
+                .map(|j| start_of(j) >= edge && end[j] + edge < n && v[j].abs() >= stuck)
+                .collect();
+            (force, source, trusted)
         };
         Ok(FrictionData {
             t,
@@ -448,6 +467,7 @@ impl Setup {
             f: force,
             source,
             normal_force_measured,
+            trusted,
         })
     }
 
@@ -549,6 +569,14 @@ impl Setup {
             position_knots,
         }
     }
+}
+
+/// Below this fraction of the RMS speed, an interval of inverse-dynamics
+/// data counts as sticking (see [`FrictionData::trusted`]).
+pub const STICK_SPEED_FRACTION: f64 = 0.01;
+
+fn rms(x: &[f64]) -> f64 {
+    (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()
 }
 
 /// Half-width (samples) of a smoothing window of `seconds` at the file's

@@ -142,7 +142,13 @@ pub fn generate(
     csv: &Path,
 ) -> Result<Case, String> {
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
-    let setup = Setup::new(file, &mut system, SAMPLE, "jacobi")?;
+    // the data come from the system file's own master algorithm
+    let master_name = file
+        .settings
+        .master
+        .clone()
+        .unwrap_or_else(|| "jacobi".to_string());
+    let setup = Setup::new(file, &mut system, SAMPLE, &master_name)?;
     let n = (duration / SAMPLE).round() as usize;
     let time: Vec<f64> = (0..=n).map(|k| k as f64 * SAMPLE).collect();
     let xr: Vec<f64> = time.iter().map(|&t| x_ref(t)).collect();
@@ -169,6 +175,7 @@ pub fn generate(
         f: vec![0.0; n],
         source: String::new(),
         normal_force_measured: true,
+        trusted: vec![true; n],
     };
     let mut truth = setup.nominal.clone();
     let mut amplitudes = Vec::new();
@@ -233,7 +240,7 @@ pub fn generate(
         ],
     };
     let mut inputs = ExternalInputs::bind(table, &system)?.with_slopes(SAMPLE);
-    let mut master = by_name("jacobi")?;
+    let mut master = by_name(&master_name)?;
     let run = simulate_with(
         &mut system,
         master.as_mut(),
