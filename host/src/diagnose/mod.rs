@@ -112,6 +112,9 @@ pub struct CandidateScore {
     /// RMS of the law's force against the force the data imply (N), training.
     pub force_rms: f64,
     pub fit_evaluations: usize,
+    /// Why its co-simulation failed (then it is rejected).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<String>,
 }
 
 /// An accepted effect.
@@ -409,8 +412,8 @@ pub fn diagnose(
                     let starts = starts(&base, *last, &context);
                     let fitted = fit::fit(&starts, &mut sim, &d_train, &train_intervals);
                     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
-                    let scored = score(&mut system, &fitted.model)
-                        .map_err(|e| format!("candidate {}: {e}", label(added)))?;
+                    // a candidate whose co-simulation fails is rejected, not fatal
+                    let scored = score(&mut system, &fitted.model);
                     Ok(Tried {
                         added: added.clone(),
                         model: fitted.model.clone(),
@@ -455,14 +458,21 @@ pub fn diagnose(
             let threshold = options.alpha / additions.len() as f64;
             let mut round = Vec::new();
             for t in &tried {
-                let (gain, p) = paired_test(&current_scored.q, &t.scored.q, options.groups);
+                let (heldout_rms, gain, p_value, failure) = match &t.scored {
+                    Ok(scored) => {
+                        let (gain, p) = paired_test(&current_scored.q, &scored.q, options.groups);
+                        (mean(&scored.q).sqrt(), gain, p, None)
+                    }
+                    Err(e) => (f64::INFINITY, f64::NEG_INFINITY, 1.0, Some(e.clone())),
+                };
                 round.push(CandidateScore {
                     name: label(&t.added),
-                    heldout_rms: mean(&t.scored.q).sqrt(),
+                    heldout_rms,
                     gain,
-                    p_value: p,
+                    p_value,
                     force_rms: t.force_rms,
                     fit_evaluations: t.evaluations,
+                    failure,
                 });
             }
             let best = (0..round.len())
@@ -479,38 +489,41 @@ pub fn diagnose(
         let Some((mut tried, k, p_value, threshold)) = accepted else {
             break;
         };
-        let mut t = tried.swap_remove(k);
+        let t = tried.swap_remove(k);
+        let (mut model, mut scored) = match t.scored {
+            Ok(s) => (t.model, s),
+            Err(e) => return Err(format!("accepted {} without a score: {e}", label(&t.added))),
+        };
         // refine the accepted model on the output error of the training data
         let polish_started = Instant::now();
         let polished = if options.polish {
-            polish(&t.model)
+            polish(&model)
         } else {
             fit::Fitted {
-                model: t.model.clone(),
+                model: model.clone(),
                 rms: f64::NAN,
                 evaluations: 0,
             }
         };
         polish_seconds += polish_started.elapsed().as_secs_f64();
         polish_runs += polished.evaluations;
-        if polished.evaluations > 0 && polished.model != t.model {
-            let scored = score(&mut system, &polished.model)
-                .map_err(|e| format!("the refined {}: {e}", label(&t.added)))?;
-            t.model = polished.model;
-            t.scored = scored;
+        if polished.evaluations > 0 && polished.model != model {
+            // kept unrefined if the refined model's co-simulation fails
+            if let Ok(s) = score(&mut system, &polished.model) {
+                model = polished.model;
+                scored = s;
+            }
         }
         // the intermediate model of a pair: its first effect alone, as fitted in the singles round
         let mut steps: Vec<(Effect, FrictionModel, Scored)> = Vec::new();
         if t.added.len() == 2 {
             if let Some(single) = singles_tried.iter().find(|s| s.added == [t.added[0]]) {
-                steps.push((t.added[0], single.model.clone(), single.scored.clone()));
+                if let Ok(single_scored) = &single.scored {
+                    steps.push((t.added[0], single.model.clone(), single_scored.clone()));
+                }
             }
         }
-        steps.push((
-            *t.added.last().expect("an effect"),
-            t.model.clone(),
-            t.scored.clone(),
-        ));
+        steps.push((*t.added.last().expect("an effect"), model, scored));
         for (effect, model, scored) in steps {
             let where_ = localise::where_improved(
                 held.friction,
@@ -597,7 +610,8 @@ struct Tried {
     model: FrictionModel,
     force_rms: f64,
     evaluations: usize,
-    scored: Scored,
+    /// The held-out co-simulation, or why it failed.
+    scored: Result<Scored, String>,
 }
 
 /// `a` or `a+b`.

@@ -154,6 +154,17 @@ pub fn markdown(d: &Diagnosis) -> String {
             d.alpha / round.len().max(1) as f64
         );
         for c in round {
+            if let Some(why) = &c.failure {
+                let _ = writeln!(
+                    s,
+                    "| `{}` | rejected: its co-simulation failed ({}) | | | {:.4} | {} |",
+                    c.name,
+                    why.replace('|', "/"),
+                    c.force_rms,
+                    c.fit_evaluations
+                );
+                continue;
+            }
             let _ = writeln!(
                 s,
                 "| `{}` | {:.5} | {:.1} % | {:.2e} | {:.4} | {} |",
