@@ -319,7 +319,7 @@ impl LuGre {
         } else {
             r.powf(p.stribeck_exponent)
         };
-        self.scale(dir, x) * (fc + (fs - fc) * (-e).exp())
+        self.scale(dir, x) * (fc + (fs - fc) * exp_neg(e))
     }
 
     /// Stribeck level `g(v)` (N) with the direction, position and
@@ -474,8 +474,17 @@ impl LuGre {
             let lambda = self.p.sigma0 * wm / self.g_unit(wm, s, x.at(tm));
             let zss_b = self.zss(v.at(t1).abs(), s, x.at(t1));
             let lh = lambda * hs;
-            let decay = (-lh).exp();
-            let phi = if lh > 0.0 { -(-lh).exp_m1() / lh } else { 1.0 };
+            let decay = exp_neg(lh);
+            let phi = if lh > 0.0 {
+                // 1 − e^(−lh) is 1 to the last bit beyond lh = 40
+                if lh > 40.0 {
+                    1.0 / lh
+                } else {
+                    -(-lh).exp_m1() / lh
+                }
+            } else {
+                1.0
+            };
             z = zss_b + (z - zss_a) * decay - (zss_b - zss_a) * phi;
             zss_a = zss_b;
             t = t1;
@@ -498,6 +507,19 @@ impl LuGre {
             [z] => Err(format!("LuGre state z = {z} is not finite")),
             _ => Err(format!("LuGre state has 1 value, got {}", s.len())),
         }
+    }
+}
+
+/// `e^(−a)` for `a ≥ 0`, with 0 beyond the smallest subnormal (a > 745.2,
+/// where `exp` returns 0 anyway) without libm's slow underflow path, which
+/// a stiff contact (σ0|v|h/g in the thousands) or a Stribeck term far above
+/// vs would otherwise take at every step.
+#[inline]
+fn exp_neg(a: f64) -> f64 {
+    if a > 745.2 {
+        0.0
+    } else {
+        (-a).exp()
     }
 }
 
