@@ -100,6 +100,8 @@ pub fn run(api: Api, model: &Model, data: &[u8]) -> usize {
     let mut calls = 0usize;
     let vars = &model.vars;
     let unknown = model.unknown_vr();
+    // FMI_SEQUENCE_TRACE=1 prints every call and its messages (to replay a finding).
+    let trace = std::env::var_os("FMI_SEQUENCE_TRACE").is_some();
     while !b.is_empty() && calls < 400 {
         let op = b.index(24);
         calls += 1;
@@ -164,6 +166,9 @@ pub fn run(api: Api, model: &Model, data: &[u8]) -> usize {
                     let n = 1 + b.index(3);
                     let vrs: Vec<Vr> = (0..n).map(|_| pick_vr(&mut b)).collect();
                     let values: Vec<f64> = (0..n).map(|_| b.real()).collect();
+                    if trace {
+                        eprintln!("fmi2SetReal {vrs:?} = {values:?}");
+                    }
                     slot.instance.set_real(&vrs, &values)
                 }
                 9 => {
@@ -353,6 +358,15 @@ pub fn run(api: Api, model: &Model, data: &[u8]) -> usize {
                 }
             }
         };
+        if trace {
+            eprintln!(
+                "op {op} on instance {k} (t = {}): status {status}",
+                slots[k].t
+            );
+            for m in slots[k].instance.log.messages.lock().unwrap().iter() {
+                eprintln!("    {}", m.text);
+            }
+        }
         check_status(&format!("operation {op}"), status);
         check_log(&slots[k.min(slots.len() - 1)]);
     }
