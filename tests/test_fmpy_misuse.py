@@ -12,29 +12,7 @@ import ctypes
 import math
 
 import pytest
-from conftest import CapturedInstance
 from fmpy.fmi1 import FMICallException
-
-
-
-@pytest.fixture
-def instance(tmp_path):
-    """Like conftest's fixture, but each instance unpacks into its own
-    directory: several instances of one FMU are alive at once here, and
-    unpacking again over a loaded binary would rewrite it under them."""
-    opened = []
-
-    def open_(name, **kwargs):
-        parent = tmp_path / f"i{len(opened)}"
-        parent.mkdir()
-        inst = CapturedInstance(name, parent, **kwargs)
-        opened.append(inst)
-        return inst
-
-    yield open_
-    for inst in opened:
-        inst.close()
-
 
 SHIPPED = ["Dahl", "LuGre", "ResetIntegrator", "Bristle", "Bristle2D", "Rig1D", "Rig2D"]
 STATES = ["Instantiated", "InitializationMode", "StepComplete", "Terminated"]

@@ -85,6 +85,31 @@ fn mutate(rng: &mut Rng, input: &[u8]) -> Vec<u8> {
     out
 }
 
+/// Accepted and refused inputs of a parser.
+#[derive(Default)]
+struct Tally {
+    accepted: usize,
+    refused: usize,
+}
+
+impl Tally {
+    /// Count `parse()`'s outcome; a panic is a finding, shown with `input`.
+    fn count<T, E: std::fmt::Display>(
+        &mut self,
+        parse: impl FnOnce() -> Result<T, E>,
+        input: impl FnOnce() -> String,
+    ) {
+        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse)) {
+            Ok(Ok(_)) => self.accepted += 1,
+            Ok(Err(e)) => {
+                assert!(!e.to_string().is_empty(), "an empty message");
+                self.refused += 1
+            }
+            Err(_) => panic!("the parser panicked on {}", input()),
+        }
+    }
+}
+
 #[test]
 fn random_call_sequences_against_every_shipped_fmu() {
     let mut rng = Rng(SEED);
@@ -162,24 +187,17 @@ fn mutated_model_descriptions_never_panic_the_parser() {
             .unwrap(),
     );
     let start = Instant::now();
-    let (mut accepted, mut refused) = (0, 0);
+    let mut tally = Tally::default();
     for iteration in 0..15000 {
         let base = &seeds[iteration % seeds.len()];
         let bytes = mutate(&mut rng, base);
         let text = String::from_utf8_lossy(&bytes);
-        let outcome = std::panic::catch_unwind(|| fricsim::fmu::ModelDescription::parse(&text));
-        match outcome {
-            Ok(Ok(_)) => accepted += 1,
-            Ok(Err(e)) => {
-                assert!(!e.to_string().is_empty());
-                refused += 1
-            }
-            Err(_) => panic!(
-                "iteration {iteration} (seed {:#x}) panicked on:\n{text}",
-                SEED + 2
-            ),
-        }
+        tally.count(
+            || fricsim::fmu::ModelDescription::parse(&text),
+            || format!("iteration {iteration} (seed {:#x}):\n{text}", SEED + 2),
+        );
     }
+    let Tally { accepted, refused } = tally;
     eprintln!(
         "{accepted} accepted, {refused} refused in {:.1?}",
         start.elapsed()
@@ -221,7 +239,7 @@ fn mutated_system_files_never_panic_the_reader() {
         })
         .collect();
     let start = Instant::now();
-    let (mut accepted, mut refused) = (0, 0);
+    let mut tally = Tally::default();
     for iteration in 0..4000 {
         let (name, ssd) = &ssds[iteration % ssds.len()];
         // Mostly the .ssd, every fourth time one .ssv instead.
@@ -237,24 +255,22 @@ fn mutated_system_files_never_panic_the_reader() {
             let bytes = mutate(&mut rng, &ssvs[k].1);
             std::fs::write(work.path().join(&ssvs[k].0), bytes).unwrap();
         }
-        let outcome = std::panic::catch_unwind(|| fricsim::ssp::SystemFile::open(&path));
-        match outcome {
-            Ok(Ok(_)) => accepted += 1,
-            Ok(Err(e)) => {
-                assert!(!e.to_string().is_empty());
-                refused += 1
-            }
-            Err(_) => panic!(
-                "iteration {iteration} (seed {:#x}) panicked on {name}:\n{}",
-                SEED + 3,
-                String::from_utf8_lossy(&ssd_bytes)
-            ),
-        }
+        tally.count(
+            || fricsim::ssp::SystemFile::open(&path),
+            || {
+                format!(
+                    "iteration {iteration} (seed {:#x}), {name}:\n{}",
+                    SEED + 3,
+                    String::from_utf8_lossy(&ssd_bytes)
+                )
+            },
+        );
         if let Some(k) = mutated_ssv {
             std::fs::write(work.path().join(&ssvs[k].0), &ssvs[k].1).unwrap();
         }
         std::fs::remove_file(&path).unwrap();
     }
+    let Tally { accepted, refused } = tally;
     eprintln!(
         "{accepted} accepted, {refused} refused in {:.1?}",
         start.elapsed()
