@@ -201,7 +201,7 @@ pub fn run(api: Api, model: &Model, data: &[u8]) -> usize {
                         (a.get_boolean)(c, vr.as_ptr(), 1, v.as_mut_ptr())
                     }
                 }
-                12 | 13 | 14 => {
+                12..=14 => {
                     let h = STEPS[b.index(STEPS.len())];
                     let t = if b.byte() < 240 { slot.t } else { b.real() };
                     let s = slot.instance.do_step(t, h);
