@@ -54,9 +54,6 @@ macro_rules! api {
         }
 
         impl Api {
-            /// Every symbol name, in the order of the fields.
-            pub const SYMBOLS: &'static [&'static str] = &[$($symbol),*];
-
             /// Resolve every function with `lookup` (symbol name → address).
             ///
             /// # Safety
@@ -260,8 +257,8 @@ unsafe impl Send for Instance {}
 pub const CO_SIMULATION: c_int = 1;
 
 impl Instance {
-    /// `fmi2Instantiate` with a recording logger; `None` if it returned NULL
-    /// (the log of the refusal is in `log`).
+    /// `fmi2Instantiate` with a recording logger; if it returned NULL, the
+    /// log with the FMU's reason instead.
     pub fn new(api: Api, name: &str, guid: &str, logging_on: bool) -> Result<Instance, Box<Log>> {
         let log = Box::<Log>::default();
         let callbacks = Box::new(Callbacks {
