@@ -23,11 +23,15 @@ for name in Dahl LuGre ResetIntegrator Bristle Bristle2D Rig1D Rig2D; do
     fmu="dist/$name.fmu"
     [ -f "$fmu" ] || { echo "$fmu missing: run ./build-fmu.sh"; exit 2; }
     mkdir -p "$work/$name"
-    unzip -q -o "$fmu" -d "$work/$name"
+    if command -v unzip > /dev/null; then
+        unzip -q -o "$fmu" -d "$work/$name"
+    else
+        python3 -m zipfile -e "$fmu" "$work/$name"
+    fi
     guid=$(grep -o 'guid="[^"]*"' "$work/$name/modelDescription.xml" | head -1 | cut -d'"' -f2)
     id=$(grep -o 'modelIdentifier="[^"]*"' "$work/$name/modelDescription.xml" | head -1 | cut -d'"' -f2)
     so="$work/$name/binaries/linux64/$id.so"
-    start=$(date +%s.%N)
+    start=$(date +%s%N)
     if [ $use_valgrind = 1 ]; then
         # One cycle first: what stays allocated at exit after any number of
         # cycles must be exactly what stays after one (no growth per cycle).
@@ -54,7 +58,8 @@ for name in Dahl LuGre ResetIntegrator Bristle Bristle2D Rig1D Rig2D; do
         "$work/leak_cycles" "$so" "$guid" "$cycles" > "$work/$name.out" || { echo "$name: FAILED"; status=1; continue; }
         summary="(no valgrind)"
     fi
-    end=$(date +%s.%N)
-    printf '%-16s %d cycles %5.1f s  %s\n' "$name" "$cycles" "$(echo "$end - $start" | bc)" "$summary"
+    end=$(date +%s%N)
+    ms=$(( (end - start) / 1000000 ))
+    printf '%-16s %d cycles %3d.%d s  %s\n' "$name" "$cycles" $((ms / 1000)) $((ms % 1000 / 100)) "$summary"
 done
 exit $status
