@@ -68,7 +68,11 @@ def instance(tmp_path):
     opened = []
 
     def open_(name, **kwargs):
-        inst = CapturedInstance(name, tmp_path, **kwargs)
+        # Each instance unpacks into its own directory: unpacking again
+        # over a binary that is loaded would rewrite it under the instance.
+        parent = tmp_path / f"instance{len(opened)}"
+        parent.mkdir()
+        inst = CapturedInstance(name, parent, **kwargs)
         opened.append(inst)
         return inst
 

@@ -133,6 +133,19 @@ pub enum FmuError {
         messages: Vec<String>,
     },
 
+    /// A call took longer than the limit set with
+    /// [`Instance::set_call_time_limit`](crate::fmu::Instance::set_call_time_limit)
+    /// (`--step-timeout`); its result is not used.
+    #[error(
+        "{function} for instance \"{instance}\" took {elapsed:.3} s, longer than the limit of {limit} s (--step-timeout); its result is not used"
+    )]
+    TimeLimit {
+        function: &'static str,
+        instance: String,
+        elapsed: f64,
+        limit: f64,
+    },
+
     /// An FMU function returned Discard, Error, Fatal or Pending;
     /// `messages` are what the instance logged during the call.
     #[error(

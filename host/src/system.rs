@@ -258,6 +258,14 @@ impl System {
         Ok(())
     }
 
+    /// A time limit on each FMI call of every component (`None`: none);
+    /// see [`crate::fmu::watchdog`] for what it can and cannot do.
+    pub fn set_call_time_limit(&mut self, limit: Option<std::time::Duration>) {
+        for c in &mut self.components {
+            c.instance.set_call_time_limit(limit);
+        }
+    }
+
     /// Copy every connected output to its input.
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
         for (k, c) in self.connections.iter().enumerate() {

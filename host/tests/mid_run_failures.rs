@@ -8,6 +8,10 @@
 //! it asks to end (fmi2Terminated); after fmi2Fatal the FMU is never called
 //! again, not even by fmi2FreeInstance. The same through `fricsim cosim`,
 //! whose CSV keeps the rows so far and ends with an `# INCOMPLETE` line.
+//! A step that takes too long (0.6 s of sleep in the FMU) under a time
+//! limit (`--step-timeout`) is reported the same way, naming the instance,
+//! the call, its duration and the limit; the watchdog says so on stderr
+//! while the call is still running.
 
 mod belt;
 mod common;
@@ -213,8 +217,13 @@ fn a_nan_output_stops_the_run_and_names_the_fmu_that_produced_it() {
 /// `fricsim cosim` with the rig failing: exit status 1, the message on
 /// stderr, the CSV with the rows so far.
 fn cosim(rig: &Rig, fault: i32, out: &Path) -> (Option<i32>, String) {
+    cosim_with(rig, fault, out, &[])
+}
+
+fn cosim_with(rig: &Rig, fault: i32, out: &Path, extra: &[&str]) -> (Option<i32>, String) {
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_fricsim"))
         .arg("cosim")
+        .args(extra)
         .arg("--fmu")
         .arg(format!("rig={}", rig.belt.display()))
         .arg("--fmu")
@@ -286,4 +295,59 @@ fn fricsim_cosim_exits_nonzero_names_the_failure_and_keeps_the_rows_so_far() {
         assert_eq!(last[0], (FAULT_STEP - 1) as f64 * H);
         assert!(last.iter().all(|x| x.is_finite()), "{csv}");
     }
+}
+
+#[test]
+fn a_step_over_the_time_limit_stops_the_run_naming_the_instance_and_the_call() {
+    let rig = rig();
+    for mut master in masters() {
+        let mut system = coupled(&rig, belt::SLOW, false);
+        system.set_call_time_limit(Some(std::time::Duration::from_millis(200)));
+        let run = simulate(&mut system, master.as_mut(), H, 1.0).unwrap();
+        let error = assert_stopped_at_the_fault(&run);
+        for part in [
+            "fmi2DoStep for instance \"rig\" took 0.6",
+            "longer than the limit of 0.2 s (--step-timeout)",
+        ] {
+            assert!(error.contains(part), "{}: {error}", master.name());
+        }
+        // A slow step is not an FMU error: the instance is freed as usual.
+        let counters = Counters::of(&system.components[0].fmu);
+        drop(system);
+        assert_eq!(counters.live_instances(), 0);
+    }
+    // Without a limit the same run completes.
+    let mut system = coupled(&rig, belt::SLOW, false);
+    let run = simulate(&mut system, &mut Jacobi::default(), H, 20.0 * H).unwrap();
+    assert!(run.error.is_none(), "{:?}", run.error);
+    assert_eq!(run.rows.len(), 21);
+}
+
+#[test]
+fn fricsim_cosim_step_timeout_reports_the_slow_call_while_it_runs_and_keeps_the_rows() {
+    let rig = rig();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("slow.csv");
+    let (code, stderr) = cosim_with(&rig, belt::SLOW, &out, &["--step-timeout", "0.2"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    for part in [
+        // the watchdog, while the call is running
+        "instance \"rig\" has been in fmi2DoStep for more than the limit of 0.2 s",
+        // the run's report, after it returned
+        "run INCOMPLETE",
+        "fmi2DoStep for instance \"rig\" took 0.6",
+    ] {
+        assert!(stderr.contains(part), "missing {part:?} in {stderr}");
+    }
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 1 + FAULT_STEP + 1, "{csv}");
+    assert!(lines[FAULT_STEP + 1].starts_with("# INCOMPLETE"), "{csv}");
+    // A limit that is not a positive number is refused.
+    let (code, stderr) = cosim_with(&rig, 0, &out, &["--step-timeout=0"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("--step-timeout must be a positive number"),
+        "{stderr}"
+    );
 }

@@ -43,6 +43,8 @@ pub struct Instance {
     /// FMU states handed out by `fmi2GetFMUstate` / `fmi2DeSerializeFMUstate`,
     /// by address, so that a pointer we did not create is refused.
     saved_states: HashMap<usize, Box<Snapshot>>,
+    /// Reused buffer for the model state checked after each step.
+    scratch: Vec<f64>,
 }
 
 struct Replay {
@@ -91,6 +93,7 @@ impl Instance {
                 h: 0.0,
             },
             saved_states: HashMap::new(),
+            scratch: Vec::new(),
         }
     }
 
@@ -200,7 +203,21 @@ impl Instance {
         for (o, vr) in out.iter_mut().zip(vrs) {
             *o = self.values.real(*vr);
         }
-        Ok(())
+        self.check_finite(vrs, out, "")
+    }
+
+    /// Values handed to the importer with `fmi2OK` are never NaN or
+    /// infinite: parameters and inputs are each finite, but together they
+    /// may overflow (a stiffness of 1e300 times a displacement). Such a
+    /// result is refused with `fmi2Error`, naming the variable.
+    fn check_finite(&self, vrs: &[u32], values: &[f64], what: &str) -> Result<(), String> {
+        match vrs.iter().zip(values).find(|(_, v)| !v.is_finite()) {
+            None => Ok(()),
+            Some((vr, v)) => Err(format!(
+                "{what}{} (value reference {vr}) evaluates to {v}: the parameters or inputs are out of the model's range",
+                self.info.variables[*vr as usize].name
+            )),
+        }
     }
 
     /// Check, then set, values of type `t`: all or nothing.
@@ -320,7 +337,7 @@ impl Instance {
                     )
                 })?;
         }
-        Ok(())
+        self.check_finite(vrs, out, "the derivative of ")
     }
 
     // ---- stepping -------------------------------------------------------
@@ -349,6 +366,16 @@ impl Instance {
         if let Err(e) = self.model.do_step(&self.values, &self.slopes, h) {
             self.state = State::Error;
             return Err(format!("step from t = {t} over h = {h} failed: {e}"));
+        }
+        // A step that overflowed (finite but extreme parameters or inputs)
+        // is a failed step too: the state is no longer meaningful.
+        self.scratch.clear();
+        self.model.save_state(&mut self.scratch);
+        if let Some(x) = self.scratch.iter().find(|x| !x.is_finite()) {
+            self.state = State::Error;
+            return Err(format!(
+                "step from t = {t} over h = {h} failed: the model state became {x}: the parameters or inputs are out of the model's range"
+            ));
         }
         // Inputs as the FMU saw them at the end of the step (u + du·h); the
         // slopes apply to one step only.
@@ -417,7 +444,7 @@ impl Instance {
             .collect();
         if let Some(j) = analytic {
             dv_unknown.copy_from_slice(&j);
-            return Ok(());
+            return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
         }
 
         // Perturbation ε along dv_known, sized so that no input moves by more
@@ -439,7 +466,7 @@ impl Instance {
         for ((d, p), m) in dv_unknown.iter_mut().zip(&plus).zip(&minus) {
             *d = (p - m) / (2.0 * eps);
         }
-        Ok(())
+        self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }
 
     fn perturbed_outputs(

@@ -557,3 +557,37 @@ fn logging_categories() {
         fmi2FreeInstance(c);
     }
 }
+
+/// Found by fuzzing (random call sequences against Rig2D: a stiffness of
+/// 1e300 and a force of -1e300): finite parameters and inputs that
+/// overflow together must not reach the importer as NaN or ±inf with
+/// `fmi2OK`. The read is refused naming the output; a step whose state
+/// overflows fails (state Error), and `fmi2Reset` recovers.
+#[test]
+fn overflowing_results_are_refused_not_returned() {
+    let c = new_instance("overflow");
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(set(c, K, 1e300), OK);
+        assert_eq!(fmi2EnterInitializationMode(c), OK);
+        assert_eq!(fmi2ExitInitializationMode(c), OK);
+        assert_eq!(set(c, U, 1e300), OK);
+        let mut y = 0.0;
+        assert_eq!(fmi2GetReal(c, &Y, 1, &mut y), ERR);
+        let m = last_error_containing("fmi2GetReal");
+        assert!(m.contains("y (value reference 1) evaluates to inf"), "{m}");
+        // The state s += u·h overflows in a long step.
+        assert_eq!(fmi2DoStep(c, 0.0, 1e300, 1), ERR);
+        let m = last_error_containing("fmi2DoStep");
+        assert!(m.contains("the model state became inf"), "{m}");
+        assert_eq!(fmi2DoStep(c, 0.0, 1e-3, 1), ERR); // not in state Error
+        assert_eq!(fmi2Reset(c), OK);
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(c), OK);
+        assert_eq!(fmi2ExitInitializationMode(c), OK);
+        assert_eq!(set(c, U, 1.0), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 1e-3, 1), OK);
+        assert!(get(c, Y).is_finite());
+        fmi2FreeInstance(c);
+    }
+}

@@ -37,6 +37,12 @@ pub struct CosimArgs {
     /// Signals to plot, as component.variable (default: all).
     #[arg(long = "plot-signal")]
     pub plot_signals: Vec<String>,
+    /// Time limit on each FMI call, in seconds: a call that takes longer
+    /// stops the run (rows so far kept, marked incomplete) naming the
+    /// instance and the call; a running call cannot be interrupted, a
+    /// watchdog reports it on stderr when it passes the limit.
+    #[arg(long = "step-timeout", value_name = "SECONDS")]
+    pub step_timeout: Option<f64>,
 }
 
 pub fn run(a: &CosimArgs) -> Result<(), String> {
@@ -83,6 +89,7 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
         components.iter().map(|(n, p)| (n.clone(), *p)).collect();
     let mut system =
         System::build(&components, &parameters, &connections).map_err(|e| e.to_string())?;
+    system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
     let mut master = fricsim::master::by_name(&a.master)?;
     let started = std::time::Instant::now();
     let run = simulate(&mut system, master.as_mut(), a.step, a.stop).map_err(|e| e.to_string())?;

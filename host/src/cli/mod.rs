@@ -56,3 +56,16 @@ pub fn default_out(system: &Path, suffix: &str) -> PathBuf {
         .unwrap_or_else(|| "system".to_string());
     PathBuf::from("out").join(format!("{stem}{suffix}.csv"))
 }
+
+/// `--step-timeout SECONDS` as a duration: a positive, finite number.
+pub fn call_time_limit(seconds: Option<f64>) -> Result<Option<std::time::Duration>, String> {
+    match seconds {
+        None => Ok(None),
+        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => {
+            Ok(Some(std::time::Duration::from_secs_f64(s)))
+        }
+        Some(s) => Err(format!(
+            "--step-timeout must be a positive number of seconds, got {s}"
+        )),
+    }
+}

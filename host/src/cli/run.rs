@@ -53,6 +53,12 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Time limit on each FMI call, in seconds: a call that takes longer
+    /// stops the run (rows so far kept, marked incomplete) naming the
+    /// instance and the call; a running call cannot be interrupted, a
+    /// watchdog reports it on stderr when it passes the limit.
+    #[arg(long = "step-timeout", value_name = "SECONDS")]
+    pub step_timeout: Option<f64>,
 }
 
 /// The progress bar and the external inputs, consulted by the run.
@@ -89,6 +95,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     let mut master = by_name(&master_name)?;
 
     let mut system = file.build(start).map_err(|e| e.to_string())?;
+    system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
     let plot_signals = if !a.plot_signals.is_empty() {
         a.plot_signals.clone()
     } else {

@@ -14,6 +14,7 @@ use super::ffi::*;
 use super::library::{c_text, Functions, Library};
 use super::logger::{fricsim_fmi2_logger, Log, Sink};
 use super::model_description::{ModelDescription, ScalarVariable, ValueReference};
+use super::watchdog::Watched;
 use super::Status;
 use crate::error::FmuError;
 use std::ffi::CString;
@@ -23,6 +24,7 @@ use std::path::{Path, PathBuf};
 use std::ptr::null_mut;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
+use std::time::Duration;
 use tempfile::TempDir;
 
 /// Error messages logged earlier are shown when a call logged nothing.
@@ -170,6 +172,8 @@ pub struct Instance {
     callbacks: ManuallyDrop<Box<fmi2CallbackFunctions>>,
     states: Vec<fmi2FMUstate>,
     fatal: bool,
+    /// The time limit on each call, if one is set ([`Instance::set_call_time_limit`]).
+    limit: Option<Arc<Watched>>,
 }
 
 impl std::fmt::Debug for Instance {
@@ -273,6 +277,7 @@ impl Instance {
             callbacks: ManuallyDrop::new(callbacks),
             states: Vec::new(),
             fatal: false,
+            limit: None,
         })
     }
 
@@ -284,7 +289,17 @@ impl Instance {
         &self.fmu
     }
 
-    /// Refuse any call after `fmi2Fatal`; otherwise the log mark before the call.
+    /// A time limit on every later FMI call of this instance (`None`: no
+    /// limit). A call that returns after the limit fails with
+    /// [`FmuError::TimeLimit`], and a watchdog reports a call still running
+    /// past it on stderr; a running call is never interrupted (see
+    /// [`super::watchdog`]).
+    pub fn set_call_time_limit(&mut self, limit: Option<Duration>) {
+        self.limit = limit.map(|l| Watched::new(&self.name, l));
+    }
+
+    /// Refuse any call after `fmi2Fatal`; otherwise the log mark before the
+    /// call (and the call's clock started, under a time limit).
     #[inline]
     fn begin(&self, function: &'static str) -> Result<u64, FmuError> {
         if self.fatal {
@@ -292,6 +307,9 @@ impl Instance {
                 function,
                 instance: self.name.clone(),
             });
+        }
+        if let Some(w) = &self.limit {
+            w.start(function);
         }
         Ok(self.sink.mark())
     }
@@ -304,7 +322,17 @@ impl Instance {
         mark: u64,
         raw: fmi2Status,
     ) -> Result<Status, FmuError> {
-        match Status::from_raw(raw) {
+        let overtime = self.limit.as_ref().and_then(|w| w.stop());
+        let status = Status::from_raw(raw);
+        if let (Some((elapsed, limit)), Status::Ok | Status::Warning) = (overtime, status) {
+            return Err(FmuError::TimeLimit {
+                function,
+                instance: self.name.clone(),
+                elapsed: elapsed.as_secs_f64(),
+                limit: limit.as_secs_f64(),
+            });
+        }
+        match status {
             Status::Ok => Ok(Status::Ok),
             Status::Warning => {
                 if self.sink.mark() == mark {

@@ -4,7 +4,8 @@
 //! - [`model_description`]: `modelDescription.xml` parsed and validated;
 //! - [`library`]: the `linux64` binary loaded and its functions resolved;
 //! - [`logger`]: the FMU's log messages (callback in `logger.c`);
-//! - [`instance`]: [`Fmu`] and its [`Instance`]s, the safe API.
+//! - [`instance`]: [`Fmu`] and its [`Instance`]s, the safe API;
+//! - [`watchdog`]: the optional time limit on each call.
 
 pub mod archive;
 mod ffi;
@@ -13,6 +14,7 @@ pub mod library;
 pub mod logger;
 pub mod model_description;
 mod status;
+pub mod watchdog;
 
 pub use archive::UnpackOptions;
 pub use instance::{Fmu, FmuState, Instance};

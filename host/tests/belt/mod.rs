@@ -20,6 +20,7 @@ pub const NAN_STATE: i32 = 1;
 pub const DISCARD: i32 = 2;
 pub const ERROR: i32 = 3;
 pub const FATAL: i32 = 4;
+pub const SLOW: i32 = 5;
 
 /// Compile the C source and zip it with its model description into
 /// `dir/BeltOscillator.fmu` (binaries/linux64/BeltOscillator.so).

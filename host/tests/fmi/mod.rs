@@ -1,0 +1,494 @@
+//! Raw access to the FMI 2.0 Co-Simulation C functions of an FMU binary, for
+//! tests that misuse them on purpose (`misuse.rs`, `fuzz_bounded.rs`,
+//! `parallel_instances.rs`) and for the fuzz targets in `fuzz/` (which
+//! include this file with `#[path]` and fill [`Api`] from the exports linked
+//! into the fuzzer, so that the FMU code is instrumented).
+//!
+//! Unlike the host's safe importer, nothing here checks anything: every
+//! pointer, length and call order is the caller's choice.
+#![allow(dead_code, clippy::missing_safety_doc)]
+
+pub mod sequence;
+
+use std::ffi::{c_void, CStr, CString};
+use std::os::raw::{c_char, c_int, c_uint};
+use std::path::Path;
+use std::ptr::{null, null_mut};
+use std::sync::Mutex;
+
+pub type Component = *mut c_void;
+pub type FmuState = *mut c_void;
+pub type Vr = c_uint;
+/// `fmi2Status` as the C `int` it is.
+pub type Status = c_int;
+
+pub const OK: Status = 0;
+pub const WARNING: Status = 1;
+pub const DISCARD: Status = 2;
+pub const ERROR: Status = 3;
+pub const FATAL: Status = 4;
+
+/// The importer's logger, declared without the variadic tail: the FMUs
+/// call it with a format and no arguments, so the ABI is the same on
+/// x86-64 (as with ctypes loggers).
+pub type LoggerFn =
+    unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char);
+
+/// `fmi2CallbackFunctions`.
+#[repr(C)]
+pub struct Callbacks {
+    pub logger: Option<LoggerFn>,
+    pub allocate_memory: Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>,
+    pub free_memory: Option<unsafe extern "C" fn(*mut c_void)>,
+    pub step_finished: Option<unsafe extern "C" fn(*mut c_void, c_int)>,
+    pub component_environment: *mut c_void,
+}
+
+macro_rules! api {
+    ($($field:ident: fn($($arg:ty),*) $(-> $ret:ty)? = $symbol:literal,)*) => {
+        /// Every function of the FMI 2.0 Co-Simulation API (FMI 2.0.4 §2.1,
+        /// §4.2) as a typed pointer.
+        #[derive(Clone, Copy)]
+        pub struct Api {
+            $(pub $field: unsafe extern "C" fn($($arg),*) $(-> $ret)?,)*
+        }
+
+        impl Api {
+            /// Resolve every function with `lookup` (symbol name → address).
+            ///
+            /// # Safety
+            /// Each address must be the function the standard gives that name.
+            pub unsafe fn from_lookup(lookup: impl Fn(&str) -> *const c_void) -> Api {
+                Api {
+                    $($field: {
+                        let address = lookup($symbol);
+                        assert!(!address.is_null(), "{} is missing", $symbol);
+                        // SAFETY: the caller's contract.
+                        unsafe { std::mem::transmute::<*const c_void, unsafe extern "C" fn($($arg),*) $(-> $ret)?>(address) }
+                    },)*
+                }
+            }
+        }
+    };
+}
+
+api! {
+    get_types_platform: fn() -> *const c_char = "fmi2GetTypesPlatform",
+    get_version: fn() -> *const c_char = "fmi2GetVersion",
+    set_debug_logging: fn(Component, c_int, usize, *const *const c_char) -> Status = "fmi2SetDebugLogging",
+    instantiate: fn(*const c_char, c_int, *const c_char, *const c_char, *const Callbacks, c_int, c_int) -> Component = "fmi2Instantiate",
+    free_instance: fn(Component) = "fmi2FreeInstance",
+    setup_experiment: fn(Component, c_int, f64, f64, c_int, f64) -> Status = "fmi2SetupExperiment",
+    enter_initialization_mode: fn(Component) -> Status = "fmi2EnterInitializationMode",
+    exit_initialization_mode: fn(Component) -> Status = "fmi2ExitInitializationMode",
+    terminate: fn(Component) -> Status = "fmi2Terminate",
+    reset: fn(Component) -> Status = "fmi2Reset",
+    get_real: fn(Component, *const Vr, usize, *mut f64) -> Status = "fmi2GetReal",
+    get_integer: fn(Component, *const Vr, usize, *mut c_int) -> Status = "fmi2GetInteger",
+    get_boolean: fn(Component, *const Vr, usize, *mut c_int) -> Status = "fmi2GetBoolean",
+    get_string: fn(Component, *const Vr, usize, *mut *const c_char) -> Status = "fmi2GetString",
+    set_real: fn(Component, *const Vr, usize, *const f64) -> Status = "fmi2SetReal",
+    set_integer: fn(Component, *const Vr, usize, *const c_int) -> Status = "fmi2SetInteger",
+    set_boolean: fn(Component, *const Vr, usize, *const c_int) -> Status = "fmi2SetBoolean",
+    set_string: fn(Component, *const Vr, usize, *const *const c_char) -> Status = "fmi2SetString",
+    get_fmu_state: fn(Component, *mut FmuState) -> Status = "fmi2GetFMUstate",
+    set_fmu_state: fn(Component, FmuState) -> Status = "fmi2SetFMUstate",
+    free_fmu_state: fn(Component, *mut FmuState) -> Status = "fmi2FreeFMUstate",
+    serialized_fmu_state_size: fn(Component, FmuState, *mut usize) -> Status = "fmi2SerializedFMUstateSize",
+    serialize_fmu_state: fn(Component, FmuState, *mut c_char, usize) -> Status = "fmi2SerializeFMUstate",
+    deserialize_fmu_state: fn(Component, *const c_char, usize, *mut FmuState) -> Status = "fmi2DeSerializeFMUstate",
+    get_directional_derivative: fn(Component, *const Vr, usize, *const Vr, usize, *const f64, *mut f64) -> Status = "fmi2GetDirectionalDerivative",
+    set_real_input_derivatives: fn(Component, *const Vr, usize, *const c_int, *const f64) -> Status = "fmi2SetRealInputDerivatives",
+    get_real_output_derivatives: fn(Component, *const Vr, usize, *const c_int, *mut f64) -> Status = "fmi2GetRealOutputDerivatives",
+    do_step: fn(Component, f64, f64, c_int) -> Status = "fmi2DoStep",
+    cancel_step: fn(Component) -> Status = "fmi2CancelStep",
+    get_status: fn(Component, c_int, *mut c_int) -> Status = "fmi2GetStatus",
+    get_real_status: fn(Component, c_int, *mut f64) -> Status = "fmi2GetRealStatus",
+    get_integer_status: fn(Component, c_int, *mut c_int) -> Status = "fmi2GetIntegerStatus",
+    get_boolean_status: fn(Component, c_int, *mut c_int) -> Status = "fmi2GetBooleanStatus",
+    get_string_status: fn(Component, c_int, *mut *const c_char) -> Status = "fmi2GetStringStatus",
+}
+
+// ---- the model description, reduced to what the probes need ---------------
+
+/// A scalar variable: value reference, name, type (`Real`, `Integer`,
+/// `Boolean`, `String`), causality, variability and start value.
+#[derive(Clone, Debug)]
+pub struct Var {
+    pub vr: Vr,
+    pub name: String,
+    pub type_name: &'static str,
+    pub causality: &'static str,
+    pub variability: &'static str,
+    pub start: Option<f64>,
+}
+
+/// One FMU as a probe sees it.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub guid: String,
+    pub vars: Vec<Var>,
+    pub log_categories: Vec<String>,
+}
+
+impl Model {
+    /// From a `modelDescription.xml` (parsed by the host's parser).
+    pub fn from_description(md: &fricsim::fmu::ModelDescription) -> Model {
+        use fricsim::fmu::VariableKind as K;
+        Model {
+            name: md.model_name.clone(),
+            guid: md.guid.clone(),
+            vars: md
+                .variables
+                .iter()
+                .map(|v| Var {
+                    vr: v.value_reference,
+                    name: v.name.clone(),
+                    type_name: v.kind.type_name(),
+                    causality: v.causality.as_str(),
+                    variability: v.variability.as_str(),
+                    start: match &v.kind {
+                        K::Real { start, .. } => *start,
+                        K::Integer { start, .. } | K::Enumeration { start, .. } => {
+                            start.map(f64::from)
+                        }
+                        K::Boolean { start } => start.map(|b| b as i32 as f64),
+                        K::String { .. } => None,
+                    },
+                })
+                .collect(),
+            log_categories: md.log_categories.iter().map(|c| c.name.clone()).collect(),
+        }
+    }
+
+    pub fn with(&self, type_name: &str, causality: &str) -> Vec<&Var> {
+        self.vars
+            .iter()
+            .filter(|v| v.type_name == type_name && v.causality == causality)
+            .collect()
+    }
+
+    pub fn first(&self, type_name: &str, causality: &str) -> Option<&Var> {
+        self.with(type_name, causality).into_iter().next()
+    }
+
+    /// A value reference no variable has.
+    pub fn unknown_vr(&self) -> Vr {
+        self.vars.iter().map(|v| v.vr).max().unwrap_or(0) + 1000
+    }
+}
+
+// ---- a logger that keeps every message, per instance ----------------------
+
+/// One message the FMU logged.
+#[derive(Clone, Debug)]
+pub struct Message {
+    pub instance: String,
+    pub status: c_int,
+    pub category: String,
+    /// The text as a C importer prints it (`%%` → `%`).
+    pub text: String,
+}
+
+/// The messages of one instance (its `componentEnvironment`).
+#[derive(Default)]
+pub struct Log {
+    pub messages: Mutex<Vec<Message>>,
+}
+
+impl Log {
+    pub fn take(&self) -> Vec<Message> {
+        std::mem::take(&mut *self.messages.lock().unwrap())
+    }
+
+    /// The text of every message of status Error or Fatal, taken.
+    pub fn take_errors(&self) -> Vec<String> {
+        self.take()
+            .into_iter()
+            .filter(|m| m.status >= ERROR)
+            .map(|m| m.text)
+            .collect()
+    }
+}
+
+unsafe extern "C" fn record(
+    environment: *mut c_void,
+    instance: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
+    let text = |p: *const c_char| {
+        if p.is_null() {
+            "<NULL>".to_string()
+        } else {
+            // SAFETY: the FMU passes NUL-terminated strings.
+            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+        }
+    };
+    if environment.is_null() {
+        return;
+    }
+    // SAFETY: every instance is created with a `Log` that outlives it.
+    let log = unsafe { &*(environment as *const Log) };
+    log.messages.lock().unwrap().push(Message {
+        instance: text(instance),
+        status,
+        category: text(category),
+        text: text(message).replace("%%", "%"),
+    });
+}
+
+// ---- an instance --------------------------------------------------------
+
+/// An instance with its logger; freed on drop. Every call is raw: the
+/// status is returned, never checked.
+pub struct Instance {
+    pub api: Api,
+    pub c: Component,
+    pub log: Box<Log>,
+    _callbacks: Box<Callbacks>,
+}
+
+// The instance is only used by one thread at a time (moved, not shared).
+unsafe impl Send for Instance {}
+
+pub const CO_SIMULATION: c_int = 1;
+
+impl Instance {
+    /// `fmi2Instantiate` with a recording logger; if it returned NULL, the
+    /// log with the FMU's reason instead.
+    pub fn new(api: Api, name: &str, guid: &str, logging_on: bool) -> Result<Instance, Box<Log>> {
+        let log = Box::<Log>::default();
+        let callbacks = Box::new(Callbacks {
+            logger: Some(record),
+            allocate_memory: None,
+            free_memory: None,
+            step_finished: None,
+            component_environment: &*log as *const Log as *mut c_void,
+        });
+        let name = CString::new(name).unwrap();
+        let guid = CString::new(guid).unwrap();
+        let resources = CString::new("file:///tmp").unwrap();
+        // SAFETY: valid strings and callbacks that outlive the instance.
+        let c = unsafe {
+            (api.instantiate)(
+                name.as_ptr(),
+                CO_SIMULATION,
+                guid.as_ptr(),
+                resources.as_ptr(),
+                &*callbacks,
+                0,
+                logging_on as c_int,
+            )
+        };
+        if c.is_null() {
+            return Err(log);
+        }
+        Ok(Instance {
+            api,
+            c,
+            log,
+            _callbacks: callbacks,
+        })
+    }
+
+    pub fn setup(&self, start: f64) -> Status {
+        unsafe { (self.api.setup_experiment)(self.c, 0, 0.0, start, 0, 0.0) }
+    }
+    pub fn enter_init(&self) -> Status {
+        unsafe { (self.api.enter_initialization_mode)(self.c) }
+    }
+    pub fn exit_init(&self) -> Status {
+        unsafe { (self.api.exit_initialization_mode)(self.c) }
+    }
+    pub fn terminate(&self) -> Status {
+        unsafe { (self.api.terminate)(self.c) }
+    }
+    pub fn reset(&self) -> Status {
+        unsafe { (self.api.reset)(self.c) }
+    }
+    pub fn do_step(&self, t: f64, h: f64) -> Status {
+        unsafe { (self.api.do_step)(self.c, t, h, 1) }
+    }
+    pub fn set_real(&self, vrs: &[Vr], values: &[f64]) -> Status {
+        assert_eq!(vrs.len(), values.len());
+        unsafe { (self.api.set_real)(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
+    }
+    pub fn get_real(&self, vrs: &[Vr]) -> (Status, Vec<f64>) {
+        let mut out = vec![f64::NAN; vrs.len()];
+        let s = unsafe { (self.api.get_real)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        (s, out)
+    }
+    pub fn set_integer(&self, vrs: &[Vr], values: &[c_int]) -> Status {
+        unsafe { (self.api.set_integer)(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
+    }
+    pub fn set_boolean(&self, vrs: &[Vr], values: &[c_int]) -> Status {
+        unsafe { (self.api.set_boolean)(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
+    }
+    pub fn set_debug_logging(&self, on: bool, categories: &[&str]) -> Status {
+        let owned: Vec<CString> = categories
+            .iter()
+            .map(|c| CString::new(*c).unwrap())
+            .collect();
+        let pointers: Vec<*const c_char> = owned.iter().map(|c| c.as_ptr()).collect();
+        let p = if pointers.is_empty() {
+            null()
+        } else {
+            pointers.as_ptr()
+        };
+        unsafe { (self.api.set_debug_logging)(self.c, on as c_int, pointers.len(), p) }
+    }
+
+    /// `fmi2GetFMUstate` into a fresh state (NULL on failure).
+    pub fn get_state(&self) -> (Status, FmuState) {
+        let mut s: FmuState = null_mut();
+        let status = unsafe { (self.api.get_fmu_state)(self.c, &mut s) };
+        (status, s)
+    }
+    pub fn free_state(&self, mut s: FmuState) -> Status {
+        unsafe { (self.api.free_fmu_state)(self.c, &mut s) }
+    }
+
+    /// The current FMU state, serialized.
+    pub fn serialize(&self) -> Vec<u8> {
+        let (status, s) = self.get_state();
+        assert_eq!(status, OK, "fmi2GetFMUstate: {:?}", self.log.take_errors());
+        let mut size = 0usize;
+        assert_eq!(
+            unsafe { (self.api.serialized_fmu_state_size)(self.c, s, &mut size) },
+            OK
+        );
+        let mut bytes = vec![0u8; size];
+        assert_eq!(
+            unsafe {
+                (self.api.serialize_fmu_state)(self.c, s, bytes.as_mut_ptr() as *mut c_char, size)
+            },
+            OK
+        );
+        self.free_state(s);
+        bytes
+    }
+
+    /// `fmi2DeSerializeFMUstate` of `bytes`, then `fmi2SetFMUstate` if it
+    /// was accepted; the status of the first call that did not return OK.
+    pub fn restore(&self, bytes: &[u8]) -> Status {
+        let mut s: FmuState = null_mut();
+        let status = unsafe {
+            (self.api.deserialize_fmu_state)(
+                self.c,
+                bytes.as_ptr() as *const c_char,
+                bytes.len(),
+                &mut s,
+            )
+        };
+        if status != OK {
+            assert!(s.is_null(), "a refused state must not be handed out");
+            return status;
+        }
+        let set = unsafe { (self.api.set_fmu_state)(self.c, s) };
+        self.free_state(s);
+        set
+    }
+
+    /// setup, enter and exit initialization mode at t = 0.
+    pub fn initialize(&self) -> Status {
+        self.setup(0.0).max(self.enter_init()).max(self.exit_init())
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        unsafe { (self.api.free_instance)(self.c) }
+    }
+}
+
+// ---- the shipped FMUs ------------------------------------------------------
+
+/// The FMUs `build-fmu.sh` writes into `dist/`.
+pub const SHIPPED: [&str; 7] = [
+    "Dahl",
+    "LuGre",
+    "ResetIntegrator",
+    "Bristle",
+    "Bristle2D",
+    "Rig1D",
+    "Rig2D",
+];
+
+/// A shipped FMU unpacked by the host's importer and its binary loaded.
+pub struct Loaded {
+    pub model: Model,
+    pub api: Api,
+    _library: libloading::Library,
+    _dir: tempfile::TempDir,
+}
+
+/// The repository root.
+pub fn repository() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap()
+}
+
+/// Unpack `dist/<name>.fmu` and load its binary (run `./build-fmu.sh` first).
+pub fn load_shipped(name: &str) -> Loaded {
+    let fmu = repository().join("dist").join(format!("{name}.fmu"));
+    assert!(
+        fmu.is_file(),
+        "{} is missing: run ./build-fmu.sh first",
+        fmu.display()
+    );
+    let dir = fricsim::fmu::archive::unpack(&fmu, &Default::default()).unwrap();
+    let md = fricsim::fmu::ModelDescription::from_file(&dir.path().join("modelDescription.xml"))
+        .unwrap();
+    let identifier = &md.co_simulation.model_identifier;
+    let so = dir
+        .path()
+        .join("binaries/linux64")
+        .join(format!("{identifier}.so"));
+    // SAFETY: our own FMU binary.
+    let library = unsafe { libloading::Library::new(&so) }.unwrap();
+    // SAFETY: the symbols are the standard's functions.
+    let api = unsafe {
+        Api::from_lookup(|symbol| {
+            library
+                .get::<*const c_void>(symbol.as_bytes())
+                .map(|s| *s)
+                .unwrap_or(null())
+        })
+    };
+    Loaded {
+        model: Model::from_description(&md),
+        api,
+        _library: library,
+        _dir: dir,
+    }
+}
+
+impl Loaded {
+    pub fn instance(&self, name: &str) -> Instance {
+        Instance::new(self.api, name, &self.model.guid, false)
+            .unwrap_or_else(|log| panic!("fmi2Instantiate failed: {:?}", log.take()))
+    }
+}
+
+// ---- a seeded generator (no dependency, same stream everywhere) -----------
+
+/// SplitMix64.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n.max(1) as u64) as usize
+    }
+    pub fn bytes(&mut self, n: usize) -> Vec<u8> {
+        (0..n).map(|_| self.next_u64() as u8).collect()
+    }
+}
