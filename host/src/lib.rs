@@ -32,6 +32,7 @@ pub mod plot;
 pub mod reference;
 pub mod results;
 pub mod ssp;
+pub mod sweep;
 pub mod system;
 
 pub use error::{ArchiveProblem, FmuError};

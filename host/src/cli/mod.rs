@@ -6,6 +6,7 @@ pub mod diagnose;
 pub mod info;
 pub mod reference;
 pub mod run;
+pub mod sweep;
 
 use fricsim::ssp::SystemFile;
 use std::path::{Path, PathBuf};

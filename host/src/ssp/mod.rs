@@ -1119,6 +1119,17 @@ impl SystemFile {
     /// Check, then instantiate the system with its parameters and
     /// connections, set up to start at `start`.
     pub fn build(&self, start: f64) -> Result<System, SspError> {
+        self.build_with(start, &[])
+    }
+
+    /// [`SystemFile::build`] with `overrides` (`component.variable`, value)
+    /// set after the file's own parameter values, so that they win: one
+    /// point of a parameter sweep (`fricsim sweep`).
+    pub fn build_with(
+        &self,
+        start: f64,
+        overrides: &[(String, ParameterValue)],
+    ) -> Result<System, SspError> {
         let checked = self.check()?;
         let parameters: Vec<(String, ParameterValue)> = self
             .parameters
@@ -1132,6 +1143,7 @@ impl SystemFile {
                 };
                 (format!("{}.{}", p.component, p.variable), v)
             })
+            .chain(overrides.iter().cloned())
             .collect();
         let connections: Vec<(String, String)> = checked
             .connections
