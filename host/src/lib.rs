@@ -23,6 +23,7 @@
 //! # Ok::<(), fricsim::FmuError>(())
 //! ```
 
+pub mod benchmarks;
 pub mod compare;
 pub mod error;
 pub mod fmu;
