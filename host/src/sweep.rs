@@ -73,6 +73,37 @@ pub fn grid(axes: &[Axis]) -> Vec<Vec<(String, f64)>> {
     points
 }
 
+/// Refuse, before anything runs, an axis whose `component.variable` the
+/// system does not have, or that is not a parameter or an input.
+pub fn check_axes(file: &SystemFile, axes: &[Axis]) -> Result<(), String> {
+    use crate::fmu::model_description::Causality;
+    let checked = file.check().map_err(|e| e.to_string())?;
+    for axis in axes {
+        let (component, variable) = axis.port.split_once('.').unwrap_or(("", &axis.port));
+        let Some((_, fmu)) = checked.fmus.iter().find(|(n, _)| n == component) else {
+            let names: Vec<&str> = checked.fmus.iter().map(|(n, _)| n.as_str()).collect();
+            return Err(format!(
+                "`{}`: no component `{component}` (components: {})",
+                axis.port,
+                names.join(", ")
+            ));
+        };
+        let var = fmu.variable(variable).map_err(|_| {
+            format!(
+                "`{}`: `{component}` has no variable `{variable}`",
+                axis.port
+            )
+        })?;
+        if !matches!(var.causality, Causality::Parameter | Causality::Input) {
+            return Err(format!(
+                "`{}` is not a parameter or an input: it cannot be swept",
+                axis.port
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The seed variables of a system file: every component's parameter
 /// called `seed` (the Bristle FMU's realisation seed), as
 /// `component.seed`.

@@ -312,8 +312,15 @@ fn host_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<HostTable, St
             let mut algorithm = by_name(master)?;
             let mut system = file.build(0.0).map_err(|e| e.to_string())?;
             let clock = Instant::now();
-            let run = simulate_with(&mut system, algorithm.as_mut(), 0.0, h, stop, &mut NoObserver)
-                .map_err(|e| e.to_string())?;
+            let run = simulate_with(
+                &mut system,
+                algorithm.as_mut(),
+                0.0,
+                h,
+                stop,
+                &mut NoObserver,
+            )
+            .map_err(|e| e.to_string())?;
             let wall = clock.elapsed().as_secs_f64();
             if let Some(e) = run.error {
                 return Err(format!("{STICK_SLIP} with {master}: {e}"));
@@ -453,7 +460,9 @@ fn fmpy_run(
     }
     let result: serde_json::Value =
         serde_json::from_slice(&out.stdout).map_err(|e| format!("bench_fmpy.py output: {e}"))?;
-    let wall = result["wall"].as_f64().ok_or("bench_fmpy.py: no wall time")?;
+    let wall = result["wall"]
+        .as_f64()
+        .ok_or("bench_fmpy.py: no wall time")?;
     let force = result["final"]["friction.F"].as_f64().unwrap_or(f64::NAN);
     Ok((wall, force))
 }
@@ -675,7 +684,11 @@ impl StickSlipModel {
             return Err(e);
         }
         std::hint::black_box(&row);
-        Ok((wall, row[row.len() - 2], iterations as f64 / n.max(1) as f64))
+        Ok((
+            wall,
+            row[row.len() - 2],
+            iterations as f64 / n.max(1) as f64,
+        ))
     }
 }
 
@@ -736,7 +749,10 @@ fn seed000_curve(repeats: usize) -> Result<Vec<CurveRow>, String> {
         let mut d = Dahl::new(dahl_params).expect("positive parameters");
         let mut sum = 0.0;
         for _ in 1..=INCREMENTS {
-            d.step(Ramp::constant(3.0 * p.delta_max / INCREMENTS as f64 / dt), dt);
+            d.step(
+                Ramp::constant(3.0 * p.delta_max / INCREMENTS as f64 / dt),
+                dt,
+            );
             sum += d.force();
         }
         sum
@@ -791,10 +807,23 @@ fn seed000_curve(repeats: usize) -> Result<Vec<CurveRow>, String> {
 
 struct ScalingRow {
     count: usize,
+    /// Bristles that disconnect or reconnect over the curve.
+    changes: usize,
     /// Placement (`Bristle::new`), s.
     placement: f64,
     /// The 1000-increment curve with one reversal, s.
     curve: f64,
+}
+
+/// Increment `k` of the curve with one reversal: 0 → 3·δmax in the first
+/// half of [`INCREMENTS`], back to −3·δmax in the second.
+fn curve_point(k: usize, delta_max: f64) -> f64 {
+    let half = INCREMENTS / 2;
+    if k <= half {
+        3.0 * delta_max * k as f64 / half as f64
+    } else {
+        3.0 * delta_max * (1.0 - 2.0 * (k - half) as f64 / half as f64)
+    }
 }
 
 fn bristle_scaling(repeats: usize) -> Result<Vec<ScalingRow>, String> {
@@ -814,22 +843,29 @@ fn bristle_scaling(repeats: usize) -> Result<Vec<ScalingRow>, String> {
             let mut b = fresh.clone();
             let mut sum = 0.0;
             for k in 1..=INCREMENTS {
-                let x = if k <= half {
-                    3.0 * p.delta_max * k as f64 / half as f64
-                } else {
-                    3.0 * p.delta_max * (1.0 - 2.0 * (k - half) as f64 / half as f64)
-                };
-                b.move_to(x);
+                b.move_to(curve_point(k, p.delta_max));
                 sum += b.force();
             }
             sum
         })?;
+        // bristles that change state over the curve (untimed)
+        let mut changes = 0;
+        let mut b = fresh.clone();
+        let mut connected = b.n_connected();
+        for k in 1..=INCREMENTS {
+            let x = curve_point(k, p.delta_max);
+            let reconnect = if k == half + 1 { count - connected } else { 0 };
+            b.move_to(x);
+            changes += reconnect + (connected + reconnect).abs_diff(b.n_connected());
+            connected = b.n_connected();
+        }
         // the clone is part of each timed curve: take it out
         let clone = per_call(repeats, || fresh.clone().force())?;
         let curve = (curve - clone).max(0.0);
         eprintln!("{count} bristles: placement {placement:e} s, curve {curve:e} s");
         rows.push(ScalingRow {
             count,
+            changes,
             placement,
             curve,
         });
@@ -1036,7 +1072,7 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
     );
     let _ = writeln!(
         s,
-        "| bristles | placement | curve | per increment | growth of the cost per increment against the count (log–log slope from the previous row) |\n|---|---|---|---|---|"
+        "| bristles | placement | curve | per increment | bristle state changes in the curve | per state change | growth of the cost per increment against the count (log–log slope from the previous row) |\n|---|---|---|---|---|---|---|"
     );
     let mut previous: Option<&ScalingRow> = None;
     for row in &r.scaling {
@@ -1048,11 +1084,13 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
         });
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.0} ns | {slope} |",
+            "| {} | {} | {} | {:.0} ns | {} | {:.1} ns | {slope} |",
             row.count,
             duration(row.placement),
             duration(row.curve),
-            row.curve / INCREMENTS as f64 * 1e9
+            row.curve / INCREMENTS as f64 * 1e9,
+            row.changes,
+            row.curve / row.changes.max(1) as f64 * 1e9
         );
         previous = Some(row);
     }

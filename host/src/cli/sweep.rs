@@ -4,7 +4,7 @@
 //! ([`fricsim::sweep`]).
 
 use fricsim::ssp::SystemFile;
-use fricsim::sweep::{grid, run_all, seed_ports, write_csv, Axis, Plan};
+use fricsim::sweep::{check_axes, grid, run_all, seed_ports, write_csv, Axis, Plan};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -82,6 +82,7 @@ pub fn run(a: &SweepArgs) -> Result<(), String> {
     } else if !a.seed_params.is_empty() {
         return Err("--seed-param needs --seeds N".into());
     }
+    check_axes(&file, &axes)?;
     let threads = match a.threads {
         Some(0) => return Err("--threads must be at least 1".into()),
         Some(n) => n,
