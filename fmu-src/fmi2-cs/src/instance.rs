@@ -32,6 +32,9 @@ pub struct Instance {
     values: Values,
     /// `du/dt` per value reference (non-zero for inputs only).
     slopes: Vec<f64>,
+    /// Value references of the inputs, the values a step changes (by
+    /// their slopes).
+    inputs: Vec<u32>,
     outputs_dirty: bool,
     initialized: bool,
     pub time: f64,
@@ -48,7 +51,10 @@ pub struct Instance {
 struct Replay {
     valid: bool,
     model_state: Vec<f64>,
-    values: Vec<f64>,
+    /// Value and slope of each of [`Instance::inputs`] before the step
+    /// (nothing else changes in a step: a parameter set since invalidates
+    /// the replay).
+    inputs: Vec<f64>,
     slopes: Vec<f64>,
     h: f64,
 }
@@ -70,6 +76,12 @@ impl Instance {
     ) -> Self {
         let values = Values::from_start(info.variables);
         let n = values.len();
+        let inputs: Vec<u32> = info
+            .variables
+            .iter()
+            .filter(|v| v.causality == Causality::Input)
+            .map(|v| v.vr)
+            .collect();
         Instance {
             info,
             name: name.to_string(),
@@ -86,10 +98,11 @@ impl Instance {
             replay: Replay {
                 valid: false,
                 model_state: Vec::new(),
-                values: vec![0.0; n],
-                slopes: vec![0.0; n],
+                inputs: vec![0.0; inputs.len()],
+                slopes: vec![0.0; inputs.len()],
                 h: 0.0,
             },
+            inputs,
             saved_states: HashMap::new(),
         }
     }
@@ -342,8 +355,10 @@ impl Instance {
         if self.model.needs_step_replay() {
             self.replay.model_state.clear();
             self.model.save_state(&mut self.replay.model_state);
-            self.replay.values.copy_from_slice(self.values.as_slice());
-            self.replay.slopes.copy_from_slice(&self.slopes);
+            for (k, &vr) in self.inputs.iter().enumerate() {
+                self.replay.inputs[k] = self.values.real(vr);
+                self.replay.slopes[k] = self.slopes[vr as usize];
+            }
             self.replay.h = h;
         }
         if let Err(e) = self.model.do_step(&self.values, &self.slopes, h) {
@@ -352,7 +367,7 @@ impl Instance {
         }
         // Inputs as the FMU saw them at the end of the step (u + du·h); the
         // slopes apply to one step only.
-        advance_inputs(self.info, &mut self.values, &mut self.slopes, h);
+        advance_inputs(&self.inputs, &mut self.values, &mut self.slopes, h);
         self.replay.valid = self.model.needs_step_replay();
         self.time = t + h;
         self.outputs_dirty = true;
@@ -453,13 +468,16 @@ impl Instance {
         if self.replay.valid {
             let mut model = self.model.clone_model();
             model.restore_state(&self.replay.model_state)?;
-            values.copy_from_slice(&self.replay.values);
+            let mut slopes = self.slopes.clone();
+            for (k, &vr) in self.inputs.iter().enumerate() {
+                values.set(vr, self.replay.inputs[k]);
+                slopes[vr as usize] = self.replay.slopes[k];
+            }
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            let mut slopes = self.replay.slopes.clone();
             model.do_step(&values, &slopes, self.replay.h)?;
-            advance_inputs(self.info, &mut values, &mut slopes, self.replay.h);
+            advance_inputs(&self.inputs, &mut values, &mut slopes, self.replay.h);
             model.compute_outputs(&mut values);
         } else {
             for (k, d) in knowns.iter().zip(dv) {
@@ -572,14 +590,12 @@ impl Instance {
 }
 
 /// After a step of length `h`, inputs stand at `u + du·h`; slopes reset.
-fn advance_inputs(info: &ModelInfo, values: &mut Values, slopes: &mut [f64], h: f64) {
-    for v in info.variables {
-        if v.causality == Causality::Input {
-            let s = &mut slopes[v.vr as usize];
-            if *s != 0.0 {
-                values.set(v.vr, values.real(v.vr) + *s * h);
-                *s = 0.0;
-            }
+fn advance_inputs(inputs: &[u32], values: &mut Values, slopes: &mut [f64], h: f64) {
+    for &vr in inputs {
+        let s = &mut slopes[vr as usize];
+        if *s != 0.0 {
+            values.set(vr, values.real(vr) + *s * h);
+            *s = 0.0;
         }
     }
 }
