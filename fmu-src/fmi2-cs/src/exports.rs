@@ -539,12 +539,7 @@ pub unsafe fn get_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2S
     unsafe {
         call!(c, "fmi2GetFMUstate", |inst| {
             let slot = out_slice(state, 1, "FMUstate")?;
-            let reuse = slot[0] as usize;
-            if reuse != 0 {
-                inst.saved_snapshot(reuse)?;
-            }
-            let snap = inst.snapshot()?;
-            slot[0] = inst.store_snapshot(snap, reuse) as fmi2FMUstate;
+            slot[0] = inst.save_snapshot(slot[0] as usize)? as fmi2FMUstate;
             Ok(fmi2Status::fmi2OK)
         })
     }
@@ -558,8 +553,7 @@ pub unsafe fn set_fmu_state(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status
             if state.is_null() {
                 return Err("argument FMUstate is NULL".into());
             }
-            let snap = inst.saved_snapshot(state as usize)?.clone();
-            inst.restore(&snap)?;
+            inst.restore_saved(state as usize)?;
             Ok(fmi2Status::fmi2OK)
         })
     }

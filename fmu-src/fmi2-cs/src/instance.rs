@@ -14,7 +14,6 @@ use crate::serialize::Snapshot;
 use crate::state_machine::State;
 use crate::variables::{Causality, ModelInfo, VarType, Variable};
 use crate::Values;
-use std::collections::HashMap;
 
 /// Relative tolerance on communication points (time is taken from the
 /// master at every step, never summed inside the FMU).
@@ -43,9 +42,20 @@ pub struct Instance {
     /// The last step, kept for directional derivatives: the state, inputs
     /// and slopes before it, and its length. Valid until an input changes.
     replay: Replay,
+    scratch: Scratch,
     /// FMU states handed out by `fmi2GetFMUstate` / `fmi2DeSerializeFMUstate`,
     /// by address, so that a pointer we did not create is refused.
-    saved_states: HashMap<usize, Box<Snapshot>>,
+    /// (A short list: a master keeps one or two; its address is the box's.)
+    saved_states: Vec<Box<Snapshot>>,
+}
+
+/// Buffers of [`Instance::directional_derivative`], kept between calls.
+#[derive(Default)]
+struct Scratch {
+    values: Option<Values>,
+    slopes: Vec<f64>,
+    model_state: Vec<f64>,
+    plus: Vec<f64>,
 }
 
 struct Replay {
@@ -103,7 +113,8 @@ impl Instance {
                 h: 0.0,
             },
             inputs,
-            saved_states: HashMap::new(),
+            scratch: Scratch::default(),
+            saved_states: Vec::new(),
         }
     }
 
@@ -449,26 +460,38 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
-        let plus = self.perturbed_outputs(knowns, dv_known, eps, unknowns)?;
-        let minus = self.perturbed_outputs(knowns, dv_known, -eps, unknowns)?;
-        for ((d, p), m) in dv_unknown.iter_mut().zip(&plus).zip(&minus) {
-            *d = (p - m) / (2.0 * eps);
+        let mut plus = std::mem::take(&mut self.scratch.plus);
+        plus.resize(unknowns.len(), 0.0);
+        let result = self
+            .perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus)
+            .and_then(|()| self.perturbed_outputs(knowns, dv_known, -eps, unknowns, dv_unknown));
+        for (d, p) in dv_unknown.iter_mut().zip(&plus) {
+            *d = (p - *d) / (2.0 * eps);
         }
-        Ok(())
+        self.scratch.plus = plus;
+        result
     }
 
+    /// The outputs `unknowns` into `out` with the inputs `knowns` moved by
+    /// `eps·dv`: after a step, the step replayed from its saved start on
+    /// the model itself (whose current state is put back after), else the
+    /// outputs at the current state. No allocation: the scratch buffers
+    /// are reused.
     fn perturbed_outputs(
-        &self,
+        &mut self,
         knowns: &[u32],
         dv: &[f64],
         eps: f64,
         unknowns: &[u32],
-    ) -> Result<Vec<f64>, String> {
-        let mut values = self.values.clone();
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        let scratch = &mut self.scratch;
+        let values = scratch.values.get_or_insert_with(|| self.values.clone());
+        values.copy_from_slice(self.values.as_slice());
         if self.replay.valid {
-            let mut model = self.model.clone_model();
-            model.restore_state(&self.replay.model_state)?;
-            let mut slopes = self.slopes.clone();
+            let slopes = &mut scratch.slopes;
+            slopes.clear();
+            slopes.extend_from_slice(&self.slopes);
             for (k, &vr) in self.inputs.iter().enumerate() {
                 values.set(vr, self.replay.inputs[k]);
                 slopes[vr as usize] = self.replay.slopes[k];
@@ -476,35 +499,66 @@ impl Instance {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            model.do_step(&values, &slopes, self.replay.h)?;
-            advance_inputs(&self.inputs, &mut values, &mut slopes, self.replay.h);
-            model.compute_outputs(&mut values);
+            let current = &mut scratch.model_state;
+            current.clear();
+            self.model.save_state(current);
+            let replayed = self
+                .model
+                .restore_state(&self.replay.model_state)
+                .and_then(|()| self.model.do_step(values, slopes, self.replay.h));
+            if replayed.is_ok() {
+                advance_inputs(&self.inputs, values, slopes, self.replay.h);
+                self.model.compute_outputs(values);
+            }
+            self.model.restore_state(current)?;
+            replayed?;
         } else {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            self.model.compute_outputs(&mut values);
+            self.model.compute_outputs(values);
         }
-        Ok(unknowns.iter().map(|u| values.real(*u)).collect())
+        for (o, u) in out.iter_mut().zip(unknowns) {
+            *o = values.real(*u);
+        }
+        Ok(())
     }
 
     // ---- FMU states -----------------------------------------------------
 
     pub fn snapshot(&mut self) -> Result<Snapshot, String> {
-        self.ensure_outputs()?;
-        let mut model_state = Vec::new();
-        if self.initialized {
-            self.model.save_state(&mut model_state);
-        }
-        Ok(Snapshot {
-            guid: self.info.guid.to_string(),
+        let mut snap = Snapshot {
+            guid: String::new(),
             state: self.state,
-            initialized: self.initialized,
-            time: self.time,
-            values: self.values.as_slice().to_vec(),
-            slopes: self.slopes.clone(),
-            model_state,
-        })
+            initialized: false,
+            time: 0.0,
+            values: Vec::new(),
+            slopes: Vec::new(),
+            model_state: Vec::new(),
+        };
+        self.snapshot_into(&mut snap)?;
+        Ok(snap)
+    }
+
+    /// Overwrite `snap` with the current state, reusing its buffers (no
+    /// allocation when it held a state of this instance before).
+    pub fn snapshot_into(&mut self, snap: &mut Snapshot) -> Result<(), String> {
+        self.ensure_outputs()?;
+        if snap.guid != self.info.guid {
+            snap.guid = self.info.guid.to_string();
+        }
+        snap.state = self.state;
+        snap.initialized = self.initialized;
+        snap.time = self.time;
+        snap.values.clear();
+        snap.values.extend_from_slice(self.values.as_slice());
+        snap.slopes.clear();
+        snap.slopes.extend_from_slice(&self.slopes);
+        snap.model_state.clear();
+        if self.initialized {
+            self.model.save_state(&mut snap.model_state);
+        }
+        Ok(())
     }
 
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
@@ -514,27 +568,34 @@ impl Instance {
                 snap.guid, self.info.guid
             ));
         }
-        let previous = self.values.clone();
-        self.values.copy_from_slice(&snap.values);
-        if snap.initialized {
-            let same_parameters = self.initialized
-                && self.info.variables.iter().all(|v| {
-                    v.causality != Causality::Parameter
-                        || previous.real(v.vr) == snap.values[v.vr as usize]
-                });
-            let result = if same_parameters {
-                Ok(())
-            } else {
-                self.model.initialize(&self.values)
-            }
-            .and_then(|_| self.model.restore_state(&snap.model_state));
-            if let Err(e) = result {
-                // Lose nothing: put the previous values and model back.
-                self.values = previous;
-                if self.initialized {
-                    let _ = self.model.initialize(&self.values);
+        let same_parameters = self.initialized
+            && self.info.variables.iter().all(|v| {
+                v.causality != Causality::Parameter
+                    || self.values.real(v.vr) == snap.values[v.vr as usize]
+            });
+        if snap.initialized && same_parameters {
+            // The usual rollback of a master: the model takes the state or
+            // refuses it unchanged, then the values follow.
+            self.model
+                .restore_state(&snap.model_state)
+                .map_err(|e| format!("cannot restore the FMU state: {e}"))?;
+            self.values.copy_from_slice(&snap.values);
+        } else {
+            let previous = self.values.clone();
+            self.values.copy_from_slice(&snap.values);
+            if snap.initialized {
+                let result = self
+                    .model
+                    .initialize(&self.values)
+                    .and_then(|_| self.model.restore_state(&snap.model_state));
+                if let Err(e) = result {
+                    // Lose nothing: put the previous values and model back.
+                    self.values = previous;
+                    if self.initialized {
+                        let _ = self.model.initialize(&self.values);
+                    }
+                    return Err(format!("cannot restore the FMU state: {e}"));
                 }
-                return Err(format!("cannot restore the FMU state: {e}"));
             }
         }
         self.slopes.copy_from_slice(&snap.slopes);
@@ -546,38 +607,67 @@ impl Instance {
         Ok(())
     }
 
+    /// `fmi2GetFMUstate`: save the current state into the snapshot at
+    /// `reuse` (which must be one of this instance's) in place, or into a
+    /// new one if `reuse` is 0; returns its address.
+    pub fn save_snapshot(&mut self, reuse: usize) -> Result<usize, String> {
+        if reuse == 0 {
+            let snap = self.snapshot()?;
+            return Ok(self.store_snapshot(snap, 0));
+        }
+        let mut snap = self.take_snapshot(reuse)?;
+        let result = self.snapshot_into(&mut snap);
+        self.saved_states.push(snap);
+        result.map(|()| reuse)
+    }
+
+    /// `fmi2SetFMUstate`: restore the saved snapshot at `address`.
+    pub fn restore_saved(&mut self, address: usize) -> Result<(), String> {
+        let snap = self.take_snapshot(address)?;
+        let result = self.restore(&snap);
+        self.saved_states.push(snap);
+        result
+    }
+
+    /// Where the snapshot at `address` is in [`Instance::saved_states`].
+    fn saved_index(&self, address: usize) -> Result<usize, String> {
+        self.saved_states
+            .iter()
+            .position(|b| &**b as *const Snapshot as usize == address)
+            .ok_or_else(|| {
+                format!(
+                    "FMUstate {address:#x} was not created by this instance (or was already freed)"
+                )
+            })
+    }
+
+    /// The saved snapshot at `address`, out of the list for a moment (no
+    /// copy; the box, and so the address, stays the same: put it back with
+    /// `saved_states.push`).
+    fn take_snapshot(&mut self, address: usize) -> Result<Box<Snapshot>, String> {
+        let i = self.saved_index(address)?;
+        Ok(self.saved_states.swap_remove(i))
+    }
+
     /// Keep a snapshot and return its address (the `fmi2FMUstate`).
     pub fn store_snapshot(&mut self, snap: Snapshot, reuse: usize) -> usize {
-        if let Some(existing) = self.saved_states.get_mut(&reuse) {
-            **existing = snap;
+        if let Ok(i) = self.saved_index(reuse) {
+            *self.saved_states[i] = snap;
             return reuse;
         }
-        let mut boxed = Box::new(snap);
-        let address = &mut *boxed as *mut Snapshot as usize;
-        self.saved_states.insert(address, boxed);
+        let boxed = Box::new(snap);
+        let address = &*boxed as *const Snapshot as usize;
+        self.saved_states.push(boxed);
         address
     }
 
     pub fn saved_snapshot(&self, address: usize) -> Result<&Snapshot, String> {
-        self.saved_states
-            .get(&address)
-            .map(|b| &**b)
-            .ok_or_else(|| {
-                format!(
-                    "FMUstate {address:#x} was not created by this instance (or was already freed)"
-                )
-            })
+        let i = self.saved_index(address)?;
+        Ok(&self.saved_states[i])
     }
 
     pub fn free_snapshot(&mut self, address: usize) -> Result<(), String> {
-        self.saved_states
-            .remove(&address)
-            .map(|_| ())
-            .ok_or_else(|| {
-                format!(
-                    "FMUstate {address:#x} was not created by this instance (or was already freed)"
-                )
-            })
+        self.take_snapshot(address).map(|_| ())
     }
 
     pub fn n_values(&self) -> usize {
