@@ -2,16 +2,16 @@
 //! file, one per point of a parameter grid (and per random seed), spread
 //! over the cores with rayon.
 //!
-//! Each run builds its own [`crate::system::System`] from the file
-//! ([`SystemFile::build_with`], the grid point's values set after the
-//! file's own), co-simulates it exactly as `fricsim run` does
+//! Each run instantiates its own [`crate::system::System`] from the FMUs
+//! opened once ([`SystemFile::instantiate`], the grid point's values set
+//! after the file's own), co-simulates it exactly as `fricsim run` does
 //! ([`simulate_with`]) and keeps a summary: the final value and the RMS
 //! over the communication points of every recorded column, and the wall
 //! time. Runs share nothing but the parsed file, so they scale with the
 //! cores; a run that fails is a row that says so, not the end of the sweep.
 
 use crate::master::{by_name, simulate_with, NoObserver};
-use crate::ssp::SystemFile;
+use crate::ssp::{CheckedSystem, SystemFile};
 use crate::system::ParameterValue;
 use rayon::prelude::*;
 use std::io::Write as _;
@@ -144,8 +144,16 @@ pub struct Outcome {
     pub error: Option<String>,
 }
 
-/// Build and co-simulate `file` at one grid point.
-pub fn run_point(file: &SystemFile, plan: &Plan, point: &[(String, f64)]) -> Outcome {
+/// Build and co-simulate `file` at one grid point: new instances of the
+/// FMUs of `checked` where they may be instantiated more than once per
+/// process, else the file built from scratch (its FMUs unpacked and loaded
+/// again, a separate copy of each binary).
+pub fn run_point(
+    file: &SystemFile,
+    checked: &CheckedSystem,
+    plan: &Plan,
+    point: &[(String, f64)],
+) -> Outcome {
     let clock = Instant::now();
     let overrides: Vec<(String, ParameterValue)> = point
         .iter()
@@ -161,9 +169,17 @@ pub fn run_point(file: &SystemFile, plan: &Plan, point: &[(String, f64)]) -> Out
         error: None,
     };
     let run = by_name(&plan.master).and_then(|mut master| {
-        let mut system = file
-            .build_with(plan.start, &overrides)
-            .map_err(|e| e.to_string())?;
+        let once_per_process = checked.fmus.iter().any(|(_, fmu)| {
+            fmu.description()
+                .co_simulation
+                .can_be_instantiated_only_once_per_process
+        });
+        let mut system = if once_per_process {
+            file.build_with(plan.start, &overrides)
+        } else {
+            file.instantiate(checked, plan.start, &overrides)
+        }
+        .map_err(|e| e.to_string())?;
         simulate_with(
             &mut system,
             master.as_mut(),
@@ -198,10 +214,11 @@ pub fn run_all(file: &SystemFile, plan: &Plan, threads: usize) -> Result<Vec<Out
         .num_threads(threads.max(1))
         .build()
         .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
+    let checked = file.check().map_err(|e| e.to_string())?;
     Ok(pool.install(|| {
         plan.points
             .par_iter()
-            .map(|point| run_point(file, plan, point))
+            .map(|point| run_point(file, &checked, plan, point))
             .collect()
     }))
 }

@@ -1130,7 +1130,18 @@ impl SystemFile {
         start: f64,
         overrides: &[(String, ParameterValue)],
     ) -> Result<System, SspError> {
-        let checked = self.check()?;
+        self.instantiate(&self.check()?, start, overrides)
+    }
+
+    /// [`SystemFile::build_with`] on FMUs already opened and checked by
+    /// [`SystemFile::check`]: new instances of the same loaded FMUs, so
+    /// that repeated runs (`fricsim sweep`) unpack and load nothing again.
+    pub fn instantiate(
+        &self,
+        checked: &CheckedSystem,
+        start: f64,
+        overrides: &[(String, ParameterValue)],
+    ) -> Result<System, SspError> {
         let parameters: Vec<(String, ParameterValue)> = self
             .parameters
             .iter()
@@ -1150,7 +1161,7 @@ impl SystemFile {
             .iter()
             .map(|c| (c.from.clone(), c.to.clone()))
             .collect();
-        let mut system = System::from_fmus(checked.fmus, &parameters, &connections, start)
+        let mut system = System::from_fmus(checked.fmus.clone(), &parameters, &connections, start)
             .map_err(|e| error(&self.ssd, system_error(e)))?;
         for s in self.settings.record.iter().chain(&self.settings.plot) {
             system.record(s).map_err(|e| {
