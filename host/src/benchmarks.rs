@@ -88,3 +88,112 @@ pub fn command_line(variable: &str, program: &str) -> String {
             .join(" ")
     })
 }
+
+// ---- workloads shared by `speed-table` and the criterion benches ---------
+
+/// The friction FMUs of dist/ and how a benchmark drives them: inputs
+/// `(name, amplitude, phase)` of `u(t) = A·sin(2π·t + φ)`, through stick
+/// and slip at the default parameters, and the outputs read every step.
+pub const FRICTION_FMUS: &[(&str, &[(&str, f64, f64)], &[&str])] = &[
+    ("Dahl", &[("v", 1e-3, 0.0)], &["F"]),
+    ("LuGre", &[("v", 1e-3, 0.0)], &["F"]),
+    ("ResetIntegrator", &[("v", 1e-3, 0.0)], &["F"]),
+    // 3·δmax = 4.7e-8 m of seed 000: loads to sliding, reverses twice a period
+    ("Bristle", &[("x", 4.7e-8, 0.0)], &["F"]),
+    (
+        "Bristle2D",
+        &[("v1", 1e-3, 0.0), ("v2", 1e-3, std::f64::consts::FRAC_PI_2)],
+        &["F1", "F2"],
+    ),
+];
+
+/// One initialised instance of a friction FMU of [`FRICTION_FMUS`] and its
+/// resolved value references: [`FmuStepper::step`] is one communication
+/// step through the C ABI (`fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal`).
+pub struct FmuStepper {
+    instance: crate::fmu::Instance,
+    inputs: &'static [(&'static str, f64, f64)],
+    input_vrs: Vec<crate::fmu::ValueReference>,
+    output_vrs: Vec<crate::fmu::ValueReference>,
+    u: Vec<f64>,
+    /// The outputs after the last step.
+    pub y: Vec<f64>,
+}
+
+impl FmuStepper {
+    /// Instantiate the `index`-th model of [`FRICTION_FMUS`] from `fmu`,
+    /// initialised at t = 0 with its default parameters.
+    pub fn new(fmu: &crate::fmu::Fmu, index: usize) -> Result<FmuStepper, String> {
+        let (model, inputs, outputs) = FRICTION_FMUS[index];
+        let vr = |name: &str| {
+            fmu.variable(name)
+                .map(|v| v.value_reference)
+                .map_err(|e| e.to_string())
+        };
+        let input_vrs = inputs
+            .iter()
+            .map(|(n, _, _)| vr(n))
+            .collect::<Result<Vec<_>, _>>()?;
+        let output_vrs = outputs.iter().map(|n| vr(n)).collect::<Result<_, _>>()?;
+        let mut instance = fmu.instantiate(model).map_err(|e| e.to_string())?;
+        instance
+            .setup_experiment(0.0, None)
+            .and_then(|_| instance.enter_initialization_mode())
+            .and_then(|_| instance.exit_initialization_mode())
+            .map_err(|e| e.to_string())?;
+        Ok(FmuStepper {
+            instance,
+            inputs,
+            input_vrs,
+            output_vrs,
+            u: vec![0.0; inputs.len()],
+            y: vec![0.0; outputs.len()],
+        })
+    }
+
+    /// Set the inputs at `t`, step to `t + h`, read the outputs.
+    pub fn step(&mut self, t: f64, h: f64) -> Result<(), crate::FmuError> {
+        for (x, (_, a, phase)) in self.u.iter_mut().zip(self.inputs) {
+            *x = a * (std::f64::consts::TAU * t + phase).sin();
+        }
+        self.instance.set_real(&self.input_vrs, &self.u)?;
+        self.instance.do_step(t, h)?;
+        self.instance.get_real(&self.output_vrs, &mut self.y)?;
+        Ok(())
+    }
+}
+
+/// Increments of the bristle curves.
+pub const INCREMENTS: usize = 1000;
+
+/// Increment `k` (1 ..= [`INCREMENTS`]) of the bristle curve with one
+/// reversal: 0 → 3·δmax in the first half, back to −3·δmax in the second.
+pub fn bristle_curve_point(k: usize, delta_max: f64) -> f64 {
+    let half = INCREMENTS / 2;
+    if k <= half {
+        3.0 * delta_max * k as f64 / half as f64
+    } else {
+        3.0 * delta_max * (1.0 - 2.0 * (k - half) as f64 / half as f64)
+    }
+}
+
+/// The bristle curve with one reversal on `bristle`; the sum of the
+/// forces (to keep the work from being optimised away).
+pub fn bristle_curve(bristle: &mut friction_laws::bristle::Bristle) -> f64 {
+    let delta_max = bristle.params().delta_max;
+    let mut sum = 0.0;
+    for k in 1..=INCREMENTS {
+        bristle.move_to(bristle_curve_point(k, delta_max));
+        sum += bristle.force();
+    }
+    sum
+}
+
+/// `/proc/loadavg`'s one-minute load average (NaN where there is none):
+/// how busy the machine was around a measurement.
+pub fn load_average() -> f64 {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|t| t.split_whitespace().next().and_then(|x| x.parse().ok()))
+        .unwrap_or(f64::NAN)
+}
