@@ -148,6 +148,26 @@ pub struct Bristle {
     relax: Vec<f64>,
     lo: usize,
     hi: usize,
+    /// Buffers a reversal rebuilds the offsets in, kept so that repeated
+    /// reversals of many bristles allocate (and fault in) no new memory.
+    work: Workspace,
+}
+
+/// Spare buffers of [`Bristle::move_to`]'s reversal. Not part of the
+/// state: a clone starts with empty ones.
+#[derive(Debug, Default)]
+struct Workspace {
+    back: Vec<f64>,
+    keys: Vec<u64>,
+    scratch: Vec<u64>,
+    d: Vec<f64>,
+    prefix: Vec<f64>,
+}
+
+impl Clone for Workspace {
+    fn clone(&self) -> Self {
+        Workspace::default()
+    }
 }
 
 /// Sort `v` ascending in the order of [`f64::total_cmp`], with the same
@@ -158,7 +178,7 @@ pub struct Bristle {
 /// negative ones), skipping the digits every key shares (the high ones, for
 /// deflections of one magnitude). A comparison sort takes most of the
 /// reversal's time from about 10⁴ bristles on; short slices use it still.
-fn sort_total(v: &mut [f64]) {
+fn sort_total(v: &mut [f64], keys: &mut Vec<u64>, scratch: &mut Vec<u64>) {
     if v.len() < 256 {
         v.sort_unstable_by(f64::total_cmp);
         return;
@@ -171,31 +191,36 @@ fn sort_total(v: &mut [f64]) {
             b | (1 << 63)
         }
     };
-    let mut keys: Vec<u64> = v.iter().map(|&x| key(x)).collect();
-    let mut scratch = vec![0u64; keys.len()];
-    for pass in 0..8 {
-        let shift = 8 * pass;
-        let mut counts = [0usize; 256];
-        for k in &keys {
-            counts[((k >> shift) & 0xff) as usize] += 1;
+    keys.clear();
+    keys.extend(v.iter().map(|&x| key(x)));
+    scratch.clear();
+    scratch.resize(keys.len(), 0);
+    // the histograms of all eight digits in one pass
+    let mut counts = [[0usize; 256]; 8];
+    for k in keys.iter() {
+        for (pass, c) in counts.iter_mut().enumerate() {
+            c[((k >> (8 * pass)) & 0xff) as usize] += 1;
         }
-        if counts.contains(&keys.len()) {
+    }
+    for (pass, c) in counts.iter_mut().enumerate() {
+        if c.contains(&keys.len()) {
             continue; // every key has this digit: the pass would not move anything
         }
+        let shift = 8 * pass;
         let mut start = 0;
-        for c in counts.iter_mut() {
-            let n = *c;
-            *c = start;
+        for count in c.iter_mut() {
+            let n = *count;
+            *count = start;
             start += n;
         }
-        for &k in &keys {
+        for &k in keys.iter() {
             let digit = ((k >> shift) & 0xff) as usize;
-            scratch[counts[digit]] = k;
-            counts[digit] += 1;
+            scratch[c[digit]] = k;
+            c[digit] += 1;
         }
-        std::mem::swap(&mut keys, &mut scratch);
+        std::mem::swap(keys, scratch);
     }
-    for (x, k) in v.iter_mut().zip(keys) {
+    for (x, &k) in v.iter_mut().zip(keys.iter()) {
         let b = if k >> 63 == 1 { k & !(1 << 63) } else { !k };
         *x = f64::from_bits(b);
     }
@@ -203,13 +228,19 @@ fn sort_total(v: &mut [f64]) {
 
 fn prefix_sums(d: &[f64]) -> Vec<f64> {
     let mut p = Vec::with_capacity(d.len() + 1);
+    prefix_sums_into(d, &mut p);
+    p
+}
+
+/// `p[k] = d[0] + … + d[k−1]`, summed in order, into `p` (cleared first).
+fn prefix_sums_into(d: &[f64], p: &mut Vec<f64>) {
+    p.clear();
     let mut s = 0.0;
     p.push(s);
     for &v in d {
         s += v;
         p.push(s);
     }
-    p
 }
 
 impl Bristle {
@@ -219,7 +250,7 @@ impl Bristle {
         let n = p.n_bristles;
         let mut rng = Rng::new(p.seed);
         let mut d = initial_placement(&mut rng, n, p.delta_max);
-        sort_total(&mut d);
+        sort_total(&mut d, &mut Vec::new(), &mut Vec::new());
         let prefix = prefix_sums(&d);
         Ok(Bristle {
             p,
@@ -233,6 +264,7 @@ impl Bristle {
             relax: vec![0.0; n],
             lo: 0,
             hi: n,
+            work: Workspace::default(),
         })
     }
 
@@ -292,15 +324,28 @@ impl Bristle {
     /// reversal reconnection (`s·(δmax − |r|)` for the disconnected ones),
     /// sorted ascending, and their prefix sums.
     fn reconnected(&self) -> (Vec<f64>, Vec<f64>) {
+        let mut work = Workspace::default();
+        self.reconnected_into(&mut work);
+        (work.d, work.prefix)
+    }
+
+    /// [`Bristle::reconnected`] into the buffers of `work` (`d`, `prefix`;
+    /// the others are scratch).
+    fn reconnected_into(&self, work: &mut Workspace) {
         let n = self.p.n_bristles;
         let dm = self.p.delta_max;
         let shift = self.x - self.x_ref;
-        let mut back: Vec<f64> = (self.hi..n)
-            .map(|k| dm - self.relax[k])
-            .chain((0..self.lo).map(|k| -(dm - self.relax[k])))
-            .collect();
-        sort_total(&mut back);
-        let mut out = Vec::with_capacity(n);
+        let back = &mut work.back;
+        back.clear();
+        back.extend(
+            (self.hi..n)
+                .map(|k| dm - self.relax[k])
+                .chain((0..self.lo).map(|k| -(dm - self.relax[k]))),
+        );
+        sort_total(back, &mut work.keys, &mut work.scratch);
+        let out = &mut work.d;
+        out.clear();
+        out.reserve(n);
         let mut i = self.lo;
         let mut j = 0;
         while i < self.hi || j < back.len() {
@@ -314,8 +359,7 @@ impl Bristle {
                 j += 1;
             }
         }
-        let prefix = prefix_sums(&out);
-        (out, prefix)
+        prefix_sums_into(out, &mut work.prefix);
     }
 
     /// Direction of a move to `x` and whether it reverses with bristles to
@@ -391,9 +435,12 @@ impl Bristle {
             return;
         }
         if reversal {
-            let (d, prefix) = self.reconnected();
-            self.d = d;
-            self.prefix = prefix;
+            let mut work = std::mem::take(&mut self.work);
+            self.reconnected_into(&mut work);
+            // the new offsets in, the old buffers kept as the next spares
+            std::mem::swap(&mut self.d, &mut work.d);
+            std::mem::swap(&mut self.prefix, &mut work.prefix);
+            self.work = work;
             self.x_ref = self.x;
             self.lo = 0;
             self.hi = self.p.n_bristles;
@@ -608,7 +655,7 @@ mod tests {
                 .collect();
             let mut expected = v.clone();
             expected.sort_unstable_by(f64::total_cmp);
-            sort_total(&mut v);
+            sort_total(&mut v, &mut Vec::new(), &mut Vec::new());
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&v), bits(&expected), "{n} values");
         }
