@@ -91,7 +91,7 @@ fn quick_mode_writes_every_table_between_its_markers() {
     }
     for threads in ["1", "2"] {
         if threads == "1" || std::thread::available_parallelism().unwrap().get() == 2 {
-            assert_eq!(row(&text, "**`fricsim sweep`**", threads).len(), 4);
+            assert_eq!(row(&text, "**`fricsim sweep`**", threads).len(), 5);
         }
     }
     assert!(text.contains("**`fricsim diagnose "), "{text}");
