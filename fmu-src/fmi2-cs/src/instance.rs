@@ -34,6 +34,10 @@ pub struct Instance {
     /// Value references of the inputs, the values a step changes (by
     /// their slopes).
     inputs: Vec<u32>,
+    /// Bumped whenever a value other than an input may have changed (a
+    /// parameter set, a reset, a state with other parameters restored): a
+    /// snapshot taken at the same version has the same parameters.
+    parameters_version: u64,
     outputs_dirty: bool,
     initialized: bool,
     pub time: f64,
@@ -113,6 +117,7 @@ impl Instance {
                 h: 0.0,
             },
             inputs,
+            parameters_version: 0,
             scratch: Scratch::default(),
             saved_states: Vec::new(),
         }
@@ -184,6 +189,7 @@ impl Instance {
 
     pub fn reset(&mut self) -> Result<(), String> {
         self.values = Values::from_start(self.info.variables);
+        self.parameters_version += 1;
         self.slopes.iter_mut().for_each(|s| *s = 0.0);
         self.outputs_dirty = true;
         self.initialized = false;
@@ -264,10 +270,12 @@ impl Instance {
             }
         }
         for (vr, value) in vrs.iter().zip(values) {
-            if self.values.real(*vr) != *value
-                || self.info.variables[*vr as usize].causality != Causality::Input
-            {
+            let input = self.info.variables[*vr as usize].causality == Causality::Input;
+            if self.values.real(*vr) != *value || !input {
                 self.replay.valid = false;
+            }
+            if !input {
+                self.parameters_version += 1;
             }
             self.values.set(*vr, *value);
         }
@@ -535,6 +543,7 @@ impl Instance {
             values: Vec::new(),
             slopes: Vec::new(),
             model_state: Vec::new(),
+            parameters_version: u64::MAX,
         };
         self.snapshot_into(&mut snap)?;
         Ok(snap)
@@ -550,6 +559,7 @@ impl Instance {
         snap.state = self.state;
         snap.initialized = self.initialized;
         snap.time = self.time;
+        snap.parameters_version = self.parameters_version;
         snap.values.clear();
         snap.values.extend_from_slice(self.values.as_slice());
         snap.slopes.clear();
@@ -569,10 +579,11 @@ impl Instance {
             ));
         }
         let same_parameters = self.initialized
-            && self.info.variables.iter().all(|v| {
-                v.causality != Causality::Parameter
-                    || self.values.real(v.vr) == snap.values[v.vr as usize]
-            });
+            && (snap.parameters_version == self.parameters_version
+                || self.info.variables.iter().all(|v| {
+                    v.causality != Causality::Parameter
+                        || self.values.real(v.vr) == snap.values[v.vr as usize]
+                }));
         if snap.initialized && same_parameters {
             // The usual rollback of a master: the model takes the state or
             // refuses it unchanged, then the values follow.
@@ -583,6 +594,7 @@ impl Instance {
         } else {
             let previous = self.values.clone();
             self.values.copy_from_slice(&snap.values);
+            self.parameters_version += 1;
             if snap.initialized {
                 let result = self
                     .model
