@@ -559,11 +559,24 @@ impl Instance {
         snap.state = self.state;
         snap.initialized = self.initialized;
         snap.time = self.time;
-        snap.parameters_version = self.parameters_version;
-        snap.values.clear();
-        snap.values.extend_from_slice(self.values.as_slice());
-        snap.slopes.clear();
-        snap.slopes.extend_from_slice(&self.slopes);
+        if snap.parameters_version == self.parameters_version
+            && snap.values.len() == self.values.len()
+            && snap.slopes.len() == self.slopes.len()
+        {
+            // A reused snapshot with the same parameters: only the inputs
+            // and their slopes can differ (outputs are recomputed after a
+            // restore).
+            for &vr in &self.inputs {
+                snap.values[vr as usize] = self.values.real(vr);
+                snap.slopes[vr as usize] = self.slopes[vr as usize];
+            }
+        } else {
+            snap.parameters_version = self.parameters_version;
+            snap.values.clear();
+            snap.values.extend_from_slice(self.values.as_slice());
+            snap.slopes.clear();
+            snap.slopes.extend_from_slice(&self.slopes);
+        }
         snap.model_state.clear();
         if self.initialized {
             self.model.save_state(&mut snap.model_state);
@@ -590,7 +603,17 @@ impl Instance {
             self.model
                 .restore_state(&snap.model_state)
                 .map_err(|e| format!("cannot restore the FMU state: {e}"))?;
-            self.values.copy_from_slice(&snap.values);
+            if snap.parameters_version == self.parameters_version {
+                // same parameters: only the inputs (and their slopes) differ;
+                // the outputs are recomputed
+                for &vr in &self.inputs {
+                    self.values.set(vr, snap.values[vr as usize]);
+                    self.slopes[vr as usize] = snap.slopes[vr as usize];
+                }
+            } else {
+                self.values.copy_from_slice(&snap.values);
+                self.slopes.copy_from_slice(&snap.slopes);
+            }
         } else {
             let previous = self.values.clone();
             self.values.copy_from_slice(&snap.values);
@@ -609,8 +632,8 @@ impl Instance {
                     return Err(format!("cannot restore the FMU state: {e}"));
                 }
             }
+            self.slopes.copy_from_slice(&snap.slopes);
         }
-        self.slopes.copy_from_slice(&snap.slopes);
         self.initialized = snap.initialized;
         self.time = snap.time;
         self.state = snap.state;
