@@ -54,9 +54,10 @@ pub struct Instance {
 }
 
 /// Buffers of [`Instance::directional_derivative`], kept between calls.
-#[derive(Default)]
 struct Scratch {
     values: Option<Values>,
+    /// The parameter version `values` holds the parameters of.
+    parameters_version: u64,
     slopes: Vec<f64>,
     model_state: Vec<f64>,
     plus: Vec<f64>,
@@ -118,7 +119,13 @@ impl Instance {
             },
             inputs,
             parameters_version: 0,
-            scratch: Scratch::default(),
+            scratch: Scratch {
+                values: None,
+                parameters_version: u64::MAX,
+                slopes: Vec::new(),
+                model_state: Vec::new(),
+                plus: Vec::new(),
+            },
             saved_states: Vec::new(),
         }
     }
@@ -495,11 +502,20 @@ impl Instance {
     ) -> Result<(), String> {
         let scratch = &mut self.scratch;
         let values = scratch.values.get_or_insert_with(|| self.values.clone());
-        values.copy_from_slice(self.values.as_slice());
+        if scratch.parameters_version == self.parameters_version {
+            // the same parameters as last time: only the inputs differ (the
+            // outputs are recomputed below)
+            for &vr in &self.inputs {
+                values.set(vr, self.values.real(vr));
+            }
+        } else {
+            values.copy_from_slice(self.values.as_slice());
+            scratch.parameters_version = self.parameters_version;
+        }
         if self.replay.valid {
+            // every slope is zero but those of the inputs, set here
             let slopes = &mut scratch.slopes;
-            slopes.clear();
-            slopes.extend_from_slice(&self.slopes);
+            slopes.resize(self.slopes.len(), 0.0);
             for (k, &vr) in self.inputs.iter().enumerate() {
                 values.set(vr, self.replay.inputs[k]);
                 slopes[vr as usize] = self.replay.slopes[k];
