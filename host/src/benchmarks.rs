@@ -91,10 +91,15 @@ pub fn command_line(variable: &str, program: &str) -> String {
 
 // ---- workloads shared by `speed-table` and the criterion benches ---------
 
+/// An input signal `u(t) = A·sin(2π·t + φ)`: (name, A, φ).
+pub type Sinusoid = (&'static str, f64, f64);
+
+/// A benchmarked FMU: model name, its inputs, the outputs read every step.
+pub type DrivenFmu = (&'static str, &'static [Sinusoid], &'static [&'static str]);
+
 /// The friction FMUs of dist/ and how a benchmark drives them: inputs
-/// `(name, amplitude, phase)` of `u(t) = A·sin(2π·t + φ)`, through stick
-/// and slip at the default parameters, and the outputs read every step.
-pub const FRICTION_FMUS: &[(&str, &[(&str, f64, f64)], &[&str])] = &[
+/// through stick and slip at the default parameters.
+pub const FRICTION_FMUS: &[DrivenFmu] = &[
     ("Dahl", &[("v", 1e-3, 0.0)], &["F"]),
     ("LuGre", &[("v", 1e-3, 0.0)], &["F"]),
     ("ResetIntegrator", &[("v", 1e-3, 0.0)], &["F"]),
@@ -112,7 +117,7 @@ pub const FRICTION_FMUS: &[(&str, &[(&str, f64, f64)], &[&str])] = &[
 /// step through the C ABI (`fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal`).
 pub struct FmuStepper {
     instance: crate::fmu::Instance,
-    inputs: &'static [(&'static str, f64, f64)],
+    inputs: &'static [Sinusoid],
     input_vrs: Vec<crate::fmu::ValueReference>,
     output_vrs: Vec<crate::fmu::ValueReference>,
     u: Vec<f64>,

@@ -49,7 +49,9 @@ pub struct Instance {
     scratch: Scratch,
     /// FMU states handed out by `fmi2GetFMUstate` / `fmi2DeSerializeFMUstate`,
     /// by address, so that a pointer we did not create is refused.
-    /// (A short list: a master keeps one or two; its address is the box's.)
+    /// (A short list: a master keeps one or two. Boxed: the address of the
+    /// box is the handle given out, and must not move with the list.)
+    #[allow(clippy::vec_box)]
     saved_states: Vec<Box<Snapshot>>,
 }
 

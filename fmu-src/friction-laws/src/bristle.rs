@@ -153,21 +153,25 @@ pub struct Bristle {
     work: Workspace,
 }
 
-/// Spare buffers of [`Bristle::move_to`]'s reversal. Not part of the
-/// state: a clone starts with empty ones.
+/// Spare buffers of [`Bristle::move_to`]'s reversal (boxed, so that a
+/// bristle model stays small until its first reversal). Not part of the
+/// state: a clone starts without.
 #[derive(Debug, Default)]
-struct Workspace {
+struct Workspace(Option<Box<Buffers>>);
+
+impl Clone for Workspace {
+    fn clone(&self) -> Self {
+        Workspace(None)
+    }
+}
+
+#[derive(Debug, Default)]
+struct Buffers {
     back: Vec<f64>,
     keys: Vec<u64>,
     scratch: Vec<u64>,
     d: Vec<f64>,
     prefix: Vec<f64>,
-}
-
-impl Clone for Workspace {
-    fn clone(&self) -> Self {
-        Workspace::default()
-    }
 }
 
 /// Sort `v` ascending in the order of [`f64::total_cmp`], with the same
@@ -324,14 +328,14 @@ impl Bristle {
     /// reversal reconnection (`s·(δmax − |r|)` for the disconnected ones),
     /// sorted ascending, and their prefix sums.
     fn reconnected(&self) -> (Vec<f64>, Vec<f64>) {
-        let mut work = Workspace::default();
+        let mut work = Buffers::default();
         self.reconnected_into(&mut work);
         (work.d, work.prefix)
     }
 
     /// [`Bristle::reconnected`] into the buffers of `work` (`d`, `prefix`;
     /// the others are scratch).
-    fn reconnected_into(&self, work: &mut Workspace) {
+    fn reconnected_into(&self, work: &mut Buffers) {
         let n = self.p.n_bristles;
         let dm = self.p.delta_max;
         let shift = self.x - self.x_ref;
@@ -435,12 +439,12 @@ impl Bristle {
             return;
         }
         if reversal {
-            let mut work = std::mem::take(&mut self.work);
+            let mut work = self.work.0.take().unwrap_or_default();
             self.reconnected_into(&mut work);
             // the new offsets in, the old buffers kept as the next spares
             std::mem::swap(&mut self.d, &mut work.d);
             std::mem::swap(&mut self.prefix, &mut work.prefix);
-            self.work = work;
+            self.work.0 = Some(work);
             self.x_ref = self.x;
             self.lo = 0;
             self.hi = self.p.n_bristles;
