@@ -38,6 +38,40 @@ pub fn splice(path: &Path, begin: &str, end: &str, block: Option<&str>) -> Resul
     std::fs::write(path, out).map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// The options every BENCHMARKS.md program has: where the repository is
+/// and which file to update.
+#[derive(clap::Args, Debug)]
+pub struct TableFileArgs {
+    /// The repository root, where examples/ and dist/ are
+    /// [default: the workspace this program was built from].
+    #[arg(long)]
+    pub root: Option<std::path::PathBuf>,
+    /// Write the tables between the markers of this file (created if
+    /// missing) instead of stdout.
+    #[arg(long)]
+    pub update: Option<std::path::PathBuf>,
+}
+
+impl TableFileArgs {
+    /// `--root`, else the workspace the program was built from.
+    pub fn root(&self) -> std::path::PathBuf {
+        self.root
+            .clone()
+            .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+    }
+}
+
+/// The exit of a BENCHMARKS.md program: its error on stderr, named.
+pub fn exit_code(program: &str, result: Result<(), String>) -> std::process::ExitCode {
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{program}: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
 /// CPU model (from /proc/cpuinfo), cores the process may use, OS.
 pub fn machine() -> String {
     let model = std::fs::read_to_string("/proc/cpuinfo")

@@ -22,13 +22,13 @@
 //! and updates BENCHMARKS.md.
 
 use clap::Parser;
-use fricsim::benchmarks::{command_line, machine, splice, today};
+use fricsim::benchmarks::{command_line, exit_code, machine, splice, today, TableFileArgs};
 use fricsim::compare::{compare, ResultFile};
 use fricsim::master::{by_name, simulate_with, NoObserver, Run};
 use fricsim::ssp::SystemFile;
 use fricsim_reference::{ReferenceModel, RTOL};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Markers of the generated part of the file given to `--update`.
@@ -109,14 +109,8 @@ struct Args {
     /// Cases, comma-separated: stick-slip, stick-slip-1e7, seed000 [default: all].
     #[arg(long, value_delimiter = ',')]
     cases: Vec<String>,
-    /// The repository root, where examples/ and dist/ are
-    /// [default: the workspace this program was built from].
-    #[arg(long)]
-    root: Option<PathBuf>,
-    /// Write the tables between the markers of this file (created if
-    /// missing) instead of stdout.
-    #[arg(long)]
-    update: Option<PathBuf>,
+    #[command(flatten)]
+    file: TableFileArgs,
 }
 
 enum Outcome {
@@ -147,21 +141,11 @@ struct Row {
 }
 
 fn main() -> std::process::ExitCode {
-    let args = Args::parse();
-    match run(&args) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("accuracy-table: {e}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    exit_code("accuracy-table", run(&Args::parse()))
 }
 
 fn run(args: &Args) -> Result<(), String> {
-    let root = args
-        .root
-        .clone()
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join(".."));
+    let root = args.file.root();
     let steps: Vec<f64> = match (&args.steps[..], args.quick) {
         ([], true) => vec![GOAL_STEP],
         ([], false) => STEPS.to_vec(),
@@ -200,7 +184,7 @@ fn run(args: &Args) -> Result<(), String> {
             .collect::<Result<_, _>>()?
     };
 
-    if let Some(path) = &args.update {
+    if let Some(path) = &args.file.update {
         splice(path, BEGIN, END, None)?; // markers missing: say so before running
     }
 
@@ -222,7 +206,7 @@ fn run(args: &Args) -> Result<(), String> {
     // own command line is shown.
     let command = command_line("ACCURACY_TABLE_COMMAND", "accuracy-table");
     let block = render(&rows, &masters, &command, total);
-    match &args.update {
+    match &args.file.update {
         None => print!("{block}"),
         Some(path) => {
             splice(path, BEGIN, END, Some(&block))?;

@@ -38,8 +38,8 @@
 
 use clap::Parser;
 use fricsim::benchmarks::{
-    bristle_curve, bristle_curve_point, command_line, load_average, machine, splice, today,
-    FmuStepper, FRICTION_FMUS, INCREMENTS,
+    bristle_curve, bristle_curve_point, command_line, exit_code, load_average, machine, splice,
+    today, FmuStepper, TableFileArgs, FRICTION_FMUS, INCREMENTS,
 };
 use fricsim::fmu::Fmu;
 use fricsim::master::{by_name, simulate_with, NoObserver};
@@ -77,28 +77,15 @@ struct Args {
     /// Timed runs per figure; the best counts [default: 3, quick: 1].
     #[arg(long)]
     repeats: Option<usize>,
-    /// The repository root, where examples/ and dist/ are
-    /// [default: the workspace this program was built from].
-    #[arg(long)]
-    root: Option<PathBuf>,
     /// The Python that has FMPy [default: ROOT/.venv/bin/python].
     #[arg(long)]
     python: Option<PathBuf>,
-    /// Write the tables between the markers of this file (created if
-    /// missing) instead of stdout.
-    #[arg(long)]
-    update: Option<PathBuf>,
+    #[command(flatten)]
+    file: TableFileArgs,
 }
 
 fn main() -> std::process::ExitCode {
-    let args = Args::parse();
-    match run(&args) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("speed-table: {e}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    exit_code("speed-table", run(&Args::parse()))
 }
 
 /// How long each part runs.
@@ -112,10 +99,7 @@ struct Sizes {
 }
 
 fn run(args: &Args) -> Result<(), String> {
-    let root = args
-        .root
-        .clone()
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join(".."));
+    let root = args.file.root();
     let sizes = if args.quick {
         Sizes {
             repeats: args.repeats.unwrap_or(1),
@@ -138,7 +122,7 @@ fn run(args: &Args) -> Result<(), String> {
     if sizes.repeats == 0 {
         return Err("--repeats must be at least 1".into());
     }
-    if let Some(path) = &args.update {
+    if let Some(path) = &args.file.update {
         splice(path, BEGIN, END, None)?; // markers missing: say so before running
     }
     let python = args
@@ -173,7 +157,7 @@ fn run(args: &Args) -> Result<(), String> {
         &command,
         total,
     );
-    match &args.update {
+    match &args.file.update {
         None => print!("{block}"),
         Some(path) => {
             splice(path, BEGIN, END, Some(&block))?;

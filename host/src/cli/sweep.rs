@@ -26,15 +26,8 @@ pub struct SweepArgs {
     /// Worker threads [default: every core].
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Start time in seconds [default: DefaultExperiment startTime, else 0].
-    #[arg(long)]
-    pub start: Option<f64>,
-    /// Stop time in seconds [default: DefaultExperiment stopTime].
-    #[arg(long)]
-    pub stop: Option<f64>,
-    /// Macro step in seconds [default: the file's stepSize annotation].
-    #[arg(long)]
-    pub step: Option<f64>,
+    #[command(flatten)]
+    pub grid: super::GridArgs,
     /// Master algorithm (as `fricsim run --master`) [default: the file's
     /// annotation, else jacobi].
     #[arg(long)]
@@ -46,12 +39,8 @@ pub struct SweepArgs {
 
 pub fn run(a: &SweepArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let (start, stop, step) = super::time_grid(&file, a.start, a.stop, a.step)?;
-    let master = a
-        .master
-        .clone()
-        .or(file.settings.master.clone())
-        .unwrap_or_else(|| "jacobi".to_string());
+    let (start, stop, step) = a.grid.resolve(&file)?;
+    let master = super::master_name(&a.master, &file);
     fricsim::master::by_name(&master)?; // refused before anything runs
     let mut axes = a
         .params
