@@ -13,7 +13,8 @@
 # of BENCHMARKS.md. Arguments go to the program: --quick (short runs, no
 # fricsim diagnose: the tables appear, the numbers mean little),
 # --repeats N, --update OTHER.md, --python PATH; --help lists them.
-# The full run takes about three minutes, most of it FMPy; run it on an
+# The full run takes about a minute after the build, most of it FMPy and
+# fricsim diagnose; run it on an
 # otherwise idle machine, since it measures time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
