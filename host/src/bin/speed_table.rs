@@ -13,8 +13,8 @@
 //!      Python (`scripts/bench_fmpy.py`, FMU2Slave), started from here;
 //!    - the monolithic limit: the same laws and rig (`friction-laws`,
 //!      `rig-dynamics`) stepped in one Rust loop with no FMI in between,
-//!      recording the same outputs ([`monolithic_jacobi`],
-//!      [`monolithic_newton`]).
+//!      recording the same outputs ([`StickSlipModel::monolithic_jacobi`],
+//!      [`StickSlipModel::monolithic_newton`]).
 //! 3. **Seed 000's Experiments 3 curve**: the force–displacement curve of
 //!    the bristle model with seed 000's parameters (0.352 kg, N = 109
 //!    bristles), 1000 displacement increments from rest to sliding
@@ -28,7 +28,8 @@
 //! 6. **`fricsim diagnose`** on the EMPS data: the command, timed.
 //!
 //! Every timed figure is the best of `--repeats` runs (the machine is
-//! shared; the best run is the one least disturbed). `--quick` shortens
+//! shared; the best run is the one least disturbed), but FMPy's, which is
+//! run once (twenty seconds of Newton in Python take half a minute). `--quick` shortens
 //! every run (for the tests: the tables appear with every row, the numbers
 //! mean little) and skips `fricsim diagnose`.
 //!
@@ -946,7 +947,7 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
     let _ = writeln!(s, "{BEGIN}");
     let _ = writeln!(
         s,
-        "Generated {} by `{command}` on {}; {total:.0} s in all; each figure the best of {} run{}; load average {:.2} at the start, {:.2} at the end (other work on the machine slows every figure, the parallel sweep most).\n",
+        "Generated {} by `{command}` on {}; {total:.0} s in all; each figure the best of {} run{} (FMPy's: one run); load average {:.2} at the start, {:.2} at the end (other work on the machine slows every figure, the parallel sweep most).\n",
         today(),
         machine(),
         sizes.repeats,
