@@ -23,6 +23,7 @@
 //! # Ok::<(), fricsim::FmuError>(())
 //! ```
 
+pub mod benchmarks;
 pub mod compare;
 pub mod error;
 pub mod fmu;
@@ -32,6 +33,7 @@ pub mod plot;
 pub mod reference;
 pub mod results;
 pub mod ssp;
+pub mod sweep;
 pub mod system;
 
 pub use error::{ArchiveProblem, FmuError};

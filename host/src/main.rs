@@ -53,6 +53,10 @@ enum Command {
     /// and reports the error on held-out data; writes report.json,
     /// report.md, plots and the refitted system.
     Diagnose(cli::diagnose::DiagnoseArgs),
+    /// Run a system once per point of a parameter grid (and per random
+    /// seed), in parallel on all cores; writes one CSV row per run with the
+    /// parameters, final values, RMS values and wall time.
+    Sweep(cli::sweep::SweepArgs),
 }
 
 fn main() -> ExitCode {
@@ -75,6 +79,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => cli::compare::run(&args),
         Command::Reference(args) => cli::reference::run(&args),
         Command::Diagnose(args) => cli::diagnose::run(&args),
+        Command::Sweep(args) => cli::sweep::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -21,6 +21,9 @@ pub struct Component {
     pub instance: Instance,
     /// Real outputs (name, value reference), recorded every step.
     pub outputs: Vec<(String, ValueReference)>,
+    /// The value references of `outputs`, in order: [`System::sample`]
+    /// reads them in one `fmi2GetReal` call.
+    output_vrs: Vec<ValueReference>,
 }
 
 impl Component {
@@ -128,7 +131,7 @@ impl System {
                 )));
             }
             let instance = fmu.instantiate(&name)?;
-            let outputs = fmu
+            let outputs: Vec<(String, ValueReference)> = fmu
                 .description()
                 .variables
                 .iter()
@@ -141,6 +144,7 @@ impl System {
                 name,
                 fmu,
                 instance,
+                output_vrs: outputs.iter().map(|(_, vr)| *vr).collect(),
                 outputs,
             });
         }
@@ -309,6 +313,7 @@ impl System {
         }
         if !component.outputs.iter().any(|(n, _)| n == v) {
             component.outputs.push((v.to_string(), var.value_reference));
+            component.output_vrs.push(var.value_reference);
         }
         Ok(())
     }
@@ -346,14 +351,13 @@ impl System {
             .collect()
     }
 
-    /// Append every recorded output to `row`.
+    /// Append every recorded output to `row`: one `fmi2GetReal` per
+    /// component.
     pub fn sample(&mut self, row: &mut Vec<f64>) -> Result<(), FmuError> {
         for c in &mut self.components {
-            for (_, vr) in &c.outputs {
-                let mut x = [0.0];
-                c.instance.get_real(&[*vr], &mut x)?;
-                row.push(x[0]);
-            }
+            let from = row.len();
+            row.resize(from + c.output_vrs.len(), 0.0);
+            c.instance.get_real(&c.output_vrs, &mut row[from..])?;
         }
         Ok(())
     }

@@ -8,6 +8,8 @@
 
 mod common;
 
+use common::table_row as cells;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -31,19 +33,6 @@ fn table(args: &[&str], update: &Path) -> Output {
         .arg(update)
         .output()
         .unwrap()
-}
-
-/// The cells of the markdown table row that starts with `| {label} |`,
-/// in the first table after `heading`.
-fn cells<'a>(text: &'a str, heading: &str, label: &str) -> Vec<&'a str> {
-    let after = &text[text
-        .find(heading)
-        .unwrap_or_else(|| panic!("no {heading:?}"))..];
-    let line = after
-        .lines()
-        .find(|l| l.starts_with(&format!("| {label} |")))
-        .unwrap_or_else(|| panic!("no row {label:?} after {heading:?} in\n{text}"));
-    line.trim_matches('|').split('|').map(str::trim).collect()
 }
 
 /// A percentage entry as a fraction ("0.0433 %" → 4.33e-4).

@@ -1,5 +1,6 @@
-//! The hot path — `set_real`, `do_step`, `get_real` — does not allocate on
-//! the host side. A counting global allocator sees every Rust allocation of
+//! The hot path — `set_real`, `do_step`, `get_real`, and a whole macro
+//! step of the Jacobi and Newton masters — does not allocate on the host
+//! side. A counting global allocator sees every Rust allocation of
 //! this process (the FMU binaries have their own). One test only, so no
 //! other test thread allocates meanwhile.
 
@@ -68,4 +69,33 @@ fn set_step_get_do_not_allocate() {
     i.enter_initialization_mode().unwrap();
     i.exit_initialization_mode().unwrap();
     assert_eq!(allocations_in_loop(&mut i, v, f), 0);
+
+    // Macro steps of the stick-slip system, past the first (which sizes
+    // the masters' buffers and, for Newton, checks the directional
+    // derivatives against finite differences once).
+    common::lugre_fmu(); // dist/ is built
+    let file = fricsim::ssp::SystemFile::open(common::repository().join("examples/stick_slip.ssd"))
+        .unwrap();
+    for name in ["jacobi", "newton"] {
+        let mut master = fricsim::master::by_name(name).unwrap();
+        let mut system = file.build(0.0).unwrap();
+        let mut buffer = vec![0.0; system.connections.len()];
+        system.propagate(&mut buffer).unwrap();
+        for c in &mut system.components {
+            c.instance.exit_initialization_mode().unwrap();
+        }
+        let h = 1e-4;
+        for k in 0..10 {
+            master.step(&mut system, k as f64 * h, h).unwrap();
+        }
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for k in 10..1010 {
+            master.step(&mut system, k as f64 * h, h).unwrap();
+        }
+        let allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(
+            allocations, 0,
+            "{name}: {allocations} allocations in 1000 steps"
+        );
+    }
 }

@@ -14,7 +14,6 @@ use crate::serialize::Snapshot;
 use crate::state_machine::State;
 use crate::variables::{Causality, ModelInfo, VarType, Variable};
 use crate::Values;
-use std::collections::HashMap;
 
 /// Relative tolerance on communication points (time is taken from the
 /// master at every step, never summed inside the FMU).
@@ -32,6 +31,13 @@ pub struct Instance {
     values: Values,
     /// `du/dt` per value reference (non-zero for inputs only).
     slopes: Vec<f64>,
+    /// Value references of the inputs, the values a step changes (by
+    /// their slopes).
+    inputs: Vec<u32>,
+    /// Bumped whenever a value other than an input may have changed (a
+    /// parameter set, a reset, a state with other parameters restored): a
+    /// snapshot taken at the same version has the same parameters.
+    parameters_version: u64,
     outputs_dirty: bool,
     initialized: bool,
     pub time: f64,
@@ -40,17 +46,34 @@ pub struct Instance {
     /// The last step, kept for directional derivatives: the state, inputs
     /// and slopes before it, and its length. Valid until an input changes.
     replay: Replay,
+    scratch: Scratch,
     /// FMU states handed out by `fmi2GetFMUstate` / `fmi2DeSerializeFMUstate`,
     /// by address, so that a pointer we did not create is refused.
-    saved_states: HashMap<usize, Box<Snapshot>>,
+    /// (A short list: a master keeps one or two. Boxed: the address of the
+    /// box is the handle given out, and must not move with the list.)
+    #[allow(clippy::vec_box)]
+    saved_states: Vec<Box<Snapshot>>,
     /// Reused buffer for the model state checked after each step.
-    scratch: Vec<f64>,
+    step_state: Vec<f64>,
+}
+
+/// Buffers of [`Instance::directional_derivative`], kept between calls.
+struct Scratch {
+    values: Option<Values>,
+    /// The parameter version `values` holds the parameters of.
+    parameters_version: u64,
+    slopes: Vec<f64>,
+    model_state: Vec<f64>,
+    plus: Vec<f64>,
 }
 
 struct Replay {
     valid: bool,
     model_state: Vec<f64>,
-    values: Vec<f64>,
+    /// Value and slope of each of [`Instance::inputs`] before the step
+    /// (nothing else changes in a step: a parameter set since invalidates
+    /// the replay).
+    inputs: Vec<f64>,
     slopes: Vec<f64>,
     h: f64,
 }
@@ -72,6 +95,12 @@ impl Instance {
     ) -> Self {
         let values = Values::from_start(info.variables);
         let n = values.len();
+        let inputs: Vec<u32> = info
+            .variables
+            .iter()
+            .filter(|v| v.causality == Causality::Input)
+            .map(|v| v.vr)
+            .collect();
         Instance {
             info,
             name: name.to_string(),
@@ -88,12 +117,21 @@ impl Instance {
             replay: Replay {
                 valid: false,
                 model_state: Vec::new(),
-                values: vec![0.0; n],
-                slopes: vec![0.0; n],
+                inputs: vec![0.0; inputs.len()],
+                slopes: vec![0.0; inputs.len()],
                 h: 0.0,
             },
-            saved_states: HashMap::new(),
-            scratch: Vec::new(),
+            inputs,
+            parameters_version: 0,
+            scratch: Scratch {
+                values: None,
+                parameters_version: u64::MAX,
+                slopes: Vec::new(),
+                model_state: Vec::new(),
+                plus: Vec::new(),
+            },
+            saved_states: Vec::new(),
+            step_state: Vec::new(),
         }
     }
 
@@ -163,6 +201,7 @@ impl Instance {
 
     pub fn reset(&mut self) -> Result<(), String> {
         self.values = Values::from_start(self.info.variables);
+        self.parameters_version += 1;
         self.slopes.iter_mut().for_each(|s| *s = 0.0);
         self.outputs_dirty = true;
         self.initialized = false;
@@ -257,10 +296,12 @@ impl Instance {
             }
         }
         for (vr, value) in vrs.iter().zip(values) {
-            if self.values.real(*vr) != *value
-                || self.info.variables[*vr as usize].causality != Causality::Input
-            {
+            let input = self.info.variables[*vr as usize].causality == Causality::Input;
+            if self.values.real(*vr) != *value || !input {
                 self.replay.valid = false;
+            }
+            if !input {
+                self.parameters_version += 1;
             }
             self.values.set(*vr, *value);
         }
@@ -359,8 +400,10 @@ impl Instance {
         if self.model.needs_step_replay() {
             self.replay.model_state.clear();
             self.model.save_state(&mut self.replay.model_state);
-            self.replay.values.copy_from_slice(self.values.as_slice());
-            self.replay.slopes.copy_from_slice(&self.slopes);
+            for (k, &vr) in self.inputs.iter().enumerate() {
+                self.replay.inputs[k] = self.values.real(vr);
+                self.replay.slopes[k] = self.slopes[vr as usize];
+            }
             self.replay.h = h;
         }
         if let Err(e) = self.model.do_step(&self.values, &self.slopes, h) {
@@ -369,9 +412,9 @@ impl Instance {
         }
         // A step that overflowed (finite but extreme parameters or inputs)
         // is a failed step too: the state is no longer meaningful.
-        self.scratch.clear();
-        self.model.save_state(&mut self.scratch);
-        if let Some(x) = self.scratch.iter().find(|x| !x.is_finite()) {
+        self.step_state.clear();
+        self.model.save_state(&mut self.step_state);
+        if let Some(x) = self.step_state.iter().find(|x| !x.is_finite()) {
             self.state = State::Error;
             return Err(format!(
                 "step from t = {t} over h = {h} failed: the model state became {x}: the parameters or inputs are out of the model's range"
@@ -379,7 +422,7 @@ impl Instance {
         }
         // Inputs as the FMU saw them at the end of the step (u + du·h); the
         // slopes apply to one step only.
-        advance_inputs(self.info, &mut self.values, &mut self.slopes, h);
+        advance_inputs(&self.inputs, &mut self.values, &mut self.slopes, h);
         self.replay.valid = self.model.needs_step_replay();
         self.time = t + h;
         self.outputs_dirty = true;
@@ -461,59 +504,130 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
-        let plus = self.perturbed_outputs(knowns, dv_known, eps, unknowns)?;
-        let minus = self.perturbed_outputs(knowns, dv_known, -eps, unknowns)?;
-        for ((d, p), m) in dv_unknown.iter_mut().zip(&plus).zip(&minus) {
-            *d = (p - m) / (2.0 * eps);
+        let mut plus = std::mem::take(&mut self.scratch.plus);
+        plus.resize(unknowns.len(), 0.0);
+        let result = self
+            .perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus)
+            .and_then(|()| self.perturbed_outputs(knowns, dv_known, -eps, unknowns, dv_unknown));
+        for (d, p) in dv_unknown.iter_mut().zip(&plus) {
+            *d = (p - *d) / (2.0 * eps);
         }
+        self.scratch.plus = plus;
+        result?;
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }
 
+    /// The outputs `unknowns` into `out` with the inputs `knowns` moved by
+    /// `eps·dv`: after a step, the step replayed from its saved start on
+    /// the model itself (whose current state is put back after), else the
+    /// outputs at the current state. No allocation: the scratch buffers
+    /// are reused.
     fn perturbed_outputs(
-        &self,
+        &mut self,
         knowns: &[u32],
         dv: &[f64],
         eps: f64,
         unknowns: &[u32],
-    ) -> Result<Vec<f64>, String> {
-        let mut values = self.values.clone();
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        let scratch = &mut self.scratch;
+        let values = scratch.values.get_or_insert_with(|| self.values.clone());
+        if scratch.parameters_version == self.parameters_version {
+            // the same parameters as last time: only the inputs differ (the
+            // outputs are recomputed below)
+            for &vr in &self.inputs {
+                values.set(vr, self.values.real(vr));
+            }
+        } else {
+            values.copy_from_slice(self.values.as_slice());
+            scratch.parameters_version = self.parameters_version;
+        }
         if self.replay.valid {
-            let mut model = self.model.clone_model();
-            model.restore_state(&self.replay.model_state)?;
-            values.copy_from_slice(&self.replay.values);
+            // every slope is zero but those of the inputs, set here
+            let slopes = &mut scratch.slopes;
+            slopes.resize(self.slopes.len(), 0.0);
+            for (k, &vr) in self.inputs.iter().enumerate() {
+                values.set(vr, self.replay.inputs[k]);
+                slopes[vr as usize] = self.replay.slopes[k];
+            }
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            let mut slopes = self.replay.slopes.clone();
-            model.do_step(&values, &slopes, self.replay.h)?;
-            advance_inputs(self.info, &mut values, &mut slopes, self.replay.h);
-            model.compute_outputs(&mut values);
+            let current = &mut scratch.model_state;
+            current.clear();
+            self.model.save_state(current);
+            let replayed = self
+                .model
+                .restore_state(&self.replay.model_state)
+                .and_then(|()| self.model.do_step(values, slopes, self.replay.h));
+            if replayed.is_ok() {
+                advance_inputs(&self.inputs, values, slopes, self.replay.h);
+                self.model.compute_outputs(values);
+            }
+            self.model.restore_state(current)?;
+            replayed?;
         } else {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            self.model.compute_outputs(&mut values);
+            self.model.compute_outputs(values);
         }
-        Ok(unknowns.iter().map(|u| values.real(*u)).collect())
+        for (o, u) in out.iter_mut().zip(unknowns) {
+            *o = values.real(*u);
+        }
+        Ok(())
     }
 
     // ---- FMU states -----------------------------------------------------
 
     pub fn snapshot(&mut self) -> Result<Snapshot, String> {
-        self.ensure_outputs()?;
-        let mut model_state = Vec::new();
-        if self.initialized {
-            self.model.save_state(&mut model_state);
-        }
-        Ok(Snapshot {
-            guid: self.info.guid.to_string(),
+        let mut snap = Snapshot {
+            guid: String::new(),
             state: self.state,
-            initialized: self.initialized,
-            time: self.time,
-            values: self.values.as_slice().to_vec(),
-            slopes: self.slopes.clone(),
-            model_state,
-        })
+            initialized: false,
+            time: 0.0,
+            values: Vec::new(),
+            slopes: Vec::new(),
+            model_state: Vec::new(),
+            parameters_version: u64::MAX,
+        };
+        self.snapshot_into(&mut snap)?;
+        Ok(snap)
+    }
+
+    /// Overwrite `snap` with the current state, reusing its buffers (no
+    /// allocation when it held a state of this instance before).
+    pub fn snapshot_into(&mut self, snap: &mut Snapshot) -> Result<(), String> {
+        self.ensure_outputs()?;
+        if snap.guid != self.info.guid {
+            snap.guid = self.info.guid.to_string();
+        }
+        snap.state = self.state;
+        snap.initialized = self.initialized;
+        snap.time = self.time;
+        if snap.parameters_version == self.parameters_version
+            && snap.values.len() == self.values.len()
+            && snap.slopes.len() == self.slopes.len()
+        {
+            // A reused snapshot with the same parameters: only the inputs
+            // and their slopes can differ (outputs are recomputed after a
+            // restore).
+            for &vr in &self.inputs {
+                snap.values[vr as usize] = self.values.real(vr);
+                snap.slopes[vr as usize] = self.slopes[vr as usize];
+            }
+        } else {
+            snap.parameters_version = self.parameters_version;
+            snap.values.clear();
+            snap.values.extend_from_slice(self.values.as_slice());
+            snap.slopes.clear();
+            snap.slopes.extend_from_slice(&self.slopes);
+        }
+        snap.model_state.clear();
+        if self.initialized {
+            self.model.save_state(&mut snap.model_state);
+        }
+        Ok(())
     }
 
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
@@ -523,30 +637,49 @@ impl Instance {
                 snap.guid, self.info.guid
             ));
         }
-        let previous = self.values.clone();
-        self.values.copy_from_slice(&snap.values);
-        if snap.initialized {
-            let same_parameters = self.initialized
-                && self.info.variables.iter().all(|v| {
+        let same_parameters = self.initialized
+            && (snap.parameters_version == self.parameters_version
+                || self.info.variables.iter().all(|v| {
                     v.causality != Causality::Parameter
-                        || previous.real(v.vr) == snap.values[v.vr as usize]
-                });
-            let result = if same_parameters {
-                Ok(())
-            } else {
-                self.model.initialize(&self.values)
-            }
-            .and_then(|_| self.model.restore_state(&snap.model_state));
-            if let Err(e) = result {
-                // Lose nothing: put the previous values and model back.
-                self.values = previous;
-                if self.initialized {
-                    let _ = self.model.initialize(&self.values);
+                        || self.values.real(v.vr) == snap.values[v.vr as usize]
+                }));
+        if snap.initialized && same_parameters {
+            // The usual rollback of a master: the model takes the state or
+            // refuses it unchanged, then the values follow.
+            self.model
+                .restore_state(&snap.model_state)
+                .map_err(|e| format!("cannot restore the FMU state: {e}"))?;
+            if snap.parameters_version == self.parameters_version {
+                // same parameters: only the inputs (and their slopes) differ;
+                // the outputs are recomputed
+                for &vr in &self.inputs {
+                    self.values.set(vr, snap.values[vr as usize]);
+                    self.slopes[vr as usize] = snap.slopes[vr as usize];
                 }
-                return Err(format!("cannot restore the FMU state: {e}"));
+            } else {
+                self.values.copy_from_slice(&snap.values);
+                self.slopes.copy_from_slice(&snap.slopes);
             }
+        } else {
+            let previous = self.values.clone();
+            self.values.copy_from_slice(&snap.values);
+            self.parameters_version += 1;
+            if snap.initialized {
+                let result = self
+                    .model
+                    .initialize(&self.values)
+                    .and_then(|_| self.model.restore_state(&snap.model_state));
+                if let Err(e) = result {
+                    // Lose nothing: put the previous values and model back.
+                    self.values = previous;
+                    if self.initialized {
+                        let _ = self.model.initialize(&self.values);
+                    }
+                    return Err(format!("cannot restore the FMU state: {e}"));
+                }
+            }
+            self.slopes.copy_from_slice(&snap.slopes);
         }
-        self.slopes.copy_from_slice(&snap.slopes);
         self.initialized = snap.initialized;
         self.time = snap.time;
         self.state = snap.state;
@@ -555,38 +688,67 @@ impl Instance {
         Ok(())
     }
 
+    /// `fmi2GetFMUstate`: save the current state into the snapshot at
+    /// `reuse` (which must be one of this instance's) in place, or into a
+    /// new one if `reuse` is 0; returns its address.
+    pub fn save_snapshot(&mut self, reuse: usize) -> Result<usize, String> {
+        if reuse == 0 {
+            let snap = self.snapshot()?;
+            return Ok(self.store_snapshot(snap, 0));
+        }
+        let mut snap = self.take_snapshot(reuse)?;
+        let result = self.snapshot_into(&mut snap);
+        self.saved_states.push(snap);
+        result.map(|()| reuse)
+    }
+
+    /// `fmi2SetFMUstate`: restore the saved snapshot at `address`.
+    pub fn restore_saved(&mut self, address: usize) -> Result<(), String> {
+        let snap = self.take_snapshot(address)?;
+        let result = self.restore(&snap);
+        self.saved_states.push(snap);
+        result
+    }
+
+    /// Where the snapshot at `address` is in [`Instance::saved_states`].
+    fn saved_index(&self, address: usize) -> Result<usize, String> {
+        self.saved_states
+            .iter()
+            .position(|b| &**b as *const Snapshot as usize == address)
+            .ok_or_else(|| {
+                format!(
+                    "FMUstate {address:#x} was not created by this instance (or was already freed)"
+                )
+            })
+    }
+
+    /// The saved snapshot at `address`, out of the list for a moment (no
+    /// copy; the box, and so the address, stays the same: put it back with
+    /// `saved_states.push`).
+    fn take_snapshot(&mut self, address: usize) -> Result<Box<Snapshot>, String> {
+        let i = self.saved_index(address)?;
+        Ok(self.saved_states.swap_remove(i))
+    }
+
     /// Keep a snapshot and return its address (the `fmi2FMUstate`).
     pub fn store_snapshot(&mut self, snap: Snapshot, reuse: usize) -> usize {
-        if let Some(existing) = self.saved_states.get_mut(&reuse) {
-            **existing = snap;
+        if let Ok(i) = self.saved_index(reuse) {
+            *self.saved_states[i] = snap;
             return reuse;
         }
-        let mut boxed = Box::new(snap);
-        let address = &mut *boxed as *mut Snapshot as usize;
-        self.saved_states.insert(address, boxed);
+        let boxed = Box::new(snap);
+        let address = &*boxed as *const Snapshot as usize;
+        self.saved_states.push(boxed);
         address
     }
 
     pub fn saved_snapshot(&self, address: usize) -> Result<&Snapshot, String> {
-        self.saved_states
-            .get(&address)
-            .map(|b| &**b)
-            .ok_or_else(|| {
-                format!(
-                    "FMUstate {address:#x} was not created by this instance (or was already freed)"
-                )
-            })
+        let i = self.saved_index(address)?;
+        Ok(&self.saved_states[i])
     }
 
     pub fn free_snapshot(&mut self, address: usize) -> Result<(), String> {
-        self.saved_states
-            .remove(&address)
-            .map(|_| ())
-            .ok_or_else(|| {
-                format!(
-                    "FMUstate {address:#x} was not created by this instance (or was already freed)"
-                )
-            })
+        self.take_snapshot(address).map(|_| ())
     }
 
     pub fn n_values(&self) -> usize {
@@ -599,14 +761,12 @@ impl Instance {
 }
 
 /// After a step of length `h`, inputs stand at `u + du·h`; slopes reset.
-fn advance_inputs(info: &ModelInfo, values: &mut Values, slopes: &mut [f64], h: f64) {
-    for v in info.variables {
-        if v.causality == Causality::Input {
-            let s = &mut slopes[v.vr as usize];
-            if *s != 0.0 {
-                values.set(v.vr, values.real(v.vr) + *s * h);
-                *s = 0.0;
-            }
+fn advance_inputs(inputs: &[u32], values: &mut Values, slopes: &mut [f64], h: f64) {
+    for &vr in inputs {
+        let s = &mut slopes[vr as usize];
+        if *s != 0.0 {
+            values.set(vr, values.real(vr) + *s * h);
+            *s = 0.0;
         }
     }
 }

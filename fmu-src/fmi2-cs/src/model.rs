@@ -68,13 +68,13 @@ pub struct ModelFactory {
 }
 
 /// The three `Model` methods that only forward to a law with
-/// `state_to_vec` / `state_from_slice` held in field `$law` of a `Clone`
+/// `write_state` / `state_from_slice` held in field `$law` of a `Clone`
 /// model: write `fmi2_cs::delegate_state!(law);` inside the `impl Model`.
 #[macro_export]
 macro_rules! delegate_state {
     ($law:ident) => {
         fn save_state(&self, out: &mut Vec<f64>) {
-            out.extend(self.$law.state_to_vec());
+            self.$law.write_state(out);
         }
 
         fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {

@@ -22,6 +22,10 @@ pub struct Snapshot {
     pub values: Vec<f64>,
     pub slopes: Vec<f64>,
     pub model_state: Vec<f64>,
+    /// The instance's parameter version when taken
+    /// ([`crate::instance::Instance`]: unchanged means no parameter was set
+    /// since); `u64::MAX` (unknown) for a deserialized state. Not serialized.
+    pub parameters_version: u64,
 }
 
 fn fnv1a(bytes: &[u8]) -> u64 {
@@ -137,6 +141,7 @@ impl Snapshot {
             values,
             slopes,
             model_state,
+            parameters_version: u64::MAX,
         })
     }
 }
@@ -203,6 +208,7 @@ mod tests {
             values: vec![1.0, 2.0, f64::MIN_POSITIVE],
             slopes: vec![0.0, 0.5, 0.0],
             model_state: vec![3.0, -4.0],
+            parameters_version: u64::MAX,
         }
     }
 

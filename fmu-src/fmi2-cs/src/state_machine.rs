@@ -152,13 +152,34 @@ pub const ALLOWED: &[(&str, u32)] = &[
 ];
 
 /// The allowed-state mask of `function`; panics on a name not in the table
-/// (a programming error caught by the tests, never by an importer).
-pub fn allowed_mask(function: &str) -> u32 {
-    ALLOWED
-        .iter()
-        .find(|(f, _)| *f == function)
-        .map(|(_, m)| *m)
-        .unwrap_or_else(|| panic!("{function} is not in the state table"))
+/// (a programming error caught by the tests, never by an importer). A
+/// `const fn`, so that the exports resolve their masks at compile time
+/// (`const { allowed_mask("fmi2DoStep") }`) and no call compares strings.
+pub const fn allowed_mask(function: &str) -> u32 {
+    let mut i = 0;
+    while i < ALLOWED.len() {
+        if same_name(ALLOWED[i].0, function) {
+            return ALLOWED[i].1;
+        }
+        i += 1;
+    }
+    panic!("function not in the state table")
+}
+
+/// `a == b` for `const fn`.
+const fn same_name(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
 }
 
 pub fn is_allowed(function: &str, state: State) -> bool {

@@ -329,9 +329,16 @@ impl Bristle2D {
         self.z = [z0 * u[0] / n, z0 * u[1] / n];
     }
 
-    /// State `[z1, z2]`.
+    /// State `[z1, z2]`, appended to `out` (no allocation once `out` has room).
+    pub fn write_state(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(&[self.z[0], self.z[1]]);
+    }
+
+    /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        vec![self.z[0], self.z[1]]
+        let mut v = Vec::new();
+        self.write_state(&mut v);
+        v
     }
 
     /// Restores `[z1, z2]` (finite; projected into the disc like

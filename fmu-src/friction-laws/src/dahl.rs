@@ -119,9 +119,16 @@ impl Dahl {
         }
     }
 
-    /// State `[F]`.
+    /// State `[F]`, appended to `out` (no allocation once `out` has room).
+    pub fn write_state(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(&[self.f]);
+    }
+
+    /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        vec![self.f]
+        let mut v = Vec::new();
+        self.write_state(&mut v);
+        v
     }
 
     /// Restores `[F]` (any finite value).

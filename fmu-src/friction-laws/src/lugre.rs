@@ -492,9 +492,16 @@ impl LuGre {
         self.z = z;
     }
 
-    /// State `[z]`.
+    /// State `[z]`, appended to `out` (no allocation once `out` has room).
+    pub fn write_state(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(&[self.z]);
+    }
+
+    /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        vec![self.z]
+        let mut v = Vec::new();
+        self.write_state(&mut v);
+        v
     }
 
     /// Restores `[z]` (finite).

@@ -776,8 +776,16 @@ impl Rig1D {
         }
     }
 
+    /// The state, appended to `out` (no allocation once `out` has room).
+    pub fn write_state(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(&[self.t, self.x, self.xd, self.xi]);
+    }
+
+    /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        vec![self.t, self.x, self.xd, self.xi]
+        let mut v = Vec::new();
+        self.write_state(&mut v);
+        v
     }
 
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {

@@ -144,10 +144,17 @@ impl Rig2D {
         }
     }
 
+    /// The state of both axes, appended to `out`.
+    pub fn write_state(&self, out: &mut Vec<f64>) {
+        self.axes[0].write_state(out);
+        self.axes[1].write_state(out);
+    }
+
+    /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        let mut s = self.axes[0].state_to_vec();
-        s.extend(self.axes[1].state_to_vec());
-        s
+        let mut v = Vec::new();
+        self.write_state(&mut v);
+        v
     }
 
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {

@@ -22,12 +22,13 @@
 //! and updates BENCHMARKS.md.
 
 use clap::Parser;
+use fricsim::benchmarks::{command_line, exit_code, machine, splice, today, TableFileArgs};
 use fricsim::compare::{compare, ResultFile};
 use fricsim::master::{by_name, simulate_with, NoObserver, Run};
 use fricsim::ssp::SystemFile;
 use fricsim_reference::{ReferenceModel, RTOL};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Markers of the generated part of the file given to `--update`.
@@ -108,14 +109,8 @@ struct Args {
     /// Cases, comma-separated: stick-slip, stick-slip-1e7, seed000 [default: all].
     #[arg(long, value_delimiter = ',')]
     cases: Vec<String>,
-    /// The repository root, where examples/ and dist/ are
-    /// [default: the workspace this program was built from].
-    #[arg(long)]
-    root: Option<PathBuf>,
-    /// Write the tables between the markers of this file (created if
-    /// missing) instead of stdout.
-    #[arg(long)]
-    update: Option<PathBuf>,
+    #[command(flatten)]
+    file: TableFileArgs,
 }
 
 enum Outcome {
@@ -146,21 +141,11 @@ struct Row {
 }
 
 fn main() -> std::process::ExitCode {
-    let args = Args::parse();
-    match run(&args) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("accuracy-table: {e}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    exit_code("accuracy-table", run(&Args::parse()))
 }
 
 fn run(args: &Args) -> Result<(), String> {
-    let root = args
-        .root
-        .clone()
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join(".."));
+    let root = args.file.root();
     let steps: Vec<f64> = match (&args.steps[..], args.quick) {
         ([], true) => vec![GOAL_STEP],
         ([], false) => STEPS.to_vec(),
@@ -199,8 +184,8 @@ fn run(args: &Args) -> Result<(), String> {
             .collect::<Result<_, _>>()?
     };
 
-    if let Some(path) = &args.update {
-        splice(path, None)?; // markers missing: say so before running
+    if let Some(path) = &args.file.update {
+        splice(path, BEGIN, END, None)?; // markers missing: say so before running
     }
 
     let started = Instant::now();
@@ -219,17 +204,12 @@ fn run(args: &Args) -> Result<(), String> {
 
     // scripts/accuracy-table.sh names itself; run directly, the program's
     // own command line is shown.
-    let command = std::env::var("ACCURACY_TABLE_COMMAND").unwrap_or_else(|_| {
-        std::iter::once("accuracy-table".to_string())
-            .chain(std::env::args().skip(1))
-            .collect::<Vec<_>>()
-            .join(" ")
-    });
+    let command = command_line("ACCURACY_TABLE_COMMAND", "accuracy-table");
     let block = render(&rows, &masters, &command, total);
-    match &args.update {
+    match &args.file.update {
         None => print!("{block}"),
         Some(path) => {
-            splice(path, Some(&block))?;
+            splice(path, BEGIN, END, Some(&block))?;
             eprintln!("wrote {}", path.display());
         }
     }
@@ -515,78 +495,4 @@ fn goal_lines(rows: &[Row], masters: &[String]) -> String {
         let _ = writeln!(s, "- {}: {}", r.case.label, parts.join("; "));
     }
     s
-}
-
-/// Replace the text between the markers of `path` with `block` (which
-/// holds the markers), keeping the rest; a missing file is created with a
-/// title, a file without the markers is refused. With no `block`, only
-/// check that this can be done.
-fn splice(path: &Path, block: Option<&str>) -> Result<(), String> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            format!("# Benchmarks\n\n{BEGIN}\n{END}\n")
-        }
-        Err(e) => return Err(format!("{}: {e}", path.display())),
-    };
-    let (Some(b), Some(e)) = (text.find(BEGIN), text.find(END)) else {
-        return Err(format!(
-            "{}: the markers `{BEGIN}` and `{END}` are missing: add them where the table goes",
-            path.display()
-        ));
-    };
-    if e < b {
-        return Err(format!(
-            "{}: the end marker comes before the begin marker",
-            path.display()
-        ));
-    }
-    let Some(block) = block else {
-        return Ok(());
-    };
-    let mut out = String::with_capacity(text.len() + block.len());
-    out.push_str(&text[..b]);
-    out.push_str(block.trim_end_matches('\n'));
-    out.push_str(&text[e + END.len()..]);
-    std::fs::write(path, out).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// CPU model (from /proc/cpuinfo), cores the process may use, OS.
-fn machine() -> String {
-    let model = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|t| {
-            t.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, v)| v.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
-    let cores = std::thread::available_parallelism()
-        .map(|n| n.get().to_string())
-        .unwrap_or_else(|_| "?".into());
-    format!(
-        "{model}, {cores} cores, {} {}",
-        std::env::consts::OS,
-        std::env::consts::ARCH
-    )
-}
-
-/// Today's date (UTC), YYYY-MM-DD, from the system clock (civil-from-days,
-/// H. Hinnant's algorithm).
-fn today() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs() as i64)
-        .unwrap_or(0);
-    let z = secs.div_euclid(86_400) + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!("{y:04}-{m:02}-{d:02}")
 }

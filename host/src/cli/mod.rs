@@ -6,9 +6,43 @@ pub mod diagnose;
 pub mod info;
 pub mod reference;
 pub mod run;
+pub mod sweep;
 
 use fricsim::ssp::SystemFile;
 use std::path::{Path, PathBuf};
+
+/// `--start`, `--stop`, `--step` of the commands that run a system file
+/// (`run`, `sweep`, `reference`), resolved by [`time_grid`].
+#[derive(clap::Args)]
+pub struct GridArgs {
+    /// Start time in seconds [default: DefaultExperiment startTime, else 0].
+    #[arg(long)]
+    pub start: Option<f64>,
+    /// Stop time in seconds [default: DefaultExperiment stopTime].
+    #[arg(long)]
+    pub stop: Option<f64>,
+    /// Macro step in seconds; for `reference` the output interval, which
+    /// the integrator's steps never cross [default: the file's stepSize
+    /// annotation].
+    #[arg(long)]
+    pub step: Option<f64>,
+}
+
+impl GridArgs {
+    /// `(start, stop, step)` from these options, else from `file`.
+    pub fn resolve(&self, file: &SystemFile) -> Result<(f64, f64, f64), String> {
+        time_grid(file, self.start, self.stop, self.step)
+    }
+}
+
+/// The master algorithm's name: `--master` if given, else the file's
+/// annotation, else jacobi (`fricsim run`, `fricsim sweep`).
+pub fn master_name(option: &Option<String>, file: &SystemFile) -> String {
+    option
+        .clone()
+        .or(file.settings.master.clone())
+        .unwrap_or_else(|| "jacobi".to_string())
+}
 
 /// The time grid of a run of `file`: `--start`, `--stop` and `--step` where
 /// given, else the file's `DefaultExperiment` and stepSize annotation

@@ -17,15 +17,8 @@ use std::path::PathBuf;
 pub struct RunArgs {
     /// The system: an .ssp archive or a SystemStructure .ssd file.
     pub system: PathBuf,
-    /// Start time in seconds [default: DefaultExperiment startTime, else 0].
-    #[arg(long)]
-    pub start: Option<f64>,
-    /// Stop time in seconds [default: DefaultExperiment stopTime].
-    #[arg(long)]
-    pub stop: Option<f64>,
-    /// Macro step in seconds [default: the file's stepSize annotation].
-    #[arg(long)]
-    pub step: Option<f64>,
+    #[command(flatten)]
+    pub grid: super::GridArgs,
     /// Master algorithm: jacobi, gauss-seidel, gauss-seidel-interpolated,
     /// newton, newton-interpolated, adaptive, fixed-point [default: the
     /// file's annotation, else jacobi].
@@ -86,13 +79,8 @@ impl Observer for Watch {
 
 pub fn run(a: &RunArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let (start, stop, step) = super::time_grid(&file, a.start, a.stop, a.step)?;
-    let master_name = a
-        .master
-        .clone()
-        .or(file.settings.master.clone())
-        .unwrap_or_else(|| "jacobi".to_string());
-    let mut master = by_name(&master_name)?;
+    let (start, stop, step) = a.grid.resolve(&file)?;
+    let mut master = by_name(&super::master_name(&a.master, &file))?;
 
     let mut system = file.build(start).map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);

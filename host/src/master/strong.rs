@@ -49,7 +49,7 @@ use crate::fmu::model_description::{Causality, VariableKind};
 use crate::fmu::{FmuState, ValueReference};
 use crate::system::System;
 use crate::FmuError;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 /// How many past residual norms the non-monotone line search compares with.
 const NONMONOTONE_MEMORY: usize = 4;
@@ -205,6 +205,18 @@ pub struct StrongCoupling {
     started: bool,
     y: Vec<f64>,
     column: Vec<f64>,
+    // Work space of a step, kept so that a step allocates nothing:
+    /// ∂Y/∂U, then I − J factorised in place.
+    jac: DMatrix<f64>,
+    /// One component's directional derivatives.
+    derivative: Vec<f64>,
+    /// U perturbed for a finite difference.
+    perturbed: Vec<f64>,
+    /// The line search's base point, the Newton direction, and the last
+    /// NONMONOTONE_MEMORY base residual norms.
+    base: Vec<f64>,
+    direction: Vec<f64>,
+    history: Vec<f64>,
 }
 
 impl StrongCoupling {
@@ -233,6 +245,12 @@ impl StrongCoupling {
             started: false,
             y: Vec::new(),
             column: Vec::new(),
+            jac: DMatrix::zeros(0, 0),
+            derivative: Vec::new(),
+            perturbed: Vec::new(),
+            base: Vec::new(),
+            direction: Vec::new(),
+            history: Vec::with_capacity(NONMONOTONE_MEMORY),
         }
     }
 
@@ -437,10 +455,10 @@ impl StrongCoupling {
             for &j in &ports {
                 let delta = f64::EPSILON.sqrt() * self.u[j].abs().max(self.nominal[j]);
                 self.restore(system, c)?;
-                let mut perturbed = self.u.clone();
-                perturbed[j] += delta;
+                self.perturbed.clone_from(&self.u);
+                self.perturbed[j] += delta;
                 let ramped = self.ports[c].ramped;
-                Self::set_inputs(system, &ports, ramped, &perturbed, &self.accepted, h)?;
+                Self::set_inputs(system, &ports, ramped, &self.perturbed, &self.accepted, h)?;
                 system.components[c].instance.do_step(t, h)?;
                 self.report.difference_steps += 1;
                 self.column.clone_from(&self.y);
@@ -464,16 +482,17 @@ impl StrongCoupling {
         jac: &mut DMatrix<f64>,
     ) -> Result<(), FmuError> {
         let ports = &self.ports[c];
-        let mut out = vec![0.0; ports.outputs.len()];
+        let out = &mut self.derivative;
+        out.resize(ports.outputs.len(), 0.0);
         for &j in &ports.inputs {
             let known = system.connections[j].to.1;
             system.components[c].instance.get_directional_derivative(
                 &ports.output_vrs,
                 &[known],
                 &[1.0],
-                &mut out,
+                out,
             )?;
-            for (&k, d) in ports.outputs.iter().zip(&out) {
+            for (&k, d) in ports.outputs.iter().zip(out.iter()) {
                 jac[(k, j)] = *d;
             }
         }
@@ -483,9 +502,14 @@ impl StrongCoupling {
     /// ∂Y/∂U, with every component stepped on `self.u` just before. Leaves
     /// components that were differenced in a perturbed state (the next
     /// iteration restores them).
-    fn jacobian(&mut self, system: &mut System, t: f64, h: f64) -> Result<DMatrix<f64>, FmuError> {
-        let n = system.connections.len();
-        let mut jac = DMatrix::zeros(n, n);
+    /// `jac` is n × n and zero on entry.
+    fn jacobian(
+        &mut self,
+        system: &mut System,
+        t: f64,
+        h: f64,
+        jac: &mut DMatrix<f64>,
+    ) -> Result<(), FmuError> {
         self.report.jacobians += 1;
         // Directional derivatives first: they need the step just taken.
         for c in 0..system.components.len() {
@@ -493,10 +517,10 @@ impl StrongCoupling {
                 continue;
             }
             match self.ports[c].directional {
-                Some(true) => self.directional_columns(system, c, &mut jac)?,
+                Some(true) => self.directional_columns(system, c, jac)?,
                 // Auto: an FMU whose call fails is differenced instead.
                 None => {
-                    if self.directional_columns(system, c, &mut jac).is_err() {
+                    if self.directional_columns(system, c, jac).is_err() {
                         self.ports[c].directional = Some(false);
                         self.report.jacobian_of[c].1 =
                             "finite differences (fmi2GetDirectionalDerivative failed)";
@@ -516,7 +540,7 @@ impl StrongCoupling {
                     }
                 }
                 Some(false) => {
-                    self.difference_columns(system, c, t, h, &mut jac)?;
+                    self.difference_columns(system, c, t, h, jac)?;
                     if self.report.jacobian_of[c].1 == "not needed" {
                         self.report.jacobian_of[c].1 = self.ports[c].differenced;
                     }
@@ -542,12 +566,12 @@ impl StrongCoupling {
                     } else {
                         self.report.jacobian_of[c].1 =
                             "finite differences (directional derivatives disagreed)";
-                        jac = reference;
+                        jac.copy_from(&reference);
                     }
                 }
             }
         }
-        Ok(jac)
+        Ok(())
     }
 }
 
@@ -739,9 +763,9 @@ impl StrongCoupling {
         // residual for a while (break-away on a Stribeck curve needs that),
         // but a cycle — Newton bouncing across the jump a hysteretic law
         // makes at a reversal — is cut by halving.
-        let mut base: Option<Vec<f64>> = None;
-        let mut history: Vec<f64> = Vec::with_capacity(NONMONOTONE_MEMORY);
-        let mut direction = vec![0.0; n];
+        let mut has_base = false;
+        self.history.clear();
+        self.direction.resize(n, 0.0);
         let mut lambda = 1.0;
         let mut worst = (f64::INFINITY, 0);
         let mut last_norm = f64::INFINITY;
@@ -793,42 +817,50 @@ impl StrongCoupling {
             match self.update {
                 Update::FixedPoint => self.u.copy_from_slice(&self.y),
                 Update::Newton => {
-                    if let Some(b) = &base {
-                        let reference = history.iter().copied().fold(0.0, f64::max);
+                    if has_base {
+                        let reference = self.history.iter().copied().fold(0.0, f64::max);
                         let sufficient =
                             norm.is_finite() && norm <= (1.0 - 1e-4 * lambda) * reference;
                         if !sufficient && lambda > 1.0 / 1024.0 {
                             lambda *= 0.5;
                             self.report.backtracks += 1;
-                            for ((u, b), d) in self.u.iter_mut().zip(b).zip(&direction) {
+                            for ((u, b), d) in
+                                self.u.iter_mut().zip(&self.base).zip(&self.direction)
+                            {
                                 *u = b + lambda * d;
                             }
                             continue;
                         }
                     }
                     // New base point: the components were just stepped on U.
-                    let jac = self.jacobian(system, t, h)?;
-                    let lhs = DMatrix::identity(n, n) - jac;
-                    let rhs =
-                        DVector::from_iterator(n, self.y.iter().zip(&self.u).map(|(y, u)| y - u));
-                    match lhs.lu().solve(&rhs) {
-                        Some(du) if du.iter().all(|d| d.is_finite()) => {
-                            direction.copy_from_slice(du.as_slice());
-                        }
+                    let mut jac = std::mem::replace(&mut self.jac, DMatrix::zeros(0, 0));
+                    if jac.shape() == (n, n) {
+                        jac.fill(0.0);
+                    } else {
+                        jac = DMatrix::zeros(n, n);
+                    }
+                    self.jacobian(system, t, h, &mut jac)?;
+                    // (I − J)·ΔU = Y − U
+                    jac.neg_mut();
+                    for k in 0..n {
+                        jac[(k, k)] += 1.0;
+                        self.direction[k] = self.y[k] - self.u[k];
+                    }
+                    if !solve_in_place(&mut jac, &mut self.direction) {
                         // I − J singular: the fixed-point direction.
-                        _ => {
-                            for ((d, y), u) in direction.iter_mut().zip(&self.y).zip(&self.u) {
-                                *d = y - u;
-                            }
+                        for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
+                            *d = y - u;
                         }
                     }
-                    base = Some(self.u.clone());
-                    if history.len() == NONMONOTONE_MEMORY {
-                        history.remove(0);
+                    self.jac = jac;
+                    self.base.clone_from(&self.u);
+                    has_base = true;
+                    if self.history.len() == NONMONOTONE_MEMORY {
+                        self.history.remove(0);
                     }
-                    history.push(norm);
+                    self.history.push(norm);
                     lambda = 1.0;
-                    for (u, d) in self.u.iter_mut().zip(&direction) {
+                    for (u, d) in self.u.iter_mut().zip(&self.direction) {
                         *u += d;
                     }
                 }
@@ -847,5 +879,61 @@ impl StrongCoupling {
                 + self.rtol * self.u[k].abs().max(self.y[k].abs()),
             residual: last_norm,
         })
+    }
+}
+
+/// Solve `a·x = b` in place (`b` becomes `x`, `a` is overwritten) by
+/// Gaussian elimination with partial pivoting. False when `a` is singular
+/// (a zero pivot) or `x` is not finite. For the few interface unknowns of a
+/// co-simulation step it needs no work space, where a general LU allocates.
+fn solve_in_place(a: &mut DMatrix<f64>, b: &mut [f64]) -> bool {
+    let n = b.len();
+    for col in 0..n {
+        let pivot = (col..n)
+            .max_by(|&i, &j| a[(i, col)].abs().total_cmp(&a[(j, col)].abs()))
+            .unwrap_or(col);
+        if a[(pivot, col)] == 0.0 || !a[(pivot, col)].is_finite() {
+            return false;
+        }
+        if pivot != col {
+            a.swap_rows(pivot, col);
+            b.swap(pivot, col);
+        }
+        for row in col + 1..n {
+            let factor = a[(row, col)] / a[(col, col)];
+            for k in col..n {
+                a[(row, k)] -= factor * a[(col, k)];
+            }
+            b[row] -= factor * b[col];
+        }
+    }
+    for row in (0..n).rev() {
+        let mut sum = b[row];
+        for k in row + 1..n {
+            sum -= a[(row, k)] * b[k];
+        }
+        b[row] = sum / a[(row, row)];
+    }
+    b.iter().all(|x| x.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gaussian_elimination_pivots_and_refuses_singular_systems() {
+        // a zero in the first pivot position needs a row swap
+        let mut a = DMatrix::from_row_slice(3, 3, &[0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 2.0, 0.0, 3.0]);
+        let x = [1.0, -2.0, 0.5];
+        let mut b: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|k| a[(i, k)] * x[k]).sum())
+            .collect();
+        assert!(solve_in_place(&mut a, &mut b));
+        for (got, want) in b.iter().zip(x) {
+            assert!((got - want).abs() < 1e-14, "{b:?}");
+        }
+        let mut singular = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 4.0]);
+        assert!(!solve_in_place(&mut singular, &mut [1.0, 1.0]));
     }
 }

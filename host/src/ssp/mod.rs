@@ -1119,7 +1119,29 @@ impl SystemFile {
     /// Check, then instantiate the system with its parameters and
     /// connections, set up to start at `start`.
     pub fn build(&self, start: f64) -> Result<System, SspError> {
-        let checked = self.check()?;
+        self.build_with(start, &[])
+    }
+
+    /// [`SystemFile::build`] with `overrides` (`component.variable`, value)
+    /// set after the file's own parameter values, so that they win: one
+    /// point of a parameter sweep (`fricsim sweep`).
+    pub fn build_with(
+        &self,
+        start: f64,
+        overrides: &[(String, ParameterValue)],
+    ) -> Result<System, SspError> {
+        self.instantiate(&self.check()?, start, overrides)
+    }
+
+    /// [`SystemFile::build_with`] on FMUs already opened and checked by
+    /// [`SystemFile::check`]: new instances of the same loaded FMUs, so
+    /// that repeated runs (`fricsim sweep`) unpack and load nothing again.
+    pub fn instantiate(
+        &self,
+        checked: &CheckedSystem,
+        start: f64,
+        overrides: &[(String, ParameterValue)],
+    ) -> Result<System, SspError> {
         let parameters: Vec<(String, ParameterValue)> = self
             .parameters
             .iter()
@@ -1132,13 +1154,14 @@ impl SystemFile {
                 };
                 (format!("{}.{}", p.component, p.variable), v)
             })
+            .chain(overrides.iter().cloned())
             .collect();
         let connections: Vec<(String, String)> = checked
             .connections
             .iter()
             .map(|c| (c.from.clone(), c.to.clone()))
             .collect();
-        let mut system = System::from_fmus(checked.fmus, &parameters, &connections, start)
+        let mut system = System::from_fmus(checked.fmus.clone(), &parameters, &connections, start)
             .map_err(|e| error(&self.ssd, system_error(e)))?;
         for s in self.settings.record.iter().chain(&self.settings.plot) {
             system.record(s).map_err(|e| {

@@ -137,3 +137,16 @@ pub fn assert_message(error: &dyn std::fmt::Display, parts: &[&str]) {
         );
     }
 }
+
+/// The cells of the first markdown table row after `heading` whose first
+/// cell is `label` or starts with `label` and a space.
+pub fn table_row<'a>(text: &'a str, heading: &str, label: &str) -> Vec<&'a str> {
+    let after = &text[text
+        .find(heading)
+        .unwrap_or_else(|| panic!("no {heading:?} in\n{text}"))..];
+    let line = after
+        .lines()
+        .find(|l| l.starts_with(&format!("| {label} ")))
+        .unwrap_or_else(|| panic!("no row {label:?} after {heading:?} in\n{text}"));
+    line.trim_matches('|').split('|').map(str::trim).collect()
+}

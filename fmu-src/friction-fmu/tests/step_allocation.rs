@@ -1,0 +1,95 @@
+//! A communication step of every friction FMU — set the inputs, step, get
+//! the outputs, as a master's loop does through `fmi2SetReal`,
+//! `fmi2DoStep`, `fmi2GetReal` — does not allocate once the first step has
+//! sized the instance's buffers (the pre-step state kept for directional
+//! derivatives included). A counting global allocator sees every
+//! allocation of this process; one test only, so no other test thread
+//! allocates meanwhile.
+
+use fmi2_cs::instance::Instance;
+use fmi2_cs::logger::Logger;
+use fmi2_cs::{Causality, VarType};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: delegates to the system allocator.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn set_step_get_do_not_allocate_in_any_friction_fmu() {
+    for factory in friction_fmu::REGISTRY.iter() {
+        let info = factory.info;
+        let logger = Logger::new(None, std::ptr::null_mut(), "probe", false);
+        let mut fmu = Instance::new(info, (factory.create)(), "probe", logger);
+        // every Real input but LuGre's normal force (which must stay >= 0)
+        let of = |causality| -> Vec<u32> {
+            info.variables
+                .iter()
+                .filter(|v| v.causality == causality && v.var_type == VarType::Real)
+                .filter(|v| v.name != "Fn")
+                .map(|v| v.vr)
+                .collect()
+        };
+        let (inputs, outputs) = (of(Causality::Input), of(Causality::Output));
+        fmu.setup_experiment(0.0, None).unwrap();
+        fmu.enter_initialization_mode().unwrap();
+        fmu.exit_initialization_mode().unwrap();
+        let (mut u, mut y) = (vec![0.0; inputs.len()], vec![0.0; outputs.len()]);
+        let h = 1e-3;
+        // a 1 Hz sinusoid of a few bristle ranges: stick, slip and reversals
+        let amplitude = if info.model_name == "Bristle" {
+            5e-8
+        } else {
+            1e-3
+        };
+        let mut step = |fmu: &mut Instance, k: usize| {
+            let t = k as f64 * h;
+            u.fill(amplitude * (std::f64::consts::TAU * t).sin());
+            fmu.set(VarType::Real, &inputs, &u).unwrap();
+            fmu.do_step(t, h).unwrap();
+            fmu.get(VarType::Real, &outputs, &mut y).unwrap();
+        };
+        step(&mut fmu, 0); // sizes the buffers
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for k in 1..2000 {
+            step(&mut fmu, k);
+        }
+        let allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        // the counter works: a snapshot (fmi2GetFMUstate) allocates
+        let counted = ALLOCATIONS.load(Ordering::Relaxed);
+        let snapshot = fmu.snapshot().unwrap();
+        assert!(ALLOCATIONS.load(Ordering::Relaxed) > counted);
+        drop(snapshot);
+        // the bristle law allocates at a reversal with disconnected
+        // bristles only (its sorted offsets are rebuilt): twice a period
+        let allowed = if info.model_name == "Bristle" {
+            2 * 2 * 3
+        } else {
+            0
+        };
+        assert!(
+            allocations <= allowed,
+            "{}: {allocations} allocations in 1999 steps",
+            info.model_name
+        );
+    }
+}

@@ -1,0 +1,238 @@
+//! What the programs that write BENCHMARKS.md share (`accuracy-table`,
+//! `speed-table`): replacing the generated part of a markdown file between
+//! two markers, and naming the machine and the date of a measurement.
+
+use std::path::Path;
+
+/// Replace the text between the markers `begin` and `end` of `path` with
+/// `block` (which holds the markers), keeping the rest; a missing file is
+/// created with a title, a file without the markers is refused. With no
+/// `block`, only check that this can be done.
+pub fn splice(path: &Path, begin: &str, end: &str, block: Option<&str>) -> Result<(), String> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            format!("# Benchmarks\n\n{begin}\n{end}\n")
+        }
+        Err(e) => return Err(format!("{}: {e}", path.display())),
+    };
+    let (Some(b), Some(e)) = (text.find(begin), text.find(end)) else {
+        return Err(format!(
+            "{}: the markers `{begin}` and `{end}` are missing: add them where the table goes",
+            path.display()
+        ));
+    };
+    if e < b {
+        return Err(format!(
+            "{}: the end marker comes before the begin marker",
+            path.display()
+        ));
+    }
+    let Some(block) = block else {
+        return Ok(());
+    };
+    let mut out = String::with_capacity(text.len() + block.len());
+    out.push_str(&text[..b]);
+    out.push_str(block.trim_end_matches('\n'));
+    out.push_str(&text[e + end.len()..]);
+    std::fs::write(path, out).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The options every BENCHMARKS.md program has: where the repository is
+/// and which file to update.
+#[derive(clap::Args, Debug)]
+pub struct TableFileArgs {
+    /// The repository root, where examples/ and dist/ are
+    /// [default: the workspace this program was built from].
+    #[arg(long)]
+    pub root: Option<std::path::PathBuf>,
+    /// Write the tables between the markers of this file (created if
+    /// missing) instead of stdout.
+    #[arg(long)]
+    pub update: Option<std::path::PathBuf>,
+}
+
+impl TableFileArgs {
+    /// `--root`, else the workspace the program was built from.
+    pub fn root(&self) -> std::path::PathBuf {
+        self.root
+            .clone()
+            .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+    }
+}
+
+/// The exit of a BENCHMARKS.md program: its error on stderr, named.
+pub fn exit_code(program: &str, result: Result<(), String>) -> std::process::ExitCode {
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{program}: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// CPU model (from /proc/cpuinfo), cores the process may use, OS.
+pub fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get().to_string())
+        .unwrap_or_else(|_| "?".into());
+    format!(
+        "{model}, {cores} cores, {} {}",
+        std::env::consts::OS,
+        std::env::consts::ARCH
+    )
+}
+
+/// Today's date (UTC), YYYY-MM-DD, from the system clock (civil-from-days,
+/// H. Hinnant's algorithm).
+pub fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs() as i64)
+        .unwrap_or(0);
+    let z = secs.div_euclid(86_400) + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// The command line a table records: `variable` when the script that ran
+/// the program set it (the script names itself), else the program's own.
+pub fn command_line(variable: &str, program: &str) -> String {
+    std::env::var(variable).unwrap_or_else(|_| {
+        std::iter::once(program.to_string())
+            .chain(std::env::args().skip(1))
+            .collect::<Vec<_>>()
+            .join(" ")
+    })
+}
+
+// ---- workloads shared by `speed-table` and the criterion benches ---------
+
+/// An input signal `u(t) = A·sin(2π·t + φ)`: (name, A, φ).
+pub type Sinusoid = (&'static str, f64, f64);
+
+/// A benchmarked FMU: model name, its inputs, the outputs read every step.
+pub type DrivenFmu = (&'static str, &'static [Sinusoid], &'static [&'static str]);
+
+/// The friction FMUs of dist/ and how a benchmark drives them: inputs
+/// through stick and slip at the default parameters.
+pub const FRICTION_FMUS: &[DrivenFmu] = &[
+    ("Dahl", &[("v", 1e-3, 0.0)], &["F"]),
+    ("LuGre", &[("v", 1e-3, 0.0)], &["F"]),
+    ("ResetIntegrator", &[("v", 1e-3, 0.0)], &["F"]),
+    // 3·δmax = 4.7e-8 m of seed 000: loads to sliding, reverses twice a period
+    ("Bristle", &[("x", 4.7e-8, 0.0)], &["F"]),
+    (
+        "Bristle2D",
+        &[("v1", 1e-3, 0.0), ("v2", 1e-3, std::f64::consts::FRAC_PI_2)],
+        &["F1", "F2"],
+    ),
+];
+
+/// One initialised instance of a friction FMU of [`FRICTION_FMUS`] and its
+/// resolved value references: [`FmuStepper::step`] is one communication
+/// step through the C ABI (`fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal`).
+pub struct FmuStepper {
+    instance: crate::fmu::Instance,
+    inputs: &'static [Sinusoid],
+    input_vrs: Vec<crate::fmu::ValueReference>,
+    output_vrs: Vec<crate::fmu::ValueReference>,
+    u: Vec<f64>,
+    /// The outputs after the last step.
+    pub y: Vec<f64>,
+}
+
+impl FmuStepper {
+    /// Instantiate the `index`-th model of [`FRICTION_FMUS`] from `fmu`,
+    /// initialised at t = 0 with its default parameters.
+    pub fn new(fmu: &crate::fmu::Fmu, index: usize) -> Result<FmuStepper, String> {
+        let (model, inputs, outputs) = FRICTION_FMUS[index];
+        let vr = |name: &str| {
+            fmu.variable(name)
+                .map(|v| v.value_reference)
+                .map_err(|e| e.to_string())
+        };
+        let input_vrs = inputs
+            .iter()
+            .map(|(n, _, _)| vr(n))
+            .collect::<Result<Vec<_>, _>>()?;
+        let output_vrs = outputs.iter().map(|n| vr(n)).collect::<Result<_, _>>()?;
+        let mut instance = fmu.instantiate(model).map_err(|e| e.to_string())?;
+        instance
+            .setup_experiment(0.0, None)
+            .and_then(|_| instance.enter_initialization_mode())
+            .and_then(|_| instance.exit_initialization_mode())
+            .map_err(|e| e.to_string())?;
+        Ok(FmuStepper {
+            instance,
+            inputs,
+            input_vrs,
+            output_vrs,
+            u: vec![0.0; inputs.len()],
+            y: vec![0.0; outputs.len()],
+        })
+    }
+
+    /// Set the inputs at `t`, step to `t + h`, read the outputs.
+    pub fn step(&mut self, t: f64, h: f64) -> Result<(), crate::FmuError> {
+        for (x, (_, a, phase)) in self.u.iter_mut().zip(self.inputs) {
+            *x = a * (std::f64::consts::TAU * t + phase).sin();
+        }
+        self.instance.set_real(&self.input_vrs, &self.u)?;
+        self.instance.do_step(t, h)?;
+        self.instance.get_real(&self.output_vrs, &mut self.y)?;
+        Ok(())
+    }
+}
+
+/// Increments of the bristle curves.
+pub const INCREMENTS: usize = 1000;
+
+/// Increment `k` (1 ..= [`INCREMENTS`]) of the bristle curve with one
+/// reversal: 0 → 3·δmax in the first half, back to −3·δmax in the second.
+pub fn bristle_curve_point(k: usize, delta_max: f64) -> f64 {
+    let half = INCREMENTS / 2;
+    if k <= half {
+        3.0 * delta_max * k as f64 / half as f64
+    } else {
+        3.0 * delta_max * (1.0 - 2.0 * (k - half) as f64 / half as f64)
+    }
+}
+
+/// The bristle curve with one reversal on `bristle`; the sum of the
+/// forces (to keep the work from being optimised away).
+pub fn bristle_curve(bristle: &mut friction_laws::bristle::Bristle) -> f64 {
+    let delta_max = bristle.params().delta_max;
+    let mut sum = 0.0;
+    for k in 1..=INCREMENTS {
+        bristle.move_to(bristle_curve_point(k, delta_max));
+        sum += bristle.force();
+    }
+    sum
+}
+
+/// `/proc/loadavg`'s one-minute load average (NaN where there is none):
+/// how busy the machine was around a measurement.
+pub fn load_average() -> f64 {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|t| t.split_whitespace().next().and_then(|x| x.parse().ok()))
+        .unwrap_or(f64::NAN)
+}
