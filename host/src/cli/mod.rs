@@ -40,8 +40,7 @@ impl GridArgs {
 pub fn master_name(option: &Option<String>, file: &SystemFile) -> String {
     option
         .clone()
-        .or(file.settings.master.clone())
-        .unwrap_or_else(|| "jacobi".to_string())
+        .unwrap_or_else(|| file.settings.master_or_default())
 }
 
 /// The time grid of a run of `file`: `--start`, `--stop` and `--step` where

@@ -98,6 +98,42 @@ pub fn held_out_block(b: usize) -> bool {
     b % 3 == 1
 }
 
+/// A file's time span cut into equal blocks (at least 3), every third held
+/// out ([`held_out_block`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Blocks {
+    t0: f64,
+    t1: f64,
+    pub count: usize,
+}
+
+impl Blocks {
+    pub fn new(time: &[f64], count: usize) -> Blocks {
+        Blocks {
+            t0: time.first().copied().unwrap_or(0.0),
+            t1: time.last().copied().unwrap_or(0.0),
+            count: count.max(3),
+        }
+    }
+
+    /// Whether the block holding time `t` is held out.
+    pub fn held_out(&self, t: f64) -> bool {
+        let b = ((t - self.t0) / (self.t1 - self.t0) * self.count as f64) as usize;
+        held_out_block(b.min(self.count - 1))
+    }
+
+    /// The positions of a co-simulation's samples (of the file with
+    /// `time`) that are held out (`held`) or used for training.
+    fn picker<'a>(self, time: &[f64], held: bool) -> Picker<'a> {
+        let time = time.to_vec();
+        Box::new(move |r: &ChannelResiduals| {
+            (0..r.samples.len())
+                .filter(|&s| self.held_out(time[r.samples[s]]) == held)
+                .collect()
+        })
+    }
+}
+
 /// One candidate tried in one round.
 #[derive(Clone, Debug, Serialize)]
 pub struct CandidateScore {
@@ -254,11 +290,7 @@ pub fn diagnose(
         Some(h) => h,
         None => problem::median_spacing(&train.time),
     };
-    let master = file
-        .settings
-        .master
-        .clone()
-        .unwrap_or_else(|| "jacobi".to_string());
+    let master = file.settings.master_or_default();
     let setup = Setup::new(file, &mut system, step, &master)?;
     let d_train = setup.friction_data(&system, &train, options.smooth)?;
     let d_held = match &heldout_file {
@@ -267,12 +299,10 @@ pub fn diagnose(
     };
 
     // which samples and intervals train and which are held out
-    let (t0, t1) = (train.time[0], *train.time.last().unwrap());
-    let blocks = options.blocks.max(3);
-    let block_of = move |t: f64| (((t - t0) / (t1 - t0) * blocks as f64) as usize).min(blocks - 1);
+    let blocks = Blocks::new(&train.time, options.blocks);
     let split = heldout_file.is_none();
     let train_intervals: Vec<usize> = (0..d_train.t.len())
-        .filter(|&j| d_train.trusted[j] && (!split || !held_out_block(block_of(d_train.t[j]))))
+        .filter(|&j| d_train.trusted[j] && (!split || !blocks.held_out(d_train.t[j])))
         .collect();
     let held = match (&heldout_file, &d_held) {
         (Some(h), Some(dh)) => HeldOut {
@@ -281,21 +311,14 @@ pub fn diagnose(
             samples: Box::new(|r: &ChannelResiduals| (0..r.samples.len()).collect()),
             intervals: (0..dh.t.len()).filter(|&j| dh.trusted[j]).collect(),
         },
-        _ => {
-            let time = train.time.clone();
-            HeldOut {
-                data: &train,
-                friction: &d_train,
-                samples: Box::new(move |r: &ChannelResiduals| {
-                    (0..r.samples.len())
-                        .filter(|&s| held_out_block(block_of(time[r.samples[s]])))
-                        .collect()
-                }),
-                intervals: (0..d_train.t.len())
-                    .filter(|&j| d_train.trusted[j] && held_out_block(block_of(d_train.t[j])))
-                    .collect(),
-            }
-        }
+        _ => HeldOut {
+            data: &train,
+            friction: &d_train,
+            samples: blocks.picker(&train.time, true),
+            intervals: (0..d_train.t.len())
+                .filter(|&j| d_train.trusted[j] && blocks.held_out(d_train.t[j]))
+                .collect(),
+        },
     };
     if train_intervals.len() < problem::MIN_SAMPLES / 2 || held.intervals.len() < options.groups {
         return Err(format!(
@@ -342,14 +365,7 @@ pub fn diagnose(
     // the output error on the training samples, for [`fit::polish`]
     let train_samples: Picker = match &heldout_file {
         Some(_) => Box::new(|r: &ChannelResiduals| (0..r.samples.len()).collect()),
-        None => {
-            let time = train.time.clone();
-            Box::new(move |r: &ChannelResiduals| {
-                (0..r.samples.len())
-                    .filter(|&s| !held_out_block(block_of(time[r.samples[s]])))
-                    .collect()
-            })
-        }
+        None => blocks.picker(&train.time, false),
     };
     let polish = |model: &FrictionModel| -> fit::Fitted {
         let train_residuals = |m: &FrictionModel| -> Option<nalgebra::DVector<f64>> {
@@ -573,8 +589,8 @@ pub fn diagnose(
         heldout: match &heldout_file {
             Some(h) => h.label.clone(),
             None => format!(
-                "every third of {blocks} equal time blocks of {} (blocks 2, 5, 8, ...)",
-                train.label
+                "every third of {} equal time blocks of {} (blocks 2, 5, 8, ...)",
+                blocks.count, train.label
             ),
         },
         force_source: d_train.source.clone(),

@@ -249,13 +249,16 @@ pub fn export_case(
     )?;
     let mut system = nominal_file.build(0.0).map_err(|e| e.to_string())?;
     let data = Measured::read(&csv, &system)?;
-    let setup = Setup::new(&nominal_file, &mut system, synthetic::SAMPLE, "jacobi")?;
+    let setup = Setup::new(
+        &nominal_file,
+        &mut system,
+        synthetic::SAMPLE,
+        &nominal_file.settings.master_or_default(),
+    )?;
     let d = setup.friction_data(&system, &data, options.smooth)?;
-    let (t0, t1) = (data.time[0], *data.time.last().unwrap_or(&0.0));
-    let blocks = options.blocks.max(3);
+    let blocks = super::Blocks::new(&data.time, options.blocks);
     let mut text = String::from("t,v,x,Fn,F,trusted,heldout\n");
     for j in 0..d.t.len() {
-        let block = (((d.t[j] - t0) / (t1 - t0) * blocks as f64) as usize).min(blocks - 1);
         let _ = writeln!(
             text,
             "{:?},{:?},{:?},{:?},{:?},{},{}",
@@ -265,7 +268,7 @@ pub fn export_case(
             d.fn_[j],
             d.f[j],
             u8::from(d.trusted[j]),
-            u8::from(super::held_out_block(block))
+            u8::from(blocks.held_out(d.t[j]))
         );
     }
     let write = |name: String, body: &str| {

@@ -143,11 +143,7 @@ pub fn generate(
 ) -> Result<Case, String> {
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
     // the data come from the system file's own master algorithm
-    let master_name = file
-        .settings
-        .master
-        .clone()
-        .unwrap_or_else(|| "jacobi".to_string());
+    let master_name = file.settings.master_or_default();
     let setup = Setup::new(file, &mut system, SAMPLE, &master_name)?;
     let n = (duration / SAMPLE).round() as usize;
     let time: Vec<f64> = (0..=n).map(|k| k as f64 * SAMPLE).collect();

@@ -189,6 +189,13 @@ pub struct Settings {
     pub location: Option<String>,
 }
 
+impl Settings {
+    /// The annotation's master algorithm, else `jacobi`.
+    pub fn master_or_default(&self) -> String {
+        self.master.clone().unwrap_or_else(|| "jacobi".to_string())
+    }
+}
+
 /// A parsed system file. For an `.ssp`, the unpacked archive lives as long
 /// as this value.
 #[derive(Debug)]
