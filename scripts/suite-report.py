@@ -56,9 +56,10 @@ def section(diag, sindy, seconds, command):
     out.append("")
     out.append(
         "| hidden | magnitude | cases | diagnose: named right | effect size within 10 % | held-out RMS drop ≥ 2× (median drop) | "
+        "model error against the noise-free truth: drop ≥ 2× (median drop) | "
         "PySINDy: named right | PySINDy: invented an effect |"
     )
-    out.append("|---|---|---|---|---|---|---|---|")
+    out.append("|---|---|---|---|---|---|---|---|---|")
     order = sorted(rows, key=lambda k: (k[0] == "none", "+" in k[0], k[0], -k[1]))
     totals = {}
     for k in order:
@@ -68,30 +69,35 @@ def section(diag, sindy, seconds, command):
         within = sum(r["sizes_within"] for r in d)
         drops = sorted(r["heldout_drop"] for r in d)
         drop2 = sum(x >= 2.0 for x in drops)
+        truth_drops = sorted(r["truth_drop"] for r in d)
+        truth2 = sum(x >= 2.0 for x in truth_drops)
         s_named = sum(r["named_right"] for r in s)
         s_invented = sum(bool(r["invented"]) for r in s)
         if k[0] == "none":
             out.append(
-                f"| none | - | {n} | no effect claimed {pct(named, n)} | - | - | "
+                f"| none | - | {n} | no effect claimed {pct(named, n)} | - | - | - | "
                 f"no effect claimed {pct(s_named, len(s))} | {pct(s_invented, len(s))} |"
             )
         else:
             med = drops[len(drops) // 2] if drops else float("nan")
+            tmed = truth_drops[len(truth_drops) // 2] if truth_drops else float("nan")
             out.append(
                 f"| {k[0]} | {k[1]:g} | {n} | {pct(named, n)} | {pct(within, n)} | {pct(drop2, n)} ({med:.2f}×) | "
+                f"{pct(truth2, n)} ({tmed:.1f}×) | "
                 f"{pct(s_named, len(s))} | {pct(s_invented, len(s))} |"
             )
         if k[0] != "none" and "+" not in k[0]:
-            t = totals.setdefault(k[1], [0, 0, 0, 0, 0, 0, 0])
-            for i, v in enumerate([n, named, within, drop2, len(s), s_named, s_invented]):
+            t = totals.setdefault(k[1], [0, 0, 0, 0, 0, 0, 0, 0])
+            for i, v in enumerate([n, named, within, drop2, len(s), s_named, s_invented, truth2]):
                 t[i] += v
     out.append("")
     for m in sorted(totals, reverse=True):
-        n, named, within, drop2, sn, s_named, s_invented = totals[m]
+        n, named, within, drop2, sn, s_named, s_invented, truth2 = totals[m]
         out.append(
             f"- **One effect at {m:g}**: diagnose names it in {pct(named, n)} cases "
             f"({100 * named / max(n, 1):.0f} %), fits its size within 10 % in {pct(within, n)} and drops the "
-            f"held-out RMS at least 2× in {pct(drop2, n)}; PySINDy names it in {pct(s_named, sn)} "
+            f"held-out RMS at least 2× in {pct(drop2, n)} (the model error against the noise-free truth "
+            f"in {pct(truth2, n)}); PySINDy names it in {pct(s_named, sn)} "
             f"({100 * s_named / max(sn, 1):.0f} %) and invents an effect in {pct(s_invented, sn)}."
         )
     null_d = [r for r in diag if not r["case"]["hidden"]]

@@ -133,9 +133,9 @@ fn run() -> Result<(), String> {
     let work = tempfile::tempdir().map_err(|e| e.to_string())?;
     let mut results: Vec<CaseResult> = Vec::new();
     println!(
-        "| hidden | magnitude | seed | found | named right | size error | baseline RMS | final RMS | drop | noise | s |"
+        "| hidden | magnitude | seed | found | named right | size error | baseline RMS | final RMS | drop | noise | drop against the truth | s |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for case in &cases {
         let r = run_case(&a.system, case, a.duration, &options, work.path())?;
         let found: Vec<&str> = r.found.iter().map(|e| e.name()).collect();
@@ -145,7 +145,7 @@ fn run() -> Result<(), String> {
             .map(|s| format!("{} {:.1} %", s.quantity, 100.0 * s.relative_error))
             .collect();
         println!(
-            "| {} | {} | {} | {} | {} | {} | {:.5} | {:.5} | {:.2} | {:.5} | {:.1} |",
+            "| {} | {} | {} | {} | {} | {} | {:.5} | {:.5} | {:.2} | {:.5} | {:.1} | {:.1} |",
             case.label(),
             case.magnitude,
             case.seed,
@@ -164,6 +164,7 @@ fn run() -> Result<(), String> {
             r.final_rms,
             r.heldout_drop,
             r.noise_floor_rms,
+            r.truth_drop,
             r.seconds
         );
         results.push(r);
@@ -194,13 +195,15 @@ fn summary(results: &[CaseResult]) -> Vec<String> {
             .collect();
         if !single.is_empty() {
             lines.push(format!(
-                "one effect at {m}: named right {}/{}, effect size within {:.0} % {}/{}, held-out RMS drop >= 2x {}/{}, an effect invented {}/{}",
+                "one effect at {m}: named right {}/{}, effect size within {:.0} % {}/{}, held-out RMS drop >= 2x {}/{} (against the noise-free truth {}/{}), an effect invented {}/{}",
                 count(&single, &|r| r.named_right),
                 single.len(),
                 100.0 * SIZE_TOLERANCE,
                 count(&single, &|r| r.sizes_within),
                 single.len(),
                 count(&single, &|r| r.heldout_drop >= 2.0),
+                single.len(),
+                count(&single, &|r| r.truth_drop >= 2.0),
                 single.len(),
                 count(&single, &|r| r.found.iter().any(|e| !r.case.hidden.contains(e))),
                 single.len(),

@@ -4,7 +4,15 @@
 //! ([`fricsim::diagnose`]).
 
 use fricsim::diagnose::model::Effect;
-use fricsim::diagnose::{diagnose, report, Options};
+use fricsim::diagnose::{diagnose, report, CrossValidate, Options};
+
+/// `--cross-validate`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum CrossValidateArg {
+    Auto,
+    Always,
+    Never,
+}
 use fricsim::ssp::SystemFile;
 use std::path::PathBuf;
 
@@ -39,6 +47,11 @@ pub struct DiagnoseArgs {
     /// row of a table of break-away measurements).
     #[arg(long, default_value_t = fricsim::diagnose::SPLIT_BLOCKS)]
     pub blocks: usize,
+    /// Without --heldout: score every block by three-fold cross-validation
+    /// (each third of the blocks held out once) or only one third; auto
+    /// cross-validates data of at most 5000 samples.
+    #[arg(long, value_enum, default_value_t = CrossValidateArg::Auto)]
+    pub cross_validate: CrossValidateArg,
     /// Smoothing window of the measured position for the inverse dynamics (s).
     #[arg(long, default_value_t = 0.01)]
     pub smooth: f64,
@@ -55,6 +68,11 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         smooth: a.smooth,
         blocks: a.blocks,
         polish: !a.no_polish,
+        cross_validate: match a.cross_validate {
+            CrossValidateArg::Auto => CrossValidate::Auto,
+            CrossValidateArg::Always => CrossValidate::Always,
+            CrossValidateArg::Never => CrossValidate::Never,
+        },
         ..Options::default()
     };
     if !(a.alpha > 0.0 && a.alpha < 1.0) {

@@ -241,6 +241,18 @@ impl FrictionModel {
         m
     }
 
+    /// Whether adding `a` and `b` together brings parameters that neither
+    /// brings alone (an interaction: with both position and direction, one
+    /// position table per direction). Without one, the pair is the sum of
+    /// two single additions, which the singles round has already tried.
+    pub fn interact(&self, a: Effect, b: Effect, context: &Context) -> bool {
+        let n = |m: &FrictionModel| m.free().len() as isize;
+        let n0 = n(self);
+        let (na, nb) = (n(&self.with(a, context)), n(&self.with(b, context)));
+        let nab = n(&self.with(a, context).with(b, context));
+        nab - n0 > (na - n0) + (nb - n0)
+    }
+
     /// The free parameters of this model (the nominal levels and those of
     /// every effect it has), as transformed coordinates θ.
     pub fn free(&self) -> Vec<Free> {
@@ -442,4 +454,48 @@ pub struct Context {
     /// Mean normal force (N), 1 when not measured.
     pub mean_normal_force: f64,
     pub position_knots: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_position_and_direction_interact() {
+        let m = FrictionModel::from_values(&BTreeMap::from([
+            ("Fc".to_string(), 5.0),
+            ("Fs".to_string(), 5.0),
+            ("vs".to_string(), 0.01),
+            ("sigma0".to_string(), 1e7),
+            ("sigma1".to_string(), 0.0),
+            ("sigma2".to_string(), 0.0),
+            ("stribeck_exponent".to_string(), 2.0),
+            ("Fc_neg".to_string(), 5.0),
+            ("Fs_neg".to_string(), 5.0),
+            ("direction_dependent".to_string(), 0.0),
+            ("normal_force_form".to_string(), 0.0),
+            ("position_dependent".to_string(), 0.0),
+        ]))
+        .unwrap();
+        let context = Context {
+            speed_scale: 0.1,
+            x_min: 0.0,
+            x_max: 0.27,
+            travel: 0.27,
+            mean_normal_force: 1.0,
+            position_knots: 6,
+        };
+        let mut interacting = Vec::new();
+        for (i, &a) in Effect::ALL.iter().enumerate() {
+            for &b in &Effect::ALL[i + 1..] {
+                if m.interact(a, b, &context) {
+                    interacting.push((a, b));
+                }
+            }
+        }
+        assert_eq!(
+            interacting,
+            [(Effect::PositionDependent, Effect::DirectionDependent)]
+        );
+    }
 }

@@ -145,6 +145,11 @@ pub fn markdown(d: &Diagnosis) -> String {
         }
     }
     let _ = writeln!(s, "\n## Candidates tried\n");
+    let _ = writeln!(
+        s,
+        "Each candidate is the current model with one effect added (or two that interact), refitted; p is the one-sided p-value of Clark and West's test for nested models on the held-out samples (per sample 2·e₀·(ŷ₁ − ŷ₀), averaged per group, Student's t), against α = {} divided by the candidates of the round; the mean square must also drop by at least 2 %. A round of pairs follows a round in which no single effect was accepted.\n",
+        d.alpha
+    );
     for (r, round) in d.rounds.iter().enumerate() {
         let _ = writeln!(
             s,

@@ -132,7 +132,9 @@ fn apply(
     m
 }
 
-/// Generate a case and write its CSV to `csv`.
+/// Generate a case and write its CSV to `csv`; with `noise_free`, also
+/// the same columns without measurement noise and quantisation there (the
+/// truth the suite measures a model's error against).
 pub fn generate(
     file: &SystemFile,
     hidden: &[Effect],
@@ -140,6 +142,7 @@ pub fn generate(
     seed: u64,
     duration: f64,
     csv: &Path,
+    noise_free: Option<&Path>,
 ) -> Result<Case, String> {
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
     // the data come from the system file's own master algorithm
@@ -288,6 +291,20 @@ pub fn generate(
         .map_err(io)?;
     }
     out.flush().map_err(io)?;
+    if let Some(path) = noise_free {
+        let io = |e: std::io::Error| format!("{}: {e}", path.display());
+        let mut out = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+        writeln!(out, "time,rig.x_ref,rig.v_ref,friction.Fn,rig.x,rig.u_ctrl").map_err(io)?;
+        for k in 0..time.len() {
+            writeln!(
+                out,
+                "{:?},{:?},{:?},{:?},{:?},{:?}",
+                time[k], xr[k], vr[k], fn_signal[k], x[k], u[k]
+            )
+            .map_err(io)?;
+        }
+        out.flush().map_err(io)?;
+    }
     Ok(Case {
         hidden: hidden.to_vec(),
         magnitude,
