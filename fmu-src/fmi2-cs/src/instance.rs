@@ -31,6 +31,9 @@ pub struct Instance {
     values: Values,
     /// `du/dt` per value reference (non-zero for inputs only).
     slopes: Vec<f64>,
+    /// Whether a slope may be non-zero (false: every input is held over the
+    /// next step, and the step need not look at the slopes).
+    sloped: bool,
     /// Value references of the inputs, the values a step changes (by
     /// their slopes).
     inputs: Vec<u32>,
@@ -53,8 +56,59 @@ pub struct Instance {
     /// box is the handle given out, and must not move with the list.)
     #[allow(clippy::vec_box)]
     saved_states: Vec<Box<Snapshot>>,
-    /// Reused buffer for the model state checked after each step.
+    /// The model state saved after the last step (checked for finiteness
+    /// there); while [`Instance::step_state_current`] it is also the state
+    /// the next step starts from, which that step keeps for its replay
+    /// without asking the model again.
     step_state: Vec<f64>,
+    /// Whether the model state is still the one in `step_state`: cleared by
+    /// everything that gives the model another state (initialization, a
+    /// reset, a restored FMU state).
+    step_state_current: bool,
+    /// Per value reference, what the hot paths check ([`flag`]): the type,
+    /// the causality, when it may be set. One byte per variable, so that a
+    /// get or set validates its value references with one load each; the
+    /// messages still come from the table.
+    flags: Vec<u8>,
+}
+
+/// Bits of [`Instance::flags`].
+mod flag {
+    pub const REAL: u8 = 1 << 0;
+    pub const INTEGER: u8 = 1 << 1;
+    pub const BOOLEAN: u8 = 1 << 2;
+    pub const OUTPUT: u8 = 1 << 3;
+    pub const INPUT: u8 = 1 << 4;
+    /// May be set before and in initialization mode.
+    pub const SETTABLE_BEFORE_INIT: u8 = 1 << 5;
+    /// May be set in step mode.
+    pub const SETTABLE_IN_STEP: u8 = 1 << 6;
+}
+
+/// The type bit of `t` in [`Instance::flags`].
+fn type_flag(t: VarType) -> u8 {
+    match t {
+        VarType::Real => flag::REAL,
+        VarType::Integer => flag::INTEGER,
+        VarType::Boolean => flag::BOOLEAN,
+    }
+}
+
+fn flags_of(v: &Variable) -> u8 {
+    let mut f = type_flag(v.var_type);
+    if v.causality == Causality::Output {
+        f |= flag::OUTPUT;
+    }
+    if v.causality == Causality::Input {
+        f |= flag::INPUT;
+    }
+    if v.settable_before_init() {
+        f |= flag::SETTABLE_BEFORE_INIT;
+    }
+    if v.settable_in_step_mode() {
+        f |= flag::SETTABLE_IN_STEP;
+    }
+    f
 }
 
 /// Buffers of [`Instance::directional_derivative`], kept between calls.
@@ -72,9 +126,13 @@ struct Replay {
     model_state: Vec<f64>,
     /// Value and slope of each of [`Instance::inputs`] before the step
     /// (nothing else changes in a step: a parameter set since invalidates
-    /// the replay).
+    /// the replay), unless `held`.
     inputs: Vec<f64>,
     slopes: Vec<f64>,
+    /// Every input was held over the step (no slope): the inputs before it
+    /// are the inputs now (setting another value invalidates the replay),
+    /// and `inputs`, `slopes` were not written.
+    held: bool,
     h: f64,
 }
 
@@ -109,6 +167,7 @@ impl Instance {
             model,
             values,
             slopes: vec![0.0; n],
+            sloped: false,
             outputs_dirty: true,
             initialized: false,
             time: 0.0,
@@ -119,6 +178,7 @@ impl Instance {
                 model_state: Vec::new(),
                 inputs: vec![0.0; inputs.len()],
                 slopes: vec![0.0; inputs.len()],
+                held: false,
                 h: 0.0,
             },
             inputs,
@@ -132,6 +192,8 @@ impl Instance {
             },
             saved_states: Vec::new(),
             step_state: Vec::new(),
+            step_state_current: false,
+            flags: info.variables.iter().map(flags_of).collect(),
         }
     }
 
@@ -185,6 +247,7 @@ impl Instance {
     }
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), String> {
+        self.step_state_current = false;
         self.model.initialize(&self.values)?;
         self.model.compute_outputs(&mut self.values);
         self.outputs_dirty = false;
@@ -200,9 +263,11 @@ impl Instance {
     }
 
     pub fn reset(&mut self) -> Result<(), String> {
+        self.step_state_current = false;
         self.values = Values::from_start(self.info.variables);
         self.parameters_version += 1;
         self.slopes.iter_mut().for_each(|s| *s = 0.0);
+        self.sloped = false;
         self.outputs_dirty = true;
         self.initialized = false;
         self.replay.valid = false;
@@ -218,6 +283,7 @@ impl Instance {
     fn ensure_outputs(&mut self) -> Result<(), String> {
         if self.outputs_dirty {
             if !self.initialized {
+                self.step_state_current = false;
                 self.model.initialize(&self.values)?;
             }
             self.model.compute_outputs(&mut self.values);
@@ -230,19 +296,35 @@ impl Instance {
 
     /// Read values of type `t` into `out` (already checked: same length).
     pub fn get(&mut self, t: VarType, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
-        for vr in vrs {
-            self.variable_of_type(*vr, t)?;
+        // One flag byte per value reference: known, of type `t`, an output?
+        let want = type_flag(t);
+        let mut wrong = false;
+        let mut outputs = 0;
+        for &vr in vrs {
+            let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+            wrong |= f & want == 0;
+            outputs |= f;
         }
-        let wants_outputs = vrs
-            .iter()
-            .any(|vr| self.info.variables[*vr as usize].causality == Causality::Output);
-        if wants_outputs {
+        if wrong {
+            for vr in vrs {
+                self.variable_of_type(*vr, t)?;
+            }
+        }
+        if outputs & flag::OUTPUT != 0 {
             self.ensure_outputs()?;
         }
-        for (o, vr) in out.iter_mut().zip(vrs) {
-            *o = self.values.real(*vr);
+        let data = self.values.as_slice();
+        let mut finite = true;
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            let x = data[vr as usize];
+            *o = x;
+            finite &= x.is_finite();
         }
-        self.check_finite(vrs, out, "")
+        if finite {
+            Ok(())
+        } else {
+            self.check_finite(vrs, out, "")
+        }
     }
 
     /// Values handed to the importer with `fmi2OK` are never NaN or
@@ -262,6 +344,67 @@ impl Instance {
     /// Check, then set, values of type `t`: all or nothing.
     pub fn set(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         let in_step_mode = self.state == State::StepComplete;
+        // The usual case in one pass over the flag bytes: known, of type
+        // `t`, settable now, finite; the inputs get the model's own check.
+        let want = type_flag(t)
+            | if in_step_mode {
+                flag::SETTABLE_IN_STEP
+            } else {
+                flag::SETTABLE_BEFORE_INIT
+            };
+        let mut fine = true;
+        let mut inputs = 0;
+        for (&vr, value) in vrs.iter().zip(values) {
+            let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+            fine &= f & want == want && value.is_finite();
+            inputs |= f;
+        }
+        if !fine {
+            self.check_set(t, vrs, values, in_step_mode)?;
+        } else if inputs & flag::INPUT != 0 {
+            for (&vr, &value) in vrs.iter().zip(values) {
+                if self.flags[vr as usize] & flag::INPUT != 0 {
+                    self.check_input(vr, value)?;
+                }
+            }
+        }
+        let mut invalidates = false;
+        for (&vr, &value) in vrs.iter().zip(values) {
+            let input = self.flags[vr as usize] & flag::INPUT != 0;
+            invalidates |= !input || self.values.real(vr) != value;
+            if !input {
+                self.parameters_version += 1;
+            }
+            self.values.set(vr, value);
+        }
+        if invalidates {
+            self.replay.valid = false;
+        }
+        if !vrs.is_empty() {
+            self.outputs_dirty = true;
+        }
+        Ok(())
+    }
+
+    /// The model's check of input `vr` = `value`, as an FMI message.
+    fn check_input(&self, vr: u32, value: f64) -> Result<(), String> {
+        self.model.check_input(vr, value).map_err(|e| {
+            format!(
+                "{} (value reference {vr}) = {value}: {e}",
+                self.info.variables[vr as usize].name
+            )
+        })
+    }
+
+    /// Every check of [`Instance::set`], value by value, with the message
+    /// of the first that fails.
+    fn check_set(
+        &self,
+        t: VarType,
+        vrs: &[u32],
+        values: &[f64],
+        in_step_mode: bool,
+    ) -> Result<(), String> {
         for (vr, value) in vrs.iter().zip(values) {
             let v = self.variable_of_type(*vr, t)?;
             let allowed = if in_step_mode {
@@ -290,23 +433,8 @@ impl Instance {
                 ));
             }
             if v.causality == Causality::Input {
-                self.model
-                    .check_input(*vr, *value)
-                    .map_err(|e| format!("{} (value reference {vr}) = {value}: {e}", v.name))?;
+                self.check_input(*vr, *value)?;
             }
-        }
-        for (vr, value) in vrs.iter().zip(values) {
-            let input = self.info.variables[*vr as usize].causality == Causality::Input;
-            if self.values.real(*vr) != *value || !input {
-                self.replay.valid = false;
-            }
-            if !input {
-                self.parameters_version += 1;
-            }
-            self.values.set(*vr, *value);
-        }
-        if !vrs.is_empty() {
-            self.outputs_dirty = true;
         }
         Ok(())
     }
@@ -337,6 +465,7 @@ impl Instance {
         }
         for (vr, slope) in vrs.iter().zip(slopes) {
             self.slopes[*vr as usize] = *slope;
+            self.sloped |= *slope != 0.0;
         }
         if !vrs.is_empty() {
             self.replay.valid = false;
@@ -397,15 +526,25 @@ impl Instance {
                 t - self.time
             ));
         }
-        if self.model.needs_step_replay() {
-            self.replay.model_state.clear();
-            self.model.save_state(&mut self.replay.model_state);
-            for (k, &vr) in self.inputs.iter().enumerate() {
-                self.replay.inputs[k] = self.values.real(vr);
-                self.replay.slopes[k] = self.slopes[vr as usize];
+        let replay = self.model.needs_step_replay();
+        if replay {
+            if self.step_state_current {
+                // the state after the last step is the state now
+                std::mem::swap(&mut self.replay.model_state, &mut self.step_state);
+            } else {
+                self.replay.model_state.clear();
+                self.model.save_state(&mut self.replay.model_state);
+            }
+            self.replay.held = !self.sloped;
+            if self.sloped {
+                for (k, &vr) in self.inputs.iter().enumerate() {
+                    self.replay.inputs[k] = self.values.real(vr);
+                    self.replay.slopes[k] = self.slopes[vr as usize];
+                }
             }
             self.replay.h = h;
         }
+        self.step_state_current = false;
         if let Err(e) = self.model.do_step(&self.values, &self.slopes, h) {
             self.state = State::Error;
             return Err(format!("step from t = {t} over h = {h} failed: {e}"));
@@ -414,16 +553,26 @@ impl Instance {
         // is a failed step too: the state is no longer meaningful.
         self.step_state.clear();
         self.model.save_state(&mut self.step_state);
-        if let Some(x) = self.step_state.iter().find(|x| !x.is_finite()) {
+        if !self
+            .step_state
+            .iter()
+            .fold(true, |ok, x| ok & x.is_finite())
+        {
             self.state = State::Error;
+            let x = self.step_state.iter().find(|x| !x.is_finite()).copied();
             return Err(format!(
-                "step from t = {t} over h = {h} failed: the model state became {x}: the parameters or inputs are out of the model's range"
+                "step from t = {t} over h = {h} failed: the model state became {}: the parameters or inputs are out of the model's range",
+                x.unwrap_or(f64::NAN)
             ));
         }
+        self.step_state_current = true;
         // Inputs as the FMU saw them at the end of the step (u + du·h); the
         // slopes apply to one step only.
-        advance_inputs(&self.inputs, &mut self.values, &mut self.slopes, h);
-        self.replay.valid = self.model.needs_step_replay();
+        if self.sloped {
+            advance_inputs(&self.inputs, &mut self.values, &mut self.slopes, h);
+            self.sloped = false;
+        }
+        self.replay.valid = replay;
         self.time = t + h;
         self.outputs_dirty = true;
         Ok(fmi2Status::fmi2OK)
@@ -547,8 +696,13 @@ impl Instance {
             let slopes = &mut scratch.slopes;
             slopes.resize(self.slopes.len(), 0.0);
             for (k, &vr) in self.inputs.iter().enumerate() {
-                values.set(vr, self.replay.inputs[k]);
-                slopes[vr as usize] = self.replay.slopes[k];
+                if self.replay.held {
+                    // the value now (set above) is the value before the step
+                    slopes[vr as usize] = 0.0;
+                } else {
+                    values.set(vr, self.replay.inputs[k]);
+                    slopes[vr as usize] = self.replay.slopes[k];
+                }
             }
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
@@ -564,7 +718,10 @@ impl Instance {
                 advance_inputs(&self.inputs, values, slopes, self.replay.h);
                 self.model.compute_outputs(values);
             }
-            self.model.restore_state(current)?;
+            if let Err(e) = self.model.restore_state(current) {
+                self.step_state_current = false;
+                return Err(e);
+            }
             replayed?;
         } else {
             for (k, d) in knowns.iter().zip(dv) {
@@ -631,6 +788,7 @@ impl Instance {
     }
 
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
+        self.step_state_current = false;
         if snap.guid != self.info.guid || snap.values.len() != self.values.len() {
             return Err(format!(
                 "the FMU state belongs to GUID {}, not this FMU ({})",
@@ -680,6 +838,7 @@ impl Instance {
             }
             self.slopes.copy_from_slice(&snap.slopes);
         }
+        self.sloped = self.slopes.iter().any(|s| *s != 0.0);
         self.initialized = snap.initialized;
         self.time = snap.time;
         self.state = snap.state;

@@ -174,6 +174,9 @@ pub struct Instance {
     fatal: bool,
     /// The time limit on each call, if one is set ([`Instance::set_call_time_limit`]).
     limit: Option<Arc<Watched>>,
+    /// Calls made so far that may have changed a value of the instance
+    /// (every call but `fmi2Get…`), see [`Instance::changes`].
+    changes: u64,
 }
 
 impl std::fmt::Debug for Instance {
@@ -278,11 +281,20 @@ impl Instance {
             states: Vec::new(),
             fatal: false,
             limit: None,
+            changes: 0,
         })
     }
 
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// A count that moves with every call that may change a value of the
+    /// instance (every FMI call but the `fmi2Get…` ones): while it stands
+    /// still, `fmi2GetReal` answers as it did, and a value read since can
+    /// be used again instead of asking the FMU once more.
+    pub fn changes(&self) -> u64 {
+        self.changes
     }
 
     pub fn fmu(&self) -> &Fmu {
@@ -299,9 +311,13 @@ impl Instance {
     }
 
     /// Refuse any call after `fmi2Fatal`; otherwise the log mark before the
-    /// call (and the call's clock started, under a time limit).
+    /// call (and the call's clock started, under a time limit). Every call
+    /// but a getter's counts as a change ([`Instance::changes`]).
     #[inline]
-    fn begin(&self, function: &'static str) -> Result<u64, FmuError> {
+    fn begin(&mut self, function: &'static str) -> Result<u64, FmuError> {
+        if !function.starts_with("fmi2Get") {
+            self.changes = self.changes.wrapping_add(1);
+        }
         if self.fatal {
             return Err(FmuError::AfterFatal {
                 function,
@@ -314,9 +330,23 @@ impl Instance {
         Ok(self.sink.mark())
     }
 
-    /// The status of a call as a `Result`.
+    /// The status of a call as a `Result`: `fmi2OK` (0) without a time limit
+    /// at once, anything else through [`Instance::finish_checked`].
     #[inline]
     fn finish(
+        &mut self,
+        function: &'static str,
+        mark: u64,
+        raw: fmi2Status,
+    ) -> Result<Status, FmuError> {
+        if raw == 0 && self.limit.is_none() {
+            return Ok(Status::Ok);
+        }
+        self.finish_checked(function, mark, raw)
+    }
+
+    #[inline(never)]
+    fn finish_checked(
         &mut self,
         function: &'static str,
         mark: u64,
