@@ -104,11 +104,15 @@ fn ramp_response_matches_the_closed_form() {
 }
 
 /// In the default mode (prescribed ramp, no drive, controller or dither)
-/// the rig computes exactly what the first version of this file did (bits
-/// recorded from it, commit 6271953): other tests compare against runs of
-/// the stick-slip benchmark.
+/// the rig computes what the first version of this file did (bits
+/// recorded from it, commit 6271953), to rounding: other tests compare
+/// against runs of the stick-slip benchmark. Bit for bit until the stage
+/// equations were solved in closed form (gauss_legendre::linear_stage_sums,
+/// the same method, where the first version differenced the right-hand
+/// side for the stage matrix); since then to 1e-13 of each value (5.3e-15
+/// at most, after 700 steps of the damped case, when that was changed).
 #[test]
-fn default_mode_is_bit_identical_to_the_first_version() {
+fn default_mode_matches_the_first_version_to_rounding() {
     const BENCHMARK: [[u64; 5]; 5] = [
         [
             0xbfb02339506cc1fb,
@@ -215,19 +219,25 @@ fn default_mode_is_bit_identical_to_the_first_version() {
             rig.step(&u, &du, h);
             if (i + 1) % (n / 5) == 0 {
                 let u1 = u.at(&du, h);
-                out.push(
-                    [
-                        rig.position(&u1),
-                        rig.velocity(),
-                        rig.acceleration(&u1),
-                        rig.spring_force(&u1),
-                        rig.slip_velocity(),
-                    ]
-                    .map(f64::to_bits),
+                out.push([
+                    rig.position(&u1),
+                    rig.velocity(),
+                    rig.acceleration(&u1),
+                    rig.spring_force(&u1),
+                    rig.slip_velocity(),
+                ]);
+            }
+        }
+        for (row, golden) in out.iter().zip(golden) {
+            for (x, bits) in row.iter().zip(golden) {
+                let first = f64::from_bits(*bits);
+                assert!(
+                    (x - first).abs() <= 1e-13 * first.abs(),
+                    "{p:?}: {x:e}, first version {first:e}"
                 );
             }
         }
-        assert_eq!(out, golden.to_vec(), "{p:?}");
+        assert_eq!(out.len(), golden.len());
     }
 }
 
