@@ -43,10 +43,15 @@ static NEXT_SLOT: AtomicUsize = AtomicUsize::new(0);
 /// from [`RECENTLY_LIVE`], else from [`LIVE`]. (Freeing an instance while
 /// another thread is inside a call on it is a caller's error the lock never
 /// prevented either.)
+#[inline]
 fn is_live(c: usize) -> bool {
-    if c != 0 && RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c) {
-        return true;
-    }
+    (c != 0 && RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c)) || is_live_locked(c)
+}
+
+/// [`is_live`] from [`LIVE`], noting a live `c` in [`RECENTLY_LIVE`].
+#[cold]
+#[inline(never)]
+fn is_live_locked(c: usize) -> bool {
     let live = live();
     let found = live.contains(&c);
     if found {
@@ -139,20 +144,13 @@ pub unsafe fn call_allowed(
 /// # Safety
 /// When non-null, `ptr` must point to `n` readable elements (the FMI
 /// contract); we check null, alignment and a plausible length.
+#[inline(always)]
 pub unsafe fn in_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a [T], String> {
     if n == 0 {
         return Ok(&[]);
     }
-    if ptr.is_null() {
-        return Err(format!("argument {what} is NULL but its length is {n}"));
-    }
-    if n > MAX_ARRAY_LENGTH {
-        return Err(format!(
-            "length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"
-        ));
-    }
-    if !ptr.is_aligned() {
-        return Err(format!("argument {what} = {ptr:p} is not aligned"));
+    if ptr.is_null() || n > MAX_ARRAY_LENGTH || !ptr.is_aligned() {
+        return Err(slice_error(ptr as usize, ptr.is_null(), n, what));
     }
     // SAFETY: non-null, aligned, length bounded; validity is the caller's contract.
     Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
@@ -162,23 +160,30 @@ pub unsafe fn in_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a
 ///
 /// # Safety
 /// As [`in_slice`], for `n` writable elements.
+#[inline(always)]
 pub unsafe fn out_slice<'a, T>(ptr: *mut T, n: usize, what: &str) -> Result<&'a mut [T], String> {
     if n == 0 {
         return Ok(&mut []);
     }
-    if ptr.is_null() {
-        return Err(format!("argument {what} is NULL but its length is {n}"));
-    }
-    if n > MAX_ARRAY_LENGTH {
-        return Err(format!(
-            "length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"
-        ));
-    }
-    if !ptr.is_aligned() {
-        return Err(format!("argument {what} = {ptr:p} is not aligned"));
+    if ptr.is_null() || n > MAX_ARRAY_LENGTH || !ptr.is_aligned() {
+        return Err(slice_error(ptr as usize, ptr.is_null(), n, what));
     }
     // SAFETY: as above.
     Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
+}
+
+/// Why [`in_slice`] or [`out_slice`] refused an array (null, too long, or
+/// misaligned, checked in that order).
+#[cold]
+#[inline(never)]
+fn slice_error(address: usize, null: bool, n: usize, what: &str) -> String {
+    if null {
+        format!("argument {what} is NULL but its length is {n}")
+    } else if n > MAX_ARRAY_LENGTH {
+        format!("length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts")
+    } else {
+        format!("argument {what} = {address:#x} is not aligned")
+    }
 }
 
 /// # Safety

@@ -380,6 +380,13 @@ pub struct Rig1D {
     xi: f64,
     /// ω of the sub-step rule (it depends on the parameters only).
     omega: f64,
+    /// The linear part of the right-hand side, unsaturated
+    /// ([`Rig1D::linear_part`] of piece 0; from the parameters only).
+    linear: [[f64; 2]; 2],
+    /// The plain mode of [`Rig1D::step_plain`]: m > 0, no controller, the
+    /// prescribed ramp without a sinusoid, no drive force (a dither is
+    /// allowed: it moves the surface, not the body).
+    plain: bool,
 }
 
 impl Rig1D {
@@ -392,8 +399,16 @@ impl Rig1D {
             xd: p.v0,
             xi: 0.0,
             omega: 0.0,
+            linear: [[0.0; 2]; 2],
+            plain: p.m > 0.0
+                && !p.control.on()
+                && p.actuator == Actuator::Prescribed
+                && !p.act_sine.is_active()
+                && p.drive.f_step == 0.0
+                && !p.drive.sine.is_active(),
         };
         rig.omega = rig.substep_omega(p.m == 0.0);
+        rig.linear = rig.linear_part(0, p.m == 0.0);
         if p.m == 0.0 {
             rig.xd = rig.quasi_static_velocity(&Rig1DInputs::default(), &Rig1DInputs::default());
         }
@@ -582,6 +597,39 @@ impl Rig1D {
 
     /// Advance by `h` with inputs u(τ) = u + du·τ, τ ∈ [0, h].
     pub fn step(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
+        if self.plain && self.omega * h <= OMEGA_H_MAX {
+            self.step_plain(u, du, h);
+        } else {
+            self.step_general(u, du, h);
+        }
+    }
+
+    /// [`Rig1D::step`] in the plain mode with one sub-step: what the general
+    /// path computes there, bit for bit (the terms that are zero in this
+    /// mode are added as zeros, as it adds them), without its mode
+    /// dispatch.
+    fn step_plain(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
+        let p = &self.p;
+        let (x, xd) = (self.x, self.xd);
+        let (t0, tau0) = (self.t + 0.0, 0.0);
+        let rhs = |c: f64| -> (f64, f64) {
+            let (t, tau) = (t0 + c * h, tau0 + c * h);
+            // x_a0 + v_a·t + (inactive sinusoid); F_d and F_ctrl are 0
+            let xa = p.x_a0 + p.v_a * t + 0.0;
+            let ext = u.f_ext + du.f_ext * tau;
+            let fr = u.friction + du.friction * tau;
+            let force = p.k * (xa - x) - p.c * xd + ext - fr + (0.0 + 0.0) + 0.0;
+            (xd, force / p.m)
+        };
+        let ((a0, a1), (b0, b1)) = (rhs(C[0]), rhs(C[1]));
+        let sums = linear_stage_sums(h, self.linear, [a0, a1, b0, b1]);
+        self.x = x + h * 0.5 * sums[0];
+        self.xd = xd + h * 0.5 * sums[1];
+        self.t += h;
+    }
+
+    /// [`Rig1D::step`] in every mode.
+    fn step_general(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
         let p = self.p;
         if p.m == 0.0 && p.c == 0.0 {
             // pure force balance: nothing to integrate
@@ -777,7 +825,12 @@ impl Rig1D {
             (xd, force / p.m)
         };
         let ((a0, a1), (b0, b1)) = (rhs(C[0]), rhs(C[1]));
-        let sums = linear_stage_sums(len, self.linear_part(piece, first_order), [a0, a1, b0, b1]);
+        let linear = if piece == 0 {
+            self.linear
+        } else {
+            self.linear_part(piece, first_order)
+        };
+        let sums = linear_stage_sums(len, linear, [a0, a1, b0, b1]);
         let x_new = x + len * 0.5 * sums[0];
         let xd_new = if first_order {
             0.5 * sums[0]

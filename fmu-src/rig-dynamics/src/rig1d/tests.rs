@@ -868,3 +868,52 @@ fn invalid_parameters_are_refused_with_name_and_value() {
         assert_eq!(Control::from_code(code).unwrap().code(), code);
     }
 }
+
+/// The plain mode's step (no controller, drive or actuator sinusoid) is
+/// the general path's arithmetic, bit for bit, with ramped inputs, steps of
+/// several lengths and a dither, damped and undamped.
+#[test]
+fn plain_step_is_the_general_step_bit_for_bit() {
+    for p in [
+        Rig1DParams::default(),
+        Rig1DParams {
+            m: 0.5,
+            c: 0.3,
+            k: 20.0,
+            x0: 0.01,
+            v0: -0.02,
+            v_a: 0.05,
+            x_a0: 0.001,
+            v_surface: 0.01,
+            dither: Sinusoid::new(1e-4, 30.0),
+            ..Default::default()
+        },
+    ] {
+        let mut plain = Rig1D::new(p).unwrap();
+        let mut general = Rig1D::new(p).unwrap();
+        assert!(plain.plain);
+        for i in 0..2000 {
+            let h = 1e-3 * (1.0 + 0.25 * (i % 3) as f64);
+            let t = plain.time();
+            let u = Rig1DInputs {
+                friction: 0.5 * (7.0 * t).sin() + 0.2,
+                f_ext: 0.1 * (3.0 * t).cos(),
+                ..Default::default()
+            };
+            let du = Rig1DInputs {
+                friction: 3.5 * (7.0 * t).cos(),
+                f_ext: -0.3 * (3.0 * t).sin(),
+                ..Default::default()
+            };
+            plain.step(&u, &du, h);
+            general.step_general(&u, &du, h);
+            let bits = |r: &Rig1D| {
+                r.state_to_vec()
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&plain), bits(&general), "step {i}");
+        }
+    }
+}
