@@ -623,19 +623,23 @@ impl Instance {
         }
         self.ensure_outputs()?;
 
-        // Analytic where the model provides every entry.
-        let analytic: Option<Vec<f64>> = unknowns
-            .iter()
-            .map(|u| {
-                knowns.iter().zip(dv_known).try_fold(0.0, |acc, (k, dv)| {
-                    self.model
-                        .partial_derivative(&self.values, *u, *k)
-                        .map(|d| acc + d * dv)
-                })
-            })
-            .collect();
-        if let Some(j) = analytic {
-            dv_unknown.copy_from_slice(&j);
+        // Analytic where the model provides every entry (written as it
+        // goes: the differences below overwrite every entry otherwise).
+        let mut analytic = true;
+        'rows: for (out, u) in dv_unknown.iter_mut().zip(unknowns) {
+            let mut acc = 0.0;
+            for (k, dv) in knowns.iter().zip(dv_known) {
+                match self.model.partial_derivative(&self.values, *u, *k) {
+                    Some(d) => acc += d * dv,
+                    None => {
+                        analytic = false;
+                        break 'rows;
+                    }
+                }
+            }
+            *out = acc;
+        }
+        if analytic {
             return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
         }
 
@@ -692,14 +696,15 @@ impl Instance {
             scratch.parameters_version = self.parameters_version;
         }
         if self.replay.valid {
-            // every slope is zero but those of the inputs, set here
+            // Every slope is zero between calls; those of the inputs are set
+            // here when the step had any (and zero again when done). Held
+            // inputs: the values now (set above) are the values before the
+            // step.
             let slopes = &mut scratch.slopes;
             slopes.resize(self.slopes.len(), 0.0);
-            for (k, &vr) in self.inputs.iter().enumerate() {
-                if self.replay.held {
-                    // the value now (set above) is the value before the step
-                    slopes[vr as usize] = 0.0;
-                } else {
+            let held = self.replay.held;
+            if !held {
+                for (k, &vr) in self.inputs.iter().enumerate() {
                     values.set(vr, self.replay.inputs[k]);
                     slopes[vr as usize] = self.replay.slopes[k];
                 }
@@ -707,18 +712,27 @@ impl Instance {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
+            // the state to come back to: kept since the step if the model
+            // has not left it, else saved here
             let current = &mut scratch.model_state;
-            current.clear();
-            self.model.save_state(current);
+            let kept = self.step_state_current;
+            if !kept {
+                current.clear();
+                self.model.save_state(current);
+            }
             let replayed = self
                 .model
                 .restore_state(&self.replay.model_state)
                 .and_then(|()| self.model.do_step(values, slopes, self.replay.h));
-            if replayed.is_ok() {
+            if !held {
+                // the inputs at the end of the step; every slope zero again
                 advance_inputs(&self.inputs, values, slopes, self.replay.h);
-                self.model.compute_outputs(values);
             }
-            if let Err(e) = self.model.restore_state(current) {
+            if replayed.is_ok() {
+                self.model.compute_outputs_of(values, unknowns);
+            }
+            let back = if kept { &self.step_state } else { &*current };
+            if let Err(e) = self.model.restore_state(back) {
                 self.step_state_current = false;
                 return Err(e);
             }
@@ -727,7 +741,7 @@ impl Instance {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            self.model.compute_outputs(values);
+            self.model.compute_outputs_of(values, unknowns);
         }
         for (o, u) in out.iter_mut().zip(unknowns) {
             *o = values.real(*u);
@@ -838,7 +852,11 @@ impl Instance {
             }
             self.slopes.copy_from_slice(&snap.slopes);
         }
-        self.sloped = self.slopes.iter().any(|s| *s != 0.0);
+        // only inputs have slopes
+        self.sloped = self
+            .inputs
+            .iter()
+            .any(|&vr| self.slopes[vr as usize] != 0.0);
         self.initialized = snap.initialized;
         self.time = snap.time;
         self.state = snap.state;
