@@ -75,17 +75,36 @@ struct Sampled {
     row: Vec<f64>,
     offsets: Vec<usize>,
     changes: Vec<u64>,
+    /// Per connection, where its output was in the component's outputs
+    /// last time (checked before use).
+    positions: Vec<usize>,
 }
 
 impl Sampled {
     /// Output `vr` of component `c` as sampled, if `c` has seen no call
-    /// since that could have changed it.
-    fn value(&self, components: &[Component], c: usize, vr: ValueReference) -> Option<f64> {
+    /// since that could have changed it; `k` is the connection it is for.
+    fn value(
+        &mut self,
+        components: &[Component],
+        k: usize,
+        c: usize,
+        vr: ValueReference,
+    ) -> Option<f64> {
         let component = components.get(c)?;
         if self.changes.get(c) != Some(&component.instance.changes()) {
             return None;
         }
-        let i = component.output_vrs.iter().position(|v| *v == vr)?;
+        if self.positions.len() <= k {
+            self.positions.resize(k + 1, 0);
+        }
+        let known = self.positions[k];
+        let i = if component.output_vrs.get(known) == Some(&vr) {
+            known
+        } else {
+            let i = component.output_vrs.iter().position(|v| *v == vr)?;
+            self.positions[k] = i;
+            i
+        };
         self.row.get(self.offsets.get(c)? + i).copied()
     }
 }
@@ -303,7 +322,7 @@ impl System {
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
         for (k, c) in self.connections.iter().enumerate() {
             let (from, vr) = c.from;
-            buffer[k] = match self.sampled.value(&self.components, from, vr) {
+            buffer[k] = match self.sampled.value(&self.components, k, from, vr) {
                 Some(x) => x,
                 None => {
                     let mut x = [0.0];

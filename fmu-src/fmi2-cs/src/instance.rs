@@ -70,6 +70,11 @@ pub struct Instance {
     /// get or set validates its value references with one load each; the
     /// messages still come from the table.
     flags: Vec<u8>,
+    /// The last list of value references [`Instance::get`] found valid for
+    /// type `.0`, and whether it holds an output (`.2`): a master reads the
+    /// same list at every step, and comparing it is cheaper than checking
+    /// it again when it is long.
+    checked_get: (VarType, Vec<u32>, bool),
 }
 
 /// Bits of [`Instance::flags`].
@@ -194,6 +199,7 @@ impl Instance {
             step_state: Vec::new(),
             step_state_current: false,
             flags: info.variables.iter().map(flags_of).collect(),
+            checked_get: (VarType::Real, Vec::new(), false),
         }
     }
 
@@ -296,21 +302,37 @@ impl Instance {
 
     /// Read values of type `t` into `out` (already checked: same length).
     pub fn get(&mut self, t: VarType, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
-        // One flag byte per value reference: known, of type `t`, an output?
-        let want = type_flag(t);
-        let mut wrong = false;
-        let mut outputs = 0;
-        for &vr in vrs {
-            let f = self.flags.get(vr as usize).copied().unwrap_or(0);
-            wrong |= f & want == 0;
-            outputs |= f;
-        }
-        if wrong {
-            for vr in vrs {
-                self.variable_of_type(*vr, t)?;
+        /// Shorter lists are checked as fast as compared.
+        const REMEMBERED: usize = 4;
+        let checked = &self.checked_get;
+        let outputs = if vrs.len() >= REMEMBERED && checked.0 == t && checked.1 == vrs {
+            checked.2
+        } else {
+            // One flag byte per value reference: known, of type `t`, an output?
+            let want = type_flag(t);
+            let mut wrong = false;
+            let mut flags = 0;
+            for &vr in vrs {
+                let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+                wrong |= f & want == 0;
+                flags |= f;
             }
-        }
-        if outputs & flag::OUTPUT != 0 {
+            if wrong {
+                for vr in vrs {
+                    self.variable_of_type(*vr, t)?;
+                }
+            }
+            let outputs = flags & flag::OUTPUT != 0;
+            if vrs.len() >= REMEMBERED {
+                let remembered = &mut self.checked_get;
+                remembered.0 = t;
+                remembered.1.clear();
+                remembered.1.extend_from_slice(vrs);
+                remembered.2 = outputs;
+            }
+            outputs
+        };
+        if outputs {
             self.ensure_outputs()?;
         }
         let data = self.values.as_slice();
