@@ -409,13 +409,21 @@ impl Instance {
     }
 
     /// The model's check of input `vr` = `value`, as an FMI message.
+    #[inline]
     fn check_input(&self, vr: u32, value: f64) -> Result<(), String> {
-        self.model.check_input(vr, value).map_err(|e| {
-            format!(
-                "{} (value reference {vr}) = {value}: {e}",
-                self.info.variables[vr as usize].name
-            )
-        })
+        match self.model.check_input(vr, value) {
+            Ok(()) => Ok(()),
+            Err(e) => Err(self.input_refused(vr, value, e)),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn input_refused(&self, vr: u32, value: f64, why: String) -> String {
+        format!(
+            "{} (value reference {vr}) = {value}: {why}",
+            self.info.variables[vr as usize].name
+        )
     }
 
     /// Every check of [`Instance::set`], value by value, with the message
@@ -619,6 +627,34 @@ impl Instance {
         dv_known: &[f64],
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
+        // the usual case through the flag bytes, else the messages below
+        let has = |vr: u32, bits: u8| {
+            self.flags
+                .get(vr as usize)
+                .is_some_and(|f| f & bits == bits)
+        };
+        let fine = unknowns
+            .iter()
+            .all(|&vr| has(vr, flag::REAL | flag::OUTPUT))
+            && knowns
+                .iter()
+                .zip(dv_known)
+                .all(|(&vr, dv)| has(vr, flag::REAL | flag::INPUT) && dv.is_finite());
+        if !fine {
+            self.check_directional(unknowns, knowns, dv_known)?;
+        }
+        self.ensure_outputs()?;
+        self.directional_checked(unknowns, knowns, dv_known, dv_unknown)
+    }
+
+    /// The checks of [`Instance::directional_derivative`], value by value,
+    /// with the message of the first that fails.
+    fn check_directional(
+        &self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+    ) -> Result<(), String> {
         for vr in unknowns {
             let v = self.variable_of_type(*vr, VarType::Real)?;
             if v.causality != Causality::Output {
@@ -643,8 +679,17 @@ impl Instance {
                 ));
             }
         }
-        self.ensure_outputs()?;
+        Ok(())
+    }
 
+    /// [`Instance::directional_derivative`] once the arguments are checked.
+    fn directional_checked(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
         // Analytic where the model provides every entry (written as it
         // goes: the differences below overwrite every entry otherwise).
         let mut analytic = true;
