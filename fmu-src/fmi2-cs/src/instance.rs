@@ -336,13 +336,14 @@ impl Instance {
             self.ensure_outputs()?;
         }
         let data = self.values.as_slice();
-        let mut finite = true;
+        // x·0 is 0 for a finite x, NaN otherwise; so is the sum
+        let mut zero = 0.0;
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let x = data[vr as usize];
             *o = x;
-            finite &= x.is_finite();
+            zero += x * 0.0;
         }
-        if finite {
+        if zero == 0.0 {
             Ok(())
         } else {
             self.check_finite(vrs, out, "")
@@ -365,6 +366,41 @@ impl Instance {
 
     /// Check, then set, values of type `t`: all or nothing.
     pub fn set(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
+        if let ([vr], [value]) = (vrs, values) {
+            return self.set_one(t, *vr, *value);
+        }
+        self.set_many(t, vrs, values)
+    }
+
+    /// [`Instance::set`] of one value (a master sets an input per
+    /// connection): the same checks and effects, without the loops.
+    fn set_one(&mut self, t: VarType, vr: u32, value: f64) -> Result<(), String> {
+        let in_step_mode = self.state == State::StepComplete;
+        let want = type_flag(t)
+            | if in_step_mode {
+                flag::SETTABLE_IN_STEP
+            } else {
+                flag::SETTABLE_BEFORE_INIT
+            };
+        let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+        if f & want != want || !value.is_finite() {
+            self.check_set(t, &[vr], &[value], in_step_mode)?;
+        } else if f & flag::INPUT != 0 {
+            self.check_input(vr, value)?;
+        }
+        let input = f & flag::INPUT != 0;
+        if !input || self.values.real(vr) != value {
+            self.replay.valid = false;
+        }
+        if !input {
+            self.parameters_version += 1;
+        }
+        self.values.set(vr, value);
+        self.outputs_dirty = true;
+        Ok(())
+    }
+
+    fn set_many(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         let in_step_mode = self.state == State::StepComplete;
         // The usual case in one pass over the flag bytes: known, of type
         // `t`, settable now, finite; the inputs get the model's own check.
@@ -543,13 +579,18 @@ impl Instance {
     // ---- stepping -------------------------------------------------------
 
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<fmi2Status, String> {
-        if !(h.is_finite() && h > 0.0) {
+        // (comparisons with NaN are false: NaN fails both checks)
+        let h_fine = h > 0.0 && h < f64::INFINITY;
+        if !h_fine {
             return Err(format!(
                 "communicationStepSize must be finite and > 0 but was {h}"
             ));
         }
-        let tolerance = TIME_TOLERANCE * self.time.abs().max(1.0);
-        if !t.is_finite() || (t - self.time).abs() > tolerance {
+        // self.time is finite
+        let scale = self.time.abs();
+        let tolerance = TIME_TOLERANCE * if scale > 1.0 { scale } else { 1.0 };
+        let on_time = (t - self.time).abs() <= tolerance;
+        if !on_time {
             return Err(format!(
                 "expected currentCommunicationPoint = {} but was {t} (difference {:e})",
                 self.time,
@@ -583,11 +624,8 @@ impl Instance {
         // is a failed step too: the state is no longer meaningful.
         self.step_state.clear();
         self.model.save_state(&mut self.step_state);
-        if !self
-            .step_state
-            .iter()
-            .fold(true, |ok, x| ok & x.is_finite())
-        {
+        // x·0 is 0 for a finite x, NaN otherwise; so is the sum
+        if self.step_state.iter().fold(0.0, |zero, x| zero + x * 0.0) != 0.0 {
             self.state = State::Error;
             let x = self.step_state.iter().find(|x| !x.is_finite()).copied();
             return Err(format!(
