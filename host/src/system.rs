@@ -410,22 +410,18 @@ impl System {
         let sampled = &mut self.sampled;
         sampled.offsets.clear();
         sampled.changes.clear();
-        let mut result = Ok(());
         for c in &mut self.components {
             let from = row.len();
             sampled.offsets.push(from - start);
             row.resize(from + c.output_vrs.len(), 0.0);
             if let Err(e) = c.instance.get_real(&c.output_vrs, &mut row[from..]) {
-                result = Err(e);
-                break;
+                sampled.changes.clear(); // nothing sampled to reuse
+                return Err(e);
             }
             sampled.changes.push(c.instance.changes());
         }
-        if result.is_err() {
-            sampled.changes.clear();
-        }
         sampled.row.clear();
         sampled.row.extend_from_slice(&row[start..]);
-        result
+        Ok(())
     }
 }

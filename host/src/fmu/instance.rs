@@ -662,7 +662,10 @@ impl Instance {
         let mark = self.begin(F)?;
         // SAFETY: plain values.
         let raw = unsafe { (self.functions.do_step)(self.component, t, h, fmi2False) };
-        let mut result = self.finish(F, mark, raw);
+        if raw == 0 && self.limit.is_none() {
+            return Ok(Status::Ok);
+        }
+        let mut result = self.finish_checked(F, mark, raw);
         if let Err(FmuError::Call {
             status: Status::Discard,
             messages,
