@@ -762,22 +762,43 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
+        // After a step, both replays start from the saved pre-step state;
+        // the state now is put back once, after both: kept since the step
+        // if the model has not left it, else saved here.
+        let replaying = self.replay.valid;
+        let kept = self.step_state_current;
+        if replaying && !kept {
+            let current = &mut self.scratch.model_state;
+            current.clear();
+            self.model.save_state(current);
+        }
         let mut plus = std::mem::take(&mut self.scratch.plus);
         plus.resize(unknowns.len(), 0.0);
         let result = self
             .perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus)
             .and_then(|()| self.perturbed_outputs(knowns, dv_known, -eps, unknowns, dv_unknown));
-        for (d, p) in dv_unknown.iter_mut().zip(&plus) {
+        self.scratch.plus = plus;
+        if replaying {
+            let back = if kept {
+                &self.step_state
+            } else {
+                &self.scratch.model_state
+            };
+            if let Err(e) = self.model.restore_state(back) {
+                self.step_state_current = false;
+                return Err(e);
+            }
+        }
+        result?;
+        for (d, p) in dv_unknown.iter_mut().zip(&self.scratch.plus) {
             *d = (p - *d) / (2.0 * eps);
         }
-        self.scratch.plus = plus;
-        result?;
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }
 
     /// The outputs `unknowns` into `out` with the inputs `knowns` moved by
     /// `eps·dv`: after a step, the step replayed from its saved start on
-    /// the model itself (whose current state is put back after), else the
+    /// the model itself (the caller puts its current state back), else the
     /// outputs at the current state. No allocation: the scratch buffers
     /// are reused.
     fn perturbed_outputs(
@@ -817,14 +838,6 @@ impl Instance {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            // the state to come back to: kept since the step if the model
-            // has not left it, else saved here
-            let current = &mut scratch.model_state;
-            let kept = self.step_state_current;
-            if !kept {
-                current.clear();
-                self.model.save_state(current);
-            }
             let replayed = self
                 .model
                 .restore_state(&self.replay.model_state)
@@ -835,11 +848,6 @@ impl Instance {
             }
             if replayed.is_ok() {
                 self.model.compute_outputs_of(values, unknowns);
-            }
-            let back = if kept { &self.step_state } else { &*current };
-            if let Err(e) = self.model.restore_state(back) {
-                self.step_state_current = false;
-                return Err(e);
             }
             replayed?;
         } else {

@@ -729,13 +729,13 @@ impl Instance {
         values: &[f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2SetRealInputDerivatives";
-        let f = self
-            .functions
-            .set_real_input_derivatives
-            .ok_or(FmuError::NotSupported {
-                function: F,
-                capability: "canInterpolateInputs=\"true\"",
-            })?;
+        let f =
+            self.functions
+                .set_real_input_derivatives
+                .ok_or_else(|| FmuError::NotSupported {
+                    function: F,
+                    capability: "canInterpolateInputs=\"true\"",
+                })?;
         let mark = self.begin(F)?;
         same_length(F, "orders", vrs.len(), orders.len())?;
         same_length(F, "values", vrs.len(), values.len())?;
@@ -760,13 +760,13 @@ impl Instance {
         values: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetRealOutputDerivatives";
-        let f = self
-            .functions
-            .get_real_output_derivatives
-            .ok_or(FmuError::NotSupported {
-                function: F,
-                capability: "maxOutputDerivativeOrder > 0",
-            })?;
+        let f =
+            self.functions
+                .get_real_output_derivatives
+                .ok_or_else(|| FmuError::NotSupported {
+                    function: F,
+                    capability: "maxOutputDerivativeOrder > 0",
+                })?;
         let mark = self.begin(F)?;
         same_length(F, "orders", vrs.len(), orders.len())?;
         same_length(F, "values", vrs.len(), values.len())?;
@@ -792,13 +792,13 @@ impl Instance {
         out: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetDirectionalDerivative";
-        let f = self
-            .functions
-            .get_directional_derivative
-            .ok_or(FmuError::NotSupported {
-                function: F,
-                capability: "providesDirectionalDerivative=\"true\"",
-            })?;
+        let f =
+            self.functions
+                .get_directional_derivative
+                .ok_or_else(|| FmuError::NotSupported {
+                    function: F,
+                    capability: "providesDirectionalDerivative=\"true\"",
+                })?;
         let mark = self.begin(F)?;
         same_length(F, "seed", knowns.len(), seed.len())?;
         same_length(F, "out", unknowns.len(), out.len())?;
@@ -834,7 +834,7 @@ impl Instance {
         f: Option<T>,
         capability: &'static str,
     ) -> Result<T, FmuError> {
-        f.ok_or(FmuError::NotSupported {
+        f.ok_or_else(|| FmuError::NotSupported {
             function,
             capability,
         })
