@@ -190,6 +190,15 @@ impl std::fmt::Debug for Instance {
     }
 }
 
+/// The error of a call the FMU does not declare, made only when needed.
+#[cold]
+fn not_supported(function: &'static str, capability: &'static str) -> FmuError {
+    FmuError::NotSupported {
+        function,
+        capability,
+    }
+}
+
 fn same_length(
     function: &'static str,
     what: &'static str,
@@ -729,13 +738,9 @@ impl Instance {
         values: &[f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2SetRealInputDerivatives";
-        let f =
-            self.functions
-                .set_real_input_derivatives
-                .ok_or_else(|| FmuError::NotSupported {
-                    function: F,
-                    capability: "canInterpolateInputs=\"true\"",
-                })?;
+        let Some(f) = self.functions.set_real_input_derivatives else {
+            return Err(not_supported(F, "canInterpolateInputs=\"true\""));
+        };
         let mark = self.begin(F)?;
         same_length(F, "orders", vrs.len(), orders.len())?;
         same_length(F, "values", vrs.len(), values.len())?;
@@ -760,13 +765,9 @@ impl Instance {
         values: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetRealOutputDerivatives";
-        let f =
-            self.functions
-                .get_real_output_derivatives
-                .ok_or_else(|| FmuError::NotSupported {
-                    function: F,
-                    capability: "maxOutputDerivativeOrder > 0",
-                })?;
+        let Some(f) = self.functions.get_real_output_derivatives else {
+            return Err(not_supported(F, "maxOutputDerivativeOrder > 0"));
+        };
         let mark = self.begin(F)?;
         same_length(F, "orders", vrs.len(), orders.len())?;
         same_length(F, "values", vrs.len(), values.len())?;
@@ -792,13 +793,9 @@ impl Instance {
         out: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetDirectionalDerivative";
-        let f =
-            self.functions
-                .get_directional_derivative
-                .ok_or_else(|| FmuError::NotSupported {
-                    function: F,
-                    capability: "providesDirectionalDerivative=\"true\"",
-                })?;
+        let Some(f) = self.functions.get_directional_derivative else {
+            return Err(not_supported(F, "providesDirectionalDerivative=\"true\""));
+        };
         let mark = self.begin(F)?;
         same_length(F, "seed", knowns.len(), seed.len())?;
         same_length(F, "out", unknowns.len(), out.len())?;
@@ -834,10 +831,10 @@ impl Instance {
         f: Option<T>,
         capability: &'static str,
     ) -> Result<T, FmuError> {
-        f.ok_or_else(|| FmuError::NotSupported {
-            function,
-            capability,
-        })
+        match f {
+            Some(f) => Ok(f),
+            None => Err(not_supported(function, capability)),
+        }
     }
 
     /// `fmi2GetFMUstate` into a new state.
