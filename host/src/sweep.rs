@@ -194,9 +194,16 @@ pub fn run_point(
         Ok(run) => {
             let n = run.rows.len().max(1) as f64;
             outcome.last = run.rows.last().cloned().unwrap_or_default();
-            outcome.rms = (0..run.columns.len())
-                .map(|k| (run.rows.iter().map(|r| r[k] * r[k]).sum::<f64>() / n).sqrt())
-                .collect();
+            // one pass over the rows (each column summed in row order, as
+            // column by column would): the rows are read once, not once
+            // per column, which on two cores made the sweep wait on memory
+            let mut squares = vec![0.0; run.columns.len()];
+            for row in &run.rows {
+                for (sum, y) in squares.iter_mut().zip(row) {
+                    *sum += y * y;
+                }
+            }
+            outcome.rms = squares.iter().map(|s| (s / n).sqrt()).collect();
             outcome.points = run.rows.len();
             outcome.columns = run.columns;
             outcome.error = run.error;

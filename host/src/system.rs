@@ -63,6 +63,50 @@ pub struct Connection {
 pub struct System {
     pub components: Vec<Component>,
     pub connections: Vec<Connection>,
+    /// The last row [`System::sample`] read, for [`System::propagate`].
+    sampled: Sampled,
+}
+
+/// The outputs [`System::sample`] read last: the row, where each
+/// component's outputs start in it, and each component's
+/// [`Instance::changes`] then (`u64::MAX`: nothing read).
+#[derive(Default)]
+struct Sampled {
+    row: Vec<f64>,
+    offsets: Vec<usize>,
+    changes: Vec<u64>,
+    /// Per connection, where its output was in the component's outputs
+    /// last time (checked before use).
+    positions: Vec<usize>,
+}
+
+impl Sampled {
+    /// Output `vr` of component `c` as sampled, if `c` has seen no call
+    /// since that could have changed it; `k` is the connection it is for.
+    fn value(
+        &mut self,
+        components: &[Component],
+        k: usize,
+        c: usize,
+        vr: ValueReference,
+    ) -> Option<f64> {
+        let component = components.get(c)?;
+        if self.changes.get(c) != Some(&component.instance.changes()) {
+            return None;
+        }
+        if self.positions.len() <= k {
+            self.positions.resize(k + 1, 0);
+        }
+        let known = self.positions[k];
+        let i = if component.output_vrs.get(known) == Some(&vr) {
+            known
+        } else {
+            let i = component.output_vrs.iter().position(|v| *v == vr)?;
+            self.positions[k] = i;
+            i
+        };
+        self.row.get(self.offsets.get(c)? + i).copied()
+    }
 }
 
 fn split_port(port: &str) -> Result<(&str, &str), SystemError> {
@@ -151,6 +195,7 @@ impl System {
         let mut system = System {
             components: list,
             connections: Vec::new(),
+            sampled: Sampled::default(),
         };
         for (from, to) in connections {
             let (fi, fv) = find(&system.components, from)?;
@@ -270,14 +315,21 @@ impl System {
         }
     }
 
-    /// Copy every connected output to its input.
+    /// Copy every connected output to its input. An output read by the
+    /// last [`System::sample`], of a component that has seen no call since
+    /// that could have changed it, is taken from that row instead of being
+    /// asked for again.
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
         for (k, c) in self.connections.iter().enumerate() {
-            let mut x = [0.0];
-            self.components[c.from.0]
-                .instance
-                .get_real(&[c.from.1], &mut x)?;
-            buffer[k] = x[0];
+            let (from, vr) = c.from;
+            buffer[k] = match self.sampled.value(&self.components, k, from, vr) {
+                Some(x) => x,
+                None => {
+                    let mut x = [0.0];
+                    self.components[from].instance.get_real(&[vr], &mut x)?;
+                    x[0]
+                }
+            };
         }
         for (k, c) in self.connections.iter().enumerate() {
             self.components[c.to.0]
@@ -354,11 +406,22 @@ impl System {
     /// Append every recorded output to `row`: one `fmi2GetReal` per
     /// component.
     pub fn sample(&mut self, row: &mut Vec<f64>) -> Result<(), FmuError> {
+        let start = row.len();
+        let sampled = &mut self.sampled;
+        sampled.offsets.clear();
+        sampled.changes.clear();
         for c in &mut self.components {
             let from = row.len();
+            sampled.offsets.push(from - start);
             row.resize(from + c.output_vrs.len(), 0.0);
-            c.instance.get_real(&c.output_vrs, &mut row[from..])?;
+            if let Err(e) = c.instance.get_real(&c.output_vrs, &mut row[from..]) {
+                sampled.changes.clear(); // nothing sampled to reuse
+                return Err(e);
+            }
+            sampled.changes.push(c.instance.changes());
         }
+        sampled.row.clear();
+        sampled.row.extend_from_slice(&row[start..]);
         Ok(())
     }
 }

@@ -10,12 +10,11 @@ use crate::model::ModelFactory;
 use crate::serialize::Snapshot;
 use crate::state_machine::{allowed_mask, is_allowed, State};
 use crate::variables::VarType;
-use std::cell::Cell;
 use std::collections::BTreeSet;
 use std::ffi::CStr;
 use std::os::raw::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// Addresses of the instances this library created and has not freed.
@@ -28,41 +27,39 @@ fn live() -> std::sync::MutexGuard<'static, BTreeSet<usize>> {
     LIVE.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// How many instances have been freed so far: bumped by every
-/// `fmi2FreeInstance` after the address left [`LIVE`].
-static FREED: AtomicU64 = AtomicU64::new(0);
-
 /// Slots of [`RECENTLY_LIVE`].
 const RECENT: usize = 8;
 
-thread_local! {
-    /// Addresses this thread found in [`LIVE`] recently, each with the
-    /// value of [`FREED`] at that time: still live as long as nothing has
-    /// been freed since. Spares the lock of [`LIVE`] on every call of a
-    /// co-simulation's step loop, which calls the same few instances.
-    static RECENTLY_LIVE: Cell<[(usize, u64); RECENT]> =
-        const { Cell::new([(0, u64::MAX); RECENT]) };
-}
+/// Addresses found in [`LIVE`] recently (0: empty), so that the step loop
+/// of a co-simulation, which calls the same few instances over and over,
+/// checks its pointer with a few loads instead of the lock. Written only
+/// with [`LIVE`] locked; an address leaves it, with the lock held, before
+/// its instance is freed.
+static RECENTLY_LIVE: [AtomicUsize; RECENT] = [const { AtomicUsize::new(0) }; RECENT];
+/// The slot of [`RECENTLY_LIVE`] the next address found goes to.
+static NEXT_SLOT: AtomicUsize = AtomicUsize::new(0);
 
 /// Whether `c` is an instance of this library that has not been freed:
-/// from the thread's recent answers while no instance was freed since,
-/// else from [`LIVE`]. (Freeing an instance while another thread is inside
-/// a call on it is a caller's error the lock never prevented either.)
+/// from [`RECENTLY_LIVE`], else from [`LIVE`]. (Freeing an instance while
+/// another thread is inside a call on it is a caller's error the lock never
+/// prevented either.)
+#[inline]
 fn is_live(c: usize) -> bool {
-    let freed = FREED.load(Ordering::Acquire);
-    let recent = RECENTLY_LIVE.with(Cell::get);
-    if recent.contains(&(c, freed)) {
-        return true;
+    (c != 0 && RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c)) || is_live_locked(c)
+}
+
+/// [`is_live`] from [`LIVE`], noting a live `c` in [`RECENTLY_LIVE`].
+#[cold]
+#[inline(never)]
+fn is_live_locked(c: usize) -> bool {
+    let live = live();
+    let found = live.contains(&c);
+    if found {
+        let slot = NEXT_SLOT.fetch_add(1, Ordering::Relaxed) % RECENT;
+        RECENTLY_LIVE[slot].store(c, Ordering::Release);
     }
-    let live = live().contains(&c);
-    if live {
-        let mut updated = recent;
-        // oldest out: shift and put the newest first
-        updated.copy_within(0..RECENT - 1, 1);
-        updated[0] = (c, freed);
-        RECENTLY_LIVE.with(|r| r.set(updated));
-    }
-    live
+    drop(live);
+    found
 }
 
 fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
@@ -147,20 +144,13 @@ pub unsafe fn call_allowed(
 /// # Safety
 /// When non-null, `ptr` must point to `n` readable elements (the FMI
 /// contract); we check null, alignment and a plausible length.
+#[inline(always)]
 pub unsafe fn in_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a [T], String> {
     if n == 0 {
         return Ok(&[]);
     }
-    if ptr.is_null() {
-        return Err(format!("argument {what} is NULL but its length is {n}"));
-    }
-    if n > MAX_ARRAY_LENGTH {
-        return Err(format!(
-            "length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"
-        ));
-    }
-    if !ptr.is_aligned() {
-        return Err(format!("argument {what} = {ptr:p} is not aligned"));
+    if ptr.is_null() || n > MAX_ARRAY_LENGTH || !ptr.is_aligned() {
+        return Err(slice_error(ptr as usize, ptr.is_null(), n, what));
     }
     // SAFETY: non-null, aligned, length bounded; validity is the caller's contract.
     Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
@@ -170,23 +160,30 @@ pub unsafe fn in_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a
 ///
 /// # Safety
 /// As [`in_slice`], for `n` writable elements.
+#[inline(always)]
 pub unsafe fn out_slice<'a, T>(ptr: *mut T, n: usize, what: &str) -> Result<&'a mut [T], String> {
     if n == 0 {
         return Ok(&mut []);
     }
-    if ptr.is_null() {
-        return Err(format!("argument {what} is NULL but its length is {n}"));
-    }
-    if n > MAX_ARRAY_LENGTH {
-        return Err(format!(
-            "length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts"
-        ));
-    }
-    if !ptr.is_aligned() {
-        return Err(format!("argument {what} = {ptr:p} is not aligned"));
+    if ptr.is_null() || n > MAX_ARRAY_LENGTH || !ptr.is_aligned() {
+        return Err(slice_error(ptr as usize, ptr.is_null(), n, what));
     }
     // SAFETY: as above.
     Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
+}
+
+/// Why [`in_slice`] or [`out_slice`] refused an array (null, too long, or
+/// misaligned, checked in that order).
+#[cold]
+#[inline(never)]
+fn slice_error(address: usize, null: bool, n: usize, what: &str) -> String {
+    if null {
+        format!("argument {what} is NULL but its length is {n}")
+    } else if n > MAX_ARRAY_LENGTH {
+        format!("length of {what} is {n}, more than the {MAX_ARRAY_LENGTH} this FMU accepts")
+    } else {
+        format!("argument {what} = {address:#x} is not aligned")
+    }
 }
 
 /// # Safety
@@ -288,9 +285,18 @@ pub unsafe fn free_instance(c: fmi2Component) {
         if c.is_null() {
             return;
         }
-        let removed = live().remove(&(c as usize));
+        let removed = {
+            let mut live = live();
+            let removed = live.remove(&(c as usize));
+            for slot in &RECENTLY_LIVE {
+                // only with the lock held, as every store into the slots
+                if slot.load(Ordering::Acquire) == c as usize {
+                    slot.store(0, Ordering::Release);
+                }
+            }
+            removed
+        };
         if removed {
-            FREED.fetch_add(1, Ordering::AcqRel);
             // SAFETY: was live, so it came from Box::into_raw and is freed once.
             let instance = unsafe { Box::from_raw(c as *mut Instance) };
             if !is_allowed("fmi2FreeInstance", instance.state) && instance.state != State::Fatal {

@@ -31,6 +31,9 @@ pub struct Instance {
     values: Values,
     /// `du/dt` per value reference (non-zero for inputs only).
     slopes: Vec<f64>,
+    /// Whether a slope may be non-zero (false: every input is held over the
+    /// next step, and the step need not look at the slopes).
+    sloped: bool,
     /// Value references of the inputs, the values a step changes (by
     /// their slopes).
     inputs: Vec<u32>,
@@ -53,8 +56,64 @@ pub struct Instance {
     /// box is the handle given out, and must not move with the list.)
     #[allow(clippy::vec_box)]
     saved_states: Vec<Box<Snapshot>>,
-    /// Reused buffer for the model state checked after each step.
+    /// The model state saved after the last step (checked for finiteness
+    /// there); while [`Instance::step_state_current`] it is also the state
+    /// the next step starts from, which that step keeps for its replay
+    /// without asking the model again.
     step_state: Vec<f64>,
+    /// Whether the model state is still the one in `step_state`: cleared by
+    /// everything that gives the model another state (initialization, a
+    /// reset, a restored FMU state).
+    step_state_current: bool,
+    /// Per value reference, what the hot paths check ([`flag`]): the type,
+    /// the causality, when it may be set. One byte per variable, so that a
+    /// get or set validates its value references with one load each; the
+    /// messages still come from the table.
+    flags: Vec<u8>,
+    /// The last list of value references [`Instance::get`] found valid for
+    /// type `.0`, and whether it holds an output (`.2`): a master reads the
+    /// same list at every step, and comparing it is cheaper than checking
+    /// it again when it is long.
+    checked_get: (VarType, Vec<u32>, bool),
+}
+
+/// Bits of [`Instance::flags`].
+mod flag {
+    pub const REAL: u8 = 1 << 0;
+    pub const INTEGER: u8 = 1 << 1;
+    pub const BOOLEAN: u8 = 1 << 2;
+    pub const OUTPUT: u8 = 1 << 3;
+    pub const INPUT: u8 = 1 << 4;
+    /// May be set before and in initialization mode.
+    pub const SETTABLE_BEFORE_INIT: u8 = 1 << 5;
+    /// May be set in step mode.
+    pub const SETTABLE_IN_STEP: u8 = 1 << 6;
+}
+
+/// The type bit of `t` in [`Instance::flags`].
+fn type_flag(t: VarType) -> u8 {
+    match t {
+        VarType::Real => flag::REAL,
+        VarType::Integer => flag::INTEGER,
+        VarType::Boolean => flag::BOOLEAN,
+    }
+}
+
+fn flags_of(v: &Variable) -> u8 {
+    let mut f = type_flag(v.var_type);
+    if v.causality == Causality::Output {
+        f |= flag::OUTPUT;
+    }
+    if v.causality == Causality::Input {
+        f |= flag::INPUT;
+    }
+    if v.settable_before_init() {
+        f |= flag::SETTABLE_BEFORE_INIT;
+    }
+    if v.settable_in_step_mode() {
+        f |= flag::SETTABLE_IN_STEP;
+    }
+    f
 }
 
 /// Buffers of [`Instance::directional_derivative`], kept between calls.
@@ -72,9 +131,13 @@ struct Replay {
     model_state: Vec<f64>,
     /// Value and slope of each of [`Instance::inputs`] before the step
     /// (nothing else changes in a step: a parameter set since invalidates
-    /// the replay).
+    /// the replay), unless `held`.
     inputs: Vec<f64>,
     slopes: Vec<f64>,
+    /// Every input was held over the step (no slope): the inputs before it
+    /// are the inputs now (setting another value invalidates the replay),
+    /// and `inputs`, `slopes` were not written.
+    held: bool,
     h: f64,
 }
 
@@ -109,6 +172,7 @@ impl Instance {
             model,
             values,
             slopes: vec![0.0; n],
+            sloped: false,
             outputs_dirty: true,
             initialized: false,
             time: 0.0,
@@ -119,6 +183,7 @@ impl Instance {
                 model_state: Vec::new(),
                 inputs: vec![0.0; inputs.len()],
                 slopes: vec![0.0; inputs.len()],
+                held: false,
                 h: 0.0,
             },
             inputs,
@@ -132,6 +197,9 @@ impl Instance {
             },
             saved_states: Vec::new(),
             step_state: Vec::new(),
+            step_state_current: false,
+            flags: info.variables.iter().map(flags_of).collect(),
+            checked_get: (VarType::Real, Vec::new(), false),
         }
     }
 
@@ -185,6 +253,7 @@ impl Instance {
     }
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), String> {
+        self.step_state_current = false;
         self.model.initialize(&self.values)?;
         self.model.compute_outputs(&mut self.values);
         self.outputs_dirty = false;
@@ -200,9 +269,11 @@ impl Instance {
     }
 
     pub fn reset(&mut self) -> Result<(), String> {
+        self.step_state_current = false;
         self.values = Values::from_start(self.info.variables);
         self.parameters_version += 1;
         self.slopes.iter_mut().for_each(|s| *s = 0.0);
+        self.sloped = false;
         self.outputs_dirty = true;
         self.initialized = false;
         self.replay.valid = false;
@@ -218,6 +289,7 @@ impl Instance {
     fn ensure_outputs(&mut self) -> Result<(), String> {
         if self.outputs_dirty {
             if !self.initialized {
+                self.step_state_current = false;
                 self.model.initialize(&self.values)?;
             }
             self.model.compute_outputs(&mut self.values);
@@ -230,19 +302,52 @@ impl Instance {
 
     /// Read values of type `t` into `out` (already checked: same length).
     pub fn get(&mut self, t: VarType, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
-        for vr in vrs {
-            self.variable_of_type(*vr, t)?;
-        }
-        let wants_outputs = vrs
-            .iter()
-            .any(|vr| self.info.variables[*vr as usize].causality == Causality::Output);
-        if wants_outputs {
+        /// Shorter lists are checked as fast as compared.
+        const REMEMBERED: usize = 4;
+        let checked = &self.checked_get;
+        let outputs = if vrs.len() >= REMEMBERED && checked.0 == t && checked.1 == vrs {
+            checked.2
+        } else {
+            // One flag byte per value reference: known, of type `t`, an output?
+            let want = type_flag(t);
+            let mut wrong = false;
+            let mut flags = 0;
+            for &vr in vrs {
+                let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+                wrong |= f & want == 0;
+                flags |= f;
+            }
+            if wrong {
+                for vr in vrs {
+                    self.variable_of_type(*vr, t)?;
+                }
+            }
+            let outputs = flags & flag::OUTPUT != 0;
+            if vrs.len() >= REMEMBERED {
+                let remembered = &mut self.checked_get;
+                remembered.0 = t;
+                remembered.1.clear();
+                remembered.1.extend_from_slice(vrs);
+                remembered.2 = outputs;
+            }
+            outputs
+        };
+        if outputs {
             self.ensure_outputs()?;
         }
-        for (o, vr) in out.iter_mut().zip(vrs) {
-            *o = self.values.real(*vr);
+        let data = self.values.as_slice();
+        // x·0 is 0 for a finite x, NaN otherwise; so is the sum
+        let mut zero = 0.0;
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            let x = data[vr as usize];
+            *o = x;
+            zero += x * 0.0;
         }
-        self.check_finite(vrs, out, "")
+        if zero == 0.0 {
+            Ok(())
+        } else {
+            self.check_finite(vrs, out, "")
+        }
     }
 
     /// Values handed to the importer with `fmi2OK` are never NaN or
@@ -261,7 +366,111 @@ impl Instance {
 
     /// Check, then set, values of type `t`: all or nothing.
     pub fn set(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
+        if let ([vr], [value]) = (vrs, values) {
+            return self.set_one(t, *vr, *value);
+        }
+        self.set_many(t, vrs, values)
+    }
+
+    /// [`Instance::set`] of one value (a master sets an input per
+    /// connection): the same checks and effects, without the loops.
+    fn set_one(&mut self, t: VarType, vr: u32, value: f64) -> Result<(), String> {
         let in_step_mode = self.state == State::StepComplete;
+        let want = type_flag(t)
+            | if in_step_mode {
+                flag::SETTABLE_IN_STEP
+            } else {
+                flag::SETTABLE_BEFORE_INIT
+            };
+        let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+        if f & want != want || !value.is_finite() {
+            self.check_set(t, &[vr], &[value], in_step_mode)?;
+        } else if f & flag::INPUT != 0 {
+            self.check_input(vr, value)?;
+        }
+        let input = f & flag::INPUT != 0;
+        if !input || self.values.real(vr) != value {
+            self.replay.valid = false;
+        }
+        if !input {
+            self.parameters_version += 1;
+        }
+        self.values.set(vr, value);
+        self.outputs_dirty = true;
+        Ok(())
+    }
+
+    fn set_many(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
+        let in_step_mode = self.state == State::StepComplete;
+        // The usual case in one pass over the flag bytes: known, of type
+        // `t`, settable now, finite; the inputs get the model's own check.
+        let want = type_flag(t)
+            | if in_step_mode {
+                flag::SETTABLE_IN_STEP
+            } else {
+                flag::SETTABLE_BEFORE_INIT
+            };
+        let mut fine = true;
+        let mut inputs = 0;
+        for (&vr, value) in vrs.iter().zip(values) {
+            let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+            fine &= f & want == want && value.is_finite();
+            inputs |= f;
+        }
+        if !fine {
+            self.check_set(t, vrs, values, in_step_mode)?;
+        } else if inputs & flag::INPUT != 0 {
+            for (&vr, &value) in vrs.iter().zip(values) {
+                if self.flags[vr as usize] & flag::INPUT != 0 {
+                    self.check_input(vr, value)?;
+                }
+            }
+        }
+        let mut invalidates = false;
+        for (&vr, &value) in vrs.iter().zip(values) {
+            let input = self.flags[vr as usize] & flag::INPUT != 0;
+            invalidates |= !input || self.values.real(vr) != value;
+            if !input {
+                self.parameters_version += 1;
+            }
+            self.values.set(vr, value);
+        }
+        if invalidates {
+            self.replay.valid = false;
+        }
+        if !vrs.is_empty() {
+            self.outputs_dirty = true;
+        }
+        Ok(())
+    }
+
+    /// The model's check of input `vr` = `value`, as an FMI message.
+    #[inline]
+    fn check_input(&self, vr: u32, value: f64) -> Result<(), String> {
+        match self.model.check_input(vr, value) {
+            Ok(()) => Ok(()),
+            Err(e) => Err(self.input_refused(vr, value, e)),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn input_refused(&self, vr: u32, value: f64, why: String) -> String {
+        format!(
+            "{} (value reference {vr}) = {value}: {why}",
+            self.info.variables[vr as usize].name
+        )
+    }
+
+    /// Every check of [`Instance::set`], value by value, with the message
+    /// of the first that fails.
+    fn check_set(
+        &self,
+        t: VarType,
+        vrs: &[u32],
+        values: &[f64],
+        in_step_mode: bool,
+    ) -> Result<(), String> {
         for (vr, value) in vrs.iter().zip(values) {
             let v = self.variable_of_type(*vr, t)?;
             let allowed = if in_step_mode {
@@ -290,23 +499,8 @@ impl Instance {
                 ));
             }
             if v.causality == Causality::Input {
-                self.model
-                    .check_input(*vr, *value)
-                    .map_err(|e| format!("{} (value reference {vr}) = {value}: {e}", v.name))?;
+                self.check_input(*vr, *value)?;
             }
-        }
-        for (vr, value) in vrs.iter().zip(values) {
-            let input = self.info.variables[*vr as usize].causality == Causality::Input;
-            if self.values.real(*vr) != *value || !input {
-                self.replay.valid = false;
-            }
-            if !input {
-                self.parameters_version += 1;
-            }
-            self.values.set(*vr, *value);
-        }
-        if !vrs.is_empty() {
-            self.outputs_dirty = true;
         }
         Ok(())
     }
@@ -337,6 +531,7 @@ impl Instance {
         }
         for (vr, slope) in vrs.iter().zip(slopes) {
             self.slopes[*vr as usize] = *slope;
+            self.sloped |= *slope != 0.0;
         }
         if !vrs.is_empty() {
             self.replay.valid = false;
@@ -384,28 +579,43 @@ impl Instance {
     // ---- stepping -------------------------------------------------------
 
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<fmi2Status, String> {
-        if !(h.is_finite() && h > 0.0) {
+        // (comparisons with NaN are false: NaN fails both checks)
+        let h_fine = h > 0.0 && h < f64::INFINITY;
+        if !h_fine {
             return Err(format!(
                 "communicationStepSize must be finite and > 0 but was {h}"
             ));
         }
-        let tolerance = TIME_TOLERANCE * self.time.abs().max(1.0);
-        if !t.is_finite() || (t - self.time).abs() > tolerance {
+        // self.time is finite
+        let scale = self.time.abs();
+        let tolerance = TIME_TOLERANCE * if scale > 1.0 { scale } else { 1.0 };
+        let on_time = (t - self.time).abs() <= tolerance;
+        if !on_time {
             return Err(format!(
                 "expected currentCommunicationPoint = {} but was {t} (difference {:e})",
                 self.time,
                 t - self.time
             ));
         }
-        if self.model.needs_step_replay() {
-            self.replay.model_state.clear();
-            self.model.save_state(&mut self.replay.model_state);
-            for (k, &vr) in self.inputs.iter().enumerate() {
-                self.replay.inputs[k] = self.values.real(vr);
-                self.replay.slopes[k] = self.slopes[vr as usize];
+        let replay = self.model.needs_step_replay();
+        if replay {
+            if self.step_state_current {
+                // the state after the last step is the state now
+                std::mem::swap(&mut self.replay.model_state, &mut self.step_state);
+            } else {
+                self.replay.model_state.clear();
+                self.model.save_state(&mut self.replay.model_state);
+            }
+            self.replay.held = !self.sloped;
+            if self.sloped {
+                for (k, &vr) in self.inputs.iter().enumerate() {
+                    self.replay.inputs[k] = self.values.real(vr);
+                    self.replay.slopes[k] = self.slopes[vr as usize];
+                }
             }
             self.replay.h = h;
         }
+        self.step_state_current = false;
         if let Err(e) = self.model.do_step(&self.values, &self.slopes, h) {
             self.state = State::Error;
             return Err(format!("step from t = {t} over h = {h} failed: {e}"));
@@ -414,16 +624,23 @@ impl Instance {
         // is a failed step too: the state is no longer meaningful.
         self.step_state.clear();
         self.model.save_state(&mut self.step_state);
-        if let Some(x) = self.step_state.iter().find(|x| !x.is_finite()) {
+        // x·0 is 0 for a finite x, NaN otherwise; so is the sum
+        if self.step_state.iter().fold(0.0, |zero, x| zero + x * 0.0) != 0.0 {
             self.state = State::Error;
+            let x = self.step_state.iter().find(|x| !x.is_finite()).copied();
             return Err(format!(
-                "step from t = {t} over h = {h} failed: the model state became {x}: the parameters or inputs are out of the model's range"
+                "step from t = {t} over h = {h} failed: the model state became {}: the parameters or inputs are out of the model's range",
+                x.unwrap_or(f64::NAN)
             ));
         }
+        self.step_state_current = true;
         // Inputs as the FMU saw them at the end of the step (u + du·h); the
         // slopes apply to one step only.
-        advance_inputs(&self.inputs, &mut self.values, &mut self.slopes, h);
-        self.replay.valid = self.model.needs_step_replay();
+        if self.sloped {
+            advance_inputs(&self.inputs, &mut self.values, &mut self.slopes, h);
+            self.sloped = false;
+        }
+        self.replay.valid = replay;
         self.time = t + h;
         self.outputs_dirty = true;
         Ok(fmi2Status::fmi2OK)
@@ -447,6 +664,34 @@ impl Instance {
         knowns: &[u32],
         dv_known: &[f64],
         dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        // the usual case through the flag bytes, else the messages below
+        let has = |vr: u32, bits: u8| {
+            self.flags
+                .get(vr as usize)
+                .is_some_and(|f| f & bits == bits)
+        };
+        let fine = unknowns
+            .iter()
+            .all(|&vr| has(vr, flag::REAL | flag::OUTPUT))
+            && knowns
+                .iter()
+                .zip(dv_known)
+                .all(|(&vr, dv)| has(vr, flag::REAL | flag::INPUT) && dv.is_finite());
+        if !fine {
+            self.check_directional(unknowns, knowns, dv_known)?;
+        }
+        self.ensure_outputs()?;
+        self.directional_checked(unknowns, knowns, dv_known, dv_unknown)
+    }
+
+    /// The checks of [`Instance::directional_derivative`], value by value,
+    /// with the message of the first that fails.
+    fn check_directional(
+        &self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
     ) -> Result<(), String> {
         for vr in unknowns {
             let v = self.variable_of_type(*vr, VarType::Real)?;
@@ -472,21 +717,34 @@ impl Instance {
                 ));
             }
         }
-        self.ensure_outputs()?;
+        Ok(())
+    }
 
-        // Analytic where the model provides every entry.
-        let analytic: Option<Vec<f64>> = unknowns
-            .iter()
-            .map(|u| {
-                knowns.iter().zip(dv_known).try_fold(0.0, |acc, (k, dv)| {
-                    self.model
-                        .partial_derivative(&self.values, *u, *k)
-                        .map(|d| acc + d * dv)
-                })
-            })
-            .collect();
-        if let Some(j) = analytic {
-            dv_unknown.copy_from_slice(&j);
+    /// [`Instance::directional_derivative`] once the arguments are checked.
+    fn directional_checked(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        // Analytic where the model provides every entry (written as it
+        // goes: the differences below overwrite every entry otherwise).
+        let mut analytic = true;
+        'rows: for (out, u) in dv_unknown.iter_mut().zip(unknowns) {
+            let mut acc = 0.0;
+            for (k, dv) in knowns.iter().zip(dv_known) {
+                match self.model.partial_derivative(&self.values, *u, *k) {
+                    Some(d) => acc += d * dv,
+                    None => {
+                        analytic = false;
+                        break 'rows;
+                    }
+                }
+            }
+            *out = acc;
+        }
+        if analytic {
             return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
         }
 
@@ -504,22 +762,43 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
+        // After a step, both replays start from the saved pre-step state;
+        // the state now is put back once, after both: kept since the step
+        // if the model has not left it, else saved here.
+        let replaying = self.replay.valid;
+        let kept = self.step_state_current;
+        if replaying && !kept {
+            let current = &mut self.scratch.model_state;
+            current.clear();
+            self.model.save_state(current);
+        }
         let mut plus = std::mem::take(&mut self.scratch.plus);
         plus.resize(unknowns.len(), 0.0);
         let result = self
             .perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus)
             .and_then(|()| self.perturbed_outputs(knowns, dv_known, -eps, unknowns, dv_unknown));
-        for (d, p) in dv_unknown.iter_mut().zip(&plus) {
+        self.scratch.plus = plus;
+        if replaying {
+            let back = if kept {
+                &self.step_state
+            } else {
+                &self.scratch.model_state
+            };
+            if let Err(e) = self.model.restore_state(back) {
+                self.step_state_current = false;
+                return Err(e);
+            }
+        }
+        result?;
+        for (d, p) in dv_unknown.iter_mut().zip(&self.scratch.plus) {
             *d = (p - *d) / (2.0 * eps);
         }
-        self.scratch.plus = plus;
-        result?;
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }
 
     /// The outputs `unknowns` into `out` with the inputs `knowns` moved by
     /// `eps·dv`: after a step, the step replayed from its saved start on
-    /// the model itself (whose current state is put back after), else the
+    /// the model itself (the caller puts its current state back), else the
     /// outputs at the current state. No allocation: the scratch buffers
     /// are reused.
     fn perturbed_outputs(
@@ -543,34 +822,39 @@ impl Instance {
             scratch.parameters_version = self.parameters_version;
         }
         if self.replay.valid {
-            // every slope is zero but those of the inputs, set here
+            // Every slope is zero between calls; those of the inputs are set
+            // here when the step had any (and zero again when done). Held
+            // inputs: the values now (set above) are the values before the
+            // step.
             let slopes = &mut scratch.slopes;
             slopes.resize(self.slopes.len(), 0.0);
-            for (k, &vr) in self.inputs.iter().enumerate() {
-                values.set(vr, self.replay.inputs[k]);
-                slopes[vr as usize] = self.replay.slopes[k];
+            let held = self.replay.held;
+            if !held {
+                for (k, &vr) in self.inputs.iter().enumerate() {
+                    values.set(vr, self.replay.inputs[k]);
+                    slopes[vr as usize] = self.replay.slopes[k];
+                }
             }
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            let current = &mut scratch.model_state;
-            current.clear();
-            self.model.save_state(current);
             let replayed = self
                 .model
                 .restore_state(&self.replay.model_state)
                 .and_then(|()| self.model.do_step(values, slopes, self.replay.h));
-            if replayed.is_ok() {
+            if !held {
+                // the inputs at the end of the step; every slope zero again
                 advance_inputs(&self.inputs, values, slopes, self.replay.h);
-                self.model.compute_outputs(values);
             }
-            self.model.restore_state(current)?;
+            if replayed.is_ok() {
+                self.model.compute_outputs_of(values, unknowns);
+            }
             replayed?;
         } else {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            self.model.compute_outputs(values);
+            self.model.compute_outputs_of(values, unknowns);
         }
         for (o, u) in out.iter_mut().zip(unknowns) {
             *o = values.real(*u);
@@ -631,6 +915,7 @@ impl Instance {
     }
 
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
+        self.step_state_current = false;
         if snap.guid != self.info.guid || snap.values.len() != self.values.len() {
             return Err(format!(
                 "the FMU state belongs to GUID {}, not this FMU ({})",
@@ -680,6 +965,11 @@ impl Instance {
             }
             self.slopes.copy_from_slice(&snap.slopes);
         }
+        // only inputs have slopes
+        self.sloped = self
+            .inputs
+            .iter()
+            .any(|&vr| self.slopes[vr as usize] != 0.0);
         self.initialized = snap.initialized;
         self.time = snap.time;
         self.state = snap.state;

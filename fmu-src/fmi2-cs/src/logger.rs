@@ -117,6 +117,7 @@ impl Logger {
         self.log(fmi2Status::fmi2Warning, CATEGORY_WARNING, message);
     }
 
+    #[inline]
     pub fn call(&mut self, message: impl FnOnce() -> String) {
         if self.enabled[CATEGORY_CALLS] {
             let m = message();

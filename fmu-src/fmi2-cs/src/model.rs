@@ -29,6 +29,14 @@ pub trait Model: Send {
     /// Write every output into `values` from the state and the current inputs.
     fn compute_outputs(&self, values: &mut Values);
 
+    /// Write at least the outputs `outputs` (value references of outputs)
+    /// into `values`, for directional derivatives, which need only these;
+    /// the others may be left as they are. By default every output.
+    fn compute_outputs_of(&self, values: &mut Values, outputs: &[u32]) {
+        let _ = outputs;
+        self.compute_outputs(values);
+    }
+
     /// Advance the state over `h` seconds. `slopes[vr]` is `du/dt` of input
     /// `vr` (zero when not set).
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String>;

@@ -227,6 +227,28 @@ pub struct LuGre {
     z: f64,
     /// Largest relative slope of the scale tables (1/m), 0 without table.
     table_rate: f64,
+    /// The Stribeck level of the last step's inputs, which the outputs
+    /// after the step ask for again (not state: a function of the
+    /// parameters and its key).
+    level: Level,
+}
+
+/// `g_unit(w, dir, x)` for one (w, dir < 0, x); `w` NaN: empty.
+#[derive(Clone, Copy, Debug)]
+struct Level {
+    w: f64,
+    negative: bool,
+    x: f64,
+    g: f64,
+}
+
+impl Level {
+    const EMPTY: Level = Level {
+        w: f64::NAN,
+        negative: false,
+        x: f64::NAN,
+        g: f64::NAN,
+    };
 }
 
 impl LuGre {
@@ -252,6 +274,7 @@ impl LuGre {
             p,
             z: 0.0,
             table_rate,
+            level: Level::EMPTY,
         })
     }
 
@@ -307,6 +330,15 @@ impl LuGre {
     /// Stribeck level per unit normal force for speed `w = |v|`, direction
     /// `dir` and position `x`: `Fc' + (Fs' − Fc')·exp(−(w/vs)^δ)`.
     fn g_unit(&self, w: f64, dir: f64, x: f64) -> f64 {
+        let l = &self.level;
+        if w == l.w && (dir < 0.0) == l.negative && (x == l.x || !self.p.position_dependent) {
+            return l.g;
+        }
+        self.g_unit_computed(w, dir, x)
+    }
+
+    /// [`LuGre::g_unit`] without [`LuGre::level`].
+    fn g_unit_computed(&self, w: f64, dir: f64, x: f64) -> f64 {
         let p = &self.p;
         let (fc, fs) = if dir < 0.0 && p.direction_dependent {
             (p.fc_neg, p.fs_neg)
@@ -413,6 +445,10 @@ impl LuGre {
         if h.is_nan() || h <= 0.0 {
             return;
         }
+        if inp.v.slope == 0.0 && (inp.x.slope == 0.0 || !self.p.position_dependent) {
+            self.step_held(inp.v.value, inp.x.value, h);
+            return;
+        }
         let (pieces, n) = one_sign_pieces(inp.v, h);
         for &(a, b) in &pieces[..n] {
             let s = sign_on(inp.v, a, b);
@@ -420,6 +456,28 @@ impl LuGre {
                 self.integrate_piece(inp, a, b, s);
             }
         }
+    }
+
+    /// [`LuGre::step`] with `v` and the level constant over the step: the
+    /// exact update `z ← zss + (z − zss)·e^(−λh)`, the arithmetic of the
+    /// general path (one piece, one sub-step, `zss` the same at both ends)
+    /// without what it does not need. The level is kept for the outputs.
+    fn step_held(&mut self, v: f64, x: f64, h: f64) {
+        if v == 0.0 || v.is_nan() {
+            return;
+        }
+        let s = if v > 0.0 { 1.0 } else { -1.0 };
+        let w = v.abs();
+        let g = self.g_unit(w, s, x);
+        self.level = Level {
+            w,
+            negative: s < 0.0,
+            x,
+            g,
+        };
+        let zss = g * s / self.p.sigma0;
+        let lambda = self.p.sigma0 * w / g;
+        self.z = zss + (self.z - zss) * exp_neg(lambda * h);
     }
 
     /// Sub-stepped integration over `[a, b]` on which `sgn v = s ≠ 0`.

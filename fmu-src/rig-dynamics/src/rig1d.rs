@@ -40,7 +40,10 @@
 //! bound ω·h_sub = 0.02 is 1.4e-9 of a radian per natural period (∝ (ω·h)⁴:
 //! 9e-11 at ω·h = 0.01, and one sub-step of h is used when ω·h ≤ 0.02).
 //! Inputs (F, F_ext, x_act_in, x_ref, v_ref) move linearly over a step
-//! with their slopes (first-order input interpolation).
+//! with their slopes (first-order input interpolation). The right-hand side
+//! is affine in (x, ẋ) with a linear part fixed by the parameters (and the
+//! saturation piece), so the stage equations reduce to a 2×2 system solved
+//! in closed form (`gauss_legendre::linear_stage_sums`).
 //!
 //! **Saturation** is handled piecewise and exactly up to event location:
 //! sat(u) is continuous, and on each side of ±u_max the closed loop is
@@ -62,10 +65,11 @@
 //! the acceleration output is 0.
 //!
 //! Defaults: the 1995 stick-slip benchmark (m = 1 kg, k = 2 N/m, pulled at
-//! 0.1 m/s, everything else off); in that mode the arithmetic is the one of
-//! the first version of this file, bit for bit.
+//! 0.1 m/s, everything else off); in that mode the results are those of
+//! the first version of this file to rounding (the stage equations are
+//! solved in closed form, `gauss_legendre::linear_stage_sums`).
 
-use crate::gauss_legendre::{stage_derivatives, C};
+use crate::gauss_legendre::{linear_stage_sums, C};
 use crate::signals::Sinusoid;
 use crate::{check_finite, check_non_negative};
 
@@ -374,6 +378,15 @@ pub struct Rig1D {
     xd: f64,
     /// ξ = ∫(v_ref − ẋ) dt of the controller (0 when it is off).
     xi: f64,
+    /// ω of the sub-step rule (it depends on the parameters only).
+    omega: f64,
+    /// The linear part of the right-hand side, unsaturated
+    /// ([`Rig1D::linear_part`] of piece 0; from the parameters only).
+    linear: [[f64; 2]; 2],
+    /// The plain mode of [`Rig1D::step_plain`]: m > 0, no controller, the
+    /// prescribed ramp without a sinusoid, no drive force (a dither is
+    /// allowed: it moves the surface, not the body).
+    plain: bool,
 }
 
 impl Rig1D {
@@ -385,7 +398,17 @@ impl Rig1D {
             x: p.x0,
             xd: p.v0,
             xi: 0.0,
+            omega: 0.0,
+            linear: [[0.0; 2]; 2],
+            plain: p.m > 0.0
+                && !p.control.on()
+                && p.actuator == Actuator::Prescribed
+                && !p.act_sine.is_active()
+                && p.drive.f_step == 0.0
+                && !p.drive.sine.is_active(),
         };
+        rig.omega = rig.substep_omega(p.m == 0.0);
+        rig.linear = rig.linear_part(0, p.m == 0.0);
         if p.m == 0.0 {
             rig.xd = rig.quasi_static_velocity(&Rig1DInputs::default(), &Rig1DInputs::default());
         }
@@ -574,6 +597,39 @@ impl Rig1D {
 
     /// Advance by `h` with inputs u(τ) = u + du·τ, τ ∈ [0, h].
     pub fn step(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
+        if self.plain && self.omega * h <= OMEGA_H_MAX {
+            self.step_plain(u, du, h);
+        } else {
+            self.step_general(u, du, h);
+        }
+    }
+
+    /// [`Rig1D::step`] in the plain mode with one sub-step: what the general
+    /// path computes there, bit for bit (the terms that are zero in this
+    /// mode are added as zeros, as it adds them), without its mode
+    /// dispatch.
+    fn step_plain(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
+        let p = &self.p;
+        let (x, xd) = (self.x, self.xd);
+        let (t0, tau0) = (self.t + 0.0, 0.0);
+        let rhs = |c: f64| -> (f64, f64) {
+            let (t, tau) = (t0 + c * h, tau0 + c * h);
+            // x_a0 + v_a·t + (inactive sinusoid); F_d and F_ctrl are 0
+            let xa = p.x_a0 + p.v_a * t + 0.0;
+            let ext = u.f_ext + du.f_ext * tau;
+            let fr = u.friction + du.friction * tau;
+            let force = p.k * (xa - x) - p.c * xd + ext - fr + (0.0 + 0.0) + 0.0;
+            (xd, force / p.m)
+        };
+        let ((a0, a1), (b0, b1)) = (rhs(C[0]), rhs(C[1]));
+        let sums = linear_stage_sums(h, self.linear, [a0, a1, b0, b1]);
+        self.x = x + h * 0.5 * sums[0];
+        self.xd = xd + h * 0.5 * sums[1];
+        self.t += h;
+    }
+
+    /// [`Rig1D::step`] in every mode.
+    fn step_general(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
         let p = self.p;
         if p.m == 0.0 && p.c == 0.0 {
             // pure force balance: nothing to integrate
@@ -630,13 +686,32 @@ impl Rig1D {
         du: &Rig1DInputs,
         first_order: bool,
     ) {
-        let omega = self.substep_omega(first_order);
-        let n = ((omega * len / OMEGA_H_MAX).ceil() as usize).clamp(1, 1_000_000);
+        let _ = first_order; // ω is kept from the parameters
+                             // ⌈q⌉ is 1 for 0 < q ≤ 1: no call to ceil at the usual step
+        let q = self.omega * len / OMEGA_H_MAX;
+        let n = if q <= 1.0 { 1 } else { q.ceil() as usize }.clamp(1, 1_000_000);
         let hs = len / n as f64;
         for i in 0..n {
             let tau0 = tau_start + i as f64 * hs;
             self.substep(tau0, hs, u, du, first_order);
         }
+    }
+
+    /// The linear part `L` of the right-hand side in (x, ẋ) with sat(·)
+    /// replaced by its piece `piece` (0: linear, ±1: constant).
+    fn linear_part(&self, piece: i8, first_order: bool) -> [[f64; 2]; 2] {
+        let p = &self.p;
+        if first_order {
+            // c·ẋ = k(x_a − x) + …
+            return [[-p.k / p.c, 0.0], [0.0, 0.0]];
+        }
+        let g = &p.control;
+        let (k, c) = if g.on() && piece == 0 {
+            (p.k + g.gain * (g.kp + g.ki), p.c + g.gain * g.kd)
+        } else {
+            (p.k, p.c)
+        };
+        [[0.0, 1.0], [-k / p.m, -c / p.m]]
     }
 
     /// One sub-step, split where the command crosses ±u_max (see the module
@@ -712,56 +787,55 @@ impl Rig1D {
         let ctrl = &p.control;
         let (x, xd, xi) = (self.x, self.xd, self.xi);
         let t0 = self.t + tau0;
-        let r0 = self.reference(t0, tau0, u, du).2;
-        // The time-dependent part at each stage time t0 + c_j·len.
-        let stages = C.map(|cj| {
-            let (t, tau) = (t0 + cj * len, tau0 + cj * len);
-            let (x_ref, v_ref, r) = self.reference(t, tau, u, du);
-            Stage {
-                xa: self.actuator_at(t, u.x_act + du.x_act * tau),
-                ext: u.f_ext + du.f_ext * tau,
-                fr: u.friction + du.friction * tau,
-                drive: p.drive.value(t),
-                x_ref,
-                v_ref,
-                // ξ at the stage is xi_base − x_stage (exact: ξ̇ = v_ref − ẋ)
-                xi_base: xi + (r - r0) + x,
+        let r0 = if ctrl.on() {
+            self.reference(t0, tau0, u, du).2
+        } else {
+            0.0
+        };
+        // The right-hand side at the start state (x, ẋ) at stage time
+        // t0 + c·len: affine in the state with the linear part
+        // `linear_part`, so the stage equations are solved in closed form
+        // (gauss_legendre::linear_stage_sums) from these two values.
+        let rhs = |c: f64| -> (f64, f64) {
+            let (t, tau) = (t0 + c * len, tau0 + c * len);
+            let xa = self.actuator_at(t, u.x_act + du.x_act * tau);
+            let ext = u.f_ext + du.f_ext * tau;
+            let fr = u.friction + du.friction * tau;
+            let drive = p.drive.value(t);
+            if first_order {
+                // c·ẋ = k(x_a − x) + F_ext − F + F_d (quasi-static, seed 000)
+                return ((p.k * (xa - x) + ext - fr + drive) / p.c, 0.0);
             }
-        });
-        // F_ctrl at stage j for the stage state (x, ẋ): affine in both.
-        let control = |s: &Stage, sx: f64, sv: f64| -> f64 {
-            match (ctrl.on(), piece) {
+            // F_ctrl with sat(·) replaced by its piece
+            let control = match (ctrl.on(), piece) {
                 (false, _) => 0.0,
                 (true, 0) => {
+                    let (x_ref, v_ref, r) = self.reference(t, tau, u, du);
+                    // ξ at the stage is ξ_base − x_stage (exact: ξ̇ = v_ref − ẋ)
+                    let xi_base = xi + (r - r0) + x;
                     ctrl.gain
-                        * (ctrl.kp * (s.x_ref - sx)
-                            + ctrl.kd * (ctrl.ff * s.v_ref - sv)
-                            + ctrl.ki * (s.xi_base - sx))
+                        * (ctrl.kp * (x_ref - x)
+                            + ctrl.kd * (ctrl.ff * v_ref - xd)
+                            + ctrl.ki * (xi_base - x))
                 }
                 (true, side) => ctrl.gain * f64::from(side) * ctrl.u_max,
-            }
-        };
-        let kv = if first_order {
-            // c·ẋ = k(x_a − x) + F_ext − F + F_d (quasi-static, seed 000)
-            stage_derivatives(x, xd, len, |j, sx, _| {
-                let s = &stages[j];
-                let rhs = p.k * (s.xa - sx) + s.ext - s.fr + s.drive;
-                (rhs / p.c, 0.0)
-            })
-        } else {
+            };
             // m·ẍ = k(x_a − x) − c·ẋ + F_ext − F + F_d + F_ctrl
-            stage_derivatives(x, xd, len, |j, sx, sv| {
-                let s = &stages[j];
-                let force =
-                    p.k * (s.xa - sx) - p.c * sv + s.ext - s.fr + s.drive + control(s, sx, sv);
-                (sv, force / p.m)
-            })
+            let force = p.k * (xa - x) - p.c * xd + ext - fr + drive + control;
+            (xd, force / p.m)
         };
-        let x_new = x + len * 0.5 * (kv[0] + kv[2]);
-        let xd_new = if first_order {
-            0.5 * (kv[0] + kv[2])
+        let ((a0, a1), (b0, b1)) = (rhs(C[0]), rhs(C[1]));
+        let linear = if piece == 0 {
+            self.linear
         } else {
-            xd + len * 0.5 * (kv[1] + kv[3])
+            self.linear_part(piece, first_order)
+        };
+        let sums = linear_stage_sums(len, linear, [a0, a1, b0, b1]);
+        let x_new = x + len * 0.5 * sums[0];
+        let xd_new = if first_order {
+            0.5 * sums[0]
+        } else {
+            xd + len * 0.5 * sums[1]
         };
         let xi_new = if ctrl.on() {
             let r1 = self.reference(t0 + len, tau0 + len, u, du).2;
@@ -797,17 +871,6 @@ impl Rig1D {
             _ => Err(format!("Rig1D state must be 4 finite numbers, got {s:?}")),
         }
     }
-}
-
-/// Forcing of one Gauss–Legendre stage.
-struct Stage {
-    xa: f64,
-    ext: f64,
-    fr: f64,
-    drive: f64,
-    x_ref: f64,
-    v_ref: f64,
-    xi_base: f64,
 }
 
 /// θ ∈ [0, len] where g changes sign, g(0) = g0, g(len) = g_len (Illinois

@@ -43,7 +43,7 @@ use fricsim::benchmarks::{
     today, FmuStepper, TableFileArgs, FRICTION_FMUS, INCREMENTS,
 };
 use fricsim::fmu::Fmu;
-use fricsim::master::{by_name, simulate_with, NoObserver};
+use fricsim::master::{by_name, simulate_with, step_count, NoObserver};
 use fricsim::ssp::{SystemFile, Value};
 use fricsim::sweep::{grid, run_all, Axis, Plan};
 use friction_laws::bristle::{Bristle, BristleParams};
@@ -81,6 +81,17 @@ struct Args {
     /// The Python that has FMPy [default: ROOT/.venv/bin/python].
     #[arg(long)]
     python: Option<PathBuf>,
+    /// Run only one side of the stick-slip benchmark, once, and print its
+    /// time and final force (for profilers such as callgrind): `host` or
+    /// `monolithic`, with `--master` and `--stop`; no table is written.
+    #[arg(long, value_parser = ["host", "monolithic"])]
+    only: Option<String>,
+    /// The master of `--only`: jacobi or newton.
+    #[arg(long, default_value = "jacobi", value_parser = ["jacobi", "newton"])]
+    master: String,
+    /// The stop time of `--only`, s [default: the benchmark's 20 s].
+    #[arg(long)]
+    stop: Option<f64>,
     #[command(flatten)]
     file: TableFileArgs,
 }
@@ -101,6 +112,9 @@ struct Sizes {
 
 fn run(args: &Args) -> Result<(), String> {
     let root = args.file.root();
+    if let Some(side) = &args.only {
+        return run_one(&root, side, &args.master, args.stop.unwrap_or(20.0));
+    }
     let sizes = if args.quick {
         Sizes {
             repeats: args.repeats.unwrap_or(1),
@@ -310,6 +324,51 @@ fn host_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<HostTable, St
         });
     }
     Ok(HostTable { stop, rows })
+}
+
+/// `--only`: one run of one side of the stick-slip benchmark.
+fn run_one(root: &Path, side: &str, master: &str, stop: f64) -> Result<(), String> {
+    let file = SystemFile::open(root.join(STICK_SLIP)).map_err(|e| e.to_string())?;
+    let h = STICK_SLIP_STEP;
+    let (wall, force) = if side == "host" {
+        let mut algorithm = by_name(master)?;
+        let mut system = file.build(0.0).map_err(|e| e.to_string())?;
+        let clock = Instant::now();
+        let run = simulate_with(
+            &mut system,
+            algorithm.as_mut(),
+            0.0,
+            h,
+            stop,
+            &mut NoObserver,
+        )
+        .map_err(|e| e.to_string())?;
+        let wall = clock.elapsed().as_secs_f64();
+        if let Some(e) = run.error {
+            return Err(format!("{STICK_SLIP} with {master}: {e}"));
+        }
+        if let Some(report) = algorithm.report() {
+            eprintln!("{report}");
+        }
+        (wall, final_value(&run.columns, &run.rows, "friction.F")?)
+    } else {
+        let model = StickSlipModel::from_file(&file)?;
+        let (wall, force, iterations) = match master {
+            "jacobi" => model.monolithic_jacobi(h, stop),
+            _ => model.monolithic_newton(h, stop)?,
+        };
+        if master != "jacobi" {
+            eprintln!("mean iterations {iterations:.3}");
+        }
+        (wall, force)
+    };
+    let steps = step_count(0.0, h, stop);
+    println!(
+        "{side} {master}: {:.3} ms, {:.1} ns per step, final friction.F {force:.9}",
+        wall * 1e3,
+        wall / steps.max(1) as f64 * 1e9
+    );
+    Ok(())
 }
 
 fn final_value(columns: &[String], rows: &[Vec<f64>], name: &str) -> Result<f64, String> {

@@ -174,6 +174,9 @@ pub struct Instance {
     fatal: bool,
     /// The time limit on each call, if one is set ([`Instance::set_call_time_limit`]).
     limit: Option<Arc<Watched>>,
+    /// Calls made so far that may have changed a value of the instance
+    /// (every call but `fmi2Get…`), see [`Instance::changes`].
+    changes: u64,
 }
 
 impl std::fmt::Debug for Instance {
@@ -184,6 +187,15 @@ impl std::fmt::Debug for Instance {
             .field("states", &self.states.len())
             .field("fatal", &self.fatal)
             .finish_non_exhaustive()
+    }
+}
+
+/// The error of a call the FMU does not declare, made only when needed.
+#[cold]
+fn not_supported(function: &'static str, capability: &'static str) -> FmuError {
+    FmuError::NotSupported {
+        function,
+        capability,
     }
 }
 
@@ -278,11 +290,20 @@ impl Instance {
             states: Vec::new(),
             fatal: false,
             limit: None,
+            changes: 0,
         })
     }
 
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// A count that moves with every call that may change a value of the
+    /// instance (every FMI call but the `fmi2Get…` ones): while it stands
+    /// still, `fmi2GetReal` answers as it did, and a value read since can
+    /// be used again instead of asking the FMU once more.
+    pub fn changes(&self) -> u64 {
+        self.changes
     }
 
     pub fn fmu(&self) -> &Fmu {
@@ -299,9 +320,13 @@ impl Instance {
     }
 
     /// Refuse any call after `fmi2Fatal`; otherwise the log mark before the
-    /// call (and the call's clock started, under a time limit).
+    /// call (and the call's clock started, under a time limit). Every call
+    /// but a getter's counts as a change ([`Instance::changes`]).
     #[inline]
-    fn begin(&self, function: &'static str) -> Result<u64, FmuError> {
+    fn begin(&mut self, function: &'static str) -> Result<u64, FmuError> {
+        if !function.starts_with("fmi2Get") {
+            self.changes = self.changes.wrapping_add(1);
+        }
         if self.fatal {
             return Err(FmuError::AfterFatal {
                 function,
@@ -314,9 +339,23 @@ impl Instance {
         Ok(self.sink.mark())
     }
 
-    /// The status of a call as a `Result`.
+    /// The status of a call as a `Result`: `fmi2OK` (0) without a time limit
+    /// at once, anything else through [`Instance::finish_checked`].
     #[inline]
     fn finish(
+        &mut self,
+        function: &'static str,
+        mark: u64,
+        raw: fmi2Status,
+    ) -> Result<Status, FmuError> {
+        if raw == 0 && self.limit.is_none() {
+            return Ok(Status::Ok);
+        }
+        self.finish_checked(function, mark, raw)
+    }
+
+    #[inline(never)]
+    fn finish_checked(
         &mut self,
         function: &'static str,
         mark: u64,
@@ -632,7 +671,10 @@ impl Instance {
         let mark = self.begin(F)?;
         // SAFETY: plain values.
         let raw = unsafe { (self.functions.do_step)(self.component, t, h, fmi2False) };
-        let mut result = self.finish(F, mark, raw);
+        if raw == 0 && self.limit.is_none() {
+            return Ok(Status::Ok);
+        }
+        let mut result = self.finish_checked(F, mark, raw);
         if let Err(FmuError::Call {
             status: Status::Discard,
             messages,
@@ -696,13 +738,9 @@ impl Instance {
         values: &[f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2SetRealInputDerivatives";
-        let f = self
-            .functions
-            .set_real_input_derivatives
-            .ok_or(FmuError::NotSupported {
-                function: F,
-                capability: "canInterpolateInputs=\"true\"",
-            })?;
+        let Some(f) = self.functions.set_real_input_derivatives else {
+            return Err(not_supported(F, "canInterpolateInputs=\"true\""));
+        };
         let mark = self.begin(F)?;
         same_length(F, "orders", vrs.len(), orders.len())?;
         same_length(F, "values", vrs.len(), values.len())?;
@@ -727,13 +765,9 @@ impl Instance {
         values: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetRealOutputDerivatives";
-        let f = self
-            .functions
-            .get_real_output_derivatives
-            .ok_or(FmuError::NotSupported {
-                function: F,
-                capability: "maxOutputDerivativeOrder > 0",
-            })?;
+        let Some(f) = self.functions.get_real_output_derivatives else {
+            return Err(not_supported(F, "maxOutputDerivativeOrder > 0"));
+        };
         let mark = self.begin(F)?;
         same_length(F, "orders", vrs.len(), orders.len())?;
         same_length(F, "values", vrs.len(), values.len())?;
@@ -759,13 +793,9 @@ impl Instance {
         out: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetDirectionalDerivative";
-        let f = self
-            .functions
-            .get_directional_derivative
-            .ok_or(FmuError::NotSupported {
-                function: F,
-                capability: "providesDirectionalDerivative=\"true\"",
-            })?;
+        let Some(f) = self.functions.get_directional_derivative else {
+            return Err(not_supported(F, "providesDirectionalDerivative=\"true\""));
+        };
         let mark = self.begin(F)?;
         same_length(F, "seed", knowns.len(), seed.len())?;
         same_length(F, "out", unknowns.len(), out.len())?;
@@ -801,10 +831,10 @@ impl Instance {
         f: Option<T>,
         capability: &'static str,
     ) -> Result<T, FmuError> {
-        f.ok_or(FmuError::NotSupported {
-            function,
-            capability,
-        })
+        match f {
+            Some(f) => Ok(f),
+            None => Err(not_supported(function, capability)),
+        }
     }
 
     /// `fmi2GetFMUstate` into a new state.

@@ -888,21 +888,37 @@ impl StrongCoupling {
 /// co-simulation step it needs no work space, where a general LU allocates.
 fn solve_in_place(a: &mut DMatrix<f64>, b: &mut [f64]) -> bool {
     let n = b.len();
+    if a.shape() != (n, n) {
+        return false;
+    }
+    // column-major: (row, col) at row + col·n
+    let m = a.as_mut_slice();
     for col in 0..n {
-        let pivot = (col..n)
-            .max_by(|&i, &j| a[(i, col)].abs().total_cmp(&a[(j, col)].abs()))
-            .unwrap_or(col);
-        if a[(pivot, col)] == 0.0 || !a[(pivot, col)].is_finite() {
+        // the largest magnitude, the last of equal ones (as max_by)
+        let mut pivot = col;
+        for row in col + 1..n {
+            if m[row + col * n]
+                .abs()
+                .total_cmp(&m[pivot + col * n].abs())
+                .is_ge()
+            {
+                pivot = row;
+            }
+        }
+        let p = m[pivot + col * n];
+        if p == 0.0 || !p.is_finite() {
             return false;
         }
         if pivot != col {
-            a.swap_rows(pivot, col);
+            for k in 0..n {
+                m.swap(pivot + k * n, col + k * n);
+            }
             b.swap(pivot, col);
         }
         for row in col + 1..n {
-            let factor = a[(row, col)] / a[(col, col)];
+            let factor = m[row + col * n] / m[col + col * n];
             for k in col..n {
-                a[(row, k)] -= factor * a[(col, k)];
+                m[row + k * n] -= factor * m[col + k * n];
             }
             b[row] -= factor * b[col];
         }
@@ -910,9 +926,9 @@ fn solve_in_place(a: &mut DMatrix<f64>, b: &mut [f64]) -> bool {
     for row in (0..n).rev() {
         let mut sum = b[row];
         for k in row + 1..n {
-            sum -= a[(row, k)] * b[k];
+            sum -= m[row + k * n] * b[k];
         }
-        b[row] = sum / a[(row, row)];
+        b[row] = sum / m[row + row * n];
     }
     b.iter().all(|x| x.is_finite())
 }

@@ -104,11 +104,15 @@ fn ramp_response_matches_the_closed_form() {
 }
 
 /// In the default mode (prescribed ramp, no drive, controller or dither)
-/// the rig computes exactly what the first version of this file did (bits
-/// recorded from it, commit 6271953): other tests compare against runs of
-/// the stick-slip benchmark.
+/// the rig computes what the first version of this file did (bits
+/// recorded from it, commit 6271953), to rounding: other tests compare
+/// against runs of the stick-slip benchmark. Bit for bit until the stage
+/// equations were solved in closed form (gauss_legendre::linear_stage_sums,
+/// the same method, where the first version differenced the right-hand
+/// side for the stage matrix); since then to 1e-13 of each value (5.3e-15
+/// at most, after 700 steps of the damped case, when that was changed).
 #[test]
-fn default_mode_is_bit_identical_to_the_first_version() {
+fn default_mode_matches_the_first_version_to_rounding() {
     const BENCHMARK: [[u64; 5]; 5] = [
         [
             0xbfb02339506cc1fb,
@@ -215,19 +219,25 @@ fn default_mode_is_bit_identical_to_the_first_version() {
             rig.step(&u, &du, h);
             if (i + 1) % (n / 5) == 0 {
                 let u1 = u.at(&du, h);
-                out.push(
-                    [
-                        rig.position(&u1),
-                        rig.velocity(),
-                        rig.acceleration(&u1),
-                        rig.spring_force(&u1),
-                        rig.slip_velocity(),
-                    ]
-                    .map(f64::to_bits),
+                out.push([
+                    rig.position(&u1),
+                    rig.velocity(),
+                    rig.acceleration(&u1),
+                    rig.spring_force(&u1),
+                    rig.slip_velocity(),
+                ]);
+            }
+        }
+        for (row, golden) in out.iter().zip(golden) {
+            for (x, bits) in row.iter().zip(golden) {
+                let first = f64::from_bits(*bits);
+                assert!(
+                    (x - first).abs() <= 1e-13 * first.abs(),
+                    "{p:?}: {x:e}, first version {first:e}"
                 );
             }
         }
-        assert_eq!(out, golden.to_vec(), "{p:?}");
+        assert_eq!(out.len(), golden.len());
     }
 }
 
@@ -856,5 +866,54 @@ fn invalid_parameters_are_refused_with_name_and_value() {
     }
     for code in 0..3 {
         assert_eq!(Control::from_code(code).unwrap().code(), code);
+    }
+}
+
+/// The plain mode's step (no controller, drive or actuator sinusoid) is
+/// the general path's arithmetic, bit for bit, with ramped inputs, steps of
+/// several lengths and a dither, damped and undamped.
+#[test]
+fn plain_step_is_the_general_step_bit_for_bit() {
+    for p in [
+        Rig1DParams::default(),
+        Rig1DParams {
+            m: 0.5,
+            c: 0.3,
+            k: 20.0,
+            x0: 0.01,
+            v0: -0.02,
+            v_a: 0.05,
+            x_a0: 0.001,
+            v_surface: 0.01,
+            dither: Sinusoid::new(1e-4, 30.0),
+            ..Default::default()
+        },
+    ] {
+        let mut plain = Rig1D::new(p).unwrap();
+        let mut general = Rig1D::new(p).unwrap();
+        assert!(plain.plain);
+        for i in 0..2000 {
+            let h = 1e-3 * (1.0 + 0.25 * (i % 3) as f64);
+            let t = plain.time();
+            let u = Rig1DInputs {
+                friction: 0.5 * (7.0 * t).sin() + 0.2,
+                f_ext: 0.1 * (3.0 * t).cos(),
+                ..Default::default()
+            };
+            let du = Rig1DInputs {
+                friction: 3.5 * (7.0 * t).cos(),
+                f_ext: -0.3 * (3.0 * t).sin(),
+                ..Default::default()
+            };
+            plain.step(&u, &du, h);
+            general.step_general(&u, &du, h);
+            let bits = |r: &Rig1D| {
+                r.state_to_vec()
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&plain), bits(&general), "step {i}");
+        }
     }
 }
