@@ -278,23 +278,8 @@ fn host_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<HostTable, St
         let mut host_final = f64::NAN;
         let mut host_iterations = 0.0;
         let host = best_of(sizes.repeats, || {
-            let mut algorithm = by_name(master)?;
-            let mut system = file.build(0.0).map_err(|e| e.to_string())?;
-            let clock = Instant::now();
-            let run = simulate_with(
-                &mut system,
-                algorithm.as_mut(),
-                0.0,
-                h,
-                stop,
-                &mut NoObserver,
-            )
-            .map_err(|e| e.to_string())?;
-            let wall = clock.elapsed().as_secs_f64();
-            if let Some(e) = run.error {
-                return Err(format!("{STICK_SLIP} with {master}: {e}"));
-            }
-            host_final = final_value(&run.columns, &run.rows, "friction.F")?;
+            let (wall, force, algorithm) = host_run(&file, master, h, stop)?;
+            host_final = force;
             if let Some(report) = algorithm.report() {
                 host_iterations = mean_iterations(&report);
             }
@@ -331,31 +316,46 @@ fn host_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<HostTable, St
     Ok(HostTable { stop, rows })
 }
 
+/// One host run of the stick-slip benchmark with `master`: the wall time
+/// of the run (initialization and stepping; the system is built before the
+/// clock starts), the final friction force, and the master (for its
+/// convergence report).
+fn host_run(
+    file: &SystemFile,
+    master: &str,
+    h: f64,
+    stop: f64,
+) -> Result<(f64, f64, Box<dyn fricsim::master::MasterAlgorithm>), String> {
+    let mut algorithm = by_name(master)?;
+    let mut system = file.build(0.0).map_err(|e| e.to_string())?;
+    let clock = Instant::now();
+    let run = simulate_with(
+        &mut system,
+        algorithm.as_mut(),
+        0.0,
+        h,
+        stop,
+        &mut NoObserver,
+    )
+    .map_err(|e| e.to_string())?;
+    let wall = clock.elapsed().as_secs_f64();
+    if let Some(e) = run.error {
+        return Err(format!("{STICK_SLIP} with {master}: {e}"));
+    }
+    let force = final_value(&run.columns, &run.rows, "friction.F")?;
+    Ok((wall, force, algorithm))
+}
+
 /// `--only`: one run of one side of the stick-slip benchmark.
 fn run_one(root: &Path, side: &str, master: &str, stop: f64) -> Result<(), String> {
     let file = SystemFile::open(root.join(STICK_SLIP)).map_err(|e| e.to_string())?;
     let h = STICK_SLIP_STEP;
     let (wall, force) = if side == "host" {
-        let mut algorithm = by_name(master)?;
-        let mut system = file.build(0.0).map_err(|e| e.to_string())?;
-        let clock = Instant::now();
-        let run = simulate_with(
-            &mut system,
-            algorithm.as_mut(),
-            0.0,
-            h,
-            stop,
-            &mut NoObserver,
-        )
-        .map_err(|e| e.to_string())?;
-        let wall = clock.elapsed().as_secs_f64();
-        if let Some(e) = run.error {
-            return Err(format!("{STICK_SLIP} with {master}: {e}"));
-        }
+        let (wall, force, algorithm) = host_run(&file, master, h, stop)?;
         if let Some(report) = algorithm.report() {
             eprintln!("{report}");
         }
-        (wall, final_value(&run.columns, &run.rows, "friction.F")?)
+        (wall, force)
     } else {
         let model = StickSlipModel::from_file(&file)?;
         let (wall, force, iterations) = match master {

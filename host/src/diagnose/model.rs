@@ -222,21 +222,26 @@ impl FrictionModel {
                 m.fs_neg = m.fs;
                 m.scale_neg = m.scale_pos.clone();
             }
-            Effect::NormalLoad => {
-                let n = context.mean_normal_force;
-                m.normal_force_form = true;
-                for x in [
-                    &mut m.fc,
-                    &mut m.fs,
-                    &mut m.fc_neg,
-                    &mut m.fs_neg,
-                    &mut m.sigma0,
-                    &mut m.sigma1,
-                    &mut m.sigma2,
-                ] {
-                    *x /= n;
-                }
-            }
+            Effect::NormalLoad => m = m.per_newton(context.mean_normal_force),
+        }
+        m
+    }
+
+    /// The normal-force form with the same force at a normal force `n`:
+    /// every level and coefficient per newton of the input Fn.
+    pub fn per_newton(&self, n: f64) -> FrictionModel {
+        let mut m = self.clone();
+        m.normal_force_form = true;
+        for x in [
+            &mut m.fc,
+            &mut m.fs,
+            &mut m.fc_neg,
+            &mut m.fs_neg,
+            &mut m.sigma0,
+            &mut m.sigma1,
+            &mut m.sigma2,
+        ] {
+            *x /= n;
         }
         m
     }

@@ -114,20 +114,7 @@ fn apply(
             m.fc_neg = m.fc * (1.0 + a);
             m.fs_neg = m.fs * (1.0 + a);
         }
-        Effect::NormalLoad => {
-            m.normal_force_form = true;
-            for x in [
-                &mut m.fc,
-                &mut m.fs,
-                &mut m.fc_neg,
-                &mut m.fs_neg,
-                &mut m.sigma0,
-                &mut m.sigma1,
-                &mut m.sigma2,
-            ] {
-                *x /= FN_MEAN;
-            }
-        }
+        Effect::NormalLoad => m = m.per_newton(FN_MEAN),
     }
     m
 }
