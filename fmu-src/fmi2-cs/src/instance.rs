@@ -372,16 +372,23 @@ impl Instance {
         self.set_many(t, vrs, values)
     }
 
+    /// Whether the instance is in step mode, and the flags a variable of
+    /// type `t` needs to be set now.
+    #[inline]
+    fn settable(&self, t: VarType) -> (bool, u8) {
+        let in_step_mode = self.state == State::StepComplete;
+        let when = if in_step_mode {
+            flag::SETTABLE_IN_STEP
+        } else {
+            flag::SETTABLE_BEFORE_INIT
+        };
+        (in_step_mode, type_flag(t) | when)
+    }
+
     /// [`Instance::set`] of one value (a master sets an input per
     /// connection): the same checks and effects, without the loops.
     fn set_one(&mut self, t: VarType, vr: u32, value: f64) -> Result<(), String> {
-        let in_step_mode = self.state == State::StepComplete;
-        let want = type_flag(t)
-            | if in_step_mode {
-                flag::SETTABLE_IN_STEP
-            } else {
-                flag::SETTABLE_BEFORE_INIT
-            };
+        let (in_step_mode, want) = self.settable(t);
         let f = self.flags.get(vr as usize).copied().unwrap_or(0);
         if f & want != want || !value.is_finite() {
             self.check_set(t, &[vr], &[value], in_step_mode)?;
@@ -401,15 +408,9 @@ impl Instance {
     }
 
     fn set_many(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
-        let in_step_mode = self.state == State::StepComplete;
         // The usual case in one pass over the flag bytes: known, of type
         // `t`, settable now, finite; the inputs get the model's own check.
-        let want = type_flag(t)
-            | if in_step_mode {
-                flag::SETTABLE_IN_STEP
-            } else {
-                flag::SETTABLE_BEFORE_INIT
-            };
+        let (in_step_mode, want) = self.settable(t);
         let mut fine = true;
         let mut inputs = 0;
         for (&vr, value) in vrs.iter().zip(values) {

@@ -299,6 +299,11 @@ pub struct PlotData {
     pub residual_after: Vec<f64>,
 }
 
+/// Every compared sample of a co-simulation.
+fn all_samples(r: &ChannelResiduals) -> Vec<usize> {
+    (0..r.samples.len()).collect()
+}
+
 /// The held-out part: the file scored and its friction intervals.
 struct HeldOut<'a> {
     data: &'a Measured,
@@ -439,8 +444,8 @@ pub fn diagnose(
             },
             vec![Fold {
                 train_intervals: all_intervals.clone(),
-                held: Box::new(|r: &ChannelResiduals| (0..r.samples.len()).collect()),
-                train: Box::new(|r: &ChannelResiduals| (0..r.samples.len()).collect()),
+                held: Box::new(all_samples),
+                train: Box::new(all_samples),
             }],
         ),
         _ => {
@@ -563,17 +568,17 @@ pub fn diagnose(
         let budget = POLISH_ITERATIONS * (model.free().len() + 1) + 1;
         fit::polish(model, &mut residual, budget)
     };
-    let every_sample: Picker = Box::new(|r: &ChannelResiduals| (0..r.samples.len()).collect());
+    let every_sample: Picker = Box::new(all_samples);
     // the model reported: fitted on every training interval (the fold's
     // own model when there is one fold)
-    let fit_whole = |starts: &[FrictionModel], fold_models: &[FrictionModel]| -> FrictionModel {
+    let fit_whole = |starts: &[FrictionModel],
+                     fold_models: &[FrictionModel]|
+     -> Result<FrictionModel, String> {
         if folds.len() == 1 {
-            return fold_models[0].clone();
+            return Ok(fold_models[0].clone());
         }
-        match FrictionSim::new(&setup.friction_fmu) {
-            Ok(mut sim) => fit::fit(starts, &mut sim, &d_train, &all_intervals).model,
-            Err(_) => fold_models[0].clone(),
-        }
+        let mut sim = FrictionSim::new(&setup.friction_fmu)?;
+        Ok(fit::fit(starts, &mut sim, &d_train, &all_intervals).model)
     };
     // fit `starts` (per fold: built from that fold's model) on each fold
     let fit_folds = |starts: &(dyn Fn(&FrictionModel) -> Vec<FrictionModel> + Sync),
@@ -608,7 +613,7 @@ pub fn diagnose(
     let nominal_scored =
         score(&mut system, &nominal_folds).map_err(|e| format!("the nominal system: {e}"))?;
     let (baseline_folds, _, _) = fit_folds(&|m: &FrictionModel| vec![m.clone()], &nominal_folds)?;
-    let baseline_model = fit_whole(std::slice::from_ref(&setup.nominal), &baseline_folds);
+    let baseline_model = fit_whole(std::slice::from_ref(&setup.nominal), &baseline_folds)?;
     let baseline_scored = score(&mut system, &baseline_folds)
         .map_err(|e| format!("the refitted nominal system: {e}"))?;
     // the groups of the acceptance test: the held-out blocks when there
@@ -617,17 +622,13 @@ pub fn diagnose(
     let group: Vec<usize> = {
         let picked = &baseline_scored.picked;
         let n = picked.len();
-        let block_of =
-            |k: usize| blocks.block(held.data.time[baseline_scored.residuals.samples[k]]);
-        let held_blocks = if heldout_file.is_some() {
-            0
-        } else {
-            let mut b: Vec<usize> = picked.iter().map(|&k| block_of(k)).collect();
-            b.dedup();
-            b.len()
-        };
-        if held_blocks >= options.groups {
-            picked.iter().map(|&k| block_of(k)).collect()
+        let by_block: Vec<usize> = picked
+            .iter()
+            .map(|&k| blocks.block(held.data.time[baseline_scored.residuals.samples[k]]))
+            .collect();
+        let held_blocks = 1 + by_block.windows(2).filter(|w| w[0] != w[1]).count();
+        if heldout_file.is_none() && held_blocks >= options.groups {
+            by_block
         } else {
             let g = options.groups.clamp(2, n.max(2));
             (0..n).map(|i| i * g / n.max(1)).collect()
@@ -748,7 +749,7 @@ pub fn diagnose(
             Ok(s) => (t.models, s),
             Err(e) => return Err(format!("accepted {} without a score: {e}", label(&t.added))),
         };
-        let mut whole = fit_whole(&addition_starts(&t.added)(&current), &models);
+        let mut whole = fit_whole(&addition_starts(&t.added)(&current), &models)?;
         // refine the accepted models on the output error of their training data
         let polish_started = Instant::now();
         if options.polish {
@@ -781,7 +782,7 @@ pub fn diagnose(
             if let Some(single) = singles_tried.iter().find(|s| s.added == [t.added[0]]) {
                 if let Ok(single_scored) = &single.scored {
                     let single_whole =
-                        fit_whole(&addition_starts(&single.added)(&current), &single.models);
+                        fit_whole(&addition_starts(&single.added)(&current), &single.models)?;
                     steps.push((
                         t.added[0],
                         single_whole,
@@ -996,10 +997,10 @@ pub fn nested_test(before: &Scored, after: &Scored, scales: &[f64], group: &[usi
     }
     let f: Vec<f64> = (0..n)
         .map(|i| {
-            let (k0, k1) = (before.picked[i], after.picked[i]);
+            let k = before.picked[i];
             let change = (0..scales.len())
                 .map(|c| {
-                    let d = before.residuals.residuals[c][k0] - after.residuals.residuals[c][k1];
+                    let d = before.residuals.residuals[c][k] - after.residuals.residuals[c][k];
                     (d / scales[c]).powi(2)
                 })
                 .sum::<f64>()
