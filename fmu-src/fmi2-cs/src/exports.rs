@@ -105,26 +105,17 @@ pub unsafe fn call_allowed(
     // SAFETY: c is a live instance created by Box::into_raw in `instantiate`.
     let instance = unsafe { &mut *(c as *mut Instance) };
     let outcome = catch_unwind(AssertUnwindSafe(|| {
+        // The step loop's case in two tests: the state allows the call and
+        // call logging is off; everything else is out of line.
         if allowed & instance.state as u32 == 0 {
-            instance.logger.error(&format!(
-                "{function}: illegal call sequence: not allowed in state {}",
-                instance.state.name()
-            ));
-            return fmi2Status::fmi2Error;
+            return illegal_call(instance, function);
         }
-        instance.logger.call(|| {
-            format!(
-                "{function} (state {}, t = {})",
-                instance.state.name(),
-                instance.time
-            )
-        });
+        if instance.logger.logs_calls() {
+            log_call(instance, function);
+        }
         match body(instance) {
             Ok(status) => status,
-            Err(message) => {
-                instance.logger.error(&format!("{function}: {message}"));
-                fmi2Status::fmi2Error
-            }
+            Err(message) => log_error(instance, function, message),
         }
     }));
     outcome.unwrap_or_else(|payload| {
@@ -137,6 +128,38 @@ pub unsafe fn call_allowed(
         }));
         fmi2Status::fmi2Fatal
     })
+}
+
+/// [`call_allowed`] of a function the instance's state does not allow:
+/// logged, `fmi2Error`, the instance unchanged.
+#[cold]
+#[inline(never)]
+fn illegal_call(instance: &mut Instance, function: &str) -> fmi2Status {
+    instance.logger.error(&format!(
+        "{function}: illegal call sequence: not allowed in state {}",
+        instance.state.name()
+    ));
+    fmi2Status::fmi2Error
+}
+
+/// The `logCalls` line of [`call_allowed`] (debug logging only).
+#[cold]
+#[inline(never)]
+fn log_call(instance: &mut Instance, function: &str) {
+    let message = format!(
+        "{function} (state {}, t = {})",
+        instance.state.name(),
+        instance.time
+    );
+    instance.logger.call(|| message);
+}
+
+/// An error of a call's body, logged as `function: message`.
+#[cold]
+#[inline(never)]
+fn log_error(instance: &mut Instance, function: &str, message: String) -> fmi2Status {
+    instance.logger.error(&format!("{function}: {message}"));
+    fmi2Status::fmi2Error
 }
 
 /// A read-only C array as a slice; `n == 0` accepts NULL.

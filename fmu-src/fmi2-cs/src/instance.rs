@@ -65,6 +65,9 @@ pub struct Instance {
     /// everything that gives the model another state (initialization, a
     /// reset, a restored FMU state).
     step_state_current: bool,
+    /// The model's [`Model::needs_step_replay`], asked once (a property of
+    /// the model, not of its state).
+    needs_step_replay: bool,
     /// Per value reference, what the hot paths check ([`flag`]): the type,
     /// the causality, when it may be set. One byte per variable, so that a
     /// get or set validates its value references with one load each; the
@@ -158,6 +161,7 @@ impl Instance {
     ) -> Self {
         let values = Values::from_start(info.variables);
         let n = values.len();
+        let needs_step_replay = model.needs_step_replay();
         let inputs: Vec<u32> = info
             .variables
             .iter()
@@ -198,6 +202,7 @@ impl Instance {
             saved_states: Vec::new(),
             step_state: Vec::new(),
             step_state_current: false,
+            needs_step_replay,
             flags: info.variables.iter().map(flags_of).collect(),
             checked_get: (VarType::Real, Vec::new(), false),
         }
@@ -301,15 +306,22 @@ impl Instance {
     // ---- get / set ------------------------------------------------------
 
     /// Read values of type `t` into `out` (already checked: same length).
+    #[inline]
     pub fn get(&mut self, t: VarType, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
         /// Shorter lists are checked as fast as compared.
         const REMEMBERED: usize = 4;
-        let checked = &self.checked_get;
-        let outputs = if vrs.len() >= REMEMBERED && checked.0 == t && checked.1 == vrs {
-            checked.2
+        let want = type_flag(t);
+        let outputs = if let [vr] = vrs {
+            // one value (a master reading a connected output)
+            let f = self.flags.get(*vr as usize).copied().unwrap_or(0);
+            if f & want == 0 {
+                self.variable_of_type(*vr, t)?;
+            }
+            f & flag::OUTPUT != 0
+        } else if vrs.len() >= REMEMBERED && self.checked_get.0 == t && self.checked_get.1 == vrs {
+            self.checked_get.2
         } else {
             // One flag byte per value reference: known, of type `t`, an output?
-            let want = type_flag(t);
             let mut wrong = false;
             let mut flags = 0;
             for &vr in vrs {
@@ -365,6 +377,7 @@ impl Instance {
     }
 
     /// Check, then set, values of type `t`: all or nothing.
+    #[inline]
     pub fn set(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         if let ([vr], [value]) = (vrs, values) {
             return self.set_one(t, *vr, *value);
@@ -579,26 +592,20 @@ impl Instance {
 
     // ---- stepping -------------------------------------------------------
 
+    #[inline]
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<fmi2Status, String> {
-        // (comparisons with NaN are false: NaN fails both checks)
-        let h_fine = h > 0.0 && h < f64::INFINITY;
-        if !h_fine {
-            return Err(format!(
-                "communicationStepSize must be finite and > 0 but was {h}"
-            ));
+        // (comparisons with NaN are false: NaN fails both checks, and
+        // h <= f64::MAX refuses +inf)
+        if !(h > 0.0 && h <= f64::MAX) {
+            return Err(step_size_refused(h));
         }
         // self.time is finite
         let scale = self.time.abs();
         let tolerance = TIME_TOLERANCE * if scale > 1.0 { scale } else { 1.0 };
-        let on_time = (t - self.time).abs() <= tolerance;
-        if !on_time {
-            return Err(format!(
-                "expected currentCommunicationPoint = {} but was {t} (difference {:e})",
-                self.time,
-                t - self.time
-            ));
+        if !((t - self.time).abs() <= tolerance) {
+            return Err(self.communication_point_refused(t));
         }
-        let replay = self.model.needs_step_replay();
+        let replay = self.needs_step_replay;
         if replay {
             if self.step_state_current {
                 // the state after the last step is the state now
@@ -619,20 +626,15 @@ impl Instance {
         self.step_state_current = false;
         if let Err(e) = self.model.do_step(&self.values, &self.slopes, h) {
             self.state = State::Error;
-            return Err(format!("step from t = {t} over h = {h} failed: {e}"));
+            return Err(step_failed(t, h, e));
         }
         // A step that overflowed (finite but extreme parameters or inputs)
         // is a failed step too: the state is no longer meaningful.
         self.step_state.clear();
         self.model.save_state(&mut self.step_state);
-        // x·0 is 0 for a finite x, NaN otherwise; so is the sum
-        if self.step_state.iter().fold(0.0, |zero, x| zero + x * 0.0) != 0.0 {
+        if !all_finite(&self.step_state) {
             self.state = State::Error;
-            let x = self.step_state.iter().find(|x| !x.is_finite()).copied();
-            return Err(format!(
-                "step from t = {t} over h = {h} failed: the model state became {}: the parameters or inputs are out of the model's range",
-                x.unwrap_or(f64::NAN)
-            ));
+            return Err(self.state_overflowed(t, h));
         }
         self.step_state_current = true;
         // Inputs as the FMU saw them at the end of the step (u + du·h); the
@@ -645,6 +647,29 @@ impl Instance {
         self.time = t + h;
         self.outputs_dirty = true;
         Ok(fmi2Status::fmi2OK)
+    }
+
+    /// Why [`Instance::do_step`] refused `currentCommunicationPoint` `t`.
+    #[cold]
+    #[inline(never)]
+    fn communication_point_refused(&self, t: f64) -> String {
+        format!(
+            "expected currentCommunicationPoint = {} but was {t} (difference {:e})",
+            self.time,
+            t - self.time
+        )
+    }
+
+    /// Why the step from `t` over `h` failed although the model accepted
+    /// it: its state is no longer finite.
+    #[cold]
+    #[inline(never)]
+    fn state_overflowed(&self, t: f64, h: f64) -> String {
+        let x = self.step_state.iter().find(|x| !x.is_finite()).copied();
+        format!(
+            "step from t = {t} over h = {h} failed: the model state became {}: the parameters or inputs are out of the model's range",
+            x.unwrap_or(f64::NAN)
+        )
     }
 
     // ---- directional derivatives ----------------------------------------
@@ -1060,4 +1085,25 @@ fn advance_inputs(inputs: &[u32], values: &mut Values, slopes: &mut [f64], h: f6
             *s = 0.0;
         }
     }
+}
+
+/// Why [`Instance::do_step`] refused the step size `h`.
+#[cold]
+#[inline(never)]
+fn step_size_refused(h: f64) -> String {
+    format!("communicationStepSize must be finite and > 0 but was {h}")
+}
+
+/// The message of a step the model refused with `why`.
+#[cold]
+#[inline(never)]
+fn step_failed(t: f64, h: f64, why: String) -> String {
+    format!("step from t = {t} over h = {h} failed: {why}")
+}
+
+/// No NaN or infinity in `values`: `x·0` is 0 for every finite `x` and NaN
+/// otherwise, and a sum with a NaN is NaN.
+#[inline]
+fn all_finite(values: &[f64]) -> bool {
+    values.iter().fold(0.0, |zero, x| zero + x * 0.0) == 0.0
 }

@@ -76,6 +76,12 @@ impl Logger {
         self.enabled[category]
     }
 
+    /// Whether calls are logged (category `logCalls`).
+    #[inline]
+    pub fn logs_calls(&self) -> bool {
+        self.enabled[CATEGORY_CALLS]
+    }
+
     pub fn log(&mut self, status: fmi2Status, category: usize, message: &str) {
         if matches!(status, fmi2Status::fmi2Error | fmi2Status::fmi2Fatal) {
             self.last_error = Some(message.to_string());

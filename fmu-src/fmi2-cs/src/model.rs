@@ -58,6 +58,7 @@ pub trait Model: Send {
     /// Whether the layer must keep a copy of the pre-step state so that it can
     /// replay the step for directional derivatives. Models whose
     /// `partial_derivative` covers every output/input pair return `false`.
+    /// Asked once, when the instance is created.
     fn needs_step_replay(&self) -> bool {
         true
     }
