@@ -12,6 +12,7 @@ use crate::logger::Logger;
 use crate::model::Model;
 use crate::serialize::Snapshot;
 use crate::state_machine::State;
+use crate::values::copy_at;
 use crate::variables::{Causality, ModelInfo, VarType, Variable};
 use crate::Values;
 
@@ -840,9 +841,7 @@ impl Instance {
         if scratch.parameters_version == self.parameters_version {
             // the same parameters as last time: only the inputs differ (the
             // outputs are recomputed below)
-            for &vr in &self.inputs {
-                values.set(vr, self.values.real(vr));
-            }
+            values.copy_at(self.values.as_slice(), &self.inputs);
         } else {
             values.copy_from_slice(self.values.as_slice());
             scratch.parameters_version = self.parameters_version;
@@ -922,10 +921,8 @@ impl Instance {
             // A reused snapshot with the same parameters: only the inputs
             // and their slopes can differ (outputs are recomputed after a
             // restore).
-            for &vr in &self.inputs {
-                snap.values[vr as usize] = self.values.real(vr);
-                snap.slopes[vr as usize] = self.slopes[vr as usize];
-            }
+            copy_at(&mut snap.values, self.values.as_slice(), &self.inputs);
+            copy_at(&mut snap.slopes, &self.slopes, &self.inputs);
         } else {
             snap.parameters_version = self.parameters_version;
             snap.values.clear();
@@ -963,10 +960,8 @@ impl Instance {
             if snap.parameters_version == self.parameters_version {
                 // same parameters: only the inputs (and their slopes) differ;
                 // the outputs are recomputed
-                for &vr in &self.inputs {
-                    self.values.set(vr, snap.values[vr as usize]);
-                    self.slopes[vr as usize] = snap.slopes[vr as usize];
-                }
+                self.values.copy_at(&snap.values, &self.inputs);
+                copy_at(&mut self.slopes, &snap.slopes, &self.inputs);
             } else {
                 self.values.copy_from_slice(&snap.values);
                 self.slopes.copy_from_slice(&snap.slopes);

@@ -50,8 +50,25 @@ impl Values {
         self.data.is_empty()
     }
 
+    /// Overwrite the values at `vrs` with those of `from` (the values of
+    /// another instance of the same model).
+    #[inline]
+    pub fn copy_at(&mut self, from: &[f64], vrs: &[u32]) {
+        copy_at(&mut self.data, from, vrs);
+    }
+
     /// Overwrite from a slice of the same length.
     pub fn copy_from_slice(&mut self, data: &[f64]) {
         self.data.copy_from_slice(data);
+    }
+}
+
+/// `to[vr] = from[vr]` for each `vr` of `vrs`: the few entries of a
+/// per-variable array that can differ (the inputs), with both arrays
+/// borrowed once rather than looked up through their owners per entry.
+#[inline]
+pub fn copy_at(to: &mut [f64], from: &[f64], vrs: &[u32]) {
+    for &vr in vrs {
+        to[vr as usize] = from[vr as usize];
     }
 }

@@ -306,6 +306,21 @@ impl Model for LuGreFmu {
         values.set_boolean(vr::SLIDING, self.law.sliding(v, x, fn_));
     }
 
+    /// The outputs asked for only (a directional derivative wants F, and
+    /// need not find out whether the body slides): each as
+    /// [`Model::compute_outputs`] computes it.
+    fn compute_outputs_of(&self, values: &mut Values, outputs: &[u32]) {
+        let (v, x, fn_) = Self::inputs(values);
+        for &output in outputs {
+            match output {
+                vr::F => values.set(vr::F, self.law.force(v, x, fn_)),
+                vr::Z => values.set(vr::Z, self.law.z()),
+                vr::SLIDING => values.set_boolean(vr::SLIDING, self.law.sliding(v, x, fn_)),
+                _ => {}
+            }
+        }
+    }
+
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
         let ramp = |i: u32| Ramp::new(values.real(i), slopes[i as usize]);
         let inputs = LuGreInputs {
