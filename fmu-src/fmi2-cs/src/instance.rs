@@ -603,7 +603,9 @@ impl Instance {
         // self.time is finite
         let scale = self.time.abs();
         let tolerance = TIME_TOLERANCE * if scale > 1.0 { scale } else { 1.0 };
-        if !((t - self.time).abs() <= tolerance) {
+        // (a NaN t is not on time either)
+        let on_time = (t - self.time).abs() <= tolerance;
+        if !on_time {
             return Err(self.communication_point_refused(t));
         }
         let replay = self.needs_step_replay;
