@@ -423,13 +423,14 @@ impl StrongCoupling {
     }
 
     /// Roll component `c` back to its saved state (`fmi2SetFMUstate`).
+    #[inline(always)] // a hot path, and small
     fn restore(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         let state = self.states[c].as_ref().expect("saved before stepping");
         let instance = &mut system.components[c].instance;
-        self.in_saved_state[c] = None;
-        instance.set_state(state)?;
-        self.in_saved_state[c] = Some(instance.changes());
-        Ok(())
+        let restored = instance.set_state(state);
+        // after a failed fmi2SetFMUstate the FMU's state is unknown
+        self.in_saved_state[c] = restored.is_ok().then(|| instance.changes());
+        restored.map(|_| ())
     }
 
     /// Set the inputs `inputs` (connection indices) of one component from
