@@ -38,9 +38,15 @@
 //! Between iterations every component is restored to its state at `t`
 //! (`fmi2GetFMUstate` / `fmi2SetFMUstate`): every FMU must declare
 //! `canGetAndSetFMUstate`, and the first step refuses, naming the instance,
-//! before anything is stepped. An FMU without directional derivatives is
-//! differenced. A step that does not converge is an error carrying the
-//! residual ([`FmuError::NotConverged`]), never accepted. A step converges when
+//! before anything is stepped. Calls that would change nothing are left out
+//! (the FMU's change count, [`crate::fmu::Instance::changes`], tells): a
+//! state is not saved again while the FMU is still in it, and the first
+//! iterate of a step, the last accepted U the FMUs were stepped on, is not
+//! set again while they have seen nothing but getters since.
+//!
+//! An FMU without directional derivatives is differenced. A step that does
+//! not converge is an error carrying the residual
+//! ([`FmuError::NotConverged`]), never accepted. A step converges when
 //! `|R_k| ≤ atol_k + rtol·max(|U_k|, |Y_k|)` for every connection, with
 //! `atol_k = atol·nominal_k` from the input variable's nominal (default 1).
 
