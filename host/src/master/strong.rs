@@ -38,9 +38,15 @@
 //! Between iterations every component is restored to its state at `t`
 //! (`fmi2GetFMUstate` / `fmi2SetFMUstate`): every FMU must declare
 //! `canGetAndSetFMUstate`, and the first step refuses, naming the instance,
-//! before anything is stepped. An FMU without directional derivatives is
-//! differenced. A step that does not converge is an error carrying the
-//! residual ([`FmuError::NotConverged`]), never accepted. A step converges when
+//! before anything is stepped. Calls that would change nothing are left out
+//! (the FMU's change count, [`crate::fmu::Instance::changes`], tells): a
+//! state is not saved again while the FMU is still in it, and the first
+//! iterate of a step, the last accepted U the FMUs were stepped on, is not
+//! set again while they have seen nothing but getters since.
+//!
+//! An FMU without directional derivatives is differenced. A step that does
+//! not converge is an error carrying the residual
+//! ([`FmuError::NotConverged`]), never accepted. A step converges when
 //! `|R_k| ≤ atol_k + rtol·max(|U_k|, |Y_k|)` for every connection, with
 //! `atol_k = atol·nominal_k` from the input variable's nominal (default 1).
 
@@ -164,6 +170,9 @@ struct Ports {
     /// Connections whose output belongs to the component.
     outputs: Vec<usize>,
     output_vrs: Vec<ValueReference>,
+    /// The values of `output_vrs` as last read (one `fmi2GetReal` per
+    /// component instead of one per connection).
+    output_values: Vec<f64>,
     /// Directional derivatives trusted (Auto: decided at the first check).
     directional: Option<bool>,
     /// Why the component is differenced, when that is decided up front.
@@ -199,6 +208,19 @@ pub struct StrongCoupling {
     report: ConvergenceReport,
     ports: Vec<Ports>,
     states: Vec<Option<FmuState>>,
+    /// Per component: its change count ([`crate::fmu::Instance::changes`])
+    /// when its state was last saved into `states` or restored from there.
+    /// While the count stands still, the FMU is in that saved state, and
+    /// saving it again would change nothing (the step after a split, the
+    /// retry of a rejected adaptive step).
+    in_saved_state: Vec<Option<u64>>,
+    /// Per component with held inputs: its change count right after it was
+    /// stepped on `u` in the iteration that converged. While the count
+    /// stands still (nothing but `fmi2Get…` calls since: the recorded
+    /// sample, the state saved), its inputs still hold `u`, which is also
+    /// the first iterate of the next step, and setting them again would
+    /// change nothing.
+    holds_u: Vec<Option<u64>>,
     nominal: Vec<f64>,
     /// The interface values U; between steps, the last accepted ones.
     u: Vec<f64>,
@@ -240,6 +262,8 @@ impl StrongCoupling {
             },
             ports: Vec::new(),
             states: Vec::new(),
+            in_saved_state: Vec::new(),
+            holds_u: Vec::new(),
             nominal: Vec::new(),
             u: Vec::new(),
             started: false,
@@ -340,6 +364,7 @@ impl StrongCoupling {
                         .iter()
                         .map(|&k| system.connections[k].from.1)
                         .collect(),
+                    output_values: vec![0.0; outputs.len()],
                     outputs,
                     directional,
                     differenced,
@@ -364,6 +389,8 @@ impl StrongCoupling {
             })
             .collect();
         self.states = (0..system.components.len()).map(|_| None).collect();
+        self.in_saved_state = vec![None; system.components.len()];
+        self.holds_u = vec![None; system.components.len()];
         self.variable_steps = system.components.iter().all(|c| {
             c.fmu
                 .description()
@@ -382,22 +409,34 @@ impl StrongCoupling {
         Ok(())
     }
 
+    /// Save every component's state at the start of the step into
+    /// `states` (`fmi2GetFMUstate`), unless it is the saved one already.
     fn save_states(&mut self, system: &mut System) -> Result<(), FmuError> {
-        for (c, slot) in system.components.iter_mut().zip(&mut self.states) {
+        let slots = self.states.iter_mut().zip(&mut self.in_saved_state);
+        for (c, (slot, in_saved)) in system.components.iter_mut().zip(slots) {
+            let changes = c.instance.changes();
             match slot {
+                Some(_) if *in_saved == Some(changes) => continue,
                 Some(state) => {
                     c.instance.update_state(state)?;
                 }
                 None => *slot = Some(c.instance.get_state()?),
             }
+            // fmi2GetFMUstate is a getter: the count has not moved
+            *in_saved = Some(c.instance.changes());
         }
         Ok(())
     }
 
-    fn restore(&self, system: &mut System, c: usize) -> Result<(), FmuError> {
+    /// Roll component `c` back to its saved state (`fmi2SetFMUstate`).
+    #[inline(always)] // a hot path, and small
+    fn restore(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         let state = self.states[c].as_ref().expect("saved before stepping");
-        system.components[c].instance.set_state(state)?;
-        Ok(())
+        let instance = &mut system.components[c].instance;
+        let restored = instance.set_state(state);
+        // after a failed fmi2SetFMUstate the FMU's state is unknown
+        self.in_saved_state[c] = restored.is_ok().then(|| instance.changes());
+        restored.map(|_| ())
     }
 
     /// Set the inputs `inputs` (connection indices) of one component from
@@ -424,18 +463,22 @@ impl StrongCoupling {
         Ok(())
     }
 
+    /// Read the connected outputs of component `c` into `out` (one value
+    /// per connection), with one `fmi2GetReal` for all of them.
     fn read_outputs(
         system: &mut System,
         c: usize,
-        ports: &Ports,
+        ports: &mut Ports,
         out: &mut [f64],
     ) -> Result<(), FmuError> {
-        let mut values = [0.0];
-        for &k in &ports.outputs {
-            system.components[c]
-                .instance
-                .get_real(&[system.connections[k].from.1], &mut values)?;
-            out[k] = values[0];
+        if ports.outputs.is_empty() {
+            return Ok(());
+        }
+        system.components[c]
+            .instance
+            .get_real(&ports.output_vrs, &mut ports.output_values)?;
+        for (&k, &y) in ports.outputs.iter().zip(&ports.output_values) {
+            out[k] = y;
         }
         Ok(())
     }
@@ -462,7 +505,7 @@ impl StrongCoupling {
                 system.components[c].instance.do_step(t, h)?;
                 self.report.difference_steps += 1;
                 self.column.clone_from(&self.y);
-                Self::read_outputs(system, c, &self.ports[c], &mut self.column)?;
+                Self::read_outputs(system, c, &mut self.ports[c], &mut self.column)?;
                 for &k in &self.ports[c].outputs {
                     jac[(k, j)] = (self.column[k] - self.y[k]) / delta;
                 }
@@ -702,7 +745,7 @@ impl StrongCoupling {
     fn ensure_started(&mut self, system: &mut System) -> Result<(), FmuError> {
         if !self.started {
             for c in 0..system.components.len() {
-                Self::read_outputs(system, c, &self.ports[c], &mut self.u)?;
+                Self::read_outputs(system, c, &mut self.ports[c], &mut self.u)?;
             }
             self.started = true;
         }
@@ -771,8 +814,14 @@ impl StrongCoupling {
         let mut last_norm = f64::INFINITY;
         for iteration in 1..=self.max_iterations {
             for c in 0..system.components.len() {
+                // (only a converged iteration leaves a mark, for the next step)
+                let holds_u =
+                    self.holds_u[c].take() == Some(system.components[c].instance.changes());
                 if iteration > 1 {
                     self.restore(system, c)?;
+                } else if holds_u {
+                    // the first iterate is the last accepted U, still set
+                    continue;
                 }
                 let ports = &self.ports[c];
                 Self::set_inputs(
@@ -788,7 +837,7 @@ impl StrongCoupling {
                 c.instance.do_step(t, h)?;
             }
             for c in 0..system.components.len() {
-                Self::read_outputs(system, c, &self.ports[c], &mut self.y)?;
+                Self::read_outputs(system, c, &mut self.ports[c], &mut self.y)?;
             }
             worst = (0.0, 0);
             let mut norm = 0.0;
@@ -809,6 +858,16 @@ impl StrongCoupling {
                 self.report.max_iterations = self.report.max_iterations.max(iteration);
                 self.report.histogram[(iteration - 1).min(7)] += 1;
                 self.report.worst_accepted = self.report.worst_accepted.max(worst.0);
+                // Every component was just stepped on U; a ramped one has
+                // moved its inputs along the ramp.
+                for ((mark, ports), component) in self
+                    .holds_u
+                    .iter_mut()
+                    .zip(&self.ports)
+                    .zip(&system.components)
+                {
+                    *mark = (!ports.ramped).then(|| component.instance.changes());
+                }
                 return Ok(());
             }
             if iteration == self.max_iterations {
@@ -835,13 +894,16 @@ impl StrongCoupling {
                     // New base point: the components were just stepped on U.
                     let mut jac = std::mem::replace(&mut self.jac, DMatrix::zeros(0, 0));
                     if jac.shape() == (n, n) {
-                        jac.fill(0.0);
+                        jac.as_mut_slice().fill(0.0);
                     } else {
                         jac = DMatrix::zeros(n, n);
                     }
                     self.jacobian(system, t, h, &mut jac)?;
-                    // (I − J)·ΔU = Y − U
-                    jac.neg_mut();
+                    // (I − J)·ΔU = Y − U (over the slice: the matrix
+                    // iterators cost more than the few entries)
+                    for x in jac.as_mut_slice() {
+                        *x = -*x;
+                    }
                     for k in 0..n {
                         jac[(k, k)] += 1.0;
                         self.direction[k] = self.y[k] - self.u[k];
