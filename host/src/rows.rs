@@ -226,7 +226,7 @@ mod tests {
         assert_eq!(rows.get(3), None);
         let all: Vec<&[f64]> = (&rows).into_iter().collect();
         assert_eq!(all, [&[1.0, 2.0][..], &[3.0, 4.0], &[5.0, 6.0]]);
-        assert_eq!(rows.iter().rev().next(), Some(&[5.0, 6.0][..]));
+        assert_eq!(rows.iter().next_back(), Some(&[5.0, 6.0][..]));
         assert_eq!(rows.iter().len(), 3);
         assert_eq!(rows.column(1).collect::<Vec<_>>(), [2.0, 4.0, 6.0]);
         rows.pop();

@@ -216,3 +216,25 @@ pub fn simulate_with(
         error,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::all_finite;
+
+    #[test]
+    fn all_finite_finds_a_nan_or_infinity_anywhere() {
+        for n in 0..14 {
+            let mut values: Vec<f64> = (0..n).map(|i| i as f64 - 5.5).collect();
+            values.iter_mut().step_by(3).for_each(|x| *x = -0.0);
+            assert!(all_finite(&values), "{values:?}");
+            for k in 0..n {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut v = values.clone();
+                    v[k] = bad;
+                    assert!(!all_finite(&v), "{v:?}");
+                }
+            }
+        }
+        assert!(all_finite(&[f64::MAX, -f64::MAX, f64::MIN_POSITIVE]));
+    }
+}
