@@ -96,14 +96,14 @@ struct Recording {
 const NOT_READ: u64 = u64::MAX;
 
 impl Recording {
-    /// Output `column` of the last row, if component `c` has seen no call
-    /// since it was read that could have changed it.
+    /// Output `column` of `last` (the last row), if component `c` has seen
+    /// no call since it was read that could have changed it.
     #[inline]
-    fn value(&self, component: &Component, c: usize, column: usize) -> Option<f64> {
+    fn value(&self, last: &[f64], component: &Component, c: usize, column: usize) -> Option<f64> {
         if self.changes[c] != component.instance.changes() {
             return None;
         }
-        self.rows.last()?.get(column).copied()
+        last.get(column).copied()
     }
 
     /// Forget the last row's reading: no value is taken from it any more.
@@ -350,11 +350,12 @@ impl System {
     /// `buffer` is room for the values, one per connection.
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
         let recording = &self.recording;
+        let last = recording.rows.last().unwrap_or_default();
         for (slot, source) in buffer.iter_mut().zip(&self.sources) {
             let from = &mut self.components[source.component];
             let known = source
                 .column
-                .and_then(|column| recording.value(from, source.component, column));
+                .and_then(|column| recording.value(last, from, source.component, column));
             *slot = match known {
                 Some(x) => x,
                 None => {
@@ -376,9 +377,9 @@ impl System {
     }
 
     /// Work out, from the components' recorded outputs and the
-    /// connections, what [`System::propagate`] sets and reads; start a new recording if
-    /// the row changed. Called when the system is built and whenever a
-    /// recorded variable is added.
+    /// connections, what [`System::propagate`] sets and where it reads;
+    /// start the recording over if a row is now of another width. Called
+    /// when the system is built and whenever a recorded variable is added.
     fn plan(&mut self) {
         let mut offsets = Vec::with_capacity(self.components.len());
         let mut width = 0;
