@@ -193,7 +193,7 @@ pub fn run_point(
     match run {
         Ok(run) => {
             let n = run.rows.len().max(1) as f64;
-            outcome.last = run.rows.last().cloned().unwrap_or_default();
+            outcome.last = run.rows.last().map(<[f64]>::to_vec).unwrap_or_default();
             // one pass over the rows (each column summed in row order, as
             // column by column would): the rows are read once, not once
             // per column, which on two cores made the sweep wait on memory

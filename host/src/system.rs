@@ -3,6 +3,7 @@
 
 use crate::fmu::model_description::{Causality, VariableKind};
 use crate::fmu::{Fmu, Instance, ValueReference};
+use crate::rows::Rows;
 use crate::FmuError;
 use std::path::Path;
 
@@ -62,51 +63,71 @@ pub struct Connection {
 
 pub struct System {
     pub components: Vec<Component>,
+    /// The connections, fixed when the system is built (what
+    /// [`System::propagate`] does is planned from them then).
     pub connections: Vec<Connection>,
-    /// The last row [`System::sample`] read, for [`System::propagate`].
-    sampled: Sampled,
+    /// The rows [`System::sample`] read, and how [`System::propagate`]
+    /// finds a connected output in the last one.
+    recording: Recording,
+    /// The connections grouped by the component they lead to, in the order
+    /// in which those components first appear in `connections`: one
+    /// `fmi2SetReal` per component sets all its connected inputs.
+    targets: Vec<Target>,
+    /// Where each input of `targets` reads its value, one after the other
+    /// in the same order (one per connection).
+    sources: Vec<Source>,
 }
 
-/// The outputs [`System::sample`] read last: the row, where each
-/// component's outputs start in it, and each component's
-/// [`Instance::changes`] then (`u64::MAX`: nothing read).
-#[derive(Default)]
-struct Sampled {
-    row: Vec<f64>,
-    offsets: Vec<usize>,
+/// What [`System::sample`] has read: one row of every component's
+/// recorded outputs per call, and each component's [`Instance::changes`]
+/// when the last row was read, so that [`System::propagate`] can take an
+/// output from that row instead of asking the FMU again while the
+/// component has seen no call that could have changed it.
+struct Recording {
+    rows: Rows,
+    /// Per component, its [`Instance::changes`] when the last row was read;
+    /// [`NOT_READ`] where the last row cannot be used (none read, or
+    /// discarded).
     changes: Vec<u64>,
-    /// Per connection, where its output was in the component's outputs
-    /// last time (checked before use).
-    positions: Vec<usize>,
 }
 
-impl Sampled {
-    /// Output `vr` of component `c` as sampled, if `c` has seen no call
-    /// since that could have changed it; `k` is the connection it is for.
-    fn value(
-        &mut self,
-        components: &[Component],
-        k: usize,
-        c: usize,
-        vr: ValueReference,
-    ) -> Option<f64> {
-        let component = components.get(c)?;
-        if self.changes.get(c) != Some(&component.instance.changes()) {
+/// In [`Recording::changes`]: the last row is not to be used. A count
+/// that [`Instance::changes`] does not reach (one more per FMI call).
+const NOT_READ: u64 = u64::MAX;
+
+impl Recording {
+    /// Output `column` of `last` (the last row), if component `c` has seen
+    /// no call since it was read that could have changed it.
+    #[inline]
+    fn value(&self, last: &[f64], component: &Component, c: usize, column: usize) -> Option<f64> {
+        if self.changes[c] != component.instance.changes() {
             return None;
         }
-        if self.positions.len() <= k {
-            self.positions.resize(k + 1, 0);
-        }
-        let known = self.positions[k];
-        let i = if component.output_vrs.get(known) == Some(&vr) {
-            known
-        } else {
-            let i = component.output_vrs.iter().position(|v| *v == vr)?;
-            self.positions[k] = i;
-            i
-        };
-        self.row.get(self.offsets.get(c)? + i).copied()
+        last.get(column).copied()
     }
+
+    /// Forget the last row's reading: no value is taken from it any more.
+    fn invalidate(&mut self) {
+        self.changes.fill(NOT_READ);
+    }
+}
+
+/// The connected inputs of one component, for [`System::propagate`].
+struct Target {
+    /// The component the inputs belong to.
+    component: usize,
+    /// Its connected inputs, in connection order; their sources are the
+    /// next `inputs.len()` entries of [`System::sources`].
+    inputs: Vec<ValueReference>,
+}
+
+/// The output a connected input reads.
+struct Source {
+    /// The source component and output.
+    component: usize,
+    output: ValueReference,
+    /// The output's column in a recorded row, if it is recorded.
+    column: Option<usize>,
 }
 
 fn split_port(port: &str) -> Result<(&str, &str), SystemError> {
@@ -195,7 +216,12 @@ impl System {
         let mut system = System {
             components: list,
             connections: Vec::new(),
-            sampled: Sampled::default(),
+            recording: Recording {
+                rows: Rows::new(0),
+                changes: Vec::new(),
+            },
+            targets: Vec::new(),
+            sources: Vec::new(),
         };
         for (from, to) in connections {
             let (fi, fv) = find(&system.components, from)?;
@@ -244,6 +270,7 @@ impl System {
                 label: format!("{from} -> {to}"),
             });
         }
+        system.plan();
         for c in &mut system.components {
             c.instance.setup_experiment(start, None)?;
             c.instance.enter_initialization_mode()?;
@@ -315,28 +342,87 @@ impl System {
         }
     }
 
-    /// Copy every connected output to its input. An output read by the
-    /// last [`System::sample`], of a component that has seen no call since
-    /// that could have changed it, is taken from that row instead of being
-    /// asked for again.
+    /// Copy every connected output to its input: first every value is
+    /// read, then each component's connected inputs are set in one
+    /// `fmi2SetReal`. An output recorded in the last row [`System::sample`]
+    /// read, of a component that has seen no call since that could have
+    /// changed it, is taken from that row instead of being asked for again.
+    /// `buffer` is room for the values, one per connection.
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
-        for (k, c) in self.connections.iter().enumerate() {
-            let (from, vr) = c.from;
-            buffer[k] = match self.sampled.value(&self.components, k, from, vr) {
+        let recording = &self.recording;
+        let last = recording.rows.last().unwrap_or_default();
+        for (slot, source) in buffer.iter_mut().zip(&self.sources) {
+            let from = &mut self.components[source.component];
+            let known = source
+                .column
+                .and_then(|column| recording.value(last, from, source.component, column));
+            *slot = match known {
                 Some(x) => x,
                 None => {
                     let mut x = [0.0];
-                    self.components[from].instance.get_real(&[vr], &mut x)?;
+                    from.instance.get_real(&[source.output], &mut x)?;
                     x[0]
                 }
             };
         }
-        for (k, c) in self.connections.iter().enumerate() {
-            self.components[c.to.0]
+        let mut values = &buffer[..self.sources.len()];
+        for target in &self.targets {
+            let (now, rest) = values.split_at(target.inputs.len());
+            self.components[target.component]
                 .instance
-                .set_real(&[c.to.1], &[buffer[k]])?;
+                .set_real(&target.inputs, now)?;
+            values = rest;
         }
         Ok(())
+    }
+
+    /// Work out, from the components' recorded outputs and the
+    /// connections, what [`System::propagate`] sets and where it reads;
+    /// start the recording over if a row is now of another width. Called
+    /// when the system is built and whenever a recorded variable is added.
+    fn plan(&mut self) {
+        let mut offsets = Vec::with_capacity(self.components.len());
+        let mut width = 0;
+        for c in &self.components {
+            offsets.push(width);
+            width += c.output_vrs.len();
+        }
+        // connection order within each target, targets in order of first
+        // appearance
+        let mut order: Vec<usize> = Vec::new();
+        for connection in &self.connections {
+            if !order.contains(&connection.to.0) {
+                order.push(connection.to.0);
+            }
+        }
+        self.targets.clear();
+        self.sources.clear();
+        for to in order {
+            let mut inputs = Vec::new();
+            for connection in self.connections.iter().filter(|c| c.to.0 == to) {
+                let (from, output) = connection.from;
+                let column = self.components[from]
+                    .output_vrs
+                    .iter()
+                    .position(|vr| *vr == output)
+                    .map(|i| offsets[from] + i);
+                inputs.push(connection.to.1);
+                self.sources.push(Source {
+                    component: from,
+                    output,
+                    column,
+                });
+            }
+            self.targets.push(Target {
+                component: to,
+                inputs,
+            });
+        }
+        let recording = &mut self.recording;
+        recording.changes = vec![NOT_READ; self.components.len()];
+        if recording.rows.width() != width {
+            recording.rows = Rows::new(width);
+        }
     }
 
     /// Record the Real variable `component.variable` too (an input, a
@@ -366,6 +452,7 @@ impl System {
         if !component.outputs.iter().any(|(n, _)| n == v) {
             component.outputs.push((v.to_string(), var.value_reference));
             component.output_vrs.push(var.value_reference);
+            self.plan();
         }
         Ok(())
     }
@@ -403,25 +490,51 @@ impl System {
             .collect()
     }
 
-    /// Append every recorded output to `row`: one `fmi2GetReal` per
-    /// component.
-    pub fn sample(&mut self, row: &mut Vec<f64>) -> Result<(), FmuError> {
-        let start = row.len();
-        let sampled = &mut self.sampled;
-        sampled.offsets.clear();
-        sampled.changes.clear();
-        for c in &mut self.components {
-            let from = row.len();
-            sampled.offsets.push(from - start);
-            row.resize(from + c.output_vrs.len(), 0.0);
-            if let Err(e) = c.instance.get_real(&c.output_vrs, &mut row[from..]) {
-                sampled.changes.clear(); // nothing sampled to reuse
+    /// Start a new recording with room for `rows` rows (the rows read so
+    /// far are dropped).
+    pub fn start_recording(&mut self, rows: usize) {
+        let recording = &mut self.recording;
+        recording.rows = Rows::with_capacity(recording.rows.width(), rows);
+        recording.invalidate();
+    }
+
+    /// Read every recorded output into a new row of the recording, one
+    /// `fmi2GetReal` per component, in [`System::columns`] order. If a
+    /// call fails, no row is added.
+    pub fn sample(&mut self) -> Result<(), FmuError> {
+        let recording = &mut self.recording;
+        let row = recording.rows.push_zeros();
+        let mut from = 0;
+        for (c, changes) in self.components.iter_mut().zip(&mut recording.changes) {
+            let to = from + c.output_vrs.len();
+            if let Err(e) = c.instance.get_real(&c.output_vrs, &mut row[from..to]) {
+                recording.rows.pop();
+                recording.invalidate(); // nothing sampled to reuse
                 return Err(e);
             }
-            sampled.changes.push(c.instance.changes());
+            *changes = c.instance.changes();
+            from = to;
         }
-        sampled.row.clear();
-        sampled.row.extend_from_slice(&row[start..]);
         Ok(())
+    }
+
+    /// The rows read so far: one per [`System::sample`] since the
+    /// recording started.
+    pub fn recorded(&self) -> &Rows {
+        &self.recording.rows
+    }
+
+    /// Drop the last row read (one that is not to be kept, such as a row
+    /// with a NaN); [`System::propagate`] then asks the FMUs again.
+    pub fn discard_last_sample(&mut self) {
+        self.recording.rows.pop();
+        self.recording.invalidate();
+    }
+
+    /// The rows read so far; the recording starts over empty.
+    pub fn take_recording(&mut self) -> Rows {
+        let width = self.recording.rows.width();
+        self.recording.invalidate();
+        std::mem::replace(&mut self.recording.rows, Rows::new(width))
     }
 }

@@ -101,9 +101,10 @@ fn reference(name: &str, step: Option<f64>) -> Run {
         String::from_utf8_lossy(&output.stderr)
     );
     let file = ResultFile::read(&out).unwrap();
-    let rows = (0..file.time.len())
-        .map(|i| file.values.iter().map(|c| c[i]).collect())
-        .collect();
+    let rows = fricsim::master::Rows::from_rows(
+        file.columns.len(),
+        (0..file.time.len()).map(|i| file.values.iter().map(|c| c[i]).collect::<Vec<f64>>()),
+    );
     Run {
         columns: file.columns,
         time: file.time,

@@ -238,9 +238,9 @@ fn run_row(
     let reference = as_result_file(
         "reference",
         Run {
+            rows: fricsim::master::Rows::from_rows(table.columns.len(), &table.rows),
             columns: table.columns,
             time: table.time,
-            rows: table.rows,
             error: None,
         },
     );

@@ -43,7 +43,7 @@ use fricsim::benchmarks::{
     today, FmuStepper, TableFileArgs, FRICTION_FMUS, INCREMENTS,
 };
 use fricsim::fmu::Fmu;
-use fricsim::master::{by_name, simulate_with, step_count, NoObserver};
+use fricsim::master::{by_name, simulate_with, step_count, NoObserver, Rows};
 use fricsim::ssp::{SystemFile, Value};
 use fricsim::sweep::{grid, run_all, Axis, Plan};
 use friction_laws::bristle::{Bristle, BristleParams};
@@ -376,7 +376,7 @@ fn run_one(root: &Path, side: &str, master: &str, stop: f64) -> Result<(), Strin
     Ok(())
 }
 
-fn final_value(columns: &[String], rows: &[Vec<f64>], name: &str) -> Result<f64, String> {
+fn final_value(columns: &[String], rows: &Rows, name: &str) -> Result<f64, String> {
     let k = columns
         .iter()
         .position(|c| c == name)
@@ -499,6 +499,9 @@ fn input_nominal(fmus: &[(String, Fmu)], name: &str, variable: &str) -> f64 {
 /// The stick-slip system as plain Rust: Rig1D (`rig`) and LuGre
 /// (`friction`) with the file's parameter values, `rig.v → friction.v`,
 /// `friction.F → rig.F`.
+/// Columns the monolithic loops record: Rig1D's ten outputs, LuGre's two.
+const RECORDED: usize = 12;
+
 struct StickSlipModel {
     rig: Rig1DParams,
     lugre: LuGreParams,
@@ -559,15 +562,15 @@ impl StickSlipModel {
     }
 
     /// The outputs the FMUs record (Rig1D's ten, LuGre's F and z), one row
-    /// per communication point in the host's format ([`fricsim::master::Run`]),
-    /// so that only the FMI boundary differs between the two loops.
-    fn record(rows: &mut Vec<Vec<f64>>, rig: &Rig1D, lugre: &LuGre, force_in: f64, v_in: f64) {
+    /// per communication point in the host's format ([`fricsim::master::Run`]:
+    /// a [`Rows`] of [`RECORDED`] columns, written in place), so that only
+    /// the FMI boundary differs between the two loops.
+    fn record(rows: &mut Rows, rig: &Rig1D, lugre: &LuGre, force_in: f64, v_in: f64) {
         let u = Rig1DInputs {
             friction: force_in,
             ..Default::default()
         };
-        let mut row = Vec::with_capacity(12);
-        row.extend_from_slice(&[
+        rows.push_zeros().copy_from_slice(&[
             rig.position(&u),
             rig.slip_velocity(),
             rig.acceleration(&u),
@@ -581,7 +584,6 @@ impl StickSlipModel {
             lugre.force(v_in, 0.0, 0.0),
             lugre.z(),
         ]);
-        rows.push(row);
     }
 
     /// Jacobi in one loop: at each communication point the rig's slip
@@ -591,7 +593,7 @@ impl StickSlipModel {
     fn monolithic_jacobi(&self, h: f64, stop: f64) -> (f64, f64, f64) {
         let n = (stop / h).round() as usize;
         let (mut rig, mut lugre) = self.laws();
-        let mut row: Vec<Vec<f64>> = Vec::with_capacity(n + 1);
+        let mut row = Rows::with_capacity(RECORDED, n + 1);
         let (mut v_in, mut force_in) = (0.0, 0.0);
         let wall = timed(|| {
             // as the host: exchange before and after leaving initialization
@@ -633,7 +635,7 @@ impl StickSlipModel {
     fn monolithic_newton(&self, h: f64, stop: f64) -> Result<(f64, f64, f64), String> {
         let n = (stop / h).round() as usize;
         let (mut rig, mut lugre) = self.laws();
-        let mut row: Vec<Vec<f64>> = Vec::with_capacity(n + 1);
+        let mut row = Rows::with_capacity(RECORDED, n + 1);
         let mut iterations = 0usize;
         let mut failure = None;
         let step_rig = |r: &mut Rig1D, force: f64| {

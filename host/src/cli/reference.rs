@@ -11,7 +11,7 @@
 //! from the file's bindings. Systems without a monolithic model are refused
 //! with a message naming the component or connection.
 
-use fricsim::master::{step_count, Run};
+use fricsim::master::{step_count, Rows, Run};
 use fricsim::reference::spec;
 use fricsim::ssp::SystemFile;
 use fricsim_reference::{ReferenceModel, Table, RTOL};
@@ -70,7 +70,7 @@ pub fn run(a: &ReferenceArgs) -> Result<(), String> {
     let run = Run {
         columns: table.columns.clone(),
         time: table.time.clone(),
-        rows: table.rows.clone(),
+        rows: Rows::from_rows(table.columns.len(), &table.rows),
         error: None,
     };
     // The writer of `fricsim run`: the same format to the digit.

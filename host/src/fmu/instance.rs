@@ -172,6 +172,9 @@ pub struct Instance {
     callbacks: ManuallyDrop<Box<fmi2CallbackFunctions>>,
     states: Vec<fmi2FMUstate>,
     fatal: bool,
+    /// `fatal` or a time limit set: every call goes through
+    /// [`Instance::begin_guarded`], the rest skip both checks with one test.
+    guarded: bool,
     /// The time limit on each call, if one is set ([`Instance::set_call_time_limit`]).
     limit: Option<Arc<Watched>>,
     /// Calls made so far that may have changed a value of the instance
@@ -289,6 +292,7 @@ impl Instance {
             callbacks: ManuallyDrop::new(callbacks),
             states: Vec::new(),
             fatal: false,
+            guarded: false,
             limit: None,
             changes: 0,
         })
@@ -317,6 +321,7 @@ impl Instance {
     /// [`super::watchdog`]).
     pub fn set_call_time_limit(&mut self, limit: Option<Duration>) {
         self.limit = limit.map(|l| Watched::new(&self.name, l));
+        self.guarded = self.fatal || self.limit.is_some();
     }
 
     /// Refuse any call after `fmi2Fatal`; otherwise the log mark before the
@@ -327,6 +332,16 @@ impl Instance {
         if !function.starts_with("fmi2Get") {
             self.changes = self.changes.wrapping_add(1);
         }
+        if self.guarded {
+            return self.begin_guarded(function);
+        }
+        Ok(self.sink.mark())
+    }
+
+    /// [`Instance::begin`] after `fmi2Fatal` or under a time limit.
+    #[cold]
+    #[inline(never)]
+    fn begin_guarded(&mut self, function: &'static str) -> Result<u64, FmuError> {
         if self.fatal {
             return Err(FmuError::AfterFatal {
                 function,
@@ -348,7 +363,7 @@ impl Instance {
         mark: u64,
         raw: fmi2Status,
     ) -> Result<Status, FmuError> {
-        if raw == 0 && self.limit.is_none() {
+        if raw == 0 && !self.guarded {
             return Ok(Status::Ok);
         }
         self.finish_checked(function, mark, raw)
@@ -386,6 +401,7 @@ impl Instance {
             status => {
                 if status == Status::Fatal {
                     self.fatal = true;
+                    self.guarded = true;
                 }
                 Err(FmuError::Call {
                     function,
@@ -671,7 +687,7 @@ impl Instance {
         let mark = self.begin(F)?;
         // SAFETY: plain values.
         let raw = unsafe { (self.functions.do_step)(self.component, t, h, fmi2False) };
-        if raw == 0 && self.limit.is_none() {
+        if raw == 0 && !self.guarded {
             return Ok(Status::Ok);
         }
         let mut result = self.finish_checked(F, mark, raw);

@@ -4,6 +4,7 @@ pub mod gauss_seidel;
 pub mod jacobi;
 pub mod strong;
 
+pub use crate::rows::Rows;
 use crate::system::System;
 use crate::FmuError;
 
@@ -68,7 +69,8 @@ pub fn by_name(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
 pub struct Run {
     pub columns: Vec<String>,
     pub time: Vec<f64>,
-    pub rows: Vec<Vec<f64>>,
+    /// `rows[i][k]`: column `k` at `time[i]`.
+    pub rows: Rows,
     pub error: Option<String>,
 }
 
@@ -175,16 +177,11 @@ pub fn simulate_with(
     system.propagate(&mut buffer)?;
     let columns = system.columns();
     let n = step_count(start, h, stop);
-    let mut run = Run {
-        columns,
-        time: Vec::with_capacity(n + 1),
-        rows: Vec::with_capacity(n + 1),
-        error: None,
-    };
-    let mut row = Vec::with_capacity(run.columns.len());
-    system.sample(&mut row)?;
-    run.time.push(start);
-    run.rows.push(row);
+    let mut time = Vec::with_capacity(n + 1);
+    system.start_recording(n + 1);
+    system.sample()?;
+    time.push(start);
+    let mut error = None;
     for i in 0..n {
         let t = start + i as f64 * h;
         let t_next = start + (i + 1) as f64 * h;
@@ -192,23 +189,52 @@ pub fn simulate_with(
             .before_step(system, t, false)
             .and_then(|()| master.step(system, t, t_next - t));
         if let Err(e) = stepped {
-            run.error = Some(format!("at t = {t}: {e}"));
+            error = Some(format!("at t = {t}: {e}"));
             break;
         }
-        let mut row = Vec::with_capacity(run.columns.len());
-        if let Err(e) = system.sample(&mut row) {
-            run.error = Some(format!("at t = {t_next}: {e}"));
+        if let Err(e) = system.sample() {
+            error = Some(format!("at t = {t_next}: {e}"));
             break;
         }
-        // the usual case first: a full row of numbers
-        let whole = row.len() == run.columns.len() && all_finite(&row);
-        if let Some(e) = (!whole).then(|| non_finite(system, &row)).flatten() {
-            run.error = Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
+        // the usual case first: a row of numbers
+        let row = system.recorded().last().unwrap_or_default();
+        if let Some(e) = (!all_finite(row))
+            .then(|| non_finite(system, row))
+            .flatten()
+        {
+            error = Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
+            system.discard_last_sample();
             break;
         }
-        run.time.push(t_next);
-        run.rows.push(row);
+        time.push(t_next);
         observer.after_step(i + 1, n);
     }
-    Ok(run)
+    Ok(Run {
+        columns,
+        time,
+        rows: system.take_recording(),
+        error,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::all_finite;
+
+    #[test]
+    fn all_finite_finds_a_nan_or_infinity_anywhere() {
+        for n in 0..14 {
+            let mut values: Vec<f64> = (0..n).map(|i| i as f64 - 5.5).collect();
+            values.iter_mut().step_by(3).for_each(|x| *x = -0.0);
+            assert!(all_finite(&values), "{values:?}");
+            for k in 0..n {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut v = values.clone();
+                    v[k] = bad;
+                    assert!(!all_finite(&v), "{v:?}");
+                }
+            }
+        }
+        assert!(all_finite(&[f64::MAX, -f64::MAX, f64::MIN_POSITIVE]));
+    }
 }
