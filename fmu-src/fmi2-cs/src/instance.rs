@@ -77,7 +77,7 @@ pub struct Instance {
     /// The last list of value references [`Instance::get`] found valid for
     /// type `.0`, and whether it holds an output (`.2`): a master reads the
     /// same list at every step, and comparing it is cheaper than checking
-    /// it again when it is long.
+    /// it again (lists of [`Instance::REMEMBERED`] or more values).
     checked_get: (VarType, Vec<u32>, bool),
 }
 
@@ -307,52 +307,39 @@ impl Instance {
     // ---- get / set ------------------------------------------------------
 
     /// Read values of type `t` into `out` (already checked: same length).
-    #[inline]
+    /// Inlined into `fmi2GetReal` (one function frame less per call); the
+    /// check of a list of value references is out of line.
+    #[inline(always)]
     pub fn get(&mut self, t: VarType, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
-        /// Shorter lists are checked as fast as compared.
-        const REMEMBERED: usize = 4;
-        let want = type_flag(t);
         let outputs = if let [vr] = vrs {
             // one value (a master reading a connected output)
             let f = self.flags.get(*vr as usize).copied().unwrap_or(0);
-            if f & want == 0 {
+            if f & type_flag(t) == 0 {
                 self.variable_of_type(*vr, t)?;
             }
             f & flag::OUTPUT != 0
-        } else if vrs.len() >= REMEMBERED && self.checked_get.0 == t && self.checked_get.1 == vrs {
+        } else if vrs.len() >= Self::REMEMBERED
+            && self.checked_get.0 == t
+            && self.checked_get.1 == vrs
+        {
             self.checked_get.2
         } else {
-            // One flag byte per value reference: known, of type `t`, an output?
-            let mut wrong = false;
-            let mut flags = 0;
-            for &vr in vrs {
-                let f = self.flags.get(vr as usize).copied().unwrap_or(0);
-                wrong |= f & want == 0;
-                flags |= f;
-            }
-            if wrong {
-                for vr in vrs {
-                    self.variable_of_type(*vr, t)?;
-                }
-            }
-            let outputs = flags & flag::OUTPUT != 0;
-            if vrs.len() >= REMEMBERED {
-                let remembered = &mut self.checked_get;
-                remembered.0 = t;
-                remembered.1.clear();
-                remembered.1.extend_from_slice(vrs);
-                remembered.2 = outputs;
-            }
-            outputs
+            self.check_get(t, vrs)?
         };
         if outputs {
             self.ensure_outputs()?;
         }
         let data = self.values.as_slice();
+        debug_assert_eq!(data.len(), self.flags.len());
         // x·0 is 0 for a finite x, NaN otherwise; so is the sum
         let mut zero = 0.0;
         for (o, &vr) in out.iter_mut().zip(vrs) {
-            let x = data[vr as usize];
+            // SAFETY: every vr was found in `flags` above (a known value
+            // reference: `flags.get(vr)` had the type bit, and a list in
+            // `checked_get` passed `check_get`), and `values` has one entry
+            // per variable, as `flags` (both built from `info.variables`;
+            // reset and restore keep the length).
+            let x = unsafe { *data.get_unchecked(vr as usize) };
             *o = x;
             zero += x * 0.0;
         }
@@ -361,6 +348,39 @@ impl Instance {
         } else {
             self.check_finite(vrs, out, "")
         }
+    }
+
+    /// Lists at least this long that [`Instance::get`] found valid are
+    /// remembered: comparing is cheaper than checking again.
+    const REMEMBERED: usize = 2;
+
+    /// Check a list of value references of [`Instance::get`] (known, of type
+    /// `t`) and remember it; whether it holds an output.
+    #[inline(never)]
+    fn check_get(&mut self, t: VarType, vrs: &[u32]) -> Result<bool, String> {
+        // One flag byte per value reference: known, of type `t`, an output?
+        let want = type_flag(t);
+        let mut wrong = false;
+        let mut flags = 0;
+        for &vr in vrs {
+            let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+            wrong |= f & want == 0;
+            flags |= f;
+        }
+        if wrong {
+            for vr in vrs {
+                self.variable_of_type(*vr, t)?;
+            }
+        }
+        let outputs = flags & flag::OUTPUT != 0;
+        if vrs.len() >= Self::REMEMBERED {
+            let remembered = &mut self.checked_get;
+            remembered.0 = t;
+            remembered.1.clear();
+            remembered.1.extend_from_slice(vrs);
+            remembered.2 = outputs;
+        }
+        Ok(outputs)
     }
 
     /// Values handed to the importer with `fmi2OK` are never NaN or
