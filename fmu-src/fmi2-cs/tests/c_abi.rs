@@ -498,6 +498,49 @@ fn state_round_trip_and_corruption() {
 }
 
 #[test]
+fn state_keeps_input_slopes() {
+    // A state taken with an input slope restores it (in memory and
+    // serialized); the same handle reused for a state without slopes
+    // restores none, though it held one before.
+    let c = initialized("slopes");
+    set(c, U, 1.0);
+    unsafe {
+        let (vr, order, slope) = (U, 1, 2.0);
+        assert_eq!(fmi2SetRealInputDerivatives(c, &vr, 1, &order, &slope), OK);
+        let mut s: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        let mut size = 0;
+        assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
+        let mut bytes = vec![0 as c_char; size];
+        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        let sloped = get(c, Y);
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), sloped.to_bits());
+        let mut d: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut d), OK);
+        assert_eq!(fmi2SetFMUstate(c, d), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), sloped.to_bits());
+        // after the step the slope is spent: the reused handle holds none
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        assert_eq!(fmi2DoStep(c, 0.1, 0.1, 0), OK);
+        let held = get(c, Y);
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        assert_eq!(fmi2DoStep(c, 0.1, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), held.to_bits());
+        // and the handle that had a slope restores it over a state without
+        assert_eq!(fmi2SetFMUstate(c, d), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), sloped.to_bits());
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), OK);
+        assert_eq!(fmi2FreeFMUstate(c, &mut d), OK);
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
 fn directional_derivative_of_the_last_step() {
     // y(t+h) = k*u + s + u*h  ⇒  ∂y/∂u over the step = k + h
     let c = initialized("jac");
