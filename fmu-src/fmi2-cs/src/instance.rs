@@ -69,6 +69,8 @@ pub struct Instance {
     /// The model's [`Model::needs_step_replay`], asked once (a property of
     /// the model, not of its state).
     needs_step_replay: bool,
+    /// The model's [`Model::supplies_partial_derivatives`], asked once.
+    supplies_partial_derivatives: bool,
     /// Per value reference, what the hot paths check ([`flag`]): the type,
     /// the causality, when it may be set. One byte per variable, so that a
     /// get or set validates its value references with one load each; the
@@ -125,8 +127,13 @@ struct Scratch {
     values: Option<Values>,
     /// The parameter version `values` holds the parameters of.
     parameters_version: u64,
+    /// A copy of the model, made after its last `initialize`, on which
+    /// the last step is replayed: the instance's own model keeps its state,
+    /// so it need not be saved and put back around the replays. (The copy
+    /// starts each replay with `restore_state`, which restores the complete
+    /// state; `initialize` drops it, as the parameters may have changed.)
+    model: Option<Box<dyn Model>>,
     slopes: Vec<f64>,
-    model_state: Vec<f64>,
     plus: Vec<f64>,
 }
 
@@ -163,6 +170,7 @@ impl Instance {
         let values = Values::from_start(info.variables);
         let n = values.len();
         let needs_step_replay = model.needs_step_replay();
+        let supplies_partial_derivatives = model.supplies_partial_derivatives();
         let inputs: Vec<u32> = info
             .variables
             .iter()
@@ -196,14 +204,15 @@ impl Instance {
             scratch: Scratch {
                 values: None,
                 parameters_version: u64::MAX,
+                model: None,
                 slopes: Vec::new(),
-                model_state: Vec::new(),
                 plus: Vec::new(),
             },
             saved_states: Vec::new(),
             step_state: Vec::new(),
             step_state_current: false,
             needs_step_replay,
+            supplies_partial_derivatives,
             flags: info.variables.iter().map(flags_of).collect(),
             checked_get: (VarType::Real, Vec::new(), false),
         }
@@ -260,7 +269,7 @@ impl Instance {
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), String> {
         self.step_state_current = false;
-        self.model.initialize(&self.values)?;
+        self.initialize_model()?;
         self.model.compute_outputs(&mut self.values);
         self.outputs_dirty = false;
         self.initialized = true;
@@ -290,18 +299,34 @@ impl Instance {
         Ok(())
     }
 
+    /// [`Model::initialize`] with the current values; the replay copy of the
+    /// model ([`Scratch::model`]) is dropped with the old parameters.
+    fn initialize_model(&mut self) -> Result<(), String> {
+        self.scratch.model = None;
+        self.model.initialize(&self.values)
+    }
+
     /// Recompute the outputs if an input or parameter changed since the last
     /// computation. In initialization mode this validates the parameters.
+    #[inline(always)]
     fn ensure_outputs(&mut self) -> Result<(), String> {
         if self.outputs_dirty {
             if !self.initialized {
-                self.step_state_current = false;
-                self.model.initialize(&self.values)?;
+                self.initialize_for_outputs()?;
             }
             self.model.compute_outputs(&mut self.values);
             self.outputs_dirty = false;
         }
         Ok(())
+    }
+
+    /// The initialization part of [`Instance::ensure_outputs`] (before
+    /// `fmi2ExitInitializationMode` only).
+    #[cold]
+    #[inline(never)]
+    fn initialize_for_outputs(&mut self) -> Result<(), String> {
+        self.step_state_current = false;
+        self.initialize_model()
     }
 
     // ---- get / set ------------------------------------------------------
@@ -784,21 +809,9 @@ impl Instance {
     ) -> Result<(), String> {
         // Analytic where the model provides every entry (written as it
         // goes: the differences below overwrite every entry otherwise).
-        let mut analytic = true;
-        'rows: for (out, u) in dv_unknown.iter_mut().zip(unknowns) {
-            let mut acc = 0.0;
-            for (k, dv) in knowns.iter().zip(dv_known) {
-                match self.model.partial_derivative(&self.values, *u, *k) {
-                    Some(d) => acc += d * dv,
-                    None => {
-                        analytic = false;
-                        break 'rows;
-                    }
-                }
-            }
-            *out = acc;
-        }
-        if analytic {
+        if self.supplies_partial_derivatives
+            && self.analytic(unknowns, knowns, dv_known, dv_unknown)
+        {
             return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
         }
 
@@ -816,33 +829,12 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
-        // After a step, both replays start from the saved pre-step state;
-        // the state now is put back once, after both: kept since the step
-        // if the model has not left it, else saved here.
-        let replaying = self.replay.valid;
-        let kept = self.step_state_current;
-        if replaying && !kept {
-            let current = &mut self.scratch.model_state;
-            current.clear();
-            self.model.save_state(current);
-        }
         let mut plus = std::mem::take(&mut self.scratch.plus);
         plus.resize(unknowns.len(), 0.0);
         let result = self
             .perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus)
             .and_then(|()| self.perturbed_outputs(knowns, dv_known, -eps, unknowns, dv_unknown));
         self.scratch.plus = plus;
-        if replaying {
-            let back = if kept {
-                &self.step_state
-            } else {
-                &self.scratch.model_state
-            };
-            if let Err(e) = self.model.restore_state(back) {
-                self.step_state_current = false;
-                return Err(e);
-            }
-        }
         result?;
         for (d, p) in dv_unknown.iter_mut().zip(&self.scratch.plus) {
             *d = (p - *d) / (2.0 * eps);
@@ -850,11 +842,35 @@ impl Instance {
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }
 
+    /// `dv_unknown = J · dv_known` from the model's own partial derivatives,
+    /// if it supplies every entry (else `false`, `dv_unknown` partly
+    /// written).
+    #[inline(never)]
+    fn analytic(
+        &self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> bool {
+        for (out, u) in dv_unknown.iter_mut().zip(unknowns) {
+            let mut acc = 0.0;
+            for (k, dv) in knowns.iter().zip(dv_known) {
+                match self.model.partial_derivative(&self.values, *u, *k) {
+                    Some(d) => acc += d * dv,
+                    None => return false,
+                }
+            }
+            *out = acc;
+        }
+        true
+    }
+
     /// The outputs `unknowns` into `out` with the inputs `knowns` moved by
     /// `eps·dv`: after a step, the step replayed from its saved start on
-    /// the model itself (the caller puts its current state back), else the
-    /// outputs at the current state. No allocation: the scratch buffers
-    /// are reused.
+    /// the replay copy of the model ([`Scratch::model`]; the instance's
+    /// model is not touched), else the outputs at the current state. No
+    /// allocation once the scratch buffers and the copy exist.
     fn perturbed_outputs(
         &mut self,
         knowns: &[u32],
@@ -890,16 +906,18 @@ impl Instance {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            let replayed = self
+            let model = scratch
                 .model
+                .get_or_insert_with(|| self.model.clone_model());
+            let replayed = model
                 .restore_state(&self.replay.model_state)
-                .and_then(|()| self.model.do_step(values, slopes, self.replay.h));
+                .and_then(|()| model.do_step(values, slopes, self.replay.h));
             if !held {
                 // the inputs at the end of the step; every slope zero again
                 advance_inputs(&self.inputs, values, slopes, self.replay.h);
             }
             if replayed.is_ok() {
-                self.model.compute_outputs_of(values, unknowns);
+                model.compute_outputs_of(values, unknowns);
             }
             replayed?;
         } else {
@@ -1006,14 +1024,13 @@ impl Instance {
             self.parameters_version += 1;
             if snap.initialized {
                 let result = self
-                    .model
-                    .initialize(&self.values)
+                    .initialize_model()
                     .and_then(|_| self.model.restore_state(&snap.model_state));
                 if let Err(e) = result {
                     // Lose nothing: put the previous values and model back.
                     self.values = previous;
                     if self.initialized {
-                        let _ = self.model.initialize(&self.values);
+                        let _ = self.initialize_model();
                     }
                     return Err(format!("cannot restore the FMU state: {e}"));
                 }

@@ -570,6 +570,39 @@ fn directional_derivative_of_the_last_step() {
 }
 
 #[test]
+fn directional_derivative_follows_new_parameters() {
+    // The step is replayed on a copy of the model: after a reset with
+    // another gain the copy must have the new one (∂y/∂u = k + h).
+    let c = initialized("jac-k");
+    let (unknown, known, seed) = (Y, U, 1.0);
+    let mut d = 0.0;
+    unsafe {
+        for k in [2.0, 3.0] {
+            if k != 2.0 {
+                assert_eq!(fmi2Reset(c), OK);
+                assert_eq!(set(c, K, k), OK);
+                assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+                assert_eq!(fmi2EnterInitializationMode(c), OK);
+                assert_eq!(fmi2ExitInitializationMode(c), OK);
+            }
+            set(c, U, 0.7);
+            assert_eq!(fmi2DoStep(c, 0.0, 0.25, 0), OK);
+            let y = get(c, Y);
+            assert_eq!(
+                fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, &mut d),
+                OK
+            );
+            assert!((d - (k + 0.25)).abs() < 1e-8, "k = {k}: {d}");
+            // the instance's own model kept its state
+            assert_eq!(get(c, Y).to_bits(), y.to_bits());
+            assert_eq!(fmi2DoStep(c, 0.25, 0.25, 0), OK);
+            assert!((get(c, Y) - (k * 0.7 + 0.7 * 0.5)).abs() < 1e-12);
+        }
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
 fn logging_categories() {
     let cb = Box::leak(Box::new(callbacks()));
     let c = unsafe {
