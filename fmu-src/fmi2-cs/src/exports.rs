@@ -102,9 +102,14 @@ pub unsafe fn call_allowed(
         // No instance, so no logger to report to: the status says it.
         return fmi2Status::fmi2Error;
     }
-    // SAFETY: c is a live instance created by Box::into_raw in `instantiate`.
-    let instance = unsafe { &mut *(c as *mut Instance) };
-    let outcome = catch_unwind(AssertUnwindSafe(|| {
+    let instance = c as *mut Instance;
+    // (a `move` closure: `function` and the pointer are captured by value,
+    // not through a stack slot written at every call)
+    let outcome = catch_unwind(AssertUnwindSafe(move || {
+        // SAFETY: c is a live instance created by Box::into_raw in
+        // `instantiate`; this is the only reference to it until the
+        // closure returns or unwinds.
+        let instance = unsafe { &mut *instance };
         // The step loop's case in two tests: the state allows the call and
         // call logging is off; everything else is out of line.
         if allowed & instance.state as u32 == 0 {
@@ -119,6 +124,8 @@ pub unsafe fn call_allowed(
         }
     }));
     outcome.unwrap_or_else(|payload| {
+        // SAFETY: as above; the closure's reference ended with the unwind.
+        let instance = unsafe { &mut *instance };
         let message = panic_message(&*payload);
         let _ = catch_unwind(AssertUnwindSafe(|| {
             instance.state = State::Fatal;

@@ -69,6 +69,8 @@ pub struct Instance {
     /// The model's [`Model::needs_step_replay`], asked once (a property of
     /// the model, not of its state).
     needs_step_replay: bool,
+    /// The model's [`Model::supplies_partial_derivatives`], asked once.
+    supplies_partial_derivatives: bool,
     /// Per value reference, what the hot paths check ([`flag`]): the type,
     /// the causality, when it may be set. One byte per variable, so that a
     /// get or set validates its value references with one load each; the
@@ -77,7 +79,7 @@ pub struct Instance {
     /// The last list of value references [`Instance::get`] found valid for
     /// type `.0`, and whether it holds an output (`.2`): a master reads the
     /// same list at every step, and comparing it is cheaper than checking
-    /// it again when it is long.
+    /// it again (lists of [`Instance::REMEMBERED`] or more values).
     checked_get: (VarType, Vec<u32>, bool),
 }
 
@@ -125,8 +127,13 @@ struct Scratch {
     values: Option<Values>,
     /// The parameter version `values` holds the parameters of.
     parameters_version: u64,
+    /// A copy of the model, made after its last `initialize`, on which
+    /// the last step is replayed: the instance's own model keeps its state,
+    /// so it need not be saved and put back around the replays. (The copy
+    /// starts each replay with `restore_state`, which restores the complete
+    /// state; `initialize` drops it, as the parameters may have changed.)
+    model: Option<Box<dyn Model>>,
     slopes: Vec<f64>,
-    model_state: Vec<f64>,
     plus: Vec<f64>,
 }
 
@@ -163,6 +170,7 @@ impl Instance {
         let values = Values::from_start(info.variables);
         let n = values.len();
         let needs_step_replay = model.needs_step_replay();
+        let supplies_partial_derivatives = model.supplies_partial_derivatives();
         let inputs: Vec<u32> = info
             .variables
             .iter()
@@ -196,14 +204,15 @@ impl Instance {
             scratch: Scratch {
                 values: None,
                 parameters_version: u64::MAX,
+                model: None,
                 slopes: Vec::new(),
-                model_state: Vec::new(),
                 plus: Vec::new(),
             },
             saved_states: Vec::new(),
             step_state: Vec::new(),
             step_state_current: false,
             needs_step_replay,
+            supplies_partial_derivatives,
             flags: info.variables.iter().map(flags_of).collect(),
             checked_get: (VarType::Real, Vec::new(), false),
         }
@@ -260,7 +269,7 @@ impl Instance {
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), String> {
         self.step_state_current = false;
-        self.model.initialize(&self.values)?;
+        self.initialize_model()?;
         self.model.compute_outputs(&mut self.values);
         self.outputs_dirty = false;
         self.initialized = true;
@@ -290,13 +299,20 @@ impl Instance {
         Ok(())
     }
 
+    /// [`Model::initialize`] with the current values; the replay copy of the
+    /// model ([`Scratch::model`]) is dropped with the old parameters.
+    fn initialize_model(&mut self) -> Result<(), String> {
+        self.scratch.model = None;
+        self.model.initialize(&self.values)
+    }
+
     /// Recompute the outputs if an input or parameter changed since the last
     /// computation. In initialization mode this validates the parameters.
+    #[inline(always)]
     fn ensure_outputs(&mut self) -> Result<(), String> {
         if self.outputs_dirty {
             if !self.initialized {
-                self.step_state_current = false;
-                self.model.initialize(&self.values)?;
+                self.initialize_for_outputs()?;
             }
             self.model.compute_outputs(&mut self.values);
             self.outputs_dirty = false;
@@ -304,55 +320,51 @@ impl Instance {
         Ok(())
     }
 
+    /// The initialization part of [`Instance::ensure_outputs`] (before
+    /// `fmi2ExitInitializationMode` only).
+    #[cold]
+    #[inline(never)]
+    fn initialize_for_outputs(&mut self) -> Result<(), String> {
+        self.step_state_current = false;
+        self.initialize_model()
+    }
+
     // ---- get / set ------------------------------------------------------
 
     /// Read values of type `t` into `out` (already checked: same length).
-    #[inline]
+    /// Inlined into `fmi2GetReal` (one function frame less per call); the
+    /// check of a list of value references is out of line.
+    #[inline(always)]
     pub fn get(&mut self, t: VarType, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
-        /// Shorter lists are checked as fast as compared.
-        const REMEMBERED: usize = 4;
-        let want = type_flag(t);
         let outputs = if let [vr] = vrs {
             // one value (a master reading a connected output)
             let f = self.flags.get(*vr as usize).copied().unwrap_or(0);
-            if f & want == 0 {
+            if f & type_flag(t) == 0 {
                 self.variable_of_type(*vr, t)?;
             }
             f & flag::OUTPUT != 0
-        } else if vrs.len() >= REMEMBERED && self.checked_get.0 == t && self.checked_get.1 == vrs {
+        } else if vrs.len() >= Self::REMEMBERED
+            && self.checked_get.0 == t
+            && self.checked_get.1 == vrs
+        {
             self.checked_get.2
         } else {
-            // One flag byte per value reference: known, of type `t`, an output?
-            let mut wrong = false;
-            let mut flags = 0;
-            for &vr in vrs {
-                let f = self.flags.get(vr as usize).copied().unwrap_or(0);
-                wrong |= f & want == 0;
-                flags |= f;
-            }
-            if wrong {
-                for vr in vrs {
-                    self.variable_of_type(*vr, t)?;
-                }
-            }
-            let outputs = flags & flag::OUTPUT != 0;
-            if vrs.len() >= REMEMBERED {
-                let remembered = &mut self.checked_get;
-                remembered.0 = t;
-                remembered.1.clear();
-                remembered.1.extend_from_slice(vrs);
-                remembered.2 = outputs;
-            }
-            outputs
+            self.check_get(t, vrs)?
         };
         if outputs {
             self.ensure_outputs()?;
         }
         let data = self.values.as_slice();
+        debug_assert_eq!(data.len(), self.flags.len());
         // x·0 is 0 for a finite x, NaN otherwise; so is the sum
         let mut zero = 0.0;
         for (o, &vr) in out.iter_mut().zip(vrs) {
-            let x = data[vr as usize];
+            // SAFETY: every vr was found in `flags` above (a known value
+            // reference: `flags.get(vr)` had the type bit, and a list in
+            // `checked_get` passed `check_get`), and `values` has one entry
+            // per variable, as `flags` (both built from `info.variables`;
+            // reset and restore keep the length).
+            let x = unsafe { *data.get_unchecked(vr as usize) };
             *o = x;
             zero += x * 0.0;
         }
@@ -361,6 +373,39 @@ impl Instance {
         } else {
             self.check_finite(vrs, out, "")
         }
+    }
+
+    /// Lists at least this long that [`Instance::get`] found valid are
+    /// remembered: comparing is cheaper than checking again.
+    const REMEMBERED: usize = 2;
+
+    /// Check a list of value references of [`Instance::get`] (known, of type
+    /// `t`) and remember it; whether it holds an output.
+    #[inline(never)]
+    fn check_get(&mut self, t: VarType, vrs: &[u32]) -> Result<bool, String> {
+        // One flag byte per value reference: known, of type `t`, an output?
+        let want = type_flag(t);
+        let mut wrong = false;
+        let mut flags = 0;
+        for &vr in vrs {
+            let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+            wrong |= f & want == 0;
+            flags |= f;
+        }
+        if wrong {
+            for vr in vrs {
+                self.variable_of_type(*vr, t)?;
+            }
+        }
+        let outputs = flags & flag::OUTPUT != 0;
+        if vrs.len() >= Self::REMEMBERED {
+            let remembered = &mut self.checked_get;
+            remembered.0 = t;
+            remembered.1.clear();
+            remembered.1.extend_from_slice(vrs);
+            remembered.2 = outputs;
+        }
+        Ok(outputs)
     }
 
     /// Values handed to the importer with `fmi2OK` are never NaN or
@@ -401,6 +446,8 @@ impl Instance {
 
     /// [`Instance::set`] of one value (a master sets an input per
     /// connection): the same checks and effects, without the loops.
+    /// Inlined into `fmi2SetReal`: one function frame less per call.
+    #[inline(always)]
     fn set_one(&mut self, t: VarType, vr: u32, value: f64) -> Result<(), String> {
         let (in_step_mode, want) = self.settable(t);
         let f = self.flags.get(vr as usize).copied().unwrap_or(0);
@@ -421,6 +468,7 @@ impl Instance {
         Ok(())
     }
 
+    #[inline(never)]
     fn set_many(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         // The usual case in one pass over the flag bytes: known, of type
         // `t`, settable now, finite; the inputs get the model's own check.
@@ -479,6 +527,8 @@ impl Instance {
 
     /// Every check of [`Instance::set`], value by value, with the message
     /// of the first that fails.
+    #[cold]
+    #[inline(never)]
     fn check_set(
         &self,
         t: VarType,
@@ -759,21 +809,9 @@ impl Instance {
     ) -> Result<(), String> {
         // Analytic where the model provides every entry (written as it
         // goes: the differences below overwrite every entry otherwise).
-        let mut analytic = true;
-        'rows: for (out, u) in dv_unknown.iter_mut().zip(unknowns) {
-            let mut acc = 0.0;
-            for (k, dv) in knowns.iter().zip(dv_known) {
-                match self.model.partial_derivative(&self.values, *u, *k) {
-                    Some(d) => acc += d * dv,
-                    None => {
-                        analytic = false;
-                        break 'rows;
-                    }
-                }
-            }
-            *out = acc;
-        }
-        if analytic {
+        if self.supplies_partial_derivatives
+            && self.analytic(unknowns, knowns, dv_known, dv_unknown)
+        {
             return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
         }
 
@@ -791,33 +829,12 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
-        // After a step, both replays start from the saved pre-step state;
-        // the state now is put back once, after both: kept since the step
-        // if the model has not left it, else saved here.
-        let replaying = self.replay.valid;
-        let kept = self.step_state_current;
-        if replaying && !kept {
-            let current = &mut self.scratch.model_state;
-            current.clear();
-            self.model.save_state(current);
-        }
         let mut plus = std::mem::take(&mut self.scratch.plus);
         plus.resize(unknowns.len(), 0.0);
         let result = self
             .perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus)
             .and_then(|()| self.perturbed_outputs(knowns, dv_known, -eps, unknowns, dv_unknown));
         self.scratch.plus = plus;
-        if replaying {
-            let back = if kept {
-                &self.step_state
-            } else {
-                &self.scratch.model_state
-            };
-            if let Err(e) = self.model.restore_state(back) {
-                self.step_state_current = false;
-                return Err(e);
-            }
-        }
         result?;
         for (d, p) in dv_unknown.iter_mut().zip(&self.scratch.plus) {
             *d = (p - *d) / (2.0 * eps);
@@ -825,11 +842,35 @@ impl Instance {
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }
 
+    /// `dv_unknown = J · dv_known` from the model's own partial derivatives,
+    /// if it supplies every entry (else `false`, `dv_unknown` partly
+    /// written).
+    #[inline(never)]
+    fn analytic(
+        &self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> bool {
+        for (out, u) in dv_unknown.iter_mut().zip(unknowns) {
+            let mut acc = 0.0;
+            for (k, dv) in knowns.iter().zip(dv_known) {
+                match self.model.partial_derivative(&self.values, *u, *k) {
+                    Some(d) => acc += d * dv,
+                    None => return false,
+                }
+            }
+            *out = acc;
+        }
+        true
+    }
+
     /// The outputs `unknowns` into `out` with the inputs `knowns` moved by
     /// `eps·dv`: after a step, the step replayed from its saved start on
-    /// the model itself (the caller puts its current state back), else the
-    /// outputs at the current state. No allocation: the scratch buffers
-    /// are reused.
+    /// the replay copy of the model ([`Scratch::model`]; the instance's
+    /// model is not touched), else the outputs at the current state. No
+    /// allocation once the scratch buffers and the copy exist.
     fn perturbed_outputs(
         &mut self,
         knowns: &[u32],
@@ -865,16 +906,18 @@ impl Instance {
             for (k, d) in knowns.iter().zip(dv) {
                 values.set(*k, values.real(*k) + eps * d);
             }
-            let replayed = self
+            let model = scratch
                 .model
+                .get_or_insert_with(|| self.model.clone_model());
+            let replayed = model
                 .restore_state(&self.replay.model_state)
-                .and_then(|()| self.model.do_step(values, slopes, self.replay.h));
+                .and_then(|()| model.do_step(values, slopes, self.replay.h));
             if !held {
                 // the inputs at the end of the step; every slope zero again
                 advance_inputs(&self.inputs, values, slopes, self.replay.h);
             }
             if replayed.is_ok() {
-                self.model.compute_outputs_of(values, unknowns);
+                model.compute_outputs_of(values, unknowns);
             }
             replayed?;
         } else {
@@ -893,12 +936,13 @@ impl Instance {
 
     pub fn snapshot(&mut self) -> Result<Snapshot, String> {
         let mut snap = Snapshot {
-            guid: String::new(),
+            guid: self.info.guid,
             state: self.state,
             initialized: false,
             time: 0.0,
             values: Vec::new(),
             slopes: Vec::new(),
+            sloped: false,
             model_state: Vec::new(),
             parameters_version: u64::MAX,
         };
@@ -910,9 +954,7 @@ impl Instance {
     /// allocation when it held a state of this instance before).
     pub fn snapshot_into(&mut self, snap: &mut Snapshot) -> Result<(), String> {
         self.ensure_outputs()?;
-        if snap.guid != self.info.guid {
-            snap.guid = self.info.guid.to_string();
-        }
+        snap.guid = self.info.guid;
         snap.state = self.state;
         snap.initialized = self.initialized;
         snap.time = self.time;
@@ -922,9 +964,11 @@ impl Instance {
         {
             // A reused snapshot with the same parameters: only the inputs
             // and their slopes can differ (outputs are recomputed after a
-            // restore).
+            // restore), the slopes not if both sides have none.
             copy_at(&mut snap.values, self.values.as_slice(), &self.inputs);
-            copy_at(&mut snap.slopes, &self.slopes, &self.inputs);
+            if self.sloped || snap.sloped {
+                copy_at(&mut snap.slopes, &self.slopes, &self.inputs);
+            }
         } else {
             snap.parameters_version = self.parameters_version;
             snap.values.clear();
@@ -932,6 +976,7 @@ impl Instance {
             snap.slopes.clear();
             snap.slopes.extend_from_slice(&self.slopes);
         }
+        snap.sloped = self.sloped;
         snap.model_state.clear();
         if self.initialized {
             self.model.save_state(&mut snap.model_state);
@@ -941,7 +986,10 @@ impl Instance {
 
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
         self.step_state_current = false;
-        if snap.guid != self.info.guid || snap.values.len() != self.values.len() {
+        // (the GUID is our own `info.guid` for every snapshot this library
+        // made or read: the address compares equal, the text is the fallback)
+        let same_guid = std::ptr::eq(snap.guid, self.info.guid) || snap.guid == self.info.guid;
+        if !same_guid || snap.values.len() != self.values.len() {
             return Err(format!(
                 "the FMU state belongs to GUID {}, not this FMU ({})",
                 snap.guid, self.info.guid
@@ -960,10 +1008,12 @@ impl Instance {
                 .restore_state(&snap.model_state)
                 .map_err(|e| format!("cannot restore the FMU state: {e}"))?;
             if snap.parameters_version == self.parameters_version {
-                // same parameters: only the inputs (and their slopes) differ;
-                // the outputs are recomputed
+                // same parameters: only the inputs (and their slopes, unless
+                // neither side has any) differ; the outputs are recomputed
                 self.values.copy_at(&snap.values, &self.inputs);
-                copy_at(&mut self.slopes, &snap.slopes, &self.inputs);
+                if self.sloped || snap.sloped {
+                    copy_at(&mut self.slopes, &snap.slopes, &self.inputs);
+                }
             } else {
                 self.values.copy_from_slice(&snap.values);
                 self.slopes.copy_from_slice(&snap.slopes);
@@ -974,25 +1024,20 @@ impl Instance {
             self.parameters_version += 1;
             if snap.initialized {
                 let result = self
-                    .model
-                    .initialize(&self.values)
+                    .initialize_model()
                     .and_then(|_| self.model.restore_state(&snap.model_state));
                 if let Err(e) = result {
                     // Lose nothing: put the previous values and model back.
                     self.values = previous;
                     if self.initialized {
-                        let _ = self.model.initialize(&self.values);
+                        let _ = self.initialize_model();
                     }
                     return Err(format!("cannot restore the FMU state: {e}"));
                 }
             }
             self.slopes.copy_from_slice(&snap.slopes);
         }
-        // only inputs have slopes
-        self.sloped = self
-            .inputs
-            .iter()
-            .any(|&vr| self.slopes[vr as usize] != 0.0);
+        self.sloped = snap.sloped;
         self.initialized = snap.initialized;
         self.time = snap.time;
         self.state = snap.state;

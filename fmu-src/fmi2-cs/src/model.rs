@@ -55,6 +55,14 @@ pub trait Model: Send {
         None
     }
 
+    /// Whether `partial_derivative` may answer `Some` at all: a model whose
+    /// `partial_derivative` is the default returns `false`, and the layer
+    /// differentiates without asking it per entry. Asked once, when the
+    /// instance is created.
+    fn supplies_partial_derivatives(&self) -> bool {
+        true
+    }
+
     /// Whether the layer must keep a copy of the pre-step state so that it can
     /// replay the step for directional derivatives. Models whose
     /// `partial_derivative` covers every output/input pair return `false`.

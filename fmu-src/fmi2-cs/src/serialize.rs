@@ -15,12 +15,17 @@ const FORMAT_VERSION: u32 = 1;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Snapshot {
-    pub guid: String,
+    /// The model's GUID (`ModelInfo::guid` itself: compared by address
+    /// first).
+    pub guid: &'static str,
     pub state: State,
     pub initialized: bool,
     pub time: f64,
     pub values: Vec<f64>,
     pub slopes: Vec<f64>,
+    /// Whether a slope in `slopes` may be non-zero (false: all are zero,
+    /// and a copy of them can be skipped). Not serialized.
+    pub sloped: bool,
     pub model_state: Vec<f64>,
     /// The instance's parameter version when taken
     /// ([`crate::instance::Instance`]: unchanged means no parameter was set
@@ -63,7 +68,11 @@ impl Snapshot {
 
     /// Parse and check a serialized state for the model with `guid` and
     /// `n_values` variables.
-    pub fn from_bytes(bytes: &[u8], guid: &str, n_values: usize) -> Result<Snapshot, String> {
+    pub fn from_bytes(
+        bytes: &[u8],
+        guid: &'static str,
+        n_values: usize,
+    ) -> Result<Snapshot, String> {
         if bytes.len() < MAGIC.len() + 8 {
             return Err(format!(
                 "serialized state is {} bytes, too short to be one",
@@ -95,8 +104,7 @@ impl Snapshot {
         }
         let guid_len = r.u32()? as usize;
         let stored_guid = std::str::from_utf8(r.take(guid_len)?)
-            .map_err(|_| "serialized state GUID is not UTF-8".to_string())?
-            .to_string();
+            .map_err(|_| "serialized state GUID is not UTF-8".to_string())?;
         if stored_guid != guid {
             return Err(format!(
                 "serialized state belongs to the FMU with GUID {stored_guid}, not {guid}"
@@ -134,11 +142,12 @@ impl Snapshot {
             ));
         }
         Ok(Snapshot {
-            guid: stored_guid,
+            guid,
             state,
             initialized,
             time,
             values,
+            sloped: slopes.iter().any(|s| *s != 0.0),
             slopes,
             model_state,
             parameters_version: u64::MAX,
@@ -201,12 +210,13 @@ mod tests {
 
     fn sample() -> Snapshot {
         Snapshot {
-            guid: "{g}".into(),
+            guid: "{g}",
             state: State::StepComplete,
             initialized: true,
             time: 1.5,
             values: vec![1.0, 2.0, f64::MIN_POSITIVE],
             slopes: vec![0.0, 0.5, 0.0],
+            sloped: true,
             model_state: vec![3.0, -4.0],
             parameters_version: u64::MAX,
         }

@@ -498,6 +498,49 @@ fn state_round_trip_and_corruption() {
 }
 
 #[test]
+fn state_keeps_input_slopes() {
+    // A state taken with an input slope restores it (in memory and
+    // serialized); the same handle reused for a state without slopes
+    // restores none, though it held one before.
+    let c = initialized("slopes");
+    set(c, U, 1.0);
+    unsafe {
+        let (vr, order, slope) = (U, 1, 2.0);
+        assert_eq!(fmi2SetRealInputDerivatives(c, &vr, 1, &order, &slope), OK);
+        let mut s: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        let mut size = 0;
+        assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
+        let mut bytes = vec![0 as c_char; size];
+        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        let sloped = get(c, Y);
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), sloped.to_bits());
+        let mut d: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut d), OK);
+        assert_eq!(fmi2SetFMUstate(c, d), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), sloped.to_bits());
+        // after the step the slope is spent: the reused handle holds none
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        assert_eq!(fmi2DoStep(c, 0.1, 0.1, 0), OK);
+        let held = get(c, Y);
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        assert_eq!(fmi2DoStep(c, 0.1, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), held.to_bits());
+        // and the handle that had a slope restores it over a state without
+        assert_eq!(fmi2SetFMUstate(c, d), OK);
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), sloped.to_bits());
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), OK);
+        assert_eq!(fmi2FreeFMUstate(c, &mut d), OK);
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
 fn directional_derivative_of_the_last_step() {
     // y(t+h) = k*u + s + u*h  ⇒  ∂y/∂u over the step = k + h
     let c = initialized("jac");
@@ -522,6 +565,39 @@ fn directional_derivative_of_the_last_step() {
             ERR
         );
         last_error_containing("is not an output");
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
+fn directional_derivative_follows_new_parameters() {
+    // The step is replayed on a copy of the model: after a reset with
+    // another gain the copy must have the new one (∂y/∂u = k + h).
+    let c = initialized("jac-k");
+    let (unknown, known, seed) = (Y, U, 1.0);
+    let mut d = 0.0;
+    unsafe {
+        for k in [2.0, 3.0] {
+            if k != 2.0 {
+                assert_eq!(fmi2Reset(c), OK);
+                assert_eq!(set(c, K, k), OK);
+                assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+                assert_eq!(fmi2EnterInitializationMode(c), OK);
+                assert_eq!(fmi2ExitInitializationMode(c), OK);
+            }
+            set(c, U, 0.7);
+            assert_eq!(fmi2DoStep(c, 0.0, 0.25, 0), OK);
+            let y = get(c, Y);
+            assert_eq!(
+                fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, &mut d),
+                OK
+            );
+            assert!((d - (k + 0.25)).abs() < 1e-8, "k = {k}: {d}");
+            // the instance's own model kept its state
+            assert_eq!(get(c, Y).to_bits(), y.to_bits());
+            assert_eq!(fmi2DoStep(c, 0.25, 0.25, 0), OK);
+            assert!((get(c, Y) - (k * 0.7 + 0.7 * 0.5)).abs() < 1e-12);
+        }
         fmi2FreeInstance(c);
     }
 }

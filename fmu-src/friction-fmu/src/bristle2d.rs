@@ -172,6 +172,11 @@ impl Model for Bristle2DFmu {
 
     fmi2_cs::delegate_state!(law);
 
+    /// Directional derivatives by replaying the step: no partial derivatives.
+    fn supplies_partial_derivatives(&self) -> bool {
+        false
+    }
+
     fn output_derivative(&self, values: &Values, _slopes: &[f64], output: u32) -> Option<f64> {
         let z_dot = self.law.z_dot([values.real(vr::V1), values.real(vr::V2)]);
         match output {

@@ -124,6 +124,11 @@ impl Model for DahlFmu {
 
     fmi2_cs::delegate_state!(law);
 
+    /// Directional derivatives by replaying the step: no partial derivatives.
+    fn supplies_partial_derivatives(&self) -> bool {
+        false
+    }
+
     /// dF/dt = (dF/dx)·v (seed 001 eq. 3); dz/dt = (dF/dt)/σ.
     fn output_derivative(&self, values: &Values, _slopes: &[f64], output: u32) -> Option<f64> {
         let p = self.law.params();

@@ -334,6 +334,11 @@ impl Model for LuGreFmu {
 
     fmi2_cs::delegate_state!(law);
 
+    /// Directional derivatives by replaying the step: no partial derivatives.
+    fn supplies_partial_derivatives(&self) -> bool {
+        false
+    }
+
     /// dz/dt from the state equation; dF/dt = σ0·ż + σ1·z̈ + σ2·v̇ with
     /// z̈ = v̇ − σ0·d(|v|·z/g)/dt, for constant σ1 and x, Fn at rest (the
     /// general case is not offered: `None`).

@@ -121,6 +121,11 @@ impl Model for ResetFmu {
 
     fmi2_cs::delegate_state!(law);
 
+    /// Directional derivatives by replaying the step: no partial derivatives.
+    fn supplies_partial_derivatives(&self) -> bool {
+        false
+    }
+
     /// Inside the stiction range ż = v, so dF/dt = (1 + a)·σ0·v + σ1·dv/dt;
     /// at the limit moving outward ż = 0 and F is constant.
     fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {

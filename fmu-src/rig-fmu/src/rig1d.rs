@@ -534,6 +534,11 @@ impl Model for Rig1DFmu {
     }
 
     fmi2_cs::delegate_state!(rig);
+
+    /// Directional derivatives by replaying the step: no partial derivatives.
+    fn supplies_partial_derivatives(&self) -> bool {
+        false
+    }
 }
 
 #[cfg(test)]

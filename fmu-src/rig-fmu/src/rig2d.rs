@@ -306,4 +306,9 @@ impl Model for Rig2DFmu {
     }
 
     fmi2_cs::delegate_state!(rig);
+
+    /// Directional derivatives by replaying the step: no partial derivatives.
+    fn supplies_partial_derivatives(&self) -> bool {
+        false
+    }
 }
