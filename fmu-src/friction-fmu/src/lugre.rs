@@ -272,7 +272,20 @@ impl LuGreFmu {
     }
 
     fn inputs(values: &Values) -> (f64, f64, f64) {
-        (values.real(vr::V), values.real(vr::X), values.real(vr::FN))
+        let [v, x, fn_] = Self::input_entries(values.as_slice());
+        (v, x, fn_)
+    }
+
+    /// The entries of v, x and Fn in a table indexed by value reference
+    /// (the values, or their slopes): the inputs are value references
+    /// 0, 1, 2, so one length check covers the three.
+    #[inline]
+    fn input_entries(table: &[f64]) -> [f64; 3] {
+        const _: () = assert!(vr::V == 0 && vr::X == 1 && vr::FN == 2);
+        match table {
+            [v, x, fn_, ..] => [*v, *x, *fn_],
+            _ => unreachable!("a value table holds every variable"),
+        }
     }
 }
 
@@ -322,11 +335,12 @@ impl Model for LuGreFmu {
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        let ramp = |i: u32| Ramp::new(values.real(i), slopes[i as usize]);
+        let [v, x, fn_] = Self::input_entries(values.as_slice());
+        let [dv, dx, dfn] = Self::input_entries(slopes);
         let inputs = LuGreInputs {
-            v: ramp(vr::V),
-            x: ramp(vr::X),
-            fn_: ramp(vr::FN),
+            v: Ramp::new(v, dv),
+            x: Ramp::new(x, dx),
+            fn_: Ramp::new(fn_, dfn),
         };
         self.law.step(&inputs, h);
         Ok(())

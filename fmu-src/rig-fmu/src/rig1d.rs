@@ -445,7 +445,7 @@ impl Rig1DFmu {
     #[inline(never)]
     fn output(&self, v: &Values, output: u32) -> Option<f64> {
         let rig = &self.rig;
-        let u = || inputs(|r| v.real(r));
+        let u = || inputs(v.as_slice());
         Some(match output {
             vr::X => rig.position(&u()),
             vr::V => rig.slip_velocity(),
@@ -462,14 +462,24 @@ impl Rig1DFmu {
     }
 }
 
-/// The rig's inputs read from `values` (or their slopes from `slopes`).
-fn inputs(at: impl Fn(u32) -> f64) -> Rig1DInputs {
+/// The rig's inputs read from a table indexed by value reference (the
+/// values, or their slopes). The inputs are value references 0, 1 and
+/// 15..=17, so one length check covers the five.
+#[inline]
+fn inputs(table: &[f64]) -> Rig1DInputs {
+    const LAST: usize = vr::V_REF as usize;
+    const _: () = assert!(
+        vr::F as usize <= LAST && vr::F_EXT as usize <= LAST && vr::X_ACT_IN as usize <= LAST
+    );
+    let Some(t) = table.get(..=LAST) else {
+        unreachable!("a value table holds every variable")
+    };
     Rig1DInputs {
-        friction: at(vr::F),
-        f_ext: at(vr::F_EXT),
-        x_act: at(vr::X_ACT_IN),
-        x_ref: at(vr::X_REF),
-        v_ref: at(vr::V_REF),
+        friction: t[vr::F as usize],
+        f_ext: t[vr::F_EXT as usize],
+        x_act: t[vr::X_ACT_IN as usize],
+        x_ref: t[vr::X_REF as usize],
+        v_ref: t[vr::V_REF as usize],
     }
 }
 
@@ -484,7 +494,7 @@ impl Model for Rig1DFmu {
     }
 
     fn compute_outputs(&self, v: &mut Values) {
-        let u = inputs(|r| v.real(r));
+        let u = inputs(v.as_slice());
         let rig = &self.rig;
         v.set(vr::X, rig.position(&u));
         v.set(vr::V, rig.slip_velocity());
@@ -509,8 +519,8 @@ impl Model for Rig1DFmu {
     }
 
     fn do_step(&mut self, v: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        let u = inputs(|r| v.real(r));
-        let du = inputs(|r| slopes[r as usize]);
+        let u = inputs(v.as_slice());
+        let du = inputs(slopes);
         self.rig.step(&u, &du, h);
         Ok(())
     }
@@ -518,8 +528,8 @@ impl Model for Rig1DFmu {
     /// dx/dt, dx_rel/dt, dx_act/dt, dF_drive/dt always; dv/dt and
     /// dv_body/dt when m > 0 (the quasi-static velocity has no rate here).
     fn output_derivative(&self, v: &Values, slopes: &[f64], output: u32) -> Option<f64> {
-        let u = inputs(|r| v.real(r));
-        let du = inputs(|r| slopes[r as usize]);
+        let u = inputs(v.as_slice());
+        let du = inputs(slopes);
         let rig = &self.rig;
         let massive = rig.params().m > 0.0;
         match output {
