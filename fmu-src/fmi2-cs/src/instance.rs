@@ -831,9 +831,7 @@ impl Instance {
         }
         let mut plus = std::mem::take(&mut self.scratch.plus);
         plus.resize(unknowns.len(), 0.0);
-        let result = self
-            .perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus)
-            .and_then(|()| self.perturbed_outputs(knowns, dv_known, -eps, unknowns, dv_unknown));
+        let result = self.perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus, dv_unknown);
         self.scratch.plus = plus;
         result?;
         for (d, p) in dv_unknown.iter_mut().zip(&self.scratch.plus) {
@@ -866,18 +864,21 @@ impl Instance {
         true
     }
 
-    /// The outputs `unknowns` into `out` with the inputs `knowns` moved by
-    /// `eps·dv`: after a step, the step replayed from its saved start on
-    /// the replay copy of the model ([`Scratch::model`]; the instance's
-    /// model is not touched), else the outputs at the current state. No
-    /// allocation once the scratch buffers and the copy exist.
+    /// The outputs `unknowns` with the inputs `knowns` moved by `eps·dv`
+    /// into `plus` and by `-eps·dv` into `minus`: after a step, the step
+    /// replayed from its saved start on the replay copy of the model
+    /// ([`Scratch::model`]; the instance's model is not touched), else the
+    /// outputs at the current state. The scratch values are brought to the
+    /// instance's once for both. No allocation once the scratch buffers and
+    /// the copy exist.
     fn perturbed_outputs(
         &mut self,
         knowns: &[u32],
         dv: &[f64],
         eps: f64,
         unknowns: &[u32],
-        out: &mut [f64],
+        plus: &mut [f64],
+        minus: &mut [f64],
     ) -> Result<(), String> {
         let scratch = &mut self.scratch;
         let values = scratch.values.get_or_insert_with(|| self.values.clone());
@@ -889,26 +890,44 @@ impl Instance {
             values.copy_from_slice(self.values.as_slice());
             scratch.parameters_version = self.parameters_version;
         }
-        if self.replay.valid {
-            // Every slope is zero between calls; those of the inputs are set
-            // here when the step had any (and zero again when done). Held
-            // inputs: the values now (set above) are the values before the
-            // step.
-            let slopes = &mut scratch.slopes;
-            slopes.resize(self.slopes.len(), 0.0);
-            let held = self.replay.held;
-            if !held {
+        // Each pass sets the knowns from the unperturbed inputs (the
+        // instance's, or the replayed step's): the models write outputs
+        // only, so the other inputs stay as set above.
+        let passes = [(eps, plus), (-eps, minus)];
+        if !self.replay.valid {
+            for (eps, out) in passes {
+                for (&k, d) in knowns.iter().zip(dv) {
+                    values.set(k, self.values.real(k) + eps * d);
+                }
+                self.model.compute_outputs_of(values, unknowns);
+                read_outputs(values, unknowns, out);
+            }
+            return Ok(());
+        }
+        // Every slope is zero between calls; those of the inputs are set
+        // here when the step had any (and zero again when done). Held
+        // inputs: the values now (set above) are the values before the
+        // step.
+        let slopes = &mut scratch.slopes;
+        slopes.resize(self.slopes.len(), 0.0);
+        let held = self.replay.held;
+        let model = scratch
+            .model
+            .get_or_insert_with(|| self.model.clone_model());
+        for (eps, out) in passes {
+            if held {
+                for (&k, d) in knowns.iter().zip(dv) {
+                    values.set(k, self.values.real(k) + eps * d);
+                }
+            } else {
                 for (k, &vr) in self.inputs.iter().enumerate() {
                     values.set(vr, self.replay.inputs[k]);
                     slopes[vr as usize] = self.replay.slopes[k];
                 }
+                for (&k, d) in knowns.iter().zip(dv) {
+                    values.set(k, values.real(k) + eps * d);
+                }
             }
-            for (k, d) in knowns.iter().zip(dv) {
-                values.set(*k, values.real(*k) + eps * d);
-            }
-            let model = scratch
-                .model
-                .get_or_insert_with(|| self.model.clone_model());
             let replayed = model
                 .restore_state(&self.replay.model_state)
                 .and_then(|()| model.do_step(values, slopes, self.replay.h));
@@ -916,18 +935,9 @@ impl Instance {
                 // the inputs at the end of the step; every slope zero again
                 advance_inputs(&self.inputs, values, slopes, self.replay.h);
             }
-            if replayed.is_ok() {
-                model.compute_outputs_of(values, unknowns);
-            }
             replayed?;
-        } else {
-            for (k, d) in knowns.iter().zip(dv) {
-                values.set(*k, values.real(*k) + eps * d);
-            }
-            self.model.compute_outputs_of(values, unknowns);
-        }
-        for (o, u) in out.iter_mut().zip(unknowns) {
-            *o = values.real(*u);
+            model.compute_outputs_of(values, unknowns);
+            read_outputs(values, unknowns, out);
         }
         Ok(())
     }
@@ -1126,6 +1136,14 @@ fn advance_inputs(inputs: &[u32], values: &mut Values, slopes: &mut [f64], h: f6
             values.set(vr, values.real(vr) + *s * h);
             *s = 0.0;
         }
+    }
+}
+
+/// `out[i] = values[unknowns[i]]`.
+#[inline]
+fn read_outputs(values: &Values, unknowns: &[u32], out: &mut [f64]) {
+    for (o, &u) in out.iter_mut().zip(unknowns) {
+        *o = values.real(u);
     }
 }
 

@@ -26,12 +26,15 @@ pub trait Model: Send {
         Ok(())
     }
 
-    /// Write every output into `values` from the state and the current inputs.
+    /// Write every output into `values` from the state and the current
+    /// inputs, and nothing else: the layer keeps inputs and parameters in
+    /// `values` across calls.
     fn compute_outputs(&self, values: &mut Values);
 
     /// Write at least the outputs `outputs` (value references of outputs)
     /// into `values`, for directional derivatives, which need only these;
-    /// the others may be left as they are. By default every output.
+    /// the other outputs may be left as they are, inputs and parameters
+    /// must be. By default every output.
     fn compute_outputs_of(&self, values: &mut Values, outputs: &[u32]) {
         let _ = outputs;
         self.compute_outputs(values);
