@@ -134,7 +134,6 @@ struct Scratch {
     /// state; `initialize` drops it, as the parameters may have changed.)
     model: Option<Box<dyn Model>>,
     slopes: Vec<f64>,
-    plus: Vec<f64>,
 }
 
 struct Replay {
@@ -206,7 +205,6 @@ impl Instance {
                 parameters_version: u64::MAX,
                 model: None,
                 slopes: Vec::new(),
-                plus: Vec::new(),
             },
             saved_states: Vec::new(),
             step_state: Vec::new(),
@@ -829,14 +827,7 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
-        let mut plus = std::mem::take(&mut self.scratch.plus);
-        plus.resize(unknowns.len(), 0.0);
-        let result = self.perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus, dv_unknown);
-        self.scratch.plus = plus;
-        result?;
-        for (d, p) in dv_unknown.iter_mut().zip(&self.scratch.plus) {
-            *d = (p - *d) / (2.0 * eps);
-        }
+        self.central_differences(knowns, dv_known, eps, unknowns, dv_unknown)?;
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }
 
@@ -864,21 +855,21 @@ impl Instance {
         true
     }
 
-    /// The outputs `unknowns` with the inputs `knowns` moved by `eps·dv`
-    /// into `plus` and by `-eps·dv` into `minus`: after a step, the step
+    /// `out = (y(u + eps·dv) - y(u - eps·dv)) / (2·eps)` for the outputs
+    /// `unknowns` and the inputs `knowns`: after a step, with the step
     /// replayed from its saved start on the replay copy of the model
-    /// ([`Scratch::model`]; the instance's model is not touched), else the
-    /// outputs at the current state. The scratch values are brought to the
-    /// instance's once for both. No allocation once the scratch buffers and
+    /// ([`Scratch::model`]; the instance's model is not touched), else at
+    /// the current state. The scratch values are brought to the instance's
+    /// once for both evaluations, and `out` holds the first until the
+    /// second is subtracted. No allocation once the scratch buffers and
     /// the copy exist.
-    fn perturbed_outputs(
+    fn central_differences(
         &mut self,
         knowns: &[u32],
         dv: &[f64],
         eps: f64,
         unknowns: &[u32],
-        plus: &mut [f64],
-        minus: &mut [f64],
+        out: &mut [f64],
     ) -> Result<(), String> {
         let scratch = &mut self.scratch;
         let values = scratch.values.get_or_insert_with(|| self.values.clone());
@@ -893,14 +884,14 @@ impl Instance {
         // Each pass sets the knowns from the unperturbed inputs (the
         // instance's, or the replayed step's): the models write outputs
         // only, so the other inputs stay as set above.
-        let passes = [(eps, plus), (-eps, minus)];
+        let passes = [eps, -eps];
         if !self.replay.valid {
-            for (eps, out) in passes {
+            for (pass, eps) in passes.into_iter().enumerate() {
                 for (&k, d) in knowns.iter().zip(dv) {
                     values.set(k, self.values.real(k) + eps * d);
                 }
                 self.model.compute_outputs_of(values, unknowns);
-                read_outputs(values, unknowns, out);
+                difference(pass, eps, values, unknowns, out);
             }
             return Ok(());
         }
@@ -914,7 +905,7 @@ impl Instance {
         let model = scratch
             .model
             .get_or_insert_with(|| self.model.clone_model());
-        for (eps, out) in passes {
+        for (pass, eps) in passes.into_iter().enumerate() {
             if held {
                 for (&k, d) in knowns.iter().zip(dv) {
                     values.set(k, self.values.real(k) + eps * d);
@@ -937,7 +928,7 @@ impl Instance {
             }
             replayed?;
             model.compute_outputs_of(values, unknowns);
-            read_outputs(values, unknowns, out);
+            difference(pass, eps, values, unknowns, out);
         }
         Ok(())
     }
@@ -1139,11 +1130,18 @@ fn advance_inputs(inputs: &[u32], values: &mut Values, slopes: &mut [f64], h: f6
     }
 }
 
-/// `out[i] = values[unknowns[i]]`.
-#[inline]
-fn read_outputs(values: &Values, unknowns: &[u32], out: &mut [f64]) {
+/// Evaluation `pass` of [`Instance::central_differences`], with `values`
+/// at `u + e·dv`: the first (`e = ε`) keeps `y₊` in `out`, the second
+/// (`e = -ε`, so `-2·e` is exactly `2·ε`) turns it into `(y₊ - y₋) / (2·ε)`.
+#[inline(always)]
+fn difference(pass: usize, eps: f64, values: &Values, unknowns: &[u32], out: &mut [f64]) {
     for (o, &u) in out.iter_mut().zip(unknowns) {
-        *o = values.real(u);
+        let y = values.real(u);
+        *o = if pass == 0 {
+            y
+        } else {
+            (*o - y) / (-2.0 * eps)
+        };
     }
 }
 
