@@ -985,8 +985,47 @@ impl Instance {
         Ok(())
     }
 
+    /// Restore `snap` (one of this instance's saved states): all or nothing.
+    /// Inlined into `restore_saved`, the other cases out of line.
+    #[inline]
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
         self.step_state_current = false;
+        if self.initialized
+            && snap.initialized
+            && snap.parameters_version == self.parameters_version
+        {
+            // The usual rollback of a master: a state this instance took
+            // since its parameters last changed (only those carry its
+            // current parameter version; a deserialized one has u64::MAX),
+            // so of this model, with the same sizes, and the GUID and
+            // parameter checks of `restore_other` would pass. The model
+            // takes the state or refuses it unchanged, then only the inputs
+            // (and their slopes, unless neither side has any) differ; the
+            // outputs are recomputed.
+            self.model
+                .restore_state(&snap.model_state)
+                .map_err(state_refused)?;
+            self.values.copy_at(&snap.values, &self.inputs);
+            if self.sloped || snap.sloped {
+                copy_at(&mut self.slopes, &snap.slopes, &self.inputs);
+            }
+        } else {
+            self.restore_other(snap)?;
+        }
+        self.sloped = snap.sloped;
+        self.initialized = snap.initialized;
+        self.time = snap.time;
+        self.state = snap.state;
+        self.replay.valid = false;
+        self.outputs_dirty = true;
+        Ok(())
+    }
+
+    /// The model state and values of [`Instance::restore`] for any other
+    /// snapshot: deserialized, taken before a parameter was set, or before
+    /// initialization.
+    #[inline(never)]
+    fn restore_other(&mut self, snap: &Snapshot) -> Result<(), String> {
         // (the GUID is our own `info.guid` for every snapshot this library
         // made or read: the address compares equal, the text is the fallback)
         let same_guid = std::ptr::eq(snap.guid, self.info.guid) || snap.guid == self.info.guid;
@@ -997,28 +1036,15 @@ impl Instance {
             ));
         }
         let same_parameters = self.initialized
-            && (snap.parameters_version == self.parameters_version
-                || self.info.variables.iter().all(|v| {
-                    v.causality != Causality::Parameter
-                        || self.values.real(v.vr) == snap.values[v.vr as usize]
-                }));
+            && self.info.variables.iter().all(|v| {
+                v.causality != Causality::Parameter
+                    || self.values.real(v.vr) == snap.values[v.vr as usize]
+            });
         if snap.initialized && same_parameters {
-            // The usual rollback of a master: the model takes the state or
-            // refuses it unchanged, then the values follow.
             self.model
                 .restore_state(&snap.model_state)
-                .map_err(|e| format!("cannot restore the FMU state: {e}"))?;
-            if snap.parameters_version == self.parameters_version {
-                // same parameters: only the inputs (and their slopes, unless
-                // neither side has any) differ; the outputs are recomputed
-                self.values.copy_at(&snap.values, &self.inputs);
-                if self.sloped || snap.sloped {
-                    copy_at(&mut self.slopes, &snap.slopes, &self.inputs);
-                }
-            } else {
-                self.values.copy_from_slice(&snap.values);
-                self.slopes.copy_from_slice(&snap.slopes);
-            }
+                .map_err(state_refused)?;
+            self.values.copy_from_slice(&snap.values);
         } else {
             let previous = self.values.clone();
             self.values.copy_from_slice(&snap.values);
@@ -1033,17 +1059,11 @@ impl Instance {
                     if self.initialized {
                         let _ = self.initialize_model();
                     }
-                    return Err(format!("cannot restore the FMU state: {e}"));
+                    return Err(state_refused(e));
                 }
             }
-            self.slopes.copy_from_slice(&snap.slopes);
         }
-        self.sloped = snap.sloped;
-        self.initialized = snap.initialized;
-        self.time = snap.time;
-        self.state = snap.state;
-        self.replay.valid = false;
-        self.outputs_dirty = true;
+        self.slopes.copy_from_slice(&snap.slopes);
         Ok(())
     }
 
@@ -1143,6 +1163,13 @@ fn difference(pass: usize, eps: f64, values: &Values, unknowns: &[u32], out: &mu
             (*o - y) / (-2.0 * eps)
         };
     }
+}
+
+/// Why [`Instance::restore`] failed: the model refused the state.
+#[cold]
+#[inline(never)]
+fn state_refused(why: String) -> String {
+    format!("cannot restore the FMU state: {why}")
 }
 
 /// Why [`Instance::do_step`] refused the step size `h`.
