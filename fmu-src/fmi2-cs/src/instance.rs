@@ -935,56 +935,6 @@ impl Instance {
 
     // ---- FMU states -----------------------------------------------------
 
-    pub fn snapshot(&mut self) -> Result<Snapshot, String> {
-        let mut snap = Snapshot {
-            guid: self.info.guid,
-            state: self.state,
-            initialized: false,
-            time: 0.0,
-            values: Vec::new(),
-            slopes: Vec::new(),
-            sloped: false,
-            model_state: Vec::new(),
-            parameters_version: u64::MAX,
-        };
-        self.snapshot_into(&mut snap)?;
-        Ok(snap)
-    }
-
-    /// Overwrite `snap` with the current state, reusing its buffers (no
-    /// allocation when it held a state of this instance before).
-    pub fn snapshot_into(&mut self, snap: &mut Snapshot) -> Result<(), String> {
-        self.ensure_outputs()?;
-        snap.guid = self.info.guid;
-        snap.state = self.state;
-        snap.initialized = self.initialized;
-        snap.time = self.time;
-        if snap.parameters_version == self.parameters_version
-            && snap.values.len() == self.values.len()
-            && snap.slopes.len() == self.slopes.len()
-        {
-            // A reused snapshot with the same parameters: only the inputs
-            // and their slopes can differ (outputs are recomputed after a
-            // restore), the slopes not if both sides have none.
-            copy_at(&mut snap.values, self.values.as_slice(), &self.inputs);
-            if self.sloped || snap.sloped {
-                copy_at(&mut snap.slopes, &self.slopes, &self.inputs);
-            }
-        } else {
-            snap.parameters_version = self.parameters_version;
-            snap.values.clear();
-            snap.values.extend_from_slice(self.values.as_slice());
-            snap.slopes.clear();
-            snap.slopes.extend_from_slice(&self.slopes);
-        }
-        snap.sloped = self.sloped;
-        snap.model_state.clear();
-        if self.initialized {
-            self.model.save_state(&mut snap.model_state);
-        }
-        Ok(())
-    }
-
     /// Restore `snap` (one of this instance's saved states): all or nothing.
     /// Inlined into `restore_saved`, the other cases out of line.
     #[inline]
@@ -1068,17 +1018,66 @@ impl Instance {
     }
 
     /// `fmi2GetFMUstate`: save the current state into the snapshot at
-    /// `reuse` (which must be one of this instance's) in place, or into a
-    /// new one if `reuse` is 0; returns its address.
+    /// `reuse` (which must be one of this instance's) in place, reusing its
+    /// buffers, or into a new one if `reuse` is 0; returns its address.
     pub fn save_snapshot(&mut self, reuse: usize) -> Result<usize, String> {
-        if reuse == 0 {
-            let snap = self.snapshot()?;
-            return Ok(self.store_snapshot(snap, 0));
+        let reused = match reuse {
+            0 => None,
+            _ => Some(self.saved_index(reuse)?),
+        };
+        self.ensure_outputs()?;
+        let i = reused.unwrap_or_else(|| self.new_snapshot());
+        // (written in its box in the list, the instance's fields borrowed
+        // one by one beside it)
+        let snap = &mut *self.saved_states[i];
+        snap.state = self.state;
+        snap.initialized = self.initialized;
+        snap.time = self.time;
+        if snap.parameters_version == self.parameters_version {
+            // A snapshot this instance took with the same parameters (so of
+            // the same sizes): only the inputs and their slopes can differ
+            // (outputs are recomputed after a restore), the slopes not if
+            // both sides have none.
+            copy_at(&mut snap.values, self.values.as_slice(), &self.inputs);
+            if self.sloped || snap.sloped {
+                copy_at(&mut snap.slopes, &self.slopes, &self.inputs);
+            }
+        } else {
+            copy_all(snap, &self.values, &self.slopes, self.parameters_version);
         }
-        let mut snap = self.take_snapshot(reuse)?;
-        let result = self.snapshot_into(&mut snap);
-        self.saved_states.push(snap);
-        result.map(|()| reuse)
+        snap.sloped = self.sloped;
+        snap.model_state.clear();
+        if self.initialized {
+            self.model.save_state(&mut snap.model_state);
+        }
+        Ok(snap as *const Snapshot as usize)
+    }
+
+    /// The current state as a snapshot of its own, not kept by the
+    /// instance.
+    pub fn snapshot(&mut self) -> Result<Snapshot, String> {
+        let address = self.save_snapshot(0)?;
+        Ok(*self.take_snapshot(address)?)
+    }
+
+    /// A new, empty snapshot of this model at the end of
+    /// [`Instance::saved_states`] (once per master, which then reuses it);
+    /// its index.
+    #[inline(never)]
+    fn new_snapshot(&mut self) -> usize {
+        self.saved_states.push(Box::new(Snapshot {
+            guid: self.info.guid,
+            state: self.state,
+            initialized: false,
+            time: 0.0,
+            values: Vec::new(),
+            slopes: Vec::new(),
+            sloped: false,
+            model_state: Vec::new(),
+            // (no version: `save_snapshot` copies every value)
+            parameters_version: u64::MAX,
+        }));
+        self.saved_states.len() - 1
     }
 
     /// `fmi2SetFMUstate`: restore the saved snapshot at `address`.
@@ -1163,6 +1162,19 @@ fn difference(pass: usize, eps: f64, values: &Values, unknowns: &[u32], out: &mu
             (*o - y) / (-2.0 * eps)
         };
     }
+}
+
+/// Every value and slope into `snap`, taken at parameter version `version`
+/// ([`Instance::save_snapshot`] of a new snapshot, or of one taken with
+/// other parameters or deserialized).
+#[cold]
+#[inline(never)]
+fn copy_all(snap: &mut Snapshot, values: &Values, slopes: &[f64], version: u64) {
+    snap.parameters_version = version;
+    snap.values.clear();
+    snap.values.extend_from_slice(values.as_slice());
+    snap.slopes.clear();
+    snap.slopes.extend_from_slice(slopes);
 }
 
 /// Why [`Instance::restore`] failed: the model refused the state.

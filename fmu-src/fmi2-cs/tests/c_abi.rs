@@ -541,6 +541,48 @@ fn state_keeps_input_slopes() {
 }
 
 #[test]
+fn reused_states_take_every_value_after_deserialization_and_parameter_changes() {
+    // A handle overwritten by fmi2DeSerializeFMUstate, then reused by
+    // fmi2GetFMUstate, holds the state taken then (every value, not only
+    // the inputs); restored after a reset with another gain, it brings its
+    // gain back.
+    let c = initialized("reuse");
+    set(c, U, 1.0);
+    unsafe {
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        let mut s: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        let mut size = 0;
+        assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
+        let mut bytes = vec![0 as c_char; size];
+        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
+        assert_eq!(fmi2DoStep(c, 0.1, 0.1, 0), OK);
+        let mut d = s;
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut d), OK);
+        assert_eq!(d, s, "the handle is reused");
+        set(c, U, 0.5);
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        assert_eq!(fmi2DoStep(c, 0.2, 0.1, 0), OK);
+        let y = get(c, Y);
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        assert_eq!(fmi2DoStep(c, 0.2, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), y.to_bits());
+        // another gain, then the state of the first
+        assert_eq!(fmi2Reset(c), OK);
+        assert_eq!(set(c, K, 3.0), OK);
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(c), OK);
+        assert_eq!(fmi2ExitInitializationMode(c), OK);
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        assert_eq!(get(c, K), 2.0);
+        assert_eq!(fmi2DoStep(c, 0.2, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), y.to_bits());
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), OK);
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
 fn directional_derivative_of_the_last_step() {
     // y(t+h) = k*u + s + u*h  ⇒  ∂y/∂u over the step = k + h
     let c = initialized("jac");
