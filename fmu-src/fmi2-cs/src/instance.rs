@@ -94,6 +94,8 @@ mod flag {
     pub const SETTABLE_BEFORE_INIT: u8 = 1 << 5;
     /// May be set in step mode.
     pub const SETTABLE_IN_STEP: u8 = 1 << 6;
+    /// An input the model checks ([`crate::Model::input_checked`]).
+    pub const CHECKED: u8 = 1 << 7;
 }
 
 /// The type bit of `t` in [`Instance::flags`].
@@ -168,6 +170,14 @@ impl Instance {
     ) -> Self {
         let values = Values::from_start(info.variables);
         let n = values.len();
+        let flags = info
+            .variables
+            .iter()
+            .map(|v| {
+                let checked = v.causality == Causality::Input && model.input_checked(v.vr);
+                flags_of(v) | if checked { flag::CHECKED } else { 0 }
+            })
+            .collect();
         let needs_step_replay = model.needs_step_replay();
         let supplies_partial_derivatives = model.supplies_partial_derivatives();
         let inputs: Vec<u32> = info
@@ -211,7 +221,7 @@ impl Instance {
             step_state_current: false,
             needs_step_replay,
             supplies_partial_derivatives,
-            flags: info.variables.iter().map(flags_of).collect(),
+            flags,
             checked_get: (VarType::Real, Vec::new(), false),
         }
     }
@@ -451,7 +461,7 @@ impl Instance {
         let f = self.flags.get(vr as usize).copied().unwrap_or(0);
         if f & want != want || !value.is_finite() {
             self.check_set(t, &[vr], &[value], in_step_mode)?;
-        } else if f & flag::INPUT != 0 {
+        } else if f & flag::CHECKED != 0 {
             self.check_input(vr, value)?;
         }
         let input = f & flag::INPUT != 0;
@@ -469,20 +479,21 @@ impl Instance {
     #[inline(never)]
     fn set_many(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         // The usual case in one pass over the flag bytes: known, of type
-        // `t`, settable now, finite; the inputs get the model's own check.
+        // `t`, settable now, finite; the inputs the model checks get its
+        // own check.
         let (in_step_mode, want) = self.settable(t);
         let mut fine = true;
-        let mut inputs = 0;
+        let mut any = 0;
         for (&vr, value) in vrs.iter().zip(values) {
             let f = self.flags.get(vr as usize).copied().unwrap_or(0);
             fine &= f & want == want && value.is_finite();
-            inputs |= f;
+            any |= f;
         }
         if !fine {
             self.check_set(t, vrs, values, in_step_mode)?;
-        } else if inputs & flag::INPUT != 0 {
+        } else if any & flag::CHECKED != 0 {
             for (&vr, &value) in vrs.iter().zip(values) {
-                if self.flags[vr as usize] & flag::INPUT != 0 {
+                if self.flags[vr as usize] & flag::CHECKED != 0 {
                     self.check_input(vr, value)?;
                 }
             }

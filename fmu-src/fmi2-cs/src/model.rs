@@ -26,6 +26,15 @@ pub trait Model: Send {
         Ok(())
     }
 
+    /// Whether [`Model::check_input`] may refuse a value of input `vr`:
+    /// `false` lets the layer skip the call when the input is set. Asked
+    /// once per input, when the instance is created. The default, `true`,
+    /// is right for every model; one that overrides `check_input` answers
+    /// `true` for each input it checks.
+    fn input_checked(&self, _vr: u32) -> bool {
+        true
+    }
+
     /// Write every output into `values` from the state and the current
     /// inputs, and nothing else: the layer keeps inputs and parameters in
     /// `values` across calls.
