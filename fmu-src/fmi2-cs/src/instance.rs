@@ -94,8 +94,17 @@ mod flag {
     pub const SETTABLE_BEFORE_INIT: u8 = 1 << 5;
     /// May be set in step mode.
     pub const SETTABLE_IN_STEP: u8 = 1 << 6;
-    /// An input the model checks ([`crate::Model::input_checked`]).
+    /// Bit 7 of an input: the model checks it
+    /// ([`crate::Model::input_checked`]). Tested only once the byte has
+    /// the settable bits, which an output's never has.
     pub const CHECKED: u8 = 1 << 7;
+    /// Bit 7 of an output: it has no direct feedthrough (no `depends_on`),
+    /// a function of the model state alone, which [`Instance::get`] of it
+    /// alone computes by itself, cheaper than every output. Tested only
+    /// with [`OUTPUT`].
+    ///
+    /// [`Instance::get`]: crate::instance::Instance::get
+    pub const STATE_OUTPUT: u8 = 1 << 7;
 }
 
 /// The type bit of `t` in [`Instance::flags`].
@@ -111,6 +120,9 @@ fn flags_of(v: &Variable) -> u8 {
     let mut f = type_flag(v.var_type);
     if v.causality == Causality::Output {
         f |= flag::OUTPUT;
+        if v.depends_on.is_empty() {
+            f |= flag::STATE_OUTPUT;
+        }
     }
     if v.causality == Causality::Input {
         f |= flag::INPUT;
@@ -350,7 +362,16 @@ impl Instance {
             if f & type_flag(t) == 0 {
                 self.variable_of_type(*vr, t)?;
             }
-            f & flag::OUTPUT != 0
+            let state_output = flag::OUTPUT | flag::STATE_OUTPUT;
+            if f & state_output == state_output && self.outputs_dirty && self.initialized {
+                // An output of the state alone (a velocity a strongly
+                // coupled master reads after each trial step): computed by
+                // itself, the other outputs stay to be computed when read.
+                self.model.compute_outputs_of(&mut self.values, vrs);
+                false
+            } else {
+                f & flag::OUTPUT != 0
+            }
         } else if vrs.len() >= Self::REMEMBERED
             && self.checked_get.0 == t
             && self.checked_get.1 == vrs
@@ -769,7 +790,6 @@ impl Instance {
         if !fine {
             self.check_directional(unknowns, knowns, dv_known)?;
         }
-        self.ensure_outputs()?;
         self.directional_checked(unknowns, knowns, dv_known, dv_unknown)
     }
 
@@ -817,11 +837,19 @@ impl Instance {
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
         // Analytic where the model provides every entry (written as it
-        // goes: the differences below overwrite every entry otherwise).
-        if self.supplies_partial_derivatives
-            && self.analytic(unknowns, knowns, dv_known, dv_unknown)
-        {
-            return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
+        // goes: the differences below overwrite every entry otherwise),
+        // from the current values, outputs included.
+        if self.supplies_partial_derivatives {
+            self.ensure_outputs()?;
+            if self.analytic(unknowns, knowns, dv_known, dv_unknown) {
+                return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
+            }
+        }
+        // The differences compute the outputs they need on a copy of the
+        // values: the model needs only to be initialized (which, before
+        // `fmi2ExitInitializationMode`, computing the outputs does).
+        if !self.initialized {
+            self.ensure_outputs()?;
         }
 
         // Perturbation ε along dv_known, sized so that no input moves by more

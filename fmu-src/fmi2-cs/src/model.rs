@@ -41,9 +41,11 @@ pub trait Model: Send {
     fn compute_outputs(&self, values: &mut Values);
 
     /// Write at least the outputs `outputs` (value references of outputs)
-    /// into `values`, for directional derivatives, which need only these;
-    /// the other outputs may be left as they are, inputs and parameters
-    /// must be. By default every output.
+    /// into `values`, each bit for bit as [`Model::compute_outputs`] does,
+    /// for directional derivatives and for a read of one output of the
+    /// state alone (no `depends_on`), which need only these; the other
+    /// outputs may be left as they are, inputs and parameters must be. By
+    /// default every output.
     fn compute_outputs_of(&self, values: &mut Values, outputs: &[u32]) {
         let _ = outputs;
         self.compute_outputs(values);
