@@ -94,6 +94,17 @@ mod flag {
     pub const SETTABLE_BEFORE_INIT: u8 = 1 << 5;
     /// May be set in step mode.
     pub const SETTABLE_IN_STEP: u8 = 1 << 6;
+    /// Bit 7 of an input: the model checks it
+    /// ([`crate::Model::input_checked`]). Tested only once the byte has
+    /// the settable bits, which an output's never has.
+    pub const CHECKED: u8 = 1 << 7;
+    /// Bit 7 of an output: it has no direct feedthrough (no `depends_on`),
+    /// a function of the model state alone, which [`Instance::get`] of it
+    /// alone computes by itself, cheaper than every output. Tested only
+    /// with [`OUTPUT`].
+    ///
+    /// [`Instance::get`]: crate::instance::Instance::get
+    pub const STATE_OUTPUT: u8 = 1 << 7;
 }
 
 /// The type bit of `t` in [`Instance::flags`].
@@ -109,6 +120,9 @@ fn flags_of(v: &Variable) -> u8 {
     let mut f = type_flag(v.var_type);
     if v.causality == Causality::Output {
         f |= flag::OUTPUT;
+        if v.depends_on.is_empty() {
+            f |= flag::STATE_OUTPUT;
+        }
     }
     if v.causality == Causality::Input {
         f |= flag::INPUT;
@@ -134,7 +148,6 @@ struct Scratch {
     /// state; `initialize` drops it, as the parameters may have changed.)
     model: Option<Box<dyn Model>>,
     slopes: Vec<f64>,
-    plus: Vec<f64>,
 }
 
 struct Replay {
@@ -169,6 +182,14 @@ impl Instance {
     ) -> Self {
         let values = Values::from_start(info.variables);
         let n = values.len();
+        let flags = info
+            .variables
+            .iter()
+            .map(|v| {
+                let checked = v.causality == Causality::Input && model.input_checked(v.vr);
+                flags_of(v) | if checked { flag::CHECKED } else { 0 }
+            })
+            .collect();
         let needs_step_replay = model.needs_step_replay();
         let supplies_partial_derivatives = model.supplies_partial_derivatives();
         let inputs: Vec<u32> = info
@@ -206,14 +227,13 @@ impl Instance {
                 parameters_version: u64::MAX,
                 model: None,
                 slopes: Vec::new(),
-                plus: Vec::new(),
             },
             saved_states: Vec::new(),
             step_state: Vec::new(),
             step_state_current: false,
             needs_step_replay,
             supplies_partial_derivatives,
-            flags: info.variables.iter().map(flags_of).collect(),
+            flags,
             checked_get: (VarType::Real, Vec::new(), false),
         }
     }
@@ -342,7 +362,16 @@ impl Instance {
             if f & type_flag(t) == 0 {
                 self.variable_of_type(*vr, t)?;
             }
-            f & flag::OUTPUT != 0
+            let state_output = flag::OUTPUT | flag::STATE_OUTPUT;
+            if f & state_output == state_output && self.outputs_dirty && self.initialized {
+                // An output of the state alone (a velocity a strongly
+                // coupled master reads after each trial step): computed by
+                // itself, the other outputs stay to be computed when read.
+                self.model.compute_outputs_of(&mut self.values, vrs);
+                false
+            } else {
+                f & flag::OUTPUT != 0
+            }
         } else if vrs.len() >= Self::REMEMBERED
             && self.checked_get.0 == t
             && self.checked_get.1 == vrs
@@ -453,7 +482,7 @@ impl Instance {
         let f = self.flags.get(vr as usize).copied().unwrap_or(0);
         if f & want != want || !value.is_finite() {
             self.check_set(t, &[vr], &[value], in_step_mode)?;
-        } else if f & flag::INPUT != 0 {
+        } else if f & flag::CHECKED != 0 {
             self.check_input(vr, value)?;
         }
         let input = f & flag::INPUT != 0;
@@ -471,20 +500,21 @@ impl Instance {
     #[inline(never)]
     fn set_many(&mut self, t: VarType, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         // The usual case in one pass over the flag bytes: known, of type
-        // `t`, settable now, finite; the inputs get the model's own check.
+        // `t`, settable now, finite; the inputs the model checks get its
+        // own check.
         let (in_step_mode, want) = self.settable(t);
         let mut fine = true;
-        let mut inputs = 0;
+        let mut any = 0;
         for (&vr, value) in vrs.iter().zip(values) {
             let f = self.flags.get(vr as usize).copied().unwrap_or(0);
             fine &= f & want == want && value.is_finite();
-            inputs |= f;
+            any |= f;
         }
         if !fine {
             self.check_set(t, vrs, values, in_step_mode)?;
-        } else if inputs & flag::INPUT != 0 {
+        } else if any & flag::CHECKED != 0 {
             for (&vr, &value) in vrs.iter().zip(values) {
-                if self.flags[vr as usize] & flag::INPUT != 0 {
+                if self.flags[vr as usize] & flag::CHECKED != 0 {
                     self.check_input(vr, value)?;
                 }
             }
@@ -760,7 +790,6 @@ impl Instance {
         if !fine {
             self.check_directional(unknowns, knowns, dv_known)?;
         }
-        self.ensure_outputs()?;
         self.directional_checked(unknowns, knowns, dv_known, dv_unknown)
     }
 
@@ -808,11 +837,19 @@ impl Instance {
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
         // Analytic where the model provides every entry (written as it
-        // goes: the differences below overwrite every entry otherwise).
-        if self.supplies_partial_derivatives
-            && self.analytic(unknowns, knowns, dv_known, dv_unknown)
-        {
-            return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
+        // goes: the differences below overwrite every entry otherwise),
+        // from the current values, outputs included.
+        if self.supplies_partial_derivatives {
+            self.ensure_outputs()?;
+            if self.analytic(unknowns, knowns, dv_known, dv_unknown) {
+                return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
+            }
+        }
+        // The differences compute the outputs they need on a copy of the
+        // values: the model needs only to be initialized (which, before
+        // `fmi2ExitInitializationMode`, computing the outputs does).
+        if !self.initialized {
+            self.ensure_outputs()?;
         }
 
         // Perturbation ε along dv_known, sized so that no input moves by more
@@ -829,16 +866,7 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
-        let mut plus = std::mem::take(&mut self.scratch.plus);
-        plus.resize(unknowns.len(), 0.0);
-        let result = self
-            .perturbed_outputs(knowns, dv_known, eps, unknowns, &mut plus)
-            .and_then(|()| self.perturbed_outputs(knowns, dv_known, -eps, unknowns, dv_unknown));
-        self.scratch.plus = plus;
-        result?;
-        for (d, p) in dv_unknown.iter_mut().zip(&self.scratch.plus) {
-            *d = (p - *d) / (2.0 * eps);
-        }
+        self.central_differences(knowns, dv_known, eps, unknowns, dv_unknown)?;
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }
 
@@ -866,12 +894,15 @@ impl Instance {
         true
     }
 
-    /// The outputs `unknowns` into `out` with the inputs `knowns` moved by
-    /// `eps·dv`: after a step, the step replayed from its saved start on
-    /// the replay copy of the model ([`Scratch::model`]; the instance's
-    /// model is not touched), else the outputs at the current state. No
-    /// allocation once the scratch buffers and the copy exist.
-    fn perturbed_outputs(
+    /// `out = (y(u + eps·dv) - y(u - eps·dv)) / (2·eps)` for the outputs
+    /// `unknowns` and the inputs `knowns`: after a step, with the step
+    /// replayed from its saved start on the replay copy of the model
+    /// ([`Scratch::model`]; the instance's model is not touched), else at
+    /// the current state. The scratch values are brought to the instance's
+    /// once for both evaluations, and `out` holds the first until the
+    /// second is subtracted. No allocation once the scratch buffers and
+    /// the copy exist.
+    fn central_differences(
         &mut self,
         knowns: &[u32],
         dv: &[f64],
@@ -889,26 +920,44 @@ impl Instance {
             values.copy_from_slice(self.values.as_slice());
             scratch.parameters_version = self.parameters_version;
         }
-        if self.replay.valid {
-            // Every slope is zero between calls; those of the inputs are set
-            // here when the step had any (and zero again when done). Held
-            // inputs: the values now (set above) are the values before the
-            // step.
-            let slopes = &mut scratch.slopes;
-            slopes.resize(self.slopes.len(), 0.0);
-            let held = self.replay.held;
-            if !held {
+        // Each pass sets the knowns from the unperturbed inputs (the
+        // instance's, or the replayed step's): the models write outputs
+        // only, so the other inputs stay as set above.
+        let passes = [eps, -eps];
+        if !self.replay.valid {
+            for (pass, eps) in passes.into_iter().enumerate() {
+                for (&k, d) in knowns.iter().zip(dv) {
+                    values.set(k, self.values.real(k) + eps * d);
+                }
+                self.model.compute_outputs_of(values, unknowns);
+                difference(pass, eps, values, unknowns, out);
+            }
+            return Ok(());
+        }
+        // Every slope is zero between calls; those of the inputs are set
+        // here when the step had any (and zero again when done). Held
+        // inputs: the values now (set above) are the values before the
+        // step.
+        let slopes = &mut scratch.slopes;
+        slopes.resize(self.slopes.len(), 0.0);
+        let held = self.replay.held;
+        let model = scratch
+            .model
+            .get_or_insert_with(|| self.model.clone_model());
+        for (pass, eps) in passes.into_iter().enumerate() {
+            if held {
+                for (&k, d) in knowns.iter().zip(dv) {
+                    values.set(k, self.values.real(k) + eps * d);
+                }
+            } else {
                 for (k, &vr) in self.inputs.iter().enumerate() {
                     values.set(vr, self.replay.inputs[k]);
                     slopes[vr as usize] = self.replay.slopes[k];
                 }
+                for (&k, d) in knowns.iter().zip(dv) {
+                    values.set(k, values.real(k) + eps * d);
+                }
             }
-            for (k, d) in knowns.iter().zip(dv) {
-                values.set(*k, values.real(*k) + eps * d);
-            }
-            let model = scratch
-                .model
-                .get_or_insert_with(|| self.model.clone_model());
             let replayed = model
                 .restore_state(&self.replay.model_state)
                 .and_then(|()| model.do_step(values, slopes, self.replay.h));
@@ -916,76 +965,56 @@ impl Instance {
                 // the inputs at the end of the step; every slope zero again
                 advance_inputs(&self.inputs, values, slopes, self.replay.h);
             }
-            if replayed.is_ok() {
-                model.compute_outputs_of(values, unknowns);
-            }
             replayed?;
-        } else {
-            for (k, d) in knowns.iter().zip(dv) {
-                values.set(*k, values.real(*k) + eps * d);
-            }
-            self.model.compute_outputs_of(values, unknowns);
-        }
-        for (o, u) in out.iter_mut().zip(unknowns) {
-            *o = values.real(*u);
+            model.compute_outputs_of(values, unknowns);
+            difference(pass, eps, values, unknowns, out);
         }
         Ok(())
     }
 
     // ---- FMU states -----------------------------------------------------
 
-    pub fn snapshot(&mut self) -> Result<Snapshot, String> {
-        let mut snap = Snapshot {
-            guid: self.info.guid,
-            state: self.state,
-            initialized: false,
-            time: 0.0,
-            values: Vec::new(),
-            slopes: Vec::new(),
-            sloped: false,
-            model_state: Vec::new(),
-            parameters_version: u64::MAX,
-        };
-        self.snapshot_into(&mut snap)?;
-        Ok(snap)
-    }
-
-    /// Overwrite `snap` with the current state, reusing its buffers (no
-    /// allocation when it held a state of this instance before).
-    pub fn snapshot_into(&mut self, snap: &mut Snapshot) -> Result<(), String> {
-        self.ensure_outputs()?;
-        snap.guid = self.info.guid;
-        snap.state = self.state;
-        snap.initialized = self.initialized;
-        snap.time = self.time;
-        if snap.parameters_version == self.parameters_version
-            && snap.values.len() == self.values.len()
-            && snap.slopes.len() == self.slopes.len()
+    /// Restore `snap` (one of this instance's saved states): all or nothing.
+    /// Inlined into `restore_saved`, the other cases out of line.
+    #[inline]
+    pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
+        self.step_state_current = false;
+        if self.initialized
+            && snap.initialized
+            && snap.parameters_version == self.parameters_version
         {
-            // A reused snapshot with the same parameters: only the inputs
-            // and their slopes can differ (outputs are recomputed after a
-            // restore), the slopes not if both sides have none.
-            copy_at(&mut snap.values, self.values.as_slice(), &self.inputs);
+            // The usual rollback of a master: a state this instance took
+            // since its parameters last changed (only those carry its
+            // current parameter version; a deserialized one has u64::MAX),
+            // so of this model, with the same sizes, and the GUID and
+            // parameter checks of `restore_other` would pass. The model
+            // takes the state or refuses it unchanged, then only the inputs
+            // (and their slopes, unless neither side has any) differ; the
+            // outputs are recomputed.
+            self.model
+                .restore_state(&snap.model_state)
+                .map_err(state_refused)?;
+            self.values.copy_at(&snap.values, &self.inputs);
             if self.sloped || snap.sloped {
-                copy_at(&mut snap.slopes, &self.slopes, &self.inputs);
+                copy_at(&mut self.slopes, &snap.slopes, &self.inputs);
             }
         } else {
-            snap.parameters_version = self.parameters_version;
-            snap.values.clear();
-            snap.values.extend_from_slice(self.values.as_slice());
-            snap.slopes.clear();
-            snap.slopes.extend_from_slice(&self.slopes);
+            self.restore_other(snap)?;
         }
-        snap.sloped = self.sloped;
-        snap.model_state.clear();
-        if self.initialized {
-            self.model.save_state(&mut snap.model_state);
-        }
+        self.sloped = snap.sloped;
+        self.initialized = snap.initialized;
+        self.time = snap.time;
+        self.state = snap.state;
+        self.replay.valid = false;
+        self.outputs_dirty = true;
         Ok(())
     }
 
-    pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
-        self.step_state_current = false;
+    /// The model state and values of [`Instance::restore`] for any other
+    /// snapshot: deserialized, taken before a parameter was set, or before
+    /// initialization.
+    #[inline(never)]
+    fn restore_other(&mut self, snap: &Snapshot) -> Result<(), String> {
         // (the GUID is our own `info.guid` for every snapshot this library
         // made or read: the address compares equal, the text is the fallback)
         let same_guid = std::ptr::eq(snap.guid, self.info.guid) || snap.guid == self.info.guid;
@@ -996,28 +1025,15 @@ impl Instance {
             ));
         }
         let same_parameters = self.initialized
-            && (snap.parameters_version == self.parameters_version
-                || self.info.variables.iter().all(|v| {
-                    v.causality != Causality::Parameter
-                        || self.values.real(v.vr) == snap.values[v.vr as usize]
-                }));
+            && self.info.variables.iter().all(|v| {
+                v.causality != Causality::Parameter
+                    || self.values.real(v.vr) == snap.values[v.vr as usize]
+            });
         if snap.initialized && same_parameters {
-            // The usual rollback of a master: the model takes the state or
-            // refuses it unchanged, then the values follow.
             self.model
                 .restore_state(&snap.model_state)
-                .map_err(|e| format!("cannot restore the FMU state: {e}"))?;
-            if snap.parameters_version == self.parameters_version {
-                // same parameters: only the inputs (and their slopes, unless
-                // neither side has any) differ; the outputs are recomputed
-                self.values.copy_at(&snap.values, &self.inputs);
-                if self.sloped || snap.sloped {
-                    copy_at(&mut self.slopes, &snap.slopes, &self.inputs);
-                }
-            } else {
-                self.values.copy_from_slice(&snap.values);
-                self.slopes.copy_from_slice(&snap.slopes);
-            }
+                .map_err(state_refused)?;
+            self.values.copy_from_slice(&snap.values);
         } else {
             let previous = self.values.clone();
             self.values.copy_from_slice(&snap.values);
@@ -1032,32 +1048,75 @@ impl Instance {
                     if self.initialized {
                         let _ = self.initialize_model();
                     }
-                    return Err(format!("cannot restore the FMU state: {e}"));
+                    return Err(state_refused(e));
                 }
             }
-            self.slopes.copy_from_slice(&snap.slopes);
         }
-        self.sloped = snap.sloped;
-        self.initialized = snap.initialized;
-        self.time = snap.time;
-        self.state = snap.state;
-        self.replay.valid = false;
-        self.outputs_dirty = true;
+        self.slopes.copy_from_slice(&snap.slopes);
         Ok(())
     }
 
     /// `fmi2GetFMUstate`: save the current state into the snapshot at
-    /// `reuse` (which must be one of this instance's) in place, or into a
-    /// new one if `reuse` is 0; returns its address.
+    /// `reuse` (which must be one of this instance's) in place, reusing its
+    /// buffers, or into a new one if `reuse` is 0; returns its address.
     pub fn save_snapshot(&mut self, reuse: usize) -> Result<usize, String> {
-        if reuse == 0 {
-            let snap = self.snapshot()?;
-            return Ok(self.store_snapshot(snap, 0));
+        let reused = match reuse {
+            0 => None,
+            _ => Some(self.saved_index(reuse)?),
+        };
+        self.ensure_outputs()?;
+        let i = reused.unwrap_or_else(|| self.new_snapshot());
+        // (written in its box in the list, the instance's fields borrowed
+        // one by one beside it)
+        let snap = &mut *self.saved_states[i];
+        snap.state = self.state;
+        snap.initialized = self.initialized;
+        snap.time = self.time;
+        if snap.parameters_version == self.parameters_version {
+            // A snapshot this instance took with the same parameters (so of
+            // the same sizes): only the inputs and their slopes can differ
+            // (outputs are recomputed after a restore), the slopes not if
+            // both sides have none.
+            copy_at(&mut snap.values, self.values.as_slice(), &self.inputs);
+            if self.sloped || snap.sloped {
+                copy_at(&mut snap.slopes, &self.slopes, &self.inputs);
+            }
+        } else {
+            copy_all(snap, &self.values, &self.slopes, self.parameters_version);
         }
-        let mut snap = self.take_snapshot(reuse)?;
-        let result = self.snapshot_into(&mut snap);
-        self.saved_states.push(snap);
-        result.map(|()| reuse)
+        snap.sloped = self.sloped;
+        snap.model_state.clear();
+        if self.initialized {
+            self.model.save_state(&mut snap.model_state);
+        }
+        Ok(snap as *const Snapshot as usize)
+    }
+
+    /// The current state as a snapshot of its own, not kept by the
+    /// instance.
+    pub fn snapshot(&mut self) -> Result<Snapshot, String> {
+        let address = self.save_snapshot(0)?;
+        Ok(*self.take_snapshot(address)?)
+    }
+
+    /// A new, empty snapshot of this model at the end of
+    /// [`Instance::saved_states`] (once per master, which then reuses it);
+    /// its index.
+    #[inline(never)]
+    fn new_snapshot(&mut self) -> usize {
+        self.saved_states.push(Box::new(Snapshot {
+            guid: self.info.guid,
+            state: self.state,
+            initialized: false,
+            time: 0.0,
+            values: Vec::new(),
+            slopes: Vec::new(),
+            sloped: false,
+            model_state: Vec::new(),
+            // (no version: `save_snapshot` copies every value)
+            parameters_version: u64::MAX,
+        }));
+        self.saved_states.len() - 1
     }
 
     /// `fmi2SetFMUstate`: restore the saved snapshot at `address`.
@@ -1127,6 +1186,41 @@ fn advance_inputs(inputs: &[u32], values: &mut Values, slopes: &mut [f64], h: f6
             *s = 0.0;
         }
     }
+}
+
+/// Evaluation `pass` of [`Instance::central_differences`], with `values`
+/// at `u + e·dv`: the first (`e = ε`) keeps `y₊` in `out`, the second
+/// (`e = -ε`, so `-2·e` is exactly `2·ε`) turns it into `(y₊ - y₋) / (2·ε)`.
+#[inline(always)]
+fn difference(pass: usize, eps: f64, values: &Values, unknowns: &[u32], out: &mut [f64]) {
+    for (o, &u) in out.iter_mut().zip(unknowns) {
+        let y = values.real(u);
+        *o = if pass == 0 {
+            y
+        } else {
+            (*o - y) / (-2.0 * eps)
+        };
+    }
+}
+
+/// Every value and slope into `snap`, taken at parameter version `version`
+/// ([`Instance::save_snapshot`] of a new snapshot, or of one taken with
+/// other parameters or deserialized).
+#[cold]
+#[inline(never)]
+fn copy_all(snap: &mut Snapshot, values: &Values, slopes: &[f64], version: u64) {
+    snap.parameters_version = version;
+    snap.values.clear();
+    snap.values.extend_from_slice(values.as_slice());
+    snap.slopes.clear();
+    snap.slopes.extend_from_slice(slopes);
+}
+
+/// Why [`Instance::restore`] failed: the model refused the state.
+#[cold]
+#[inline(never)]
+fn state_refused(why: String) -> String {
+    format!("cannot restore the FMU state: {why}")
 }
 
 /// Why [`Instance::do_step`] refused the step size `h`.

@@ -26,12 +26,26 @@ pub trait Model: Send {
         Ok(())
     }
 
-    /// Write every output into `values` from the state and the current inputs.
+    /// Whether [`Model::check_input`] may refuse a value of input `vr`:
+    /// `false` lets the layer skip the call when the input is set. Asked
+    /// once per input, when the instance is created. The default, `true`,
+    /// is right for every model; one that overrides `check_input` answers
+    /// `true` for each input it checks.
+    fn input_checked(&self, _vr: u32) -> bool {
+        true
+    }
+
+    /// Write every output into `values` from the state and the current
+    /// inputs, and nothing else: the layer keeps inputs and parameters in
+    /// `values` across calls.
     fn compute_outputs(&self, values: &mut Values);
 
     /// Write at least the outputs `outputs` (value references of outputs)
-    /// into `values`, for directional derivatives, which need only these;
-    /// the others may be left as they are. By default every output.
+    /// into `values`, each bit for bit as [`Model::compute_outputs`] does,
+    /// for directional derivatives and for a read of one output of the
+    /// state alone (no `depends_on`), which need only these; the other
+    /// outputs may be left as they are, inputs and parameters must be. By
+    /// default every output.
     fn compute_outputs_of(&self, values: &mut Values, outputs: &[u32]) {
         let _ = outputs;
         self.compute_outputs(values);

@@ -541,6 +541,48 @@ fn state_keeps_input_slopes() {
 }
 
 #[test]
+fn reused_states_take_every_value_after_deserialization_and_parameter_changes() {
+    // A handle overwritten by fmi2DeSerializeFMUstate, then reused by
+    // fmi2GetFMUstate, holds the state taken then (every value, not only
+    // the inputs); restored after a reset with another gain, it brings its
+    // gain back.
+    let c = initialized("reuse");
+    set(c, U, 1.0);
+    unsafe {
+        assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
+        let mut s: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        let mut size = 0;
+        assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
+        let mut bytes = vec![0 as c_char; size];
+        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
+        assert_eq!(fmi2DoStep(c, 0.1, 0.1, 0), OK);
+        let mut d = s;
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut d), OK);
+        assert_eq!(d, s, "the handle is reused");
+        set(c, U, 0.5);
+        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
+        assert_eq!(fmi2DoStep(c, 0.2, 0.1, 0), OK);
+        let y = get(c, Y);
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        assert_eq!(fmi2DoStep(c, 0.2, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), y.to_bits());
+        // another gain, then the state of the first
+        assert_eq!(fmi2Reset(c), OK);
+        assert_eq!(set(c, K, 3.0), OK);
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(c), OK);
+        assert_eq!(fmi2ExitInitializationMode(c), OK);
+        assert_eq!(fmi2SetFMUstate(c, s), OK);
+        assert_eq!(get(c, K), 2.0);
+        assert_eq!(fmi2DoStep(c, 0.2, 0.1, 0), OK);
+        assert_eq!(get(c, Y).to_bits(), y.to_bits());
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), OK);
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
 fn directional_derivative_of_the_last_step() {
     // y(t+h) = k*u + s + u*h  ⇒  ∂y/∂u over the step = k + h
     let c = initialized("jac");
@@ -597,6 +639,40 @@ fn directional_derivative_follows_new_parameters() {
             assert_eq!(get(c, Y).to_bits(), y.to_bits());
             assert_eq!(fmi2DoStep(c, 0.25, 0.25, 0), OK);
             assert!((get(c, Y) - (k * 0.7 + 0.7 * 0.5)).abs() < 1e-12);
+        }
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
+fn directional_derivative_repeats_exactly_with_and_without_slopes() {
+    // Both perturbations of one call start from the same inputs, and a
+    // second call from the same state: the same bits every time, with the
+    // inputs held over the step and with an input slope (∂y/∂u = k + h
+    // either way: the slope moves u by the same amount in both replays).
+    let c = initialized("jac-again");
+    let (unknown, known, seed) = (Y, U, 1.0);
+    unsafe {
+        for slope in [0.0, 0.4] {
+            set(c, U, 0.7);
+            let order = 1;
+            assert_eq!(
+                fmi2SetRealInputDerivatives(c, &known, 1, &order, &slope),
+                OK
+            );
+            let t = if slope == 0.0 { 0.0 } else { 0.25 };
+            assert_eq!(fmi2DoStep(c, t, 0.25, 0), OK);
+            let y = get(c, Y);
+            let (mut d1, mut d2) = (0.0, 0.0);
+            for d in [&mut d1, &mut d2] {
+                assert_eq!(
+                    fmi2GetDirectionalDerivative(c, &unknown, 1, &known, 1, &seed, d),
+                    OK
+                );
+            }
+            assert!((d1 - 2.25).abs() < 1e-8, "slope {slope}: {d1}");
+            assert_eq!(d1.to_bits(), d2.to_bits(), "slope {slope}");
+            assert_eq!(get(c, Y).to_bits(), y.to_bits());
         }
         fmi2FreeInstance(c);
     }

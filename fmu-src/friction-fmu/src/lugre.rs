@@ -312,6 +312,11 @@ impl Model for LuGreFmu {
         Ok(())
     }
 
+    /// (the normal force only, as `check_input`)
+    fn input_checked(&self, input: u32) -> bool {
+        input == vr::FN
+    }
+
     fn compute_outputs(&self, values: &mut Values) {
         let (v, x, fn_) = Self::inputs(values);
         values.set(vr::F, self.law.force(v, x, fn_));

@@ -549,6 +549,11 @@ impl Model for Rig1DFmu {
     fn supplies_partial_derivatives(&self) -> bool {
         false
     }
+
+    /// Every input value is accepted (no `check_input`).
+    fn input_checked(&self, _vr: u32) -> bool {
+        false
+    }
 }
 
 #[cfg(test)]
