@@ -830,10 +830,10 @@ impl StrongCoupling {
             }
             worst = (0.0, 0);
             let mut norm = 0.0;
-            for k in 0..n {
-                let tolerance =
-                    self.atol * self.nominal[k] + self.rtol * self.u[k].abs().max(self.y[k].abs());
-                let ratio = (self.u[k] - self.y[k]).abs() / tolerance;
+            let interface = self.nominal.iter().zip(&self.u).zip(&self.y);
+            for (k, ((nominal, u), y)) in interface.enumerate() {
+                let tolerance = self.atol * nominal + self.rtol * u.abs().max(y.abs());
+                let ratio = (u - y).abs() / tolerance;
                 norm += ratio * ratio;
                 if ratio.is_nan() || (!worst.0.is_nan() && ratio > worst.0) {
                     worst = (ratio, k);
@@ -942,8 +942,20 @@ fn solve_in_place(a: &mut DMatrix<f64>, b: &mut [f64]) -> bool {
     if a.shape() != (n, n) {
         return false;
     }
-    // column-major: (row, col) at row + col·n
     let m = a.as_mut_slice();
+    match (
+        <&mut [f64; 4]>::try_from(&mut *m),
+        <&mut [f64; 2]>::try_from(&mut *b),
+    ) {
+        (Ok(m), Ok(b)) => solve_two(m, b),
+        _ => eliminate(m, b),
+    }
+}
+
+/// [`solve_in_place`] of `n` unknowns, `m` the `n × n` matrix column-major
+/// ((row, col) at row + col·n).
+fn eliminate(m: &mut [f64], b: &mut [f64]) -> bool {
+    let n = b.len();
     for col in 0..n {
         // the largest magnitude, the last of equal ones (as max_by)
         let mut pivot = col;
@@ -984,6 +996,34 @@ fn solve_in_place(a: &mut DMatrix<f64>, b: &mut [f64]) -> bool {
     b.iter().all(|x| x.is_finite())
 }
 
+/// [`eliminate`] for two unknowns (one connection each way, the usual
+/// loop), written out: the same operations on the same values in the
+/// same order, so the same bits, without the loops and index checks.
+fn solve_two(m: &mut [f64; 4], b: &mut [f64; 2]) -> bool {
+    // column 0: row 1 is the pivot if it is at least as large
+    let swap = m[1].abs().total_cmp(&m[0].abs()).is_ge();
+    let p = if swap { m[1] } else { m[0] };
+    if p == 0.0 || !p.is_finite() {
+        return false;
+    }
+    if swap {
+        m.swap(0, 1);
+        m.swap(2, 3);
+        b.swap(0, 1);
+    }
+    let factor = m[1] / m[0];
+    m[1] -= factor * m[0];
+    m[3] -= factor * m[2];
+    b[1] -= factor * b[0];
+    // column 1
+    if m[3] == 0.0 || !m[3].is_finite() {
+        return false;
+    }
+    b[1] /= m[3];
+    b[0] = (b[0] - m[2] * b[1]) / m[0];
+    b.iter().all(|x| x.is_finite())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1002,5 +1042,41 @@ mod tests {
         }
         let mut singular = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 4.0]);
         assert!(!solve_in_place(&mut singular, &mut [1.0, 1.0]));
+    }
+
+    #[test]
+    fn two_unknowns_give_the_bits_of_the_general_elimination() {
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            3.5e-7,
+            -2.25,
+            1e300,
+            f64::MIN_POSITIVE,
+            f64::INFINITY,
+            f64::NAN,
+            0.1,
+            -7.0 / 3.0,
+        ];
+        let mut cases = 0;
+        for (i, &a) in values.iter().enumerate() {
+            for (j, &b) in values.iter().enumerate() {
+                for &c in &values[(i + j) % 4..] {
+                    for &d in &values[(i * j) % 5..] {
+                        let (m, rhs) = ([a, b, c, d], [c - a, b + d]);
+                        let (mut m1, mut b1, mut m2, mut b2) = (m, rhs, m, rhs);
+                        let ok = eliminate(&mut m1, &mut b1);
+                        assert_eq!(solve_two(&mut m2, &mut b2), ok, "{m:?} {rhs:?}");
+                        if ok {
+                            assert_eq!(b1.map(f64::to_bits), b2.map(f64::to_bits), "{m:?} {rhs:?}");
+                        }
+                        cases += 1;
+                    }
+                }
+            }
+        }
+        assert!(cases > 1000);
     }
 }
