@@ -11,15 +11,34 @@
 use std::ops::{Index, IndexMut};
 
 /// Rows of `width` numbers each, row-major in one `Vec<f64>`.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Default)]
 pub struct Rows {
     /// Numbers per row.
     width: usize,
     /// Number of rows (kept apart: with `width` 0 it does not follow from
     /// `values`).
     len: usize,
-    /// Row 0, then row 1, …: `len · width` numbers.
+    /// Row 0, then row 1, …: the first `len · width` numbers. Any after
+    /// them are zeros: rows made ready ahead ([`Rows::with_capacity`]), so
+    /// that a new row costs no filling with zeros, one row at a time.
     values: Vec<f64>,
+}
+
+impl PartialEq for Rows {
+    /// The same rows (the zeros made ready ahead do not count).
+    fn eq(&self, other: &Rows) -> bool {
+        self.width == other.width && self.len == other.len && self.as_flat() == other.as_flat()
+    }
+}
+
+impl std::fmt::Debug for Rows {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Rows")
+            .field("width", &self.width)
+            .field("len", &self.len)
+            .field("values", &self.as_flat())
+            .finish()
+    }
 }
 
 impl Rows {
@@ -33,12 +52,13 @@ impl Rows {
     }
 
     /// No rows yet, with room for `rows` rows of `width` numbers before
-    /// any allocation.
+    /// any allocation: zeros made ready at once (fresh zeroed memory from
+    /// the allocator), so that [`Rows::push_zeros`] has nothing to fill.
     pub fn with_capacity(width: usize, rows: usize) -> Rows {
         Rows {
             width,
             len: 0,
-            values: Vec::with_capacity(width * rows),
+            values: vec![0.0; width * rows],
         }
     }
 
@@ -93,17 +113,22 @@ impl Rows {
             row.len(),
             self.width
         );
-        self.values.extend_from_slice(row);
-        self.len += 1;
+        self.push_zeros().copy_from_slice(row);
     }
 
     /// Append a row of zeros and return it to be filled in place (no
     /// row is built elsewhere and copied).
+    #[inline] // once per communication point, a few instructions
     pub fn push_zeros(&mut self) -> &mut [f64] {
-        let start = self.values.len();
-        self.values.resize(start + self.width, 0.0);
+        let start = self.len * self.width;
+        let end = start + self.width;
+        if self.values.len() < end {
+            // no row made ready: one more (the numbers after `end` are
+            // zeros still)
+            self.values.resize(end, 0.0);
+        }
         self.len += 1;
-        &mut self.values[start..]
+        &mut self.values[start..end]
     }
 
     /// Remove the last row, if any.
@@ -117,7 +142,7 @@ impl Rows {
     /// The rows in order.
     pub fn iter(&self) -> Iter<'_> {
         Iter {
-            rest: &self.values,
+            rest: self.as_flat(),
             width: self.width,
             len: self.len,
         }
@@ -133,7 +158,7 @@ impl Rows {
 
     /// All numbers, row after row.
     pub fn as_flat(&self) -> &[f64] {
-        &self.values
+        &self.values[..self.len * self.width]
     }
 }
 
@@ -232,6 +257,8 @@ mod tests {
         rows.pop();
         assert_eq!(rows.len(), 2);
         assert_eq!(rows.as_flat(), [1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(rows.push_zeros(), [0.0, 0.0]);
+        rows.pop();
         assert_eq!(Rows::from_rows(2, [[1.0, 2.0], [3.0, 4.0]]), rows);
         rows[1][0] = 7.0;
         assert_eq!(rows[1], [7.0, 4.0]);

@@ -29,6 +29,8 @@ use tempfile::TempDir;
 
 /// Error messages logged earlier are shown when a call logged nothing.
 const EARLIER_MESSAGES: usize = 3;
+/// The name of `fmi2DoStep` in errors (both halves of [`Instance::do_step`]).
+const DO_STEP: &str = "fmi2DoStep";
 /// Booleans are converted to `fmi2Boolean` through a stack buffer this long.
 const BOOLEAN_CHUNK: usize = 64;
 
@@ -369,6 +371,7 @@ impl Instance {
         self.finish_checked(function, mark, raw)
     }
 
+    #[cold]
     #[inline(never)]
     fn finish_checked(
         &mut self,
@@ -682,15 +685,23 @@ impl Instance {
     /// the simulation to end, asked through `fmi2GetRealStatus
     /// (fmi2LastSuccessfulTime)` and `fmi2GetBooleanStatus(fmi2Terminated)`,
     /// or why the FMU could not say.
+    #[inline] // the hot path is a few instructions; the rest is in `step_failed`
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Status, FmuError> {
-        const F: &str = "fmi2DoStep";
-        let mark = self.begin(F)?;
+        let mark = self.begin(DO_STEP)?;
         // SAFETY: plain values.
         let raw = unsafe { (self.functions.do_step)(self.component, t, h, fmi2False) };
         if raw == 0 && !self.guarded {
             return Ok(Status::Ok);
         }
-        let mut result = self.finish_checked(F, mark, raw);
+        self.step_failed(mark, raw)
+    }
+
+    /// [`Instance::do_step`] for anything but `fmi2OK` without a time
+    /// limit: the status checked, a discarded step explained.
+    #[cold]
+    #[inline(never)]
+    fn step_failed(&mut self, mark: u64, raw: fmi2Status) -> Result<Status, FmuError> {
+        let mut result = self.finish_checked(DO_STEP, mark, raw);
         if let Err(FmuError::Call {
             status: Status::Discard,
             messages,
@@ -801,6 +812,7 @@ impl Instance {
     }
 
     /// `fmi2GetDirectionalDerivative` (§2.1.9): `out` = ∂unknowns/∂knowns · `seed`.
+    #[inline] // a hot path of the strong-coupling master
     pub fn get_directional_derivative(
         &mut self,
         unknowns: &[ValueReference],
@@ -881,6 +893,7 @@ impl Instance {
     }
 
     /// `fmi2GetFMUstate` into an existing state (the FMU may reuse its memory).
+    #[inline] // a hot path of the strong-coupling master
     pub fn update_state(&mut self, state: &mut FmuState) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetFMUstate";
         let f = self.state_function(
@@ -902,6 +915,7 @@ impl Instance {
     }
 
     /// `fmi2SetFMUstate`: continue from `state`.
+    #[inline] // a hot path of the strong-coupling master
     pub fn set_state(&mut self, state: &FmuState) -> Result<Status, FmuError> {
         const F: &str = "fmi2SetFMUstate";
         let f = self.state_function(

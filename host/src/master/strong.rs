@@ -52,7 +52,7 @@
 
 use super::MasterAlgorithm;
 use crate::fmu::model_description::{Causality, VariableKind};
-use crate::fmu::{FmuState, ValueReference};
+use crate::fmu::{FmuState, Instance, ValueReference};
 use crate::system::System;
 use crate::FmuError;
 use nalgebra::DMatrix;
@@ -167,6 +167,8 @@ impl std::fmt::Display for ConvergenceReport {
 struct Ports {
     /// Connections whose input belongs to the component.
     inputs: Vec<usize>,
+    /// The component's value references of `inputs`, in order.
+    input_vrs: Vec<ValueReference>,
     /// Connections whose output belongs to the component.
     outputs: Vec<usize>,
     output_vrs: Vec<ValueReference>,
@@ -180,6 +182,43 @@ struct Ports {
     /// Inputs ramp linearly over the step from their value at `t` to `U`
     /// (`fmi2SetRealInputDerivatives`) instead of holding `U`.
     ramped: bool,
+}
+
+impl Ports {
+    /// Set the component's inputs from `u` (one value per connection):
+    /// held, or `ramped` from `start` at `t` to `u` at `t + h`.
+    #[inline] // hot: every iteration of every step
+    fn set_inputs(
+        &self,
+        instance: &mut Instance,
+        u: &[f64],
+        start: &[f64],
+        h: f64,
+    ) -> Result<(), FmuError> {
+        for (&k, &vr) in self.inputs.iter().zip(&self.input_vrs) {
+            if self.ramped {
+                instance.set_real(&[vr], &[start[k]])?;
+                instance.set_real_input_derivatives(&[vr], &[1], &[(u[k] - start[k]) / h])?;
+            } else {
+                instance.set_real(&[vr], &[u[k]])?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Read the component's connected outputs into `out` (one value per
+    /// connection), with one `fmi2GetReal` for all of them.
+    #[inline] // hot: every iteration of every step
+    fn read_outputs(&mut self, instance: &mut Instance, out: &mut [f64]) -> Result<(), FmuError> {
+        if self.outputs.is_empty() {
+            return Ok(());
+        }
+        instance.get_real(&self.output_vrs, &mut self.output_values)?;
+        for (&k, &y) in self.outputs.iter().zip(&self.output_values) {
+            out[k] = y;
+        }
+        Ok(())
+    }
 }
 
 pub struct StrongCoupling {
@@ -356,10 +395,15 @@ impl StrongCoupling {
                         "finite differences (rollback): the FMU does not provide directional derivatives (providesDirectionalDerivative=\"false\")",
                     ),
                 };
+                let inputs: Vec<usize> = (0..n)
+                    .filter(|&k| system.connections[k].to.0 == c)
+                    .collect();
                 Ports {
-                    inputs: (0..n)
-                        .filter(|&k| system.connections[k].to.0 == c)
+                    input_vrs: inputs
+                        .iter()
+                        .map(|&k| system.connections[k].to.1)
                         .collect(),
+                    inputs,
                     output_vrs: outputs
                         .iter()
                         .map(|&k| system.connections[k].from.1)
@@ -397,6 +441,8 @@ impl StrongCoupling {
                 .co_simulation
                 .can_handle_variable_communication_step_size
         });
+        let most_outputs = self.ports.iter().map(|p| p.outputs.len()).max();
+        self.derivative = vec![0.0; most_outputs.unwrap_or(0)];
         self.u = vec![0.0; n];
         self.range = vec![0.0; n];
         self.started = false;
@@ -439,50 +485,6 @@ impl StrongCoupling {
         restored.map(|_| ())
     }
 
-    /// Set the inputs `inputs` (connection indices) of one component from
-    /// `u` (one value per connection): held, or `ramped` from `start` at
-    /// `t` to `u` at `t + h`.
-    fn set_inputs(
-        system: &mut System,
-        inputs: &[usize],
-        ramped: bool,
-        u: &[f64],
-        start: &[f64],
-        h: f64,
-    ) -> Result<(), FmuError> {
-        for &k in inputs {
-            let (comp, vr) = system.connections[k].to;
-            let instance = &mut system.components[comp].instance;
-            if ramped {
-                instance.set_real(&[vr], &[start[k]])?;
-                instance.set_real_input_derivatives(&[vr], &[1], &[(u[k] - start[k]) / h])?;
-            } else {
-                instance.set_real(&[vr], &[u[k]])?;
-            }
-        }
-        Ok(())
-    }
-
-    /// Read the connected outputs of component `c` into `out` (one value
-    /// per connection), with one `fmi2GetReal` for all of them.
-    fn read_outputs(
-        system: &mut System,
-        c: usize,
-        ports: &mut Ports,
-        out: &mut [f64],
-    ) -> Result<(), FmuError> {
-        if ports.outputs.is_empty() {
-            return Ok(());
-        }
-        system.components[c]
-            .instance
-            .get_real(&ports.output_vrs, &mut ports.output_values)?;
-        for (&k, &y) in ports.outputs.iter().zip(&ports.output_values) {
-            out[k] = y;
-        }
-        Ok(())
-    }
-
     /// Columns of ∂Y/∂U for the inputs of component `c`, by rolling back
     /// and stepping with one input perturbed by δ = √ε·max(|U_j|, nominal_j).
     fn difference_columns(
@@ -493,31 +495,28 @@ impl StrongCoupling {
         h: f64,
         jac: &mut DMatrix<f64>,
     ) -> Result<(), FmuError> {
-        let ports = std::mem::take(&mut self.ports[c].inputs);
-        let result = (|| {
-            for &j in &ports {
-                let delta = f64::EPSILON.sqrt() * self.u[j].abs().max(self.nominal[j]);
-                self.restore(system, c)?;
-                self.perturbed.clone_from(&self.u);
-                self.perturbed[j] += delta;
-                let ramped = self.ports[c].ramped;
-                Self::set_inputs(system, &ports, ramped, &self.perturbed, &self.accepted, h)?;
-                system.components[c].instance.do_step(t, h)?;
-                self.report.difference_steps += 1;
-                self.column.clone_from(&self.y);
-                Self::read_outputs(system, c, &mut self.ports[c], &mut self.column)?;
-                for &k in &self.ports[c].outputs {
-                    jac[(k, j)] = (self.column[k] - self.y[k]) / delta;
-                }
+        for i in 0..self.ports[c].inputs.len() {
+            let j = self.ports[c].inputs[i];
+            let delta = f64::EPSILON.sqrt() * self.u[j].abs().max(self.nominal[j]);
+            self.restore(system, c)?;
+            self.perturbed.clone_from(&self.u);
+            self.perturbed[j] += delta;
+            let instance = &mut system.components[c].instance;
+            self.ports[c].set_inputs(instance, &self.perturbed, &self.accepted, h)?;
+            instance.do_step(t, h)?;
+            self.report.difference_steps += 1;
+            self.column.clone_from(&self.y);
+            self.ports[c].read_outputs(instance, &mut self.column)?;
+            for &k in &self.ports[c].outputs {
+                jac[(k, j)] = (self.column[k] - self.y[k]) / delta;
             }
-            Ok(())
-        })();
-        self.ports[c].inputs = ports;
-        result
+        }
+        Ok(())
     }
 
     /// Columns of ∂Y/∂U for the inputs of component `c` from
     /// `fmi2GetDirectionalDerivative`, called right after the step.
+    #[inline] // hot: at every Jacobian
     fn directional_columns(
         &mut self,
         system: &mut System,
@@ -525,16 +524,11 @@ impl StrongCoupling {
         jac: &mut DMatrix<f64>,
     ) -> Result<(), FmuError> {
         let ports = &self.ports[c];
-        let out = &mut self.derivative;
-        out.resize(ports.outputs.len(), 0.0);
-        for &j in &ports.inputs {
-            let known = system.connections[j].to.1;
-            system.components[c].instance.get_directional_derivative(
-                &ports.output_vrs,
-                &[known],
-                &[1.0],
-                out,
-            )?;
+        // (sized for the component with the most outputs in `prepare`)
+        let out = &mut self.derivative[..ports.outputs.len()];
+        let instance = &mut system.components[c].instance;
+        for (&j, &known) in ports.inputs.iter().zip(&ports.input_vrs) {
+            instance.get_directional_derivative(&ports.output_vrs, &[known], &[1.0], out)?;
             for (&k, d) in ports.outputs.iter().zip(out.iter()) {
                 jac[(k, j)] = *d;
             }
@@ -745,7 +739,8 @@ impl StrongCoupling {
     fn ensure_started(&mut self, system: &mut System) -> Result<(), FmuError> {
         if !self.started {
             for c in 0..system.components.len() {
-                Self::read_outputs(system, c, &mut self.ports[c], &mut self.u)?;
+                let instance = &mut system.components[c].instance;
+                self.ports[c].read_outputs(instance, &mut self.u)?;
             }
             self.started = true;
         }
@@ -823,28 +818,22 @@ impl StrongCoupling {
                     // the first iterate is the last accepted U, still set
                     continue;
                 }
-                let ports = &self.ports[c];
-                Self::set_inputs(
-                    system,
-                    &ports.inputs,
-                    ports.ramped,
-                    &self.u,
-                    &self.accepted,
-                    h,
-                )?;
+                let instance = &mut system.components[c].instance;
+                self.ports[c].set_inputs(instance, &self.u, &self.accepted, h)?;
             }
             for c in &mut system.components {
                 c.instance.do_step(t, h)?;
             }
             for c in 0..system.components.len() {
-                Self::read_outputs(system, c, &mut self.ports[c], &mut self.y)?;
+                let instance = &mut system.components[c].instance;
+                self.ports[c].read_outputs(instance, &mut self.y)?;
             }
             worst = (0.0, 0);
             let mut norm = 0.0;
-            for k in 0..n {
-                let tolerance =
-                    self.atol * self.nominal[k] + self.rtol * self.u[k].abs().max(self.y[k].abs());
-                let ratio = (self.u[k] - self.y[k]).abs() / tolerance;
+            let interface = self.nominal.iter().zip(&self.u).zip(&self.y);
+            for (k, ((nominal, u), y)) in interface.enumerate() {
+                let tolerance = self.atol * nominal + self.rtol * u.abs().max(y.abs());
+                let ratio = (u - y).abs() / tolerance;
                 norm += ratio * ratio;
                 if ratio.is_nan() || (!worst.0.is_nan() && ratio > worst.0) {
                     worst = (ratio, k);
@@ -953,8 +942,20 @@ fn solve_in_place(a: &mut DMatrix<f64>, b: &mut [f64]) -> bool {
     if a.shape() != (n, n) {
         return false;
     }
-    // column-major: (row, col) at row + col·n
     let m = a.as_mut_slice();
+    match (
+        <&mut [f64; 4]>::try_from(&mut *m),
+        <&mut [f64; 2]>::try_from(&mut *b),
+    ) {
+        (Ok(m), Ok(b)) => solve_two(m, b),
+        _ => eliminate(m, b),
+    }
+}
+
+/// [`solve_in_place`] of `n` unknowns, `m` the `n × n` matrix column-major
+/// ((row, col) at row + col·n).
+fn eliminate(m: &mut [f64], b: &mut [f64]) -> bool {
+    let n = b.len();
     for col in 0..n {
         // the largest magnitude, the last of equal ones (as max_by)
         let mut pivot = col;
@@ -995,6 +996,34 @@ fn solve_in_place(a: &mut DMatrix<f64>, b: &mut [f64]) -> bool {
     b.iter().all(|x| x.is_finite())
 }
 
+/// [`eliminate`] for two unknowns (one connection each way, the usual
+/// loop), written out: the same operations on the same values in the
+/// same order, so the same bits, without the loops and index checks.
+fn solve_two(m: &mut [f64; 4], b: &mut [f64; 2]) -> bool {
+    // column 0: row 1 is the pivot if it is at least as large
+    let swap = m[1].abs().total_cmp(&m[0].abs()).is_ge();
+    let p = if swap { m[1] } else { m[0] };
+    if p == 0.0 || !p.is_finite() {
+        return false;
+    }
+    if swap {
+        m.swap(0, 1);
+        m.swap(2, 3);
+        b.swap(0, 1);
+    }
+    let factor = m[1] / m[0];
+    m[1] -= factor * m[0];
+    m[3] -= factor * m[2];
+    b[1] -= factor * b[0];
+    // column 1
+    if m[3] == 0.0 || !m[3].is_finite() {
+        return false;
+    }
+    b[1] /= m[3];
+    b[0] = (b[0] - m[2] * b[1]) / m[0];
+    b.iter().all(|x| x.is_finite())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1013,5 +1042,41 @@ mod tests {
         }
         let mut singular = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 4.0]);
         assert!(!solve_in_place(&mut singular, &mut [1.0, 1.0]));
+    }
+
+    #[test]
+    fn two_unknowns_give_the_bits_of_the_general_elimination() {
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            3.5e-7,
+            -2.25,
+            1e300,
+            f64::MIN_POSITIVE,
+            f64::INFINITY,
+            f64::NAN,
+            0.1,
+            -7.0 / 3.0,
+        ];
+        let mut cases = 0;
+        for (i, &a) in values.iter().enumerate() {
+            for (j, &b) in values.iter().enumerate() {
+                for &c in &values[(i + j) % 4..] {
+                    for &d in &values[(i * j) % 5..] {
+                        let (m, rhs) = ([a, b, c, d], [c - a, b + d]);
+                        let (mut m1, mut b1, mut m2, mut b2) = (m, rhs, m, rhs);
+                        let ok = eliminate(&mut m1, &mut b1);
+                        assert_eq!(solve_two(&mut m2, &mut b2), ok, "{m:?} {rhs:?}");
+                        if ok {
+                            assert_eq!(b1.map(f64::to_bits), b2.map(f64::to_bits), "{m:?} {rhs:?}");
+                        }
+                        cases += 1;
+                    }
+                }
+            }
+        }
+        assert!(cases > 1000);
     }
 }
