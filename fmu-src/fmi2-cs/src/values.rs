@@ -42,6 +42,12 @@ impl Values {
         &self.data
     }
 
+    /// Every value, writable (a model writing its outputs with one length
+    /// check rather than one per output).
+    pub fn as_mut_slice(&mut self) -> &mut [f64] {
+        &mut self.data
+    }
+
     pub fn len(&self) -> usize {
         self.data.len()
     }

@@ -319,9 +319,10 @@ impl Model for LuGreFmu {
 
     fn compute_outputs(&self, values: &mut Values) {
         let (v, x, fn_) = Self::inputs(values);
-        values.set(vr::F, self.law.force(v, x, fn_));
+        let (force, sliding) = self.law.force_and_sliding(v, x, fn_);
+        values.set(vr::F, force);
         values.set(vr::Z, self.law.z());
-        values.set_boolean(vr::SLIDING, self.law.sliding(v, x, fn_));
+        values.set_boolean(vr::SLIDING, sliding);
     }
 
     /// The outputs asked for only (a directional derivative wants F, and

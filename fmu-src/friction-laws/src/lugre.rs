@@ -387,7 +387,13 @@ impl LuGre {
         if v == 0.0 {
             return 0.0;
         }
-        v - self.p.sigma0 * v.abs() * z / self.g_unit(v.abs(), v, x)
+        self.z_rate_at_level(z, v, self.g_unit(v.abs(), v, x))
+    }
+
+    /// [`LuGre::z_rate`] for `v ≠ 0` at the Stribeck level `g` = g(v).
+    #[inline]
+    fn z_rate_at_level(&self, z: f64, v: f64, g: f64) -> f64 {
+        v - self.p.sigma0 * v.abs() * z / g
     }
 
     /// Micro-damping `σ1(v) = σ1·exp(−(v/vd)²)`, constant when `vd = 0`.
@@ -412,6 +418,12 @@ impl LuGre {
     /// (seed 001 eq. 11, seed 002 eq. 1). Pure, like [`LuGre::z_rate`].
     pub fn force_of(&self, z: f64, v: f64, x: f64, fn_: f64) -> f64 {
         let zd = self.z_rate(z, v, x, fn_);
+        self.force_at_rate(z, v, zd, fn_)
+    }
+
+    /// The output equation with the deflection rate `zd` given.
+    #[inline]
+    fn force_at_rate(&self, z: f64, v: f64, zd: f64, fn_: f64) -> f64 {
         (self.p.sigma0 * z + self.sigma1_at(v) * zd + self.p.sigma2 * v) * self.fn_factor(fn_)
     }
 
@@ -419,7 +431,28 @@ impl LuGre {
     /// `v ≠ 0` and `sgn(v)·σ0·z ≥ 0.99·g(v)`.
     pub fn sliding(&self, v: f64, x: f64, fn_: f64) -> bool {
         let _ = fn_;
-        v != 0.0 && v.signum() * self.p.sigma0 * self.z >= 0.99 * self.g_unit(v.abs(), v, x)
+        v != 0.0 && self.sliding_at_level(v, self.g_unit(v.abs(), v, x))
+    }
+
+    /// [`LuGre::sliding`] for `v ≠ 0` at the Stribeck level `g` = g(v).
+    #[inline]
+    fn sliding_at_level(&self, v: f64, g: f64) -> bool {
+        v.signum() * self.p.sigma0 * self.z >= 0.99 * g
+    }
+
+    /// [`LuGre::force`] and [`LuGre::sliding`] at once, the Stribeck level
+    /// looked up once for both (an FMU's outputs are computed together);
+    /// the same operations as the two, so the same results.
+    pub fn force_and_sliding(&self, v: f64, x: f64, fn_: f64) -> (f64, bool) {
+        if v == 0.0 {
+            return (self.force_at_rate(self.z, v, 0.0, fn_), false);
+        }
+        let g = self.g_unit(v.abs(), v, x);
+        let zd = self.z_rate_at_level(self.z, v, g);
+        (
+            self.force_at_rate(self.z, v, zd, fn_),
+            self.sliding_at_level(v, g),
+        )
     }
 
     /// Steady deflection `zss = g·s/σ0` for speed `w`, direction `s`.
@@ -606,6 +639,36 @@ mod tests {
 
     fn rel(a: f64, b: f64) -> f64 {
         (a - b).abs() / b.abs()
+    }
+
+    /// `force_and_sliding` is `force` and `sliding` bit for bit: at rest,
+    /// both directions, in stick and in slip, with direction-dependent
+    /// levels, micro-damping and the normal-force form.
+    #[test]
+    fn force_and_sliding_is_force_and_sliding() {
+        let plain = LuGreParams::seed001();
+        let varied = LuGreParams {
+            direction_dependent: true,
+            fc_neg: 0.8 * plain.fc,
+            fs_neg: 0.9 * plain.fs,
+            vd: 0.02,
+            normal_force_form: true,
+            ..plain
+        };
+        for p in [plain, varied] {
+            let mut law = LuGre::new(p).unwrap();
+            for z in [0.0, 2e-6, -5e-6, 1e-4, -1e-4] {
+                law.set_z(z);
+                for v in [0.0, -0.0, 1e-9, -1e-9, 1e-3, -1e-3, 0.05, -0.5, 3.0] {
+                    for fn_ in [1.0, 25.0] {
+                        let (f, sliding) = law.force_and_sliding(v, 0.0, fn_);
+                        let expected = law.force(v, 0.0, fn_);
+                        assert_eq!(f.to_bits(), expected.to_bits(), "z {z}, v {v}");
+                        assert_eq!(sliding, law.sliding(v, 0.0, fn_), "z {z}, v {v}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -496,16 +496,22 @@ impl Model for Rig1DFmu {
     fn compute_outputs(&self, v: &mut Values) {
         let u = inputs(v.as_slice());
         let rig = &self.rig;
-        v.set(vr::X, rig.position(&u));
-        v.set(vr::V, rig.slip_velocity());
-        v.set(vr::A, rig.acceleration(&u));
-        v.set(vr::F_SPRING, rig.spring_force(&u));
-        v.set(vr::X_ACT, rig.actuator_position(&u));
-        v.set(vr::X_REL, rig.relative_displacement(&u));
-        v.set(vr::V_BODY, rig.velocity());
-        v.set(vr::F_DRIVE, rig.drive_force());
-        v.set(vr::U_CTRL, rig.control_command(&u));
-        v.set(vr::F_CTRL, rig.control_force(&u));
+        // the last output's entry checked once covers the other nine
+        const LAST: usize = vr::F_CTRL as usize;
+        let Some(out) = v.as_mut_slice().get_mut(..=LAST) else {
+            unreachable!("a value table holds every variable")
+        };
+        let mut set = |output: u32, x: f64| out[output as usize] = x;
+        set(vr::X, rig.position(&u));
+        set(vr::V, rig.slip_velocity());
+        set(vr::A, rig.acceleration(&u));
+        set(vr::F_SPRING, rig.spring_force(&u));
+        set(vr::X_ACT, rig.actuator_position(&u));
+        set(vr::X_REL, rig.relative_displacement(&u));
+        set(vr::V_BODY, rig.velocity());
+        set(vr::F_DRIVE, rig.drive_force());
+        set(vr::U_CTRL, rig.control_command(&u));
+        set(vr::F_CTRL, rig.control_force(&u));
     }
 
     /// The outputs asked for only (a directional derivative wants v, say):
