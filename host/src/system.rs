@@ -501,6 +501,7 @@ impl System {
     /// Read every recorded output into a new row of the recording, one
     /// `fmi2GetReal` per component, in [`System::columns`] order. If a
     /// call fails, no row is added.
+    #[inline(always)] // into the run's loop: once per macro step, whatever the master
     pub fn sample(&mut self) -> Result<(), FmuError> {
         let recording = &mut self.recording;
         let row = recording.rows.push_zeros();
