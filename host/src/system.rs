@@ -349,6 +349,14 @@ impl System {
     /// changed it, is taken from that row instead of being asked for again.
     /// `buffer` is room for the values, one per connection.
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
+        self.propagate_inline(buffer)
+    }
+
+    /// [`System::propagate`] inlined into the caller: the Jacobi master's
+    /// step, where the call itself is a fair share of the host's work (the
+    /// run's start calls the one above).
+    #[inline(always)]
+    pub(crate) fn propagate_inline(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
         let recording = &self.recording;
         let last = recording.rows.last().unwrap_or_default();
         for (slot, source) in buffer.iter_mut().zip(&self.sources) {
