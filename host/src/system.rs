@@ -349,6 +349,14 @@ impl System {
     /// changed it, is taken from that row instead of being asked for again.
     /// `buffer` is room for the values, one per connection.
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
+        self.propagate_inline(buffer)
+    }
+
+    /// [`System::propagate`] inlined into the caller: the Jacobi master's
+    /// step, where the call itself is a fair share of the host's work (the
+    /// run's start calls the one above).
+    #[inline(always)]
+    pub(crate) fn propagate_inline(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
         let recording = &self.recording;
         let last = recording.rows.last().unwrap_or_default();
         for (slot, source) in buffer.iter_mut().zip(&self.sources) {
@@ -501,6 +509,7 @@ impl System {
     /// Read every recorded output into a new row of the recording, one
     /// `fmi2GetReal` per component, in [`System::columns`] order. If a
     /// call fails, no row is added.
+    #[inline(always)] // into the run's loop: once per macro step, whatever the master
     pub fn sample(&mut self) -> Result<(), FmuError> {
         let recording = &mut self.recording;
         let row = recording.rows.push_zeros();

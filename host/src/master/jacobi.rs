@@ -17,7 +17,7 @@ impl MasterAlgorithm for Jacobi {
 
     fn step(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
         self.buffer.resize(system.connections.len(), 0.0);
-        system.propagate(&mut self.buffer)?;
+        system.propagate_inline(&mut self.buffer)?;
         for c in &mut system.components {
             c.instance.do_step(t, h)?;
         }
