@@ -277,6 +277,15 @@ impl ModelInfo {
         self.variables.iter().find(|v| v.name == name)
     }
 
+    /// The value references of the Real variables of `causality`, in
+    /// table order.
+    pub fn reals_of(&self, causality: Causality) -> impl Iterator<Item = u32> + 'static {
+        self.variables
+            .iter()
+            .filter(move |v| v.causality == causality && v.var_type == VarType::Real)
+            .map(|v| v.vr)
+    }
+
     /// Consistency of the table: value reference = index, unique names,
     /// start values where required, dependencies pointing at inputs.
     pub fn check(&self) -> Result<(), String> {

@@ -445,18 +445,27 @@ fn panic_becomes_fatal_and_never_unwinds() {
     unsafe { fmi2FreeInstance(c) };
 }
 
-#[test]
-fn state_round_trip_and_corruption() {
-    let c = initialized("state");
-    set(c, U, 1.0);
+/// The FMU state of `c` now (a new handle) and its serialized bytes.
+fn saved_and_serialized(c: fmi2Component) -> (fmi2FMUstate, Vec<c_char>) {
     unsafe {
-        fmi2DoStep(c, 0.0, 0.1, 0);
         let mut s: fmi2FMUstate = null_mut();
         assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
         let mut size = 0;
         assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
         let mut bytes = vec![0 as c_char; size];
         assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
+        (s, bytes)
+    }
+}
+
+#[test]
+fn state_round_trip_and_corruption() {
+    let c = initialized("state");
+    set(c, U, 1.0);
+    unsafe {
+        fmi2DoStep(c, 0.0, 0.1, 0);
+        let (mut s, mut bytes) = saved_and_serialized(c);
+        let size = bytes.len();
         assert_eq!(
             fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size - 1),
             ERR
@@ -507,12 +516,8 @@ fn state_keeps_input_slopes() {
     unsafe {
         let (vr, order, slope) = (U, 1, 2.0);
         assert_eq!(fmi2SetRealInputDerivatives(c, &vr, 1, &order, &slope), OK);
-        let mut s: fmi2FMUstate = null_mut();
-        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
-        let mut size = 0;
-        assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
-        let mut bytes = vec![0 as c_char; size];
-        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
+        let (mut s, bytes) = saved_and_serialized(c);
+        let size = bytes.len();
         assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
         let sloped = get(c, Y);
         assert_eq!(fmi2SetFMUstate(c, s), OK);
@@ -550,12 +555,8 @@ fn reused_states_take_every_value_after_deserialization_and_parameter_changes() 
     set(c, U, 1.0);
     unsafe {
         assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), OK);
-        let mut s: fmi2FMUstate = null_mut();
-        assert_eq!(fmi2GetFMUstate(c, &mut s), OK);
-        let mut size = 0;
-        assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut size), OK);
-        let mut bytes = vec![0 as c_char; size];
-        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), OK);
+        let (mut s, bytes) = saved_and_serialized(c);
+        let size = bytes.len();
         assert_eq!(fmi2DoStep(c, 0.1, 0.1, 0), OK);
         let mut d = s;
         assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), size, &mut d), OK);

@@ -42,11 +42,8 @@ fn set_step_get_do_not_allocate_in_any_friction_fmu() {
         let mut fmu = Instance::new(info, (factory.create)(), "probe", logger);
         // every Real input but LuGre's normal force (which must stay >= 0)
         let of = |causality| -> Vec<u32> {
-            info.variables
-                .iter()
-                .filter(|v| v.causality == causality && v.var_type == VarType::Real)
-                .filter(|v| v.name != "Fn")
-                .map(|v| v.vr)
+            info.reals_of(causality)
+                .filter(|&vr| info.variables[vr as usize].name != "Fn")
                 .collect()
         };
         let (inputs, outputs) = (of(Causality::Input), of(Causality::Output));

@@ -24,13 +24,10 @@ fn outputs_of_the_state_read_alone_are_the_full_outputs() {
         .chain(friction_fmu::REGISTRY.iter());
     for factory in factories {
         let info = factory.info;
+        // (LuGre's normal force must stay >= 0)
         let of = |causality| -> Vec<u32> {
-            info.variables
-                .iter()
-                .filter(|v| v.causality == causality && v.var_type == VarType::Real)
-                // (LuGre's normal force must stay >= 0)
-                .filter(|v| v.name != "Fn")
-                .map(|v| v.vr)
+            info.reals_of(causality)
+                .filter(|&vr| info.variables[vr as usize].name != "Fn")
                 .collect()
         };
         let (inputs, outputs) = (of(Causality::Input), of(Causality::Output));
