@@ -13,8 +13,11 @@
 //!      Python (`scripts/bench_fmpy.py`, FMU2Slave), started from here;
 //!    - the monolithic limit: the same laws and rig (`friction-laws`,
 //!      `rig-dynamics`) stepped in one Rust loop with no FMI in between,
-//!      recording the same outputs ([`StickSlipModel::monolithic_jacobi`],
-//!      [`StickSlipModel::monolithic_newton`]).
+//!      recording the same outputs and times in a recording allocated, as
+//!      the host's, inside the clock, each output computed once
+//!      ([`StickSlipModel::monolithic_jacobi`],
+//!      [`StickSlipModel::monolithic_newton`]). Only the FMI boundary and
+//!      the master's bookkeeping differ between the two.
 //! 3. **Seed 000's Experiments 3 curve**: the force–displacement curve of
 //!    the bristle model with seed 000's parameters (0.352 kg, N = 109
 //!    bristles), 1000 displacement increments from rest to sliding
@@ -502,6 +505,26 @@ fn input_nominal(fmus: &[(String, Fmu)], name: &str, variable: &str) -> f64 {
 /// Columns the monolithic loops record: Rig1D's ten outputs, LuGre's two.
 const RECORDED: usize = 12;
 
+/// What a run of a monolithic loop records, as a host run does
+/// ([`fricsim::master::Run`]): the time of each communication point and a
+/// row of outputs there.
+#[derive(Default)]
+struct Recording {
+    time: Vec<f64>,
+    rows: Rows,
+}
+
+impl Recording {
+    /// Room for `points` communication points, allocated as
+    /// [`simulate_with`] allocates the host's (inside the clock).
+    fn with_capacity(points: usize) -> Recording {
+        Recording {
+            time: Vec::with_capacity(points),
+            rows: Rows::with_capacity(RECORDED, points),
+        }
+    }
+}
+
 struct StickSlipModel {
     rig: Rig1DParams,
     lugre: LuGreParams,
@@ -561,16 +584,28 @@ impl StickSlipModel {
         )
     }
 
-    /// The outputs the FMUs record (Rig1D's ten, LuGre's F and z), one row
-    /// per communication point in the host's format ([`fricsim::master::Run`]:
-    /// a [`Rows`] of [`RECORDED`] columns, written in place), so that only
-    /// the FMI boundary differs between the two loops.
-    fn record(rows: &mut Rows, rig: &Rig1D, lugre: &LuGre, force_in: f64, v_in: f64) {
+    /// The outputs the FMUs record (Rig1D's ten, LuGre's F and z) at time
+    /// `t`, one row per communication point in the host's format
+    /// ([`fricsim::master::Run`]: the time, and a [`Rows`] of [`RECORDED`]
+    /// columns written in place), so that only the FMI boundary differs
+    /// between the two loops.
+    /// `friction_force` is LuGre's output F at its input, computed once by
+    /// the caller for the row and the exchange alike (as the host passes
+    /// on the values it recorded).
+    fn record(
+        recording: &mut Recording,
+        t: f64,
+        rig: &Rig1D,
+        lugre: &LuGre,
+        force_in: f64,
+        friction_force: f64,
+    ) {
         let u = Rig1DInputs {
             friction: force_in,
             ..Default::default()
         };
-        rows.push_zeros().copy_from_slice(&[
+        recording.time.push(t);
+        recording.rows.push_zeros().copy_from_slice(&[
             rig.position(&u),
             rig.slip_velocity(),
             rig.acceleration(&u),
@@ -581,7 +616,7 @@ impl StickSlipModel {
             rig.drive_force(),
             rig.control_command(&u),
             rig.control_force(&u),
-            lugre.force(v_in, 0.0, 0.0),
+            friction_force,
             lugre.z(),
         ]);
     }
@@ -593,18 +628,23 @@ impl StickSlipModel {
     fn monolithic_jacobi(&self, h: f64, stop: f64) -> (f64, f64, f64) {
         let n = (stop / h).round() as usize;
         let (mut rig, mut lugre) = self.laws();
-        let mut row = Rows::with_capacity(RECORDED, n + 1);
+        let mut recording = Recording::default();
         let (mut v_in, mut force_in) = (0.0, 0.0);
         let wall = timed(|| {
+            // as the host: the recording is made inside the clock
+            // ([`simulate_with`] allocates it when the run starts)
+            recording = Recording::with_capacity(n + 1);
             // as the host: exchange before and after leaving initialization
             for _ in 0..2 {
                 let force = lugre.force(v_in, 0.0, 0.0);
                 v_in = rig.slip_velocity();
                 force_in = force;
             }
-            Self::record(&mut row, &rig, &lugre, force_in, v_in);
-            for _ in 0..n {
-                let force = lugre.force(v_in, 0.0, 0.0);
+            // LuGre's F at the communication point: recorded, then passed
+            // on at the next exchange
+            let mut force = lugre.force(v_in, 0.0, 0.0);
+            Self::record(&mut recording, 0.0, &rig, &lugre, force_in, force);
+            for i in 0..n {
                 v_in = rig.slip_velocity();
                 force_in = force;
                 let u = Rig1DInputs {
@@ -617,11 +657,13 @@ impl StickSlipModel {
                     ..Default::default()
                 };
                 lugre.step(&held, h);
-                Self::record(&mut row, &rig, &lugre, force_in, v_in);
+                force = lugre.force(v_in, 0.0, 0.0);
+                let t = (i + 1) as f64 * h;
+                Self::record(&mut recording, t, &rig, &lugre, force_in, force);
             }
         });
-        std::hint::black_box(&row);
-        (wall, row[n][10], 0.0)
+        std::hint::black_box(&recording);
+        (wall, recording.rows[n][10], 0.0)
     }
 
     /// Strong coupling in one loop, as the host's `newton` master: the
@@ -635,7 +677,7 @@ impl StickSlipModel {
     fn monolithic_newton(&self, h: f64, stop: f64) -> Result<(f64, f64, f64), String> {
         let n = (stop / h).round() as usize;
         let (mut rig, mut lugre) = self.laws();
-        let mut row = Rows::with_capacity(RECORDED, n + 1);
+        let mut recording = Recording::default();
         let mut iterations = 0usize;
         let mut failure = None;
         let step_rig = |r: &mut Rig1D, force: f64| {
@@ -653,9 +695,10 @@ impl StickSlipModel {
             l.step(&held, h);
         };
         let wall = timed(|| {
+            recording = Recording::with_capacity(n + 1);
             let mut u = [rig.slip_velocity(), lugre.force(0.0, 0.0, 0.0)];
             u[1] = lugre.force(u[0], 0.0, 0.0);
-            Self::record(&mut row, &rig, &lugre, u[1], u[0]);
+            Self::record(&mut recording, 0.0, &rig, &lugre, u[1], u[1]);
             'steps: for i in 0..n {
                 let (rig0, lugre0) = (rig.clone(), lugre.clone());
                 for iteration in 1..=50 {
@@ -671,7 +714,8 @@ impl StickSlipModel {
                     });
                     if converged {
                         iterations += iteration;
-                        Self::record(&mut row, &rig, &lugre, u[1], u[0]);
+                        let t = (i + 1) as f64 * h;
+                        Self::record(&mut recording, t, &rig, &lugre, u[1], y[1]);
                         continue 'steps;
                     }
                     // ∂(rig.v)/∂F and ∂(friction.F)/∂v, central differences
@@ -702,8 +746,12 @@ impl StickSlipModel {
         if let Some(e) = failure {
             return Err(e);
         }
-        std::hint::black_box(&row);
-        Ok((wall, row[n][10], iterations as f64 / n.max(1) as f64))
+        std::hint::black_box(&recording);
+        Ok((
+            wall,
+            recording.rows[n][10],
+            iterations as f64 / n.max(1) as f64,
+        ))
     }
 }
 
