@@ -13,20 +13,30 @@ host/src/bin/speed_table.rs, from the same system file it runs itself):
 
 Every component's Real outputs are recorded at every communication point,
 as the host does. Prints one JSON object: the wall time of initialization
-and stepping (s), the number of steps, the final value of every recorded
-output, and, for newton, the iteration and Jacobian counts.
+and stepping (s; the instances are made and their parameters set before
+the clock starts, as the host builds its system before its own), the
+number of steps, the final value of every recorded output, and, for
+newton, the iteration and Jacobian counts.
 
-Masters, as host/src/master/ implements them:
+Masters, as host/src/master/ implements them, with the same FMI calls in
+the same order as the host makes them, so that the comparison is of the
+two callers, not of two call sequences:
 
-- jacobi: at each communication point every connected output is read,
-  then every input set, then every FMU stepped over [t, t + h].
+- jacobi: at each communication point every input is set from the
+  connected output recorded there (no output is read twice), then every
+  FMU stepped over [t, t + h].
 - newton: strong coupling. The unknowns are the connected inputs U, held
   over the step; stepping every FMU from its state at t gives the outputs
   Y(U); Newton solves R(U) = U − Y(U) = 0 with J = ∂Y/∂U from
   fmi2GetDirectionalDerivative after the step, (I − J)·ΔU = −R, rolling the
   FMUs back with fmi2SetFMUstate between iterations, until
   |R_k| ≤ atol_k + rtol·max(|U_k|, |Y_k|) (the host's rtol 1e-8 and
-  atol 1e-10 times the input's nominal, given in the spec).
+  atol 1e-10 times the input's nominal, given in the spec). As the host:
+  the state at t is saved with fmi2GetFMUstate into the same FMU state
+  every step (FMI 2.0 updates a state passed in), and the first iteration
+  of a step sets no input, the FMUs holding the last accepted U already.
+  The arithmetic of a step is on Python floats (a few numbers: NumPy's
+  per-call cost would be most of it), the linear solve with NumPy.
 """
 
 import json
@@ -34,8 +44,10 @@ import shutil
 import sys
 import tempfile
 import time
+from ctypes import byref
 
 import numpy as np
+from fmpy.fmi2 import fmi2FMUstate
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
@@ -86,12 +98,14 @@ def run(spec):
         h, stop, master = spec["step"], spec["stop"], spec["master"]
         n = int(round(stop / h))
 
-        started = time.perf_counter()
+        # as the host's system is built (instantiated, parameters set)
+        # before its clock starts
         for c in components:
             c.fmu.instantiate()
             c.fmu.setupExperiment(startTime=0.0)
             c.fmu.enterInitializationMode()
             c.set_parameters()
+        started = time.perf_counter()
 
         def propagate():
             values = [src.fmu.getReal([out])[0] for src, out, _, _ in links]
@@ -103,22 +117,32 @@ def run(spec):
             c.fmu.exitInitializationMode()
         propagate()
         rows = [[x for c in components for x in c.fmu.getReal(c.outputs)]]
+        # where each link's output is in a recorded row
+        first, k = {}, 0
+        for c in components:
+            first[c.name] = k
+            k += len(c.outputs)
+        columns = [first[src.name] + src.outputs.index(out) for src, out, _, _ in links]
         counts = {"iterations": 0, "jacobians": 0}
-        # newton's interface values: the inputs as the FMUs hold them now
-        u = np.array([src.fmu.getReal([out])[0] for src, out, _, _ in links])
+        newton = None
+        if master == "newton":
+            newton = Newton(components, links, spec["rtol"], spec["atol"], counts)
+        elif master != "jacobi":
+            raise SystemExit(f"unknown master {master}")
         for i in range(n):
             t = i * h
-            if master == "jacobi":
-                propagate()
+            if newton is None:
+                row = rows[-1]
+                for (_, _, dst, inp), column in zip(links, columns):
+                    dst.fmu.setReal([inp], [row[column]])
                 for c in components:
                     c.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-            elif master == "newton":
-                u = newton_step(components, links, u, t, h, counts,
-                                spec["rtol"], np.array(spec["atol"]))
             else:
-                raise SystemExit(f"unknown master {master}")
+                newton.step(t, h)
             rows.append([x for c in components for x in c.fmu.getReal(c.outputs)])
         wall = time.perf_counter() - started
+        if newton is not None:
+            newton.free()
 
         final = {f"{c.name}.{name}": value
                  for c, names in ((c, c.output_names) for c in components)
@@ -131,33 +155,53 @@ def run(spec):
         shutil.rmtree(workdir, ignore_errors=True)
 
 
-def newton_step(components, links, u, t, h, counts, rtol, atol):
-    """One strongly coupled macro step from the interface values `u`."""
-    states = [c.fmu.getFMUstate() for c in components]
-    for iteration in range(1, MAX_ITERATIONS + 1):
-        if iteration > 1:
-            for c, s in zip(components, states):
-                c.fmu.setFMUstate(s)
-        for k, (_, _, dst, inp) in enumerate(links):
-            dst.fmu.setReal([inp], [u[k]])
-        for c in components:
-            c.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-        y = np.array([src.fmu.getReal([out])[0] for src, out, _, _ in links])
-        tolerance = atol + rtol * np.maximum(np.abs(u), np.abs(y))
-        if np.all(np.abs(u - y) <= tolerance):
-            counts["iterations"] += iteration
-            for c, s in zip(components, states):
-                c.fmu.freeFMUstate(s)
-            return u
-        # J[k, j] = ∂Y_k/∂U_j, from the component that owns output k and input j
-        jac = np.zeros((len(links), len(links)))
-        for j, (_, _, dst, inp) in enumerate(links):
-            for k, (src, out, _, _) in enumerate(links):
-                if src is dst:
-                    jac[k, j] = dst.fmu.getDirectionalDerivative([out], [inp], [1.0])[0]
-        counts["jacobians"] += 1
-        u = u + np.linalg.solve(np.eye(len(links)) - jac, y - u)
-    raise SystemExit(f"newton did not converge at t = {t}")
+class Newton:
+    """Strong coupling: one FMU state per component, updated in place."""
+
+    def __init__(self, components, links, rtol, atol, counts):
+        self.components, self.links = components, links
+        self.rtol, self.atol, self.counts = rtol, atol, counts
+        self.states = [fmi2FMUstate() for _ in components]
+        # the interface values: the connected outputs as the FMUs give them
+        # now (the inputs do not hold them yet)
+        self.u = [src.fmu.getReal([out])[0] for src, out, _, _ in links]
+        self.holds_u = False
+
+    def free(self):
+        for c, s in zip(self.components, self.states):
+            c.fmu.freeFMUstate(s)
+
+    def step(self, t, h):
+        """One strongly coupled macro step from the interface values."""
+        components, links, u = self.components, self.links, self.u
+        n = len(links)
+        for c, s in zip(components, self.states):
+            c.fmu.fmi2GetFMUstate(c.fmu.component, byref(s))
+        for iteration in range(1, MAX_ITERATIONS + 1):
+            if iteration > 1:
+                for c, s in zip(components, self.states):
+                    c.fmu.setFMUstate(s)
+            if iteration > 1 or not self.holds_u:
+                for k, (_, _, dst, inp) in enumerate(links):
+                    dst.fmu.setReal([inp], [u[k]])
+            for c in components:
+                c.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            y = [src.fmu.getReal([out])[0] for src, out, _, _ in links]
+            if all(abs(uk - yk) <= a + self.rtol * max(abs(uk), abs(yk))
+                   for uk, yk, a in zip(u, y, self.atol)):
+                self.counts["iterations"] += iteration
+                self.u, self.holds_u = u, True
+                return
+            # J[k, j] = ∂Y_k/∂U_j, from the component that owns output k and input j
+            jac = np.zeros((n, n))
+            for j, (_, _, dst, inp) in enumerate(links):
+                for k, (src, out, _, _) in enumerate(links):
+                    if src is dst:
+                        jac[k, j] = dst.fmu.getDirectionalDerivative([out], [inp], [1.0])[0]
+            self.counts["jacobians"] += 1
+            du = np.linalg.solve(np.eye(n) - jac, [yk - uk for uk, yk in zip(u, y)])
+            u = [uk + d for uk, d in zip(u, du.tolist())]
+        raise SystemExit(f"newton did not converge at t = {t}")
 
 
 if __name__ == "__main__":
