@@ -82,7 +82,8 @@ pub struct Instance {
     flags: Vec<u8>,
     /// Per value reference, the scale of a finite-difference perturbation
     /// besides |u|: the variable's nominal value, else 1 (from the table,
-    /// once).
+    /// once; a NaN nominal, which `f64::max` would pass over, as -inf,
+    /// which `>` passes over).
     nominals: Box<[f64]>,
     /// The last list of value references [`Instance::get`] found valid for
     /// type `.0`, and whether it holds an output (`.2`): a master reads the
@@ -213,7 +214,10 @@ impl Instance {
         let nominals = info
             .variables
             .iter()
-            .map(|v| v.nominal.unwrap_or(1.0))
+            .map(|v| match v.nominal {
+                Some(n) if n.is_nan() => f64::NEG_INFINITY,
+                n => n.unwrap_or(1.0),
+            })
             .collect();
         let scratch_values = values.clone();
         Instance {
@@ -912,8 +916,15 @@ impl Instance {
         let mut eps = f64::INFINITY;
         for (k, dv) in knowns.iter().zip(dv_known) {
             if *dv != 0.0 {
-                let scale = self.values.real(*k).abs().max(self.nominals[*k as usize]);
-                eps = eps.min(FD_RELATIVE_STEP * scale / dv.abs());
+                // (`max` and `min` as comparisons: |u| is finite, a NaN
+                // nominal is -inf in `nominals`, and `e` is never NaN, so
+                // there is no NaN case to take)
+                let (u, nominal) = (self.values.real(*k).abs(), self.nominals[*k as usize]);
+                let scale = if u > nominal { u } else { nominal };
+                let e = FD_RELATIVE_STEP * scale / dv.abs();
+                if e < eps {
+                    eps = e;
+                }
             }
         }
         if !eps.is_finite() {
@@ -1032,39 +1043,45 @@ impl Instance {
     // ---- FMU states -----------------------------------------------------
 
     /// Restore `snap` (one of this instance's saved states): all or nothing.
-    /// Inlined into `restore_saved`, the other cases out of line.
-    #[inline]
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
         self.step_state_current = false;
-        if self.initialized
-            && snap.initialized
-            && snap.parameters_version == self.parameters_version
-        {
-            // The usual rollback of a master: a state this instance took
-            // since its parameters last changed (only those carry its
-            // current parameter version; a deserialized one has u64::MAX),
-            // so of this model, with the same sizes, and the GUID and
-            // parameter checks of `restore_other` would pass. The model
-            // takes the state or refuses it unchanged, then only the inputs
-            // (and their slopes, unless neither side has any) differ; the
-            // outputs are recomputed.
-            self.model
-                .restore_state(&snap.model_state)
-                .map_err(state_refused)?;
-            self.inputs.copy(self.values.as_mut_slice(), &snap.values);
-            if self.sloped || snap.sloped {
-                self.inputs.copy(&mut self.slopes, &snap.slopes);
-            }
+        if self.same_parameters(snap) {
+            restore_in_place(
+                &mut *self.model,
+                &mut self.values,
+                &mut self.slopes,
+                &self.inputs,
+                self.sloped,
+                snap,
+            )?;
         } else {
             self.restore_other(snap)?;
         }
-        self.sloped = snap.sloped;
-        self.initialized = snap.initialized;
-        self.time = snap.time;
-        self.state = snap.state;
+        self.restored(snap.sloped, snap.initialized, snap.time, snap.state);
+        Ok(())
+    }
+
+    /// Whether `snap` is the usual rollback of a master: a state this
+    /// instance took since its parameters last changed (only those carry
+    /// its current parameter version; a deserialized one has u64::MAX), so
+    /// of this model, with the same sizes, and the GUID and parameter
+    /// checks of [`Instance::restore_other`] would pass: restored by
+    /// [`restore_in_place`].
+    #[inline(always)]
+    fn same_parameters(&self, snap: &Snapshot) -> bool {
+        self.initialized && snap.initialized && snap.parameters_version == self.parameters_version
+    }
+
+    /// What every successful [`Instance::restore`] sets last, from the
+    /// snapshot's fields.
+    #[inline(always)]
+    fn restored(&mut self, sloped: bool, initialized: bool, time: f64, state: State) {
+        self.sloped = sloped;
+        self.initialized = initialized;
+        self.time = time;
+        self.state = state;
         self.replay.valid = false;
         self.outputs_dirty = true;
-        Ok(())
     }
 
     /// The model state and values of [`Instance::restore`] for any other
@@ -1181,7 +1198,35 @@ impl Instance {
     /// `fmi2SetFMUstate`: restore the saved snapshot at `address`.
     #[inline]
     pub fn restore_saved(&mut self, address: usize) -> Result<(), String> {
-        let snap = self.take_snapshot(address)?;
+        let i = self.saved_index(address)?;
+        let snap = &*self.saved_states[i];
+        if !self.same_parameters(snap) {
+            return self.restore_saved_other(i);
+        }
+        // `Instance::restore` of the usual rollback, with the snapshot left
+        // in the list: borrowed beside the fields the restore writes, none
+        // of which is the list.
+        self.step_state_current = false;
+        restore_in_place(
+            &mut *self.model,
+            &mut self.values,
+            &mut self.slopes,
+            &self.inputs,
+            self.sloped,
+            snap,
+        )?;
+        let (sloped, initialized, time, state) =
+            (snap.sloped, snap.initialized, snap.time, snap.state);
+        self.restored(sloped, initialized, time, state);
+        Ok(())
+    }
+
+    /// [`Instance::restore_saved`] of any other of the saved snapshots, at
+    /// `i`: out of the list for a moment (no copy; the box, and so the
+    /// address, stays the same).
+    #[inline(never)]
+    fn restore_saved_other(&mut self, i: usize) -> Result<(), String> {
+        let snap = self.saved_states.swap_remove(i);
         let result = self.restore(&snap);
         self.saved_states.push(snap);
         result
@@ -1321,6 +1366,31 @@ fn copy_all(snap: &mut Snapshot, values: &Values, slopes: &[f64], version: u64) 
     snap.values.extend_from_slice(values.as_slice());
     snap.slopes.clear();
     snap.slopes.extend_from_slice(slopes);
+}
+
+/// The model state and inputs of the usual rollback
+/// ([`Instance::same_parameters`]): the model takes the state or refuses
+/// it unchanged, then only the inputs (and their slopes, unless neither
+/// side has any: `sloped` is the instance's) differ; the outputs are
+/// recomputed. The instance's parts are borrowed one by one, so that
+/// `snap` may be one of its own saved states.
+#[inline(always)]
+fn restore_in_place(
+    model: &mut dyn Model,
+    values: &mut Values,
+    slopes: &mut [f64],
+    inputs: &Indices,
+    sloped: bool,
+    snap: &Snapshot,
+) -> Result<(), String> {
+    model
+        .restore_state(&snap.model_state)
+        .map_err(state_refused)?;
+    inputs.copy(values.as_mut_slice(), &snap.values);
+    if sloped || snap.sloped {
+        inputs.copy(slopes, &snap.slopes);
+    }
+    Ok(())
 }
 
 /// Why [`Instance::restore`] failed: the model refused the state.
