@@ -48,6 +48,26 @@ fn is_live(c: usize) -> bool {
     (c != 0 && RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c)) || is_live_locked(c)
 }
 
+/// The instance behind `c` for a call's fast path, if `c` is in
+/// [`RECENTLY_LIVE`] (no lock), its state is in `allowed` and calls are
+/// not logged; else `None`, and the call takes [`call_allowed`], which
+/// checks again and reports.
+///
+/// # Safety
+/// As [`call_allowed`]: `c` is dereferenced only if recently live.
+#[inline(always)]
+unsafe fn recent_instance<'a>(c: fmi2Component, allowed: u32) -> Option<&'a mut Instance> {
+    let c = c as usize;
+    if c == 0 || !RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c) {
+        return None;
+    }
+    // SAFETY: a recently live address is a live instance, created by
+    // `instantiate` and not freed; this is the only reference to it until
+    // the caller returns.
+    let instance = unsafe { &mut *(c as *mut Instance) };
+    (allowed & instance.state as u32 != 0 && !instance.logger.logs_calls()).then_some(instance)
+}
+
 /// [`is_live`] from [`LIVE`], noting a live `c` in [`RECENTLY_LIVE`].
 #[cold]
 #[inline(never)]
@@ -72,13 +92,15 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     }
 }
 
-/// [`call_allowed`] with the state mask of the function named by the
-/// literal, computed at compile time.
+/// [`call_allowed`] of the function named by the literal, with its state
+/// mask computed at compile time, and its name a constant of the cold
+/// paths (the closure returning it captures nothing, so a call does not
+/// store the name for them).
 macro_rules! call {
     ($c:expr, $function:literal, $body:expr) => {
-        call_allowed(
+        call_named(
             $c,
-            $function,
+            || $function,
             const { crate::state_machine::allowed_mask($function) },
             $body,
         )
@@ -98,6 +120,21 @@ pub unsafe fn call_allowed(
     allowed: u32,
     body: impl FnOnce(&mut Instance) -> Result<fmi2Status, String>,
 ) -> fmi2Status {
+    unsafe { call_named(c, move || function, allowed, body) }
+}
+
+/// [`call_allowed`] with the function's name from `function` (asked on the
+/// paths that log only).
+///
+/// # Safety
+/// As [`call_allowed`].
+#[inline(always)]
+unsafe fn call_named(
+    c: fmi2Component,
+    function: impl Fn() -> &'static str + Copy,
+    allowed: u32,
+    body: impl FnOnce(&mut Instance) -> Result<fmi2Status, String>,
+) -> fmi2Status {
     if c.is_null() || !is_live(c as usize) {
         // No instance, so no logger to report to: the status says it.
         return fmi2Status::fmi2Error;
@@ -113,20 +150,21 @@ pub unsafe fn call_allowed(
         // The step loop's case in two tests: the state allows the call and
         // call logging is off; everything else is out of line.
         if allowed & instance.state as u32 == 0 {
-            return illegal_call(instance, function);
+            return illegal_call(instance, function());
         }
         if instance.logger.logs_calls() {
-            log_call(instance, function);
+            log_call(instance, function());
         }
         match body(instance) {
             Ok(status) => status,
-            Err(message) => log_error(instance, function, message),
+            Err(message) => log_error(instance, function(), message),
         }
     }));
     outcome.unwrap_or_else(|payload| {
         // SAFETY: as above; the closure's reference ended with the unwind.
         let instance = unsafe { &mut *instance };
         let message = panic_message(&*payload);
+        let function = function();
         let _ = catch_unwind(AssertUnwindSafe(|| {
             instance.state = State::Fatal;
             instance
@@ -512,6 +550,38 @@ pub unsafe fn get_or_set_string(
 /// # Safety
 /// See [`call_allowed`] and [`in_slice`].
 pub unsafe fn set_real(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const f64,
+) -> fmi2Status {
+    // The step loop's case, one value set without a check of the model's
+    // (`Instance::set_real_plain`), before the general path: it calls
+    // nothing and cannot fail or panic, so it needs neither `catch_unwind`
+    // nor the general path's frame. Anything else, or any doubt, takes the
+    // general path, nothing changed, which checks everything in order and
+    // reports.
+    const ALLOWED: u32 = crate::state_machine::allowed_mask("fmi2SetReal");
+    if n == 1 && !vr.is_null() && vr.is_aligned() && !value.is_null() && value.is_aligned() {
+        // SAFETY: as `call_allowed`
+        if let Some(inst) = unsafe { recent_instance(c, ALLOWED) } {
+            // SAFETY: non-null and aligned, one element each (FMI contract)
+            let (vr, value) = unsafe { (*vr, *value) };
+            if inst.set_real_plain(vr, value) {
+                return fmi2Status::fmi2OK;
+            }
+        }
+    }
+    unsafe { set_real_general(c, vr, n, value) }
+}
+
+/// [`set_real`] with every check (out of line: the fast path above stays
+/// without a frame).
+///
+/// # Safety
+/// See [`call_allowed`] and [`in_slice`].
+#[inline(never)]
+unsafe fn set_real_general(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     n: usize,

@@ -12,7 +12,7 @@ use crate::logger::Logger;
 use crate::model::Model;
 use crate::serialize::Snapshot;
 use crate::state_machine::State;
-use crate::values::copy_at;
+use crate::values::Indices;
 use crate::variables::{Causality, ModelInfo, VarType, Variable};
 use crate::Values;
 
@@ -37,7 +37,7 @@ pub struct Instance {
     sloped: bool,
     /// Value references of the inputs, the values a step changes (by
     /// their slopes).
-    inputs: Vec<u32>,
+    inputs: Indices,
     /// Bumped whenever a value other than an input may have changed (a
     /// parameter set, a reset, a state with other parameters restored): a
     /// snapshot taken at the same version has the same parameters.
@@ -69,6 +69,10 @@ pub struct Instance {
     /// The model's [`Model::needs_step_replay`], asked once (a property of
     /// the model, not of its state).
     needs_step_replay: bool,
+    /// The model's [`Model::state_len`], asked again after each
+    /// `initialize` (a property of the model and its parameters), or
+    /// [`VEC_STATE`] ([`save_model_state`]).
+    state_len: usize,
     /// The model's [`Model::supplies_partial_derivatives`], asked once.
     supplies_partial_derivatives: bool,
     /// Per value reference, what the hot paths check ([`flag`]): the type,
@@ -76,6 +80,11 @@ pub struct Instance {
     /// get or set validates its value references with one load each; the
     /// messages still come from the table.
     flags: Vec<u8>,
+    /// Per value reference, the scale of a finite-difference perturbation
+    /// besides |u|: the variable's nominal value, else 1 (from the table,
+    /// once; a NaN nominal, which `f64::max` would pass over, as -inf,
+    /// which `>` passes over).
+    nominals: Box<[f64]>,
     /// The last list of value references [`Instance::get`] found valid for
     /// type `.0`, and whether it holds an output (`.2`): a master reads the
     /// same list at every step, and comparing it is cheaper than checking
@@ -138,7 +147,8 @@ fn flags_of(v: &Variable) -> u8 {
 
 /// Buffers of [`Instance::directional_derivative`], kept between calls.
 struct Scratch {
-    values: Option<Values>,
+    /// The values of the evaluations (made with the instance).
+    values: Values,
     /// The parameter version `values` holds the parameters of.
     parameters_version: u64,
     /// A copy of the model, made after its last `initialize`, on which
@@ -147,6 +157,8 @@ struct Scratch {
     /// starts each replay with `restore_state`, which restores the complete
     /// state; `initialize` drops it, as the parameters may have changed.)
     model: Option<Box<dyn Model>>,
+    /// The slopes of a replayed step, one per variable as
+    /// [`Instance::slopes`] (all zero between calls).
     slopes: Vec<f64>,
 }
 
@@ -191,6 +203,7 @@ impl Instance {
             })
             .collect();
         let needs_step_replay = model.needs_step_replay();
+        let state_len = model.state_len().unwrap_or(VEC_STATE);
         let supplies_partial_derivatives = model.supplies_partial_derivatives();
         let inputs: Vec<u32> = info
             .variables
@@ -198,6 +211,15 @@ impl Instance {
             .filter(|v| v.causality == Causality::Input)
             .map(|v| v.vr)
             .collect();
+        let nominals = info
+            .variables
+            .iter()
+            .map(|v| match v.nominal {
+                Some(n) if n.is_nan() => f64::NEG_INFINITY,
+                n => n.unwrap_or(1.0),
+            })
+            .collect();
+        let scratch_values = values.clone();
         Instance {
             info,
             name: name.to_string(),
@@ -220,20 +242,22 @@ impl Instance {
                 held: false,
                 h: 0.0,
             },
-            inputs,
+            inputs: Indices::new(inputs),
             parameters_version: 0,
             scratch: Scratch {
-                values: None,
+                values: scratch_values,
                 parameters_version: u64::MAX,
                 model: None,
-                slopes: Vec::new(),
+                slopes: vec![0.0; n],
             },
             saved_states: Vec::new(),
             step_state: Vec::new(),
             step_state_current: false,
             needs_step_replay,
+            state_len,
             supplies_partial_derivatives,
             flags,
+            nominals,
             checked_get: (VarType::Real, Vec::new(), false),
         }
     }
@@ -323,7 +347,11 @@ impl Instance {
     /// model ([`Scratch::model`]) is dropped with the old parameters.
     fn initialize_model(&mut self) -> Result<(), String> {
         self.scratch.model = None;
-        self.model.initialize(&self.values)
+        let result = self.model.initialize(&self.values);
+        // (asked whatever the outcome: the model has the state length of
+        // the parameters it now holds)
+        self.state_len = self.model.state_len().unwrap_or(VEC_STATE);
+        result
     }
 
     /// Recompute the outputs if an input or parameter changed since the last
@@ -485,16 +513,48 @@ impl Instance {
         } else if f & flag::CHECKED != 0 {
             self.check_input(vr, value)?;
         }
+        let stored = self.store_one(f, vr, value);
+        // (a value reference that passed the checks has a value: `flags`
+        // and `values` have one entry per variable)
+        assert!(stored, "value reference {vr} has no value");
+        Ok(())
+    }
+
+    /// The effects of [`Instance::set`] of variable `vr`, of flag byte `f`,
+    /// to `value`, which passed every check; `false`, and nothing changed,
+    /// if `vr` has no value.
+    #[inline(always)]
+    fn store_one(&mut self, f: u8, vr: u32, value: f64) -> bool {
+        let Some(slot) = self.values.as_mut_slice().get_mut(vr as usize) else {
+            return false;
+        };
         let input = f & flag::INPUT != 0;
-        if !input || self.values.real(vr) != value {
+        if !input || *slot != value {
             self.replay.valid = false;
         }
         if !input {
             self.parameters_version += 1;
         }
-        self.values.set(vr, value);
+        *slot = value;
         self.outputs_dirty = true;
-        Ok(())
+        true
+    }
+
+    /// [`Instance::set`] of one Real value in the step loop's case only: a
+    /// known variable settable now, a finite value, no check of the
+    /// model's to ask. Then the effects of `set` and `true`; else `false`,
+    /// nothing changed, and the caller takes `set`, which checks again and
+    /// reports. Calls nothing and cannot panic (every index is checked), so
+    /// that `fmi2SetReal` can take it before its `catch_unwind`.
+    #[inline(always)]
+    pub fn set_real_plain(&mut self, vr: u32, value: f64) -> bool {
+        let (_, want) = self.settable(VarType::Real);
+        let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+        // (bit 7 is CHECKED in a settable variable's byte)
+        f & want == want
+            && f & flag::CHECKED == 0
+            && value.is_finite()
+            && self.store_one(f, vr, value)
     }
 
     #[inline(never)]
@@ -694,8 +754,7 @@ impl Instance {
                 // the state after the last step is the state now
                 std::mem::swap(&mut self.replay.model_state, &mut self.step_state);
             } else {
-                self.replay.model_state.clear();
-                self.model.save_state(&mut self.replay.model_state);
+                save_model_state(&*self.model, self.state_len, &mut self.replay.model_state);
             }
             self.replay.held = !self.sloped;
             if self.sloped {
@@ -713,8 +772,7 @@ impl Instance {
         }
         // A step that overflowed (finite but extreme parameters or inputs)
         // is a failed step too: the state is no longer meaningful.
-        self.step_state.clear();
-        self.model.save_state(&mut self.step_state);
+        save_model_state(&*self.model, self.state_len, &mut self.step_state);
         if !all_finite(&self.step_state) {
             self.state = State::Error;
             return Err(self.state_overflowed(t, h));
@@ -767,6 +825,7 @@ impl Instance {
     /// current state. A model may supply J itself; else it is obtained by
     /// central differences along `dv_known`, replaying the step from the
     /// saved pre-step state.
+    #[inline]
     pub fn directional_derivative(
         &mut self,
         unknowns: &[u32],
@@ -857,17 +916,26 @@ impl Instance {
         let mut eps = f64::INFINITY;
         for (k, dv) in knowns.iter().zip(dv_known) {
             if *dv != 0.0 {
-                let v = &self.info.variables[*k as usize];
-                let scale = self.values.real(*k).abs().max(v.nominal.unwrap_or(1.0));
-                eps = eps.min(FD_RELATIVE_STEP * scale / dv.abs());
+                // (`max` and `min` as comparisons: |u| is finite, a NaN
+                // nominal is -inf in `nominals`, and `e` is never NaN, so
+                // there is no NaN case to take)
+                let (u, nominal) = (self.values.real(*k).abs(), self.nominals[*k as usize]);
+                let scale = if u > nominal { u } else { nominal };
+                let e = FD_RELATIVE_STEP * scale / dv.abs();
+                if e < eps {
+                    eps = e;
+                }
             }
         }
         if !eps.is_finite() {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
-        self.central_differences(knowns, dv_known, eps, unknowns, dv_unknown)?;
-        self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
+        if self.central_differences(knowns, dv_known, eps, unknowns, dv_unknown)? {
+            Ok(())
+        } else {
+            self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
+        }
     }
 
     /// `dv_unknown = J · dv_known` from the model's own partial derivatives,
@@ -900,8 +968,8 @@ impl Instance {
     /// ([`Scratch::model`]; the instance's model is not touched), else at
     /// the current state. The scratch values are brought to the instance's
     /// once for both evaluations, and `out` holds the first until the
-    /// second is subtracted. No allocation once the scratch buffers and
-    /// the copy exist.
+    /// second is subtracted. Whether every entry of `out` is finite. No
+    /// allocation once the replay copy exists.
     fn central_differences(
         &mut self,
         knowns: &[u32],
@@ -909,105 +977,111 @@ impl Instance {
         eps: f64,
         unknowns: &[u32],
         out: &mut [f64],
-    ) -> Result<(), String> {
+    ) -> Result<bool, String> {
+        // (the instance's fields borrowed once, beside the scratch ones:
+        // nothing is read through `self` again after a model call)
+        let current = self.values.as_slice();
         let scratch = &mut self.scratch;
-        let values = scratch.values.get_or_insert_with(|| self.values.clone());
+        let values = &mut scratch.values;
         if scratch.parameters_version == self.parameters_version {
             // the same parameters as last time: only the inputs differ (the
             // outputs are recomputed below)
-            values.copy_at(self.values.as_slice(), &self.inputs);
+            self.inputs.copy(values.as_mut_slice(), current);
         } else {
-            values.copy_from_slice(self.values.as_slice());
+            values.copy_from_slice(current);
             scratch.parameters_version = self.parameters_version;
         }
         // Each pass sets the knowns from the unperturbed inputs (the
         // instance's, or the replayed step's): the models write outputs
         // only, so the other inputs stay as set above.
+        let mut finite = true;
         let passes = [eps, -eps];
         if !self.replay.valid {
             for (pass, eps) in passes.into_iter().enumerate() {
-                for (&k, d) in knowns.iter().zip(dv) {
-                    values.set(k, self.values.real(k) + eps * d);
-                }
+                perturb(values, current, knowns, dv, eps);
                 self.model.compute_outputs_of(values, unknowns);
-                difference(pass, eps, values, unknowns, out);
+                finite = difference(pass, eps, values, unknowns, out);
             }
-            return Ok(());
+            return Ok(finite);
         }
         // Every slope is zero between calls; those of the inputs are set
         // here when the step had any (and zero again when done). Held
         // inputs: the values now (set above) are the values before the
         // step.
-        let slopes = &mut scratch.slopes;
-        slopes.resize(self.slopes.len(), 0.0);
-        let held = self.replay.held;
+        let replay = &self.replay;
+        let inputs = &self.inputs;
+        let slopes = &mut scratch.slopes[..];
         let model = scratch
             .model
             .get_or_insert_with(|| self.model.clone_model());
         for (pass, eps) in passes.into_iter().enumerate() {
-            if held {
-                for (&k, d) in knowns.iter().zip(dv) {
-                    values.set(k, self.values.real(k) + eps * d);
-                }
+            if replay.held {
+                perturb(values, current, knowns, dv, eps);
             } else {
-                for (k, &vr) in self.inputs.iter().enumerate() {
-                    values.set(vr, self.replay.inputs[k]);
-                    slopes[vr as usize] = self.replay.slopes[k];
+                for (k, &vr) in inputs.iter().enumerate() {
+                    values.set(vr, replay.inputs[k]);
+                    slopes[vr as usize] = replay.slopes[k];
                 }
                 for (&k, d) in knowns.iter().zip(dv) {
                     values.set(k, values.real(k) + eps * d);
                 }
             }
             let replayed = model
-                .restore_state(&self.replay.model_state)
-                .and_then(|()| model.do_step(values, slopes, self.replay.h));
-            if !held {
+                .restore_state(&replay.model_state)
+                .and_then(|()| model.do_step(values, slopes, replay.h));
+            if !replay.held {
                 // the inputs at the end of the step; every slope zero again
-                advance_inputs(&self.inputs, values, slopes, self.replay.h);
+                advance_inputs(inputs, values, slopes, replay.h);
             }
             replayed?;
             model.compute_outputs_of(values, unknowns);
-            difference(pass, eps, values, unknowns, out);
+            finite = difference(pass, eps, values, unknowns, out);
         }
-        Ok(())
+        Ok(finite)
     }
 
     // ---- FMU states -----------------------------------------------------
 
     /// Restore `snap` (one of this instance's saved states): all or nothing.
-    /// Inlined into `restore_saved`, the other cases out of line.
-    #[inline]
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
         self.step_state_current = false;
-        if self.initialized
-            && snap.initialized
-            && snap.parameters_version == self.parameters_version
-        {
-            // The usual rollback of a master: a state this instance took
-            // since its parameters last changed (only those carry its
-            // current parameter version; a deserialized one has u64::MAX),
-            // so of this model, with the same sizes, and the GUID and
-            // parameter checks of `restore_other` would pass. The model
-            // takes the state or refuses it unchanged, then only the inputs
-            // (and their slopes, unless neither side has any) differ; the
-            // outputs are recomputed.
-            self.model
-                .restore_state(&snap.model_state)
-                .map_err(state_refused)?;
-            self.values.copy_at(&snap.values, &self.inputs);
-            if self.sloped || snap.sloped {
-                copy_at(&mut self.slopes, &snap.slopes, &self.inputs);
-            }
+        if self.same_parameters(snap) {
+            restore_in_place(
+                &mut *self.model,
+                &mut self.values,
+                &mut self.slopes,
+                &self.inputs,
+                self.sloped,
+                snap,
+            )?;
         } else {
             self.restore_other(snap)?;
         }
-        self.sloped = snap.sloped;
-        self.initialized = snap.initialized;
-        self.time = snap.time;
-        self.state = snap.state;
+        self.restored(snap.sloped, snap.initialized, snap.time, snap.state);
+        Ok(())
+    }
+
+    /// Whether `snap` is the usual rollback of a master: a state this
+    /// instance took since its parameters last changed (only those carry
+    /// its current parameter version; a deserialized one has u64::MAX), so
+    /// of this model, with the same sizes, and the GUID and parameter
+    /// checks of [`Instance::restore_other`] would pass: restored by
+    /// [`restore_in_place`].
+    #[inline(always)]
+    fn same_parameters(&self, snap: &Snapshot) -> bool {
+        self.initialized && snap.initialized && snap.parameters_version == self.parameters_version
+    }
+
+    /// What every successful [`Instance::restore`] sets last, from the
+    /// snapshot's fields.
+    #[inline(always)]
+    fn restored(&mut self, sloped: bool, initialized: bool, time: f64, state: State) {
+        self.sloped = sloped;
+        self.initialized = initialized;
+        self.time = time;
+        self.state = state;
         self.replay.valid = false;
         self.outputs_dirty = true;
-        Ok(())
     }
 
     /// The model state and values of [`Instance::restore`] for any other
@@ -1059,6 +1133,7 @@ impl Instance {
     /// `fmi2GetFMUstate`: save the current state into the snapshot at
     /// `reuse` (which must be one of this instance's) in place, reusing its
     /// buffers, or into a new one if `reuse` is 0; returns its address.
+    #[inline]
     pub fn save_snapshot(&mut self, reuse: usize) -> Result<usize, String> {
         let reused = match reuse {
             0 => None,
@@ -1077,17 +1152,18 @@ impl Instance {
             // the same sizes): only the inputs and their slopes can differ
             // (outputs are recomputed after a restore), the slopes not if
             // both sides have none.
-            copy_at(&mut snap.values, self.values.as_slice(), &self.inputs);
+            self.inputs.copy(&mut snap.values, self.values.as_slice());
             if self.sloped || snap.sloped {
-                copy_at(&mut snap.slopes, &self.slopes, &self.inputs);
+                self.inputs.copy(&mut snap.slopes, &self.slopes);
             }
         } else {
             copy_all(snap, &self.values, &self.slopes, self.parameters_version);
         }
         snap.sloped = self.sloped;
-        snap.model_state.clear();
         if self.initialized {
-            self.model.save_state(&mut snap.model_state);
+            save_model_state(&*self.model, self.state_len, &mut snap.model_state);
+        } else {
+            snap.model_state.clear();
         }
         Ok(snap as *const Snapshot as usize)
     }
@@ -1120,8 +1196,37 @@ impl Instance {
     }
 
     /// `fmi2SetFMUstate`: restore the saved snapshot at `address`.
+    #[inline]
     pub fn restore_saved(&mut self, address: usize) -> Result<(), String> {
-        let snap = self.take_snapshot(address)?;
+        let i = self.saved_index(address)?;
+        let snap = &*self.saved_states[i];
+        if !self.same_parameters(snap) {
+            return self.restore_saved_other(i);
+        }
+        // `Instance::restore` of the usual rollback, with the snapshot left
+        // in the list: borrowed beside the fields the restore writes, none
+        // of which is the list.
+        self.step_state_current = false;
+        restore_in_place(
+            &mut *self.model,
+            &mut self.values,
+            &mut self.slopes,
+            &self.inputs,
+            self.sloped,
+            snap,
+        )?;
+        let (sloped, initialized, time, state) =
+            (snap.sloped, snap.initialized, snap.time, snap.state);
+        self.restored(sloped, initialized, time, state);
+        Ok(())
+    }
+
+    /// [`Instance::restore_saved`] of any other of the saved snapshots, at
+    /// `i`: out of the list for a moment (no copy; the box, and so the
+    /// address, stays the same).
+    #[inline(never)]
+    fn restore_saved_other(&mut self, i: usize) -> Result<(), String> {
+        let snap = self.saved_states.swap_remove(i);
         let result = self.restore(&snap);
         self.saved_states.push(snap);
         result
@@ -1177,6 +1282,40 @@ impl Instance {
     }
 }
 
+/// [`Instance::state_len`] of a model without [`Model::state_len`], which
+/// writes its state with [`Model::save_state`] only: no buffer has this
+/// length.
+const VEC_STATE: usize = usize::MAX;
+
+/// The complete state of `model` into `out`, replacing what it held, with
+/// `len` the model's [`Instance::state_len`]. The usual case is one
+/// comparison: a buffer of the state's length (sized by an earlier save,
+/// the length changing with the parameters only) is written in place by
+/// [`Model::write_state_into`]; the other cases are out of line.
+#[inline(always)]
+fn save_model_state(model: &dyn Model, len: usize, out: &mut Vec<f64>) {
+    if out.len() == len {
+        model.write_state_into(out);
+    } else {
+        save_model_state_resized(model, len, out);
+    }
+}
+
+/// [`save_model_state`] into a buffer of another length: sized to the
+/// state and written into, or, for a model without `state_len`, appended
+/// by [`Model::save_state`] (every time).
+#[cold]
+#[inline(never)]
+fn save_model_state_resized(model: &dyn Model, len: usize, out: &mut Vec<f64>) {
+    if len == VEC_STATE {
+        out.clear();
+        model.save_state(out);
+    } else {
+        out.resize(len, 0.0);
+        model.write_state_into(out);
+    }
+}
+
 /// After a step of length `h`, inputs stand at `u + du·h`; slopes reset.
 fn advance_inputs(inputs: &[u32], values: &mut Values, slopes: &mut [f64], h: f64) {
     for &vr in inputs {
@@ -1188,11 +1327,22 @@ fn advance_inputs(inputs: &[u32], values: &mut Values, slopes: &mut [f64], h: f6
     }
 }
 
+/// `values[k] = from[k] + eps·dv` for each known `k`: the perturbed
+/// inputs of a pass of [`Instance::central_differences`].
+#[inline(always)]
+fn perturb(values: &mut Values, from: &[f64], knowns: &[u32], dv: &[f64], eps: f64) {
+    for (&k, d) in knowns.iter().zip(dv) {
+        values.set(k, from[k as usize] + eps * d);
+    }
+}
+
 /// Evaluation `pass` of [`Instance::central_differences`], with `values`
 /// at `u + e·dv`: the first (`e = ε`) keeps `y₊` in `out`, the second
 /// (`e = -ε`, so `-2·e` is exactly `2·ε`) turns it into `(y₊ - y₋) / (2·ε)`.
+/// Whether every entry written is finite (as [`all_finite`]).
 #[inline(always)]
-fn difference(pass: usize, eps: f64, values: &Values, unknowns: &[u32], out: &mut [f64]) {
+fn difference(pass: usize, eps: f64, values: &Values, unknowns: &[u32], out: &mut [f64]) -> bool {
+    let mut zero = 0.0;
     for (o, &u) in out.iter_mut().zip(unknowns) {
         let y = values.real(u);
         *o = if pass == 0 {
@@ -1200,7 +1350,9 @@ fn difference(pass: usize, eps: f64, values: &Values, unknowns: &[u32], out: &mu
         } else {
             (*o - y) / (-2.0 * eps)
         };
+        zero += *o * 0.0;
     }
+    zero == 0.0
 }
 
 /// Every value and slope into `snap`, taken at parameter version `version`
@@ -1214,6 +1366,31 @@ fn copy_all(snap: &mut Snapshot, values: &Values, slopes: &[f64], version: u64) 
     snap.values.extend_from_slice(values.as_slice());
     snap.slopes.clear();
     snap.slopes.extend_from_slice(slopes);
+}
+
+/// The model state and inputs of the usual rollback
+/// ([`Instance::same_parameters`]): the model takes the state or refuses
+/// it unchanged, then only the inputs (and their slopes, unless neither
+/// side has any: `sloped` is the instance's) differ; the outputs are
+/// recomputed. The instance's parts are borrowed one by one, so that
+/// `snap` may be one of its own saved states.
+#[inline(always)]
+fn restore_in_place(
+    model: &mut dyn Model,
+    values: &mut Values,
+    slopes: &mut [f64],
+    inputs: &Indices,
+    sloped: bool,
+    snap: &Snapshot,
+) -> Result<(), String> {
+    model
+        .restore_state(&snap.model_state)
+        .map_err(state_refused)?;
+    inputs.copy(values.as_mut_slice(), &snap.values);
+    if sloped || snap.sloped {
+        inputs.copy(slopes, &snap.slopes);
+    }
+    Ok(())
 }
 
 /// Why [`Instance::restore`] failed: the model refused the state.

@@ -58,6 +58,26 @@ pub trait Model: Send {
     /// Append the complete state to `out` (cleared by the caller).
     fn save_state(&self, out: &mut Vec<f64>);
 
+    /// The number of values of the state, if the model writes it into a
+    /// slice with [`Model::write_state_into`]; `None` (the default) makes
+    /// the layer use [`Model::save_state`]. A property of the model and its
+    /// parameters (a number of bristles, say), not of the state: asked
+    /// after every `initialize`, not per step.
+    fn state_len(&self) -> Option<usize> {
+        None
+    }
+
+    /// Write the complete state into `out`, of `state_len()` values: the
+    /// values [`Model::save_state`] appends, bit for bit, without a vector
+    /// to grow. Called only if `state_len` answers; a model that answers
+    /// overrides this (the default goes through `save_state`, and
+    /// allocates).
+    fn write_state_into(&self, out: &mut [f64]) {
+        let mut state = Vec::with_capacity(out.len());
+        self.save_state(&mut state);
+        out.copy_from_slice(&state);
+    }
+
     /// Restore a state written by `save_state` of the same model.
     fn restore_state(&mut self, state: &[f64]) -> Result<(), String>;
 
@@ -98,14 +118,23 @@ pub struct ModelFactory {
     pub create: fn() -> Box<dyn Model>,
 }
 
-/// The three `Model` methods that only forward to a law with
-/// `write_state` / `state_from_slice` held in field `$law` of a `Clone`
-/// model: write `fmi2_cs::delegate_state!(law);` inside the `impl Model`.
+/// The five `Model` methods that only forward to a law with
+/// `write_state` / `state_len` / `write_state_into` / `state_from_slice`
+/// held in field `$law` of a `Clone` model: write
+/// `fmi2_cs::delegate_state!(law);` inside the `impl Model`.
 #[macro_export]
 macro_rules! delegate_state {
     ($law:ident) => {
         fn save_state(&self, out: &mut Vec<f64>) {
             self.$law.write_state(out);
+        }
+
+        fn state_len(&self) -> Option<usize> {
+            Some(self.$law.state_len())
+        }
+
+        fn write_state_into(&self, out: &mut [f64]) {
+            self.$law.write_state_into(out);
         }
 
         fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {

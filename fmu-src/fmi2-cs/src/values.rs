@@ -78,3 +78,72 @@ pub fn copy_at(to: &mut [f64], from: &[f64], vrs: &[u32]) {
         to[vr as usize] = from[vr as usize];
     }
 }
+
+/// A fixed list of value references (an instance's inputs) and their bound,
+/// for copying their entries between per-variable tables: the two lengths
+/// are checked once per copy against the bound, not per entry (a master's
+/// rollback copies the inputs into a snapshot and back at every step).
+#[derive(Clone, Debug, Default)]
+pub struct Indices {
+    vrs: Box<[u32]>,
+    /// One more than the largest of `vrs` (0 when empty): every entry is
+    /// below it.
+    bound: usize,
+}
+
+impl Indices {
+    pub fn new(vrs: Vec<u32>) -> Self {
+        let bound = vrs.iter().map(|&vr| vr as usize + 1).max().unwrap_or(0);
+        Indices {
+            vrs: vrs.into_boxed_slice(),
+            bound,
+        }
+    }
+
+    /// `to[vr] = from[vr]` for each value reference, as [`copy_at`] does.
+    #[inline]
+    pub fn copy(&self, to: &mut [f64], from: &[f64]) {
+        // Both tables cut to the bound: an entry's one index check then
+        // covers both (a shorter table is a bug in the layer, a panic as
+        // an out-of-bounds index would be).
+        let (to, from) = (&mut to[..self.bound], &from[..self.bound]);
+        for &vr in self.vrs.iter() {
+            to[vr as usize] = from[vr as usize];
+        }
+    }
+}
+
+impl std::ops::Deref for Indices {
+    type Target = [u32];
+
+    fn deref(&self) -> &[u32] {
+        &self.vrs
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`Indices::copy`] is [`copy_at`], in any order of the value
+    /// references, and refuses tables shorter than them (a panic, as an
+    /// index out of bounds is).
+    #[test]
+    fn indices_copy_as_copy_at_does() {
+        let from: Vec<f64> = (0..20).map(|k| k as f64 + 0.5).collect();
+        for vrs in [vec![], vec![0], vec![17, 3, 4, 0], vec![19, 1]] {
+            let indices = Indices::new(vrs.clone());
+            assert_eq!(&*indices, &vrs[..]);
+            let (mut a, mut b) = (vec![-1.0; 20], vec![-1.0; 20]);
+            indices.copy(&mut a, &from);
+            copy_at(&mut b, &from, &vrs);
+            assert_eq!(a, b);
+        }
+        let indices = Indices::new(vec![2, 5]);
+        let short = std::panic::catch_unwind(|| indices.copy(&mut [0.0; 5], &[0.0; 6]));
+        assert!(short.is_err());
+        let short = std::panic::catch_unwind(|| indices.copy(&mut [0.0; 6], &[0.0; 5]));
+        assert!(short.is_err());
+        indices.copy(&mut [0.0; 6], &[0.0; 6]);
+    }
+}

@@ -492,6 +492,32 @@ impl Bristle {
         v.extend_from_slice(&self.relax);
     }
 
+    /// The number of values of the state: `14 + 2·N`.
+    pub fn state_len(&self) -> usize {
+        14 + self.d.len() + self.relax.len()
+    }
+
+    /// The state of [`Bristle::write_state`] into `out`, of
+    /// [`Bristle::state_len`] values.
+    pub fn write_state_into(&self, out: &mut [f64]) {
+        assert_eq!(out.len(), self.state_len(), "bristle state length");
+        let (head, rest) = out.split_at_mut(14);
+        let (d, relax) = rest.split_at_mut(self.d.len());
+        head[..6].copy_from_slice(&[
+            self.x,
+            self.x_ref,
+            f64::from(self.dir),
+            self.lo as f64,
+            self.hi as f64,
+            self.p.n_bristles as f64,
+        ]);
+        for (pair, w) in head[6..].chunks_exact_mut(2).zip(self.rng.state()) {
+            pair.copy_from_slice(&[(w >> 32) as f64, (w & 0xffff_ffff) as f64]);
+        }
+        d.copy_from_slice(&self.d);
+        relax.copy_from_slice(&self.relax);
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = Vec::new();

@@ -334,6 +334,19 @@ impl Bristle2D {
         out.extend_from_slice(&[self.z[0], self.z[1]]);
     }
 
+    /// The number of values of the state (2).
+    #[inline]
+    pub fn state_len(&self) -> usize {
+        2
+    }
+
+    /// The state of [`Bristle2D::write_state`] into `out`, of
+    /// [`Bristle2D::state_len`] values.
+    #[inline]
+    pub fn write_state_into(&self, out: &mut [f64]) {
+        out.copy_from_slice(&[self.z[0], self.z[1]]);
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = Vec::new();
@@ -343,15 +356,26 @@ impl Bristle2D {
 
     /// Restores `[z1, z2]` (finite; projected into the disc like
     /// [`Bristle2D::set_z`]).
+    /// (Inlined into a caller, the messages out of line.)
+    #[inline]
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
         match s {
             [a, b] if a.is_finite() && b.is_finite() => {
                 self.set_z([*a, *b]);
                 Ok(())
             }
-            [_, _] => Err(format!("2-D bristle state {s:?} is not finite")),
-            _ => Err(format!("2-D bristle state has 2 values, got {}", s.len())),
+            _ => Err(state_refused(s)),
         }
+    }
+}
+
+/// Why [`Bristle2D::state_from_slice`] refused `s`.
+#[cold]
+#[inline(never)]
+fn state_refused(s: &[f64]) -> String {
+    match s {
+        [_, _] => format!("2-D bristle state {s:?} is not finite"),
+        _ => format!("2-D bristle state has 2 values, got {}", s.len()),
     }
 }
 
@@ -705,5 +729,20 @@ mod tests {
         let boundary = b.force_of(z, v0, true);
         assert!((inside[0] / boundary[0] - 1.1).abs() < 1e-12);
         assert!((inside[1] / boundary[1] - 1.3).abs() < 1e-12);
+    }
+
+    /// A refused state is named as before the messages moved out of line;
+    /// the slice writer writes what the vector writer appends.
+    #[test]
+    fn refused_states_are_named_and_written_states_agree() {
+        let mut b = Bristle2D::new(Bristle2DParams::default()).unwrap();
+        let err = b.state_from_slice(&[0.0, f64::NAN]).unwrap_err();
+        assert_eq!(err, "2-D bristle state [0.0, NaN] is not finite");
+        let err = b.state_from_slice(&[0.0]).unwrap_err();
+        assert_eq!(err, "2-D bristle state has 2 values, got 1");
+        b.set_z([1e-9, -2e-9]);
+        let mut s = vec![f64::NAN; b.state_len()];
+        b.write_state_into(&mut s);
+        assert_eq!(s, b.state_to_vec());
     }
 }

@@ -124,6 +124,19 @@ impl Dahl {
         out.extend_from_slice(&[self.f]);
     }
 
+    /// The number of values of the state (1).
+    #[inline]
+    pub fn state_len(&self) -> usize {
+        1
+    }
+
+    /// The state of [`Dahl::write_state`] into `out`, of
+    /// [`Dahl::state_len`] values.
+    #[inline]
+    pub fn write_state_into(&self, out: &mut [f64]) {
+        out.copy_from_slice(&[self.f]);
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = Vec::new();
@@ -132,15 +145,26 @@ impl Dahl {
     }
 
     /// Restores `[F]` (any finite value).
+    /// (Inlined into a caller, the messages out of line.)
+    #[inline]
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
         match s {
             [f] if f.is_finite() => {
                 self.f = *f;
                 Ok(())
             }
-            [f] => Err(format!("Dahl state F = {f} is not finite")),
-            _ => Err(format!("Dahl state has 1 value, got {}", s.len())),
+            _ => Err(state_refused(s)),
         }
+    }
+}
+
+/// Why [`Dahl::state_from_slice`] refused `s`.
+#[cold]
+#[inline(never)]
+fn state_refused(s: &[f64]) -> String {
+    match s {
+        [f] => format!("Dahl state F = {f} is not finite"),
+        _ => format!("Dahl state has 1 value, got {}", s.len()),
     }
 }
 
@@ -401,5 +425,20 @@ mod tests {
         }
         assert!(e.state_from_slice(&[1.0, 2.0]).is_err());
         assert!(e.state_from_slice(&[f64::INFINITY]).is_err());
+    }
+
+    /// A refused state is named as before the messages moved out of line;
+    /// the slice writer writes what the vector writer appends.
+    #[test]
+    fn refused_states_are_named_and_written_states_agree() {
+        let mut d = Dahl::new(DahlParams::default()).unwrap();
+        let err = d.state_from_slice(&[f64::INFINITY]).unwrap_err();
+        assert_eq!(err, "Dahl state F = inf is not finite");
+        let err = d.state_from_slice(&[1.0, 2.0]).unwrap_err();
+        assert_eq!(err, "Dahl state has 1 value, got 2");
+        d.state_from_slice(&[0.25]).unwrap();
+        let mut s = vec![f64::NAN; d.state_len()];
+        d.write_state_into(&mut s);
+        assert_eq!(s, d.state_to_vec());
     }
 }

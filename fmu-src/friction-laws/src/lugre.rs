@@ -588,6 +588,19 @@ impl LuGre {
         out.extend_from_slice(&[self.z]);
     }
 
+    /// The number of values of the state (1).
+    #[inline]
+    pub fn state_len(&self) -> usize {
+        1
+    }
+
+    /// The state of [`LuGre::write_state`] into `out`, of
+    /// [`LuGre::state_len`] values.
+    #[inline]
+    pub fn write_state_into(&self, out: &mut [f64]) {
+        out.copy_from_slice(&[self.z]);
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = Vec::new();
@@ -596,15 +609,26 @@ impl LuGre {
     }
 
     /// Restores `[z]` (finite).
+    /// (Inlined into a caller, the messages out of line.)
+    #[inline]
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
         match s {
             [z] if z.is_finite() => {
                 self.z = *z;
                 Ok(())
             }
-            [z] => Err(format!("LuGre state z = {z} is not finite")),
-            _ => Err(format!("LuGre state has 1 value, got {}", s.len())),
+            _ => Err(state_refused(s)),
         }
+    }
+}
+
+/// Why [`LuGre::state_from_slice`] refused `s`.
+#[cold]
+#[inline(never)]
+fn state_refused(s: &[f64]) -> String {
+    match s {
+        [z] => format!("LuGre state z = {z} is not finite"),
+        _ => format!("LuGre state has 1 value, got {}", s.len()),
     }
 }
 
@@ -1015,5 +1039,20 @@ mod tests {
         }
         assert!(b.state_from_slice(&[f64::NAN]).is_err());
         assert!(b.state_from_slice(&[0.0, 0.0]).is_err());
+    }
+
+    /// A refused state is named as before the messages moved out of line;
+    /// the slice writer writes what the vector writer appends.
+    #[test]
+    fn refused_states_are_named_and_written_states_agree() {
+        let mut l = LuGre::new(LuGreParams::default()).unwrap();
+        let err = l.state_from_slice(&[f64::NAN]).unwrap_err();
+        assert_eq!(err, "LuGre state z = NaN is not finite");
+        let err = l.state_from_slice(&[0.0, 0.0]).unwrap_err();
+        assert_eq!(err, "LuGre state has 1 value, got 2");
+        l.state_from_slice(&[1e-6]).unwrap();
+        let mut s = vec![f64::NAN; l.state_len()];
+        l.write_state_into(&mut s);
+        assert_eq!(s, l.state_to_vec());
     }
 }

@@ -128,6 +128,19 @@ impl ResetIntegrator {
         out.extend_from_slice(&[self.z]);
     }
 
+    /// The number of values of the state (1).
+    #[inline]
+    pub fn state_len(&self) -> usize {
+        1
+    }
+
+    /// The state of [`ResetIntegrator::write_state`] into `out`, of
+    /// [`ResetIntegrator::state_len`] values.
+    #[inline]
+    pub fn write_state_into(&self, out: &mut [f64]) {
+        out.copy_from_slice(&[self.z]);
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = Vec::new();
@@ -136,18 +149,26 @@ impl ResetIntegrator {
     }
 
     /// Restores `[z]` (finite).
+    /// (Inlined into a caller, the messages out of line.)
+    #[inline]
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
         match s {
             [z] if z.is_finite() => {
                 self.z = *z;
                 Ok(())
             }
-            [z] => Err(format!("reset-integrator state z = {z} is not finite")),
-            _ => Err(format!(
-                "reset-integrator state has 1 value, got {}",
-                s.len()
-            )),
+            _ => Err(state_refused(s)),
         }
+    }
+}
+
+/// Why [`ResetIntegrator::state_from_slice`] refused `s`.
+#[cold]
+#[inline(never)]
+fn state_refused(s: &[f64]) -> String {
+    match s {
+        [z] => format!("reset-integrator state z = {z} is not finite"),
+        _ => format!("reset-integrator state has 1 value, got {}", s.len()),
     }
 }
 
@@ -253,5 +274,20 @@ mod tests {
             }
         }
         assert!(q.state_from_slice(&[]).is_err());
+    }
+
+    /// A refused state is named as before the messages moved out of line;
+    /// the slice writer writes what the vector writer appends.
+    #[test]
+    fn refused_states_are_named_and_written_states_agree() {
+        let mut r = ResetIntegrator::new(ResetParams::default()).unwrap();
+        let err = r.state_from_slice(&[f64::NAN]).unwrap_err();
+        assert_eq!(err, "reset-integrator state z = NaN is not finite");
+        let err = r.state_from_slice(&[]).unwrap_err();
+        assert_eq!(err, "reset-integrator state has 1 value, got 0");
+        r.state_from_slice(&[1e-7]).unwrap();
+        let mut s = vec![f64::NAN; r.state_len()];
+        r.write_state_into(&mut s);
+        assert_eq!(s, r.state_to_vec());
     }
 }

@@ -855,6 +855,19 @@ impl Rig1D {
         out.extend_from_slice(&[self.t, self.x, self.xd, self.xi]);
     }
 
+    /// The number of values of the state (4).
+    #[inline]
+    pub fn state_len(&self) -> usize {
+        4
+    }
+
+    /// The state of [`Rig1D::write_state`] into `out`, of
+    /// [`Rig1D::state_len`] values.
+    #[inline]
+    pub fn write_state_into(&self, out: &mut [f64]) {
+        out.copy_from_slice(&[self.t, self.x, self.xd, self.xi]);
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = Vec::new();
@@ -862,6 +875,8 @@ impl Rig1D {
         v
     }
 
+    /// (Inlined into a caller, the message out of line.)
+    #[inline]
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
         match s {
             // x·0 is 0 for a finite x, NaN otherwise: one test for the four
@@ -869,9 +884,16 @@ impl Rig1D {
                 (self.t, self.x, self.xd, self.xi) = (*t, *x, *xd, *xi);
                 Ok(())
             }
-            _ => Err(format!("Rig1D state must be 4 finite numbers, got {s:?}")),
+            _ => Err(state_refused(s)),
         }
     }
+}
+
+/// Why [`Rig1D::state_from_slice`] refused `s`.
+#[cold]
+#[inline(never)]
+fn state_refused(s: &[f64]) -> String {
+    format!("Rig1D state must be 4 finite numbers, got {s:?}")
 }
 
 /// θ ∈ [0, len] where g changes sign, g(0) = g0, g(len) = g_len (Illinois

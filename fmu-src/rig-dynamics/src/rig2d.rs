@@ -150,6 +150,21 @@ impl Rig2D {
         self.axes[1].write_state(out);
     }
 
+    /// The number of values of the state (both axes').
+    #[inline]
+    pub fn state_len(&self) -> usize {
+        self.axes[0].state_len() + self.axes[1].state_len()
+    }
+
+    /// The state of [`Rig2D::write_state`] into `out`, of
+    /// [`Rig2D::state_len`] values.
+    #[inline]
+    pub fn write_state_into(&self, out: &mut [f64]) {
+        let (first, second) = out.split_at_mut(self.axes[0].state_len());
+        self.axes[0].write_state_into(first);
+        self.axes[1].write_state_into(second);
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = Vec::new();

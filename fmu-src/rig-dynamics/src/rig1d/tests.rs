@@ -917,3 +917,21 @@ fn plain_step_is_the_general_step_bit_for_bit() {
         }
     }
 }
+
+/// A refused state is named as before the message moved out of line; the
+/// slice writer writes what the vector writer appends.
+#[test]
+fn refused_states_are_named_and_written_states_agree() {
+    let mut rig = Rig1D::new(Rig1DParams::default()).unwrap();
+    let err = rig
+        .state_from_slice(&[0.0, 1.0, f64::NAN, 0.0])
+        .unwrap_err();
+    assert_eq!(
+        err,
+        "Rig1D state must be 4 finite numbers, got [0.0, 1.0, NaN, 0.0]"
+    );
+    rig.state_from_slice(&[0.5, 1e-3, -2e-3, 0.0]).unwrap();
+    let mut s = vec![f64::NAN; rig.state_len()];
+    rig.write_state_into(&mut s);
+    assert_eq!(s, rig.state_to_vec());
+}
