@@ -163,7 +163,9 @@ impl std::fmt::Display for ConvergenceReport {
     }
 }
 
-/// Per-component index lists into the connection table.
+/// Per component: its index lists into the connection table, its saved
+/// state, and where its Jacobian columns come from. Kept together so that
+/// the loops of a step walk one list beside `System::components`.
 struct Ports {
     /// Connections whose input belongs to the component.
     inputs: Vec<usize>,
@@ -179,15 +181,33 @@ struct Ports {
     directional: Option<bool>,
     /// Why the component is differenced, when that is decided up front.
     differenced: &'static str,
+    /// The convergence report says how the component's columns are
+    /// obtained (its entry is no longer "not needed").
+    reported: bool,
     /// Inputs ramp linearly over the step from their value at `t` to `U`
     /// (`fmi2SetRealInputDerivatives`) instead of holding `U`.
     ramped: bool,
+    /// The component's state at the start of the step being solved.
+    state: Option<FmuState>,
+    /// The component's change count ([`crate::fmu::Instance::changes`])
+    /// when its state was last saved into `state` or restored from there.
+    /// While the count stands still, the FMU is in that saved state, and
+    /// saving it again would change nothing (the step after a split, the
+    /// retry of a rejected adaptive step).
+    in_saved_state: Option<u64>,
+    /// With held inputs: the change count right after the component was
+    /// stepped on `u` in the iteration that converged. While the count
+    /// stands still (nothing but `fmi2Get…` calls since: the recorded
+    /// sample, the state saved), its inputs still hold `u`, which is also
+    /// the first iterate of the next step, and setting them again would
+    /// change nothing.
+    holds_u: Option<u64>,
 }
 
 impl Ports {
     /// Set the component's inputs from `u` (one value per connection):
     /// held, or `ramped` from `start` at `t` to `u` at `t + h`.
-    #[inline] // hot: every iteration of every step
+    #[inline(always)] // hot: every iteration of every step
     fn set_inputs(
         &self,
         instance: &mut Instance,
@@ -195,13 +215,27 @@ impl Ports {
         start: &[f64],
         h: f64,
     ) -> Result<(), FmuError> {
+        if self.ramped {
+            return self.set_ramped_inputs(instance, u, start, h);
+        }
         for (&k, &vr) in self.inputs.iter().zip(&self.input_vrs) {
-            if self.ramped {
-                instance.set_real(&[vr], &[start[k]])?;
-                instance.set_real_input_derivatives(&[vr], &[1], &[(u[k] - start[k]) / h])?;
-            } else {
-                instance.set_real(&[vr], &[u[k]])?;
-            }
+            instance.set_real(&[vr], &[u[k]])?;
+        }
+        Ok(())
+    }
+
+    /// [`Ports::set_inputs`] of a component whose inputs ramp.
+    #[inline(never)]
+    fn set_ramped_inputs(
+        &self,
+        instance: &mut Instance,
+        u: &[f64],
+        start: &[f64],
+        h: f64,
+    ) -> Result<(), FmuError> {
+        for (&k, &vr) in self.inputs.iter().zip(&self.input_vrs) {
+            instance.set_real(&[vr], &[start[k]])?;
+            instance.set_real_input_derivatives(&[vr], &[1], &[(u[k] - start[k]) / h])?;
         }
         Ok(())
     }
@@ -218,6 +252,63 @@ impl Ports {
             out[k] = y;
         }
         Ok(())
+    }
+
+    /// Save the component's state at the start of the step into `state`
+    /// (`fmi2GetFMUstate`), unless it is the saved one already.
+    #[inline] // hot: every step
+    fn save_state(&mut self, instance: &mut Instance) -> Result<(), FmuError> {
+        match &mut self.state {
+            Some(_) if self.in_saved_state == Some(instance.changes()) => return Ok(()),
+            Some(state) => {
+                instance.update_state(state)?;
+            }
+            None => self.state = Some(instance.get_state()?),
+        }
+        // fmi2GetFMUstate is a getter: the count has not moved
+        self.in_saved_state = Some(instance.changes());
+        Ok(())
+    }
+
+    /// Roll the component back to its saved state (`fmi2SetFMUstate`).
+    #[inline(always)] // hot: every iteration after the first
+    fn restore(&mut self, instance: &mut Instance) -> Result<(), FmuError> {
+        let state = self.state.as_ref().expect("saved before stepping");
+        let restored = instance.set_state(state);
+        // after a failed fmi2SetFMUstate the FMU's state is unknown
+        self.in_saved_state = restored.is_ok().then(|| instance.changes());
+        restored.map(|_| ())
+    }
+}
+
+/// The last few residual norms of a step's Newton base points, oldest
+/// first (at most [`NONMONOTONE_MEMORY`]; a new one pushes the oldest
+/// out), kept in place of a vector so that nothing is allocated or moved
+/// through the heap.
+#[derive(Clone, Copy, Debug, Default)]
+struct RecentNorms {
+    norms: [f64; NONMONOTONE_MEMORY],
+    len: usize,
+}
+
+impl RecentNorms {
+    fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    fn push(&mut self, norm: f64) {
+        if self.len == NONMONOTONE_MEMORY {
+            self.norms.copy_within(1.., 0);
+            self.len -= 1;
+        }
+        self.norms[self.len] = norm;
+        self.len += 1;
+    }
+
+    /// The largest, 0 if there are none (NaNs are passed over, as
+    /// `f64::max` does), taken oldest first.
+    fn max(&self) -> f64 {
+        self.norms[..self.len].iter().copied().fold(0.0, f64::max)
     }
 }
 
@@ -246,20 +337,6 @@ pub struct StrongCoupling {
     range: Vec<f64>,
     report: ConvergenceReport,
     ports: Vec<Ports>,
-    states: Vec<Option<FmuState>>,
-    /// Per component: its change count ([`crate::fmu::Instance::changes`])
-    /// when its state was last saved into `states` or restored from there.
-    /// While the count stands still, the FMU is in that saved state, and
-    /// saving it again would change nothing (the step after a split, the
-    /// retry of a rejected adaptive step).
-    in_saved_state: Vec<Option<u64>>,
-    /// Per component with held inputs: its change count right after it was
-    /// stepped on `u` in the iteration that converged. While the count
-    /// stands still (nothing but `fmi2Get…` calls since: the recorded
-    /// sample, the state saved), its inputs still hold `u`, which is also
-    /// the first iterate of the next step, and setting them again would
-    /// change nothing.
-    holds_u: Vec<Option<u64>>,
     nominal: Vec<f64>,
     /// The interface values U; between steps, the last accepted ones.
     u: Vec<f64>,
@@ -277,7 +354,7 @@ pub struct StrongCoupling {
     /// NONMONOTONE_MEMORY base residual norms.
     base: Vec<f64>,
     direction: Vec<f64>,
-    history: Vec<f64>,
+    history: RecentNorms,
 }
 
 impl StrongCoupling {
@@ -300,9 +377,6 @@ impl StrongCoupling {
                 ..Default::default()
             },
             ports: Vec::new(),
-            states: Vec::new(),
-            in_saved_state: Vec::new(),
-            holds_u: Vec::new(),
             nominal: Vec::new(),
             u: Vec::new(),
             started: false,
@@ -313,7 +387,7 @@ impl StrongCoupling {
             perturbed: Vec::new(),
             base: Vec::new(),
             direction: Vec::new(),
-            history: Vec::with_capacity(NONMONOTONE_MEMORY),
+            history: RecentNorms::default(),
         }
     }
 
@@ -412,7 +486,11 @@ impl StrongCoupling {
                     outputs,
                     directional,
                     differenced,
+                    reported: false,
                     ramped,
+                    state: None,
+                    in_saved_state: None,
+                    holds_u: None,
                 }
             })
             .collect();
@@ -432,9 +510,6 @@ impl StrongCoupling {
                     .unwrap_or(1.0)
             })
             .collect();
-        self.states = (0..system.components.len()).map(|_| None).collect();
-        self.in_saved_state = vec![None; system.components.len()];
-        self.holds_u = vec![None; system.components.len()];
         self.variable_steps = system.components.iter().all(|c| {
             c.fmu
                 .description()
@@ -444,6 +519,9 @@ impl StrongCoupling {
         let most_outputs = self.ports.iter().map(|p| p.outputs.len()).max();
         self.derivative = vec![0.0; most_outputs.unwrap_or(0)];
         self.u = vec![0.0; n];
+        self.accepted = vec![0.0; n];
+        self.base = vec![0.0; n];
+        self.direction = vec![0.0; n];
         self.range = vec![0.0; n];
         self.started = false;
         self.y = vec![0.0; n];
@@ -455,74 +533,87 @@ impl StrongCoupling {
         Ok(())
     }
 
-    /// Save every component's state at the start of the step into
-    /// `states` (`fmi2GetFMUstate`), unless it is the saved one already.
+    /// Save every component's state at the start of the step
+    /// ([`Ports::save_state`]).
     fn save_states(&mut self, system: &mut System) -> Result<(), FmuError> {
-        let slots = self.states.iter_mut().zip(&mut self.in_saved_state);
-        for (c, (slot, in_saved)) in system.components.iter_mut().zip(slots) {
-            let changes = c.instance.changes();
-            match slot {
-                Some(_) if *in_saved == Some(changes) => continue,
-                Some(state) => {
-                    c.instance.update_state(state)?;
-                }
-                None => *slot = Some(c.instance.get_state()?),
-            }
-            // fmi2GetFMUstate is a getter: the count has not moved
-            *in_saved = Some(c.instance.changes());
+        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+            ports.save_state(&mut c.instance)?;
         }
         Ok(())
     }
 
-    /// Roll component `c` back to its saved state (`fmi2SetFMUstate`).
-    #[inline(always)] // a hot path, and small
-    fn restore(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
-        let state = self.states[c].as_ref().expect("saved before stepping");
-        let instance = &mut system.components[c].instance;
-        let restored = instance.set_state(state);
-        // after a failed fmi2SetFMUstate the FMU's state is unknown
-        self.in_saved_state[c] = restored.is_ok().then(|| instance.changes());
-        restored.map(|_| ())
+    /// Roll every component back to its saved state ([`Ports::restore`]).
+    fn restore_all(&mut self, system: &mut System) -> Result<(), FmuError> {
+        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+            ports.restore(&mut c.instance)?;
+        }
+        Ok(())
     }
 
-    /// Columns of ∂Y/∂U for the inputs of component `c`, by rolling back
-    /// and stepping with one input perturbed by δ = √ε·max(|U_j|, nominal_j).
+    /// The Newton direction at U, every component just stepped on it:
+    /// `(I − J)·ΔU = Y − U` solved into `direction`, or where I − J is
+    /// singular the fixed-point direction `Y − U`.
+    #[inline(never)]
+    fn newton_direction(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
+        let n = self.u.len();
+        if self.jac.shape() == (n, n) {
+            self.jac.as_mut_slice().fill(0.0);
+        } else {
+            self.jac = DMatrix::zeros(n, n);
+        }
+        self.jacobian(system, t, h)?;
+        // (I − J)·ΔU = Y − U (over the slice: the matrix iterators cost
+        // more than the few entries)
+        let jac = &mut self.jac;
+        for x in jac.as_mut_slice() {
+            *x = -*x;
+        }
+        for k in 0..n {
+            jac[(k, k)] += 1.0;
+            self.direction[k] = self.y[k] - self.u[k];
+        }
+        if !solve_in_place(jac, &mut self.direction) {
+            // I − J singular: the fixed-point direction.
+            for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
+                *d = y - u;
+            }
+        }
+        Ok(())
+    }
+
+    /// Columns of ∂Y/∂U for the inputs of component `c` into `self.jac`, by
+    /// rolling back and stepping with one input perturbed by
+    /// δ = √ε·max(|U_j|, nominal_j).
     fn difference_columns(
         &mut self,
         system: &mut System,
         c: usize,
         t: f64,
         h: f64,
-        jac: &mut DMatrix<f64>,
     ) -> Result<(), FmuError> {
         for i in 0..self.ports[c].inputs.len() {
             let j = self.ports[c].inputs[i];
             let delta = f64::EPSILON.sqrt() * self.u[j].abs().max(self.nominal[j]);
-            self.restore(system, c)?;
+            let instance = &mut system.components[c].instance;
+            self.ports[c].restore(instance)?;
             self.perturbed.clone_from(&self.u);
             self.perturbed[j] += delta;
-            let instance = &mut system.components[c].instance;
             self.ports[c].set_inputs(instance, &self.perturbed, &self.accepted, h)?;
             instance.do_step(t, h)?;
             self.report.difference_steps += 1;
             self.column.clone_from(&self.y);
             self.ports[c].read_outputs(instance, &mut self.column)?;
             for &k in &self.ports[c].outputs {
-                jac[(k, j)] = (self.column[k] - self.y[k]) / delta;
+                self.jac[(k, j)] = (self.column[k] - self.y[k]) / delta;
             }
         }
         Ok(())
     }
 
-    /// Columns of ∂Y/∂U for the inputs of component `c` from
+    /// Columns of ∂Y/∂U for the inputs of component `c` into `self.jac`, from
     /// `fmi2GetDirectionalDerivative`, called right after the step.
     #[inline] // hot: at every Jacobian
-    fn directional_columns(
-        &mut self,
-        system: &mut System,
-        c: usize,
-        jac: &mut DMatrix<f64>,
-    ) -> Result<(), FmuError> {
+    fn directional_columns(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         let ports = &self.ports[c];
         // (sized for the component with the most outputs in `prepare`)
         let out = &mut self.derivative[..ports.outputs.len()];
@@ -530,7 +621,7 @@ impl StrongCoupling {
         for (&j, &known) in ports.inputs.iter().zip(&ports.input_vrs) {
             instance.get_directional_derivative(&ports.output_vrs, &[known], &[1.0], out)?;
             for (&k, d) in ports.outputs.iter().zip(out.iter()) {
-                jac[(k, j)] = *d;
+                self.jac[(k, j)] = *d;
             }
         }
         Ok(())
@@ -539,31 +630,28 @@ impl StrongCoupling {
     /// ∂Y/∂U, with every component stepped on `self.u` just before. Leaves
     /// components that were differenced in a perturbed state (the next
     /// iteration restores them).
-    /// `jac` is n × n and zero on entry.
-    fn jacobian(
-        &mut self,
-        system: &mut System,
-        t: f64,
-        h: f64,
-        jac: &mut DMatrix<f64>,
-    ) -> Result<(), FmuError> {
+    /// `self.jac` is n × n and zero on entry.
+    fn jacobian(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
         self.report.jacobians += 1;
         // Directional derivatives first: they need the step just taken.
         for c in 0..system.components.len() {
-            if self.ports[c].inputs.is_empty() || self.ports[c].outputs.is_empty() {
+            let ports = &self.ports[c];
+            if ports.inputs.is_empty()
+                || ports.outputs.is_empty()
+                || ports.directional == Some(false)
+            {
                 continue;
             }
-            match self.ports[c].directional {
-                Some(true) => self.directional_columns(system, c, jac)?,
+            let columns = self.directional_columns(system, c);
+            if self.ports[c].directional == Some(true) {
+                columns?;
+            } else if columns.is_err() {
                 // Auto: an FMU whose call fails is differenced instead.
-                None => {
-                    if self.directional_columns(system, c, jac).is_err() {
-                        self.ports[c].directional = Some(false);
-                        self.report.jacobian_of[c].1 =
-                            "finite differences (fmi2GetDirectionalDerivative failed)";
-                    }
-                }
-                Some(false) => {}
+                self.ports[c].directional = Some(false);
+                self.describe(
+                    c,
+                    "finite differences (fmi2GetDirectionalDerivative failed)",
+                );
             }
         }
         for c in 0..system.components.len() {
@@ -572,24 +660,24 @@ impl StrongCoupling {
             }
             match self.ports[c].directional {
                 Some(true) => {
-                    if self.report.jacobian_of[c].1 == "not needed" {
-                        self.report.jacobian_of[c].1 = "directional derivatives";
+                    if !self.ports[c].reported {
+                        self.describe(c, "directional derivatives");
                     }
                 }
                 Some(false) => {
-                    self.difference_columns(system, c, t, h, jac)?;
-                    if self.report.jacobian_of[c].1 == "not needed" {
-                        self.report.jacobian_of[c].1 = self.ports[c].differenced;
+                    self.difference_columns(system, c, t, h)?;
+                    if !self.ports[c].reported {
+                        self.describe(c, self.ports[c].differenced);
                     }
                 }
                 None => {
                     // Auto: compare with finite differences once.
-                    let mut reference = jac.clone();
-                    self.difference_columns(system, c, t, h, &mut reference)?;
+                    let directional = self.jac.clone();
+                    self.difference_columns(system, c, t, h)?;
                     let mut agree = true;
                     for &j in &self.ports[c].inputs {
                         for &k in &self.ports[c].outputs {
-                            let (a, b) = (jac[(k, j)], reference[(k, j)]);
+                            let (a, b) = (directional[(k, j)], self.jac[(k, j)]);
                             let scale = a.abs().max(b.abs()).max(1e-300);
                             if (a - b).abs() > 1e-3 * scale + 1e-12 {
                                 agree = false;
@@ -598,17 +686,25 @@ impl StrongCoupling {
                     }
                     self.ports[c].directional = Some(agree);
                     if agree {
-                        self.report.jacobian_of[c].1 =
-                            "directional derivatives (checked against finite differences)";
+                        self.describe(
+                            c,
+                            "directional derivatives (checked against finite differences)",
+                        );
+                        self.jac = directional;
                     } else {
-                        self.report.jacobian_of[c].1 =
-                            "finite differences (directional derivatives disagreed)";
-                        jac.copy_from(&reference);
+                        self.describe(c, "finite differences (directional derivatives disagreed)");
                     }
                 }
             }
         }
         Ok(())
+    }
+
+    /// Say in the convergence report how component `c`'s Jacobian columns
+    /// are obtained (its entry is "not needed" until then).
+    fn describe(&mut self, c: usize, how: &'static str) {
+        self.report.jacobian_of[c].1 = how;
+        self.ports[c].reported = true;
     }
 }
 
@@ -698,9 +794,7 @@ impl StrongCoupling {
                         return solved;
                     }
                     self.report.rejected += 1;
-                    for c in 0..system.components.len() {
-                        self.restore(system, c)?;
-                    }
+                    self.restore_all(system)?;
                     self.u.copy_from_slice(&start);
                     let shrink = match estimate {
                         Some(error) => (0.9 / error).clamp(0.2, 0.5),
@@ -736,11 +830,11 @@ impl StrongCoupling {
         worst
     }
 
+    #[inline] // at every step, and only the first does anything
     fn ensure_started(&mut self, system: &mut System) -> Result<(), FmuError> {
         if !self.started {
-            for c in 0..system.components.len() {
-                let instance = &mut system.components[c].instance;
-                self.ports[c].read_outputs(instance, &mut self.u)?;
+            for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+                ports.read_outputs(&mut c.instance, &mut self.u)?;
             }
             self.started = true;
         }
@@ -765,11 +859,8 @@ impl StrongCoupling {
                 }
                 self.report.rejected += 1;
                 self.report.iterations += self.max_iterations;
-                for c in 0..system.components.len() {
-                    self.restore(system, c)?;
-                }
-                let u = self.accepted.clone();
-                self.u.copy_from_slice(&u);
+                self.restore_all(system)?;
+                self.u.copy_from_slice(&self.accepted);
                 self.step_or_split(system, t, 0.5 * h, depth + 1)?;
                 self.step_or_split(system, t + 0.5 * h, 0.5 * h, depth + 1)
             }
@@ -792,7 +883,7 @@ impl StrongCoupling {
         // a hysteretic law reads an input a rounding error below its last
         // one as a reversal.
         self.ensure_started(system)?;
-        self.accepted.clone_from(&self.u);
+        self.accepted.copy_from_slice(&self.u);
         // Damped Newton: from the base point `base` (where the Jacobian was
         // taken) try U = base + λ·direction, halving λ while the scaled
         // residual norm is not below the largest of the last
@@ -803,30 +894,27 @@ impl StrongCoupling {
         // makes at a reversal — is cut by halving.
         let mut has_base = false;
         self.history.clear();
-        self.direction.resize(n, 0.0);
         let mut lambda = 1.0;
         let mut worst = (f64::INFINITY, 0);
         let mut last_norm = f64::INFINITY;
         for iteration in 1..=self.max_iterations {
-            for c in 0..system.components.len() {
+            for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+                let instance = &mut c.instance;
                 // (only a converged iteration leaves a mark, for the next step)
-                let holds_u =
-                    self.holds_u[c].take() == Some(system.components[c].instance.changes());
+                let holds_u = ports.holds_u.take() == Some(instance.changes());
                 if iteration > 1 {
-                    self.restore(system, c)?;
+                    ports.restore(instance)?;
                 } else if holds_u {
                     // the first iterate is the last accepted U, still set
                     continue;
                 }
-                let instance = &mut system.components[c].instance;
-                self.ports[c].set_inputs(instance, &self.u, &self.accepted, h)?;
+                ports.set_inputs(instance, &self.u, &self.accepted, h)?;
             }
             for c in &mut system.components {
                 c.instance.do_step(t, h)?;
             }
-            for c in 0..system.components.len() {
-                let instance = &mut system.components[c].instance;
-                self.ports[c].read_outputs(instance, &mut self.y)?;
+            for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+                ports.read_outputs(&mut c.instance, &mut self.y)?;
             }
             worst = (0.0, 0);
             let mut norm = 0.0;
@@ -835,7 +923,8 @@ impl StrongCoupling {
                 let tolerance = self.atol * nominal + self.rtol * u.abs().max(y.abs());
                 let ratio = (u - y).abs() / tolerance;
                 norm += ratio * ratio;
-                if ratio.is_nan() || (!worst.0.is_nan() && ratio > worst.0) {
+                // a NaN is the worst, and stays it: nothing compares greater
+                if ratio.is_nan() || ratio > worst.0 {
                     worst = (ratio, k);
                 }
             }
@@ -849,13 +938,8 @@ impl StrongCoupling {
                 self.report.worst_accepted = self.report.worst_accepted.max(worst.0);
                 // Every component was just stepped on U; a ramped one has
                 // moved its inputs along the ramp.
-                for ((mark, ports), component) in self
-                    .holds_u
-                    .iter_mut()
-                    .zip(&self.ports)
-                    .zip(&system.components)
-                {
-                    *mark = (!ports.ramped).then(|| component.instance.changes());
+                for (ports, c) in self.ports.iter_mut().zip(&system.components) {
+                    ports.holds_u = (!ports.ramped).then(|| c.instance.changes());
                 }
                 return Ok(());
             }
@@ -866,7 +950,7 @@ impl StrongCoupling {
                 Update::FixedPoint => self.u.copy_from_slice(&self.y),
                 Update::Newton => {
                     if has_base {
-                        let reference = self.history.iter().copied().fold(0.0, f64::max);
+                        let reference = self.history.max();
                         let sufficient =
                             norm.is_finite() && norm <= (1.0 - 1e-4 * lambda) * reference;
                         if !sufficient && lambda > 1.0 / 1024.0 {
@@ -881,34 +965,9 @@ impl StrongCoupling {
                         }
                     }
                     // New base point: the components were just stepped on U.
-                    let mut jac = std::mem::replace(&mut self.jac, DMatrix::zeros(0, 0));
-                    if jac.shape() == (n, n) {
-                        jac.as_mut_slice().fill(0.0);
-                    } else {
-                        jac = DMatrix::zeros(n, n);
-                    }
-                    self.jacobian(system, t, h, &mut jac)?;
-                    // (I − J)·ΔU = Y − U (over the slice: the matrix
-                    // iterators cost more than the few entries)
-                    for x in jac.as_mut_slice() {
-                        *x = -*x;
-                    }
-                    for k in 0..n {
-                        jac[(k, k)] += 1.0;
-                        self.direction[k] = self.y[k] - self.u[k];
-                    }
-                    if !solve_in_place(&mut jac, &mut self.direction) {
-                        // I − J singular: the fixed-point direction.
-                        for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
-                            *d = y - u;
-                        }
-                    }
-                    self.jac = jac;
-                    self.base.clone_from(&self.u);
+                    self.newton_direction(system, t, h)?;
+                    self.base.copy_from_slice(&self.u);
                     has_base = true;
-                    if self.history.len() == NONMONOTONE_MEMORY {
-                        self.history.remove(0);
-                    }
                     self.history.push(norm);
                     lambda = 1.0;
                     for (u, d) in self.u.iter_mut().zip(&self.direction) {
@@ -1027,6 +1086,51 @@ fn solve_two(m: &mut [f64; 4], b: &mut [f64; 2]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn recent_norms_keep_what_a_vector_of_the_last_few_keeps() {
+        // the vector it replaces: remove the oldest when full, then push
+        let mut vector: Vec<f64> = Vec::new();
+        let mut recent = RecentNorms::default();
+        let values = [
+            3.0,
+            f64::NAN,
+            0.5,
+            7.0,
+            f64::INFINITY,
+            2.0,
+            0.0,
+            f64::NAN,
+            1e-300,
+            4.0,
+            9.0,
+            1.0,
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+            0.25,
+        ];
+        for (i, &x) in values.iter().enumerate() {
+            if i % 7 == 6 {
+                vector.clear();
+                recent.clear();
+            }
+            if vector.len() == NONMONOTONE_MEMORY {
+                vector.remove(0);
+            }
+            vector.push(x);
+            recent.push(x);
+            assert_eq!(recent.len, vector.len());
+            for (a, b) in recent.norms[..recent.len].iter().zip(&vector) {
+                assert_eq!(a.to_bits(), b.to_bits(), "{vector:?}");
+            }
+            let max = vector.iter().copied().fold(0.0, f64::max);
+            assert_eq!(recent.max().to_bits(), max.to_bits(), "{vector:?}");
+        }
+        recent.clear();
+        assert_eq!(recent.max(), 0.0);
+    }
 
     #[test]
     fn gaussian_elimination_pivots_and_refuses_singular_systems() {
