@@ -177,8 +177,9 @@ struct Ports {
     /// The values of `output_vrs` as last read (one `fmi2GetReal` per
     /// component instead of one per connection).
     output_values: Vec<f64>,
-    /// Directional derivatives trusted (Auto: decided at the first check).
-    directional: Option<bool>,
+    /// Where the component's Jacobian columns come from (Auto: decided
+    /// at the first Jacobian).
+    columns: Columns,
     /// Why the component is differenced, when that is decided up front.
     differenced: &'static str,
     /// The convergence report says how the component's columns are
@@ -242,7 +243,7 @@ impl Ports {
 
     /// Read the component's connected outputs into `out` (one value per
     /// connection), with one `fmi2GetReal` for all of them.
-    #[inline] // hot: every iteration of every step
+    #[inline(always)] // hot: every iteration of every step
     fn read_outputs(&mut self, instance: &mut Instance, out: &mut [f64]) -> Result<(), FmuError> {
         if self.outputs.is_empty() {
             return Ok(());
@@ -279,6 +280,20 @@ impl Ports {
         self.in_saved_state = restored.is_ok().then(|| instance.changes());
         restored.map(|_| ())
     }
+}
+
+/// Where one component's columns of ∂Y/∂U come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Columns {
+    /// It has none: no connected inputs, or no connected outputs.
+    None,
+    /// `fmi2GetDirectionalDerivative` after the step.
+    Directional,
+    /// Finite differences (rollback and a perturbed step per input).
+    Differenced,
+    /// Auto: directional derivatives, to be checked against finite
+    /// differences at the first Jacobian.
+    Unchecked,
 }
 
 /// The last few residual norms of a step's Newton base points, oldest
@@ -344,8 +359,11 @@ pub struct StrongCoupling {
     y: Vec<f64>,
     column: Vec<f64>,
     // Work space of a step, kept so that a step allocates nothing:
-    /// ∂Y/∂U, then I − J factorised in place.
+    /// J = ∂Y/∂U, n × n. Only the blocks of the components' own inputs
+    /// and outputs are ever written: every entry outside them is zero.
     jac: DMatrix<f64>,
+    /// I − J, factorised in place.
+    newton_matrix: DMatrix<f64>,
     /// One component's directional derivatives.
     derivative: Vec<f64>,
     /// U perturbed for a finite difference.
@@ -383,6 +401,7 @@ impl StrongCoupling {
             y: Vec::new(),
             column: Vec::new(),
             jac: DMatrix::zeros(0, 0),
+            newton_matrix: DMatrix::zeros(0, 0),
             derivative: Vec::new(),
             perturbed: Vec::new(),
             base: Vec::new(),
@@ -454,24 +473,31 @@ impl StrongCoupling {
                     .filter(|&k| system.connections[k].from.0 == c)
                     .collect();
                 let ramped = self.interpolate && cs.can_interpolate_inputs;
-                let (directional, differenced) = match self.jacobian {
+                let (columns, differenced) = match self.jacobian {
                     _ if ramped => (
-                        Some(false),
+                        Columns::Differenced,
                         "finite differences (rollback): its inputs ramp over the step, and fmi2GetDirectionalDerivative gives the sensitivity to held inputs",
                     ),
-                    JacobianSource::Directional => (Some(true), ""),
+                    JacobianSource::Directional => (Columns::Directional, ""),
                     JacobianSource::FiniteDifference => {
-                        (Some(false), "finite differences (rollback)")
+                        (Columns::Differenced, "finite differences (rollback)")
                     }
-                    JacobianSource::Auto if cs.provides_directional_derivative => (None, ""),
+                    JacobianSource::Auto if cs.provides_directional_derivative => {
+                        (Columns::Unchecked, "")
+                    }
                     JacobianSource::Auto => (
-                        Some(false),
+                        Columns::Differenced,
                         "finite differences (rollback): the FMU does not provide directional derivatives (providesDirectionalDerivative=\"false\")",
                     ),
                 };
                 let inputs: Vec<usize> = (0..n)
                     .filter(|&k| system.connections[k].to.0 == c)
                     .collect();
+                let columns = if inputs.is_empty() || outputs.is_empty() {
+                    Columns::None
+                } else {
+                    columns
+                };
                 Ports {
                     input_vrs: inputs
                         .iter()
@@ -484,7 +510,7 @@ impl StrongCoupling {
                         .collect(),
                     output_values: vec![0.0; outputs.len()],
                     outputs,
-                    directional,
+                    columns,
                     differenced,
                     reported: false,
                     ramped,
@@ -518,6 +544,8 @@ impl StrongCoupling {
         });
         let most_outputs = self.ports.iter().map(|p| p.outputs.len()).max();
         self.derivative = vec![0.0; most_outputs.unwrap_or(0)];
+        self.jac = DMatrix::zeros(n, n);
+        self.newton_matrix = DMatrix::zeros(n, n);
         self.u = vec![0.0; n];
         self.accepted = vec![0.0; n];
         self.base = vec![0.0; n];
@@ -555,24 +583,22 @@ impl StrongCoupling {
     /// singular the fixed-point direction `Y − U`.
     #[inline(never)]
     fn newton_direction(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
-        let n = self.u.len();
-        if self.jac.shape() == (n, n) {
-            self.jac.as_mut_slice().fill(0.0);
-        } else {
-            self.jac = DMatrix::zeros(n, n);
-        }
         self.jacobian(system, t, h)?;
-        // (I − J)·ΔU = Y − U (over the slice: the matrix iterators cost
+        // (I − J)·ΔU = Y − U (over the slices: the matrix iterators cost
         // more than the few entries)
-        let jac = &mut self.jac;
-        for x in jac.as_mut_slice() {
-            *x = -*x;
+        let n = self.u.len();
+        let a = self.newton_matrix.as_mut_slice();
+        for (a, j) in a.iter_mut().zip(self.jac.as_slice()) {
+            *a = -j;
         }
-        for k in 0..n {
-            jac[(k, k)] += 1.0;
-            self.direction[k] = self.y[k] - self.u[k];
+        // the diagonal: every (n + 1)-th entry of the column-major slice
+        for diagonal in a.iter_mut().step_by(n + 1) {
+            *diagonal += 1.0;
         }
-        if !solve_in_place(jac, &mut self.direction) {
+        for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
+            *d = y - u;
+        }
+        if !solve_in_place(&mut self.newton_matrix, &mut self.direction) {
             // I − J singular: the fixed-point direction.
             for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
                 *d = y - u;
@@ -612,7 +638,7 @@ impl StrongCoupling {
 
     /// Columns of ∂Y/∂U for the inputs of component `c` into `self.jac`, from
     /// `fmi2GetDirectionalDerivative`, called right after the step.
-    #[inline] // hot: at every Jacobian
+    #[inline(always)] // hot: at every Jacobian
     fn directional_columns(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         let ports = &self.ports[c];
         // (sized for the component with the most outputs in `prepare`)
@@ -627,50 +653,42 @@ impl StrongCoupling {
         Ok(())
     }
 
-    /// ∂Y/∂U, with every component stepped on `self.u` just before. Leaves
-    /// components that were differenced in a perturbed state (the next
-    /// iteration restores them).
-    /// `self.jac` is n × n and zero on entry.
+    /// ∂Y/∂U into `self.jac`, with every component stepped on `self.u`
+    /// just before. Leaves components that were differenced in a perturbed
+    /// state (the next iteration restores them).
     fn jacobian(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
         self.report.jacobians += 1;
         // Directional derivatives first: they need the step just taken.
         for c in 0..system.components.len() {
-            let ports = &self.ports[c];
-            if ports.inputs.is_empty()
-                || ports.outputs.is_empty()
-                || ports.directional == Some(false)
-            {
-                continue;
-            }
-            let columns = self.directional_columns(system, c);
-            if self.ports[c].directional == Some(true) {
-                columns?;
-            } else if columns.is_err() {
+            let columns = self.ports[c].columns;
+            match columns {
+                Columns::Directional => self.directional_columns(system, c)?,
                 // Auto: an FMU whose call fails is differenced instead.
-                self.ports[c].directional = Some(false);
-                self.describe(
-                    c,
-                    "finite differences (fmi2GetDirectionalDerivative failed)",
-                );
+                Columns::Unchecked if self.directional_columns(system, c).is_err() => {
+                    self.ports[c].columns = Columns::Differenced;
+                    self.describe(
+                        c,
+                        "finite differences (fmi2GetDirectionalDerivative failed)",
+                    );
+                }
+                _ => {}
             }
         }
         for c in 0..system.components.len() {
-            if self.ports[c].inputs.is_empty() || self.ports[c].outputs.is_empty() {
-                continue;
-            }
-            match self.ports[c].directional {
-                Some(true) => {
+            match self.ports[c].columns {
+                Columns::None => {}
+                Columns::Directional => {
                     if !self.ports[c].reported {
                         self.describe(c, "directional derivatives");
                     }
                 }
-                Some(false) => {
+                Columns::Differenced => {
                     self.difference_columns(system, c, t, h)?;
                     if !self.ports[c].reported {
                         self.describe(c, self.ports[c].differenced);
                     }
                 }
-                None => {
+                Columns::Unchecked => {
                     // Auto: compare with finite differences once.
                     let directional = self.jac.clone();
                     self.difference_columns(system, c, t, h)?;
@@ -684,14 +702,15 @@ impl StrongCoupling {
                             }
                         }
                     }
-                    self.ports[c].directional = Some(agree);
                     if agree {
+                        self.ports[c].columns = Columns::Directional;
                         self.describe(
                             c,
                             "directional derivatives (checked against finite differences)",
                         );
                         self.jac = directional;
                     } else {
+                        self.ports[c].columns = Columns::Differenced;
                         self.describe(c, "finite differences (directional derivatives disagreed)");
                     }
                 }
@@ -832,12 +851,20 @@ impl StrongCoupling {
 
     #[inline] // at every step, and only the first does anything
     fn ensure_started(&mut self, system: &mut System) -> Result<(), FmuError> {
-        if !self.started {
-            for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
-                ports.read_outputs(&mut c.instance, &mut self.u)?;
-            }
-            self.started = true;
+        if self.started {
+            return Ok(());
         }
+        self.start(system)
+    }
+
+    /// U from the outputs at the start of the run.
+    #[cold]
+    #[inline(never)]
+    fn start(&mut self, system: &mut System) -> Result<(), FmuError> {
+        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+            ports.read_outputs(&mut c.instance, &mut self.u)?;
+        }
+        self.started = true;
         Ok(())
     }
 
@@ -845,6 +872,7 @@ impl StrongCoupling {
     /// with two half steps (recursively, at most `max_splits` times deep).
     /// The communication grid of the run is unchanged: the halves happen
     /// inside one macro step.
+    #[inline] // into every step; the split itself is out of line
     fn step_or_split(
         &mut self,
         system: &mut System,
@@ -853,19 +881,32 @@ impl StrongCoupling {
         depth: usize,
     ) -> Result<(), FmuError> {
         match self.solve(system, t, h) {
-            Err(e @ FmuError::NotConverged { .. }) => {
-                if depth >= self.max_splits || !self.variable_steps {
-                    return Err(e);
-                }
-                self.report.rejected += 1;
-                self.report.iterations += self.max_iterations;
-                self.restore_all(system)?;
-                self.u.copy_from_slice(&self.accepted);
-                self.step_or_split(system, t, 0.5 * h, depth + 1)?;
-                self.step_or_split(system, t + 0.5 * h, 0.5 * h, depth + 1)
-            }
+            Err(e @ FmuError::NotConverged { .. }) => self.split(system, t, h, depth, e),
             other => other,
         }
+    }
+
+    /// [`StrongCoupling::step_or_split`] after Newton failed on `[t, t + h]`
+    /// with `e`.
+    #[cold]
+    #[inline(never)]
+    fn split(
+        &mut self,
+        system: &mut System,
+        t: f64,
+        h: f64,
+        depth: usize,
+        e: FmuError,
+    ) -> Result<(), FmuError> {
+        if depth >= self.max_splits || !self.variable_steps {
+            return Err(e);
+        }
+        self.report.rejected += 1;
+        self.report.iterations += self.max_iterations;
+        self.restore_all(system)?;
+        self.u.copy_from_slice(&self.accepted);
+        self.step_or_split(system, t, 0.5 * h, depth + 1)?;
+        self.step_or_split(system, t + 0.5 * h, 0.5 * h, depth + 1)
     }
 
     fn solve(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
