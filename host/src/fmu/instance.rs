@@ -930,12 +930,28 @@ impl Instance {
         self.own(F, state)?;
         let before = state.pointer;
         // SAFETY: `state.pointer` is a live state of this instance.
-        let result = self.call(F, |component| {
+        match self.call(F, |component| {
             Ok(unsafe { f(component, &mut state.pointer) })
-        });
-        if state.pointer != before {
+        }) {
+            // the usual case: updated in place
+            Ok(status) if state.pointer == before => Ok(status),
+            result => self.updated_elsewhere(before, state.pointer, result),
+        }
+    }
+
+    /// The rest of [`Instance::update_state`] when the call failed or the
+    /// FMU put the state elsewhere: the list of states to free follows it.
+    #[cold]
+    #[inline(never)]
+    fn updated_elsewhere(
+        &mut self,
+        before: fmi2FMUstate,
+        now: fmi2FMUstate,
+        result: Result<Status, FmuError>,
+    ) -> Result<Status, FmuError> {
+        if now != before {
             if let Some(slot) = self.states.iter_mut().find(|p| **p == before) {
-                *slot = state.pointer;
+                *slot = now;
             }
         }
         result
