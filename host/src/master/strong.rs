@@ -177,6 +177,10 @@ struct Ports {
     /// The values of `output_vrs` as last read (one `fmi2GetReal` per
     /// component instead of one per connection).
     output_values: Vec<f64>,
+    /// When `outputs` are consecutive connections `k0, k0 + 1, …` (a
+    /// component with one output, say): `k0`. Their values are then read
+    /// straight into place, without `output_values`.
+    consecutive_outputs: Option<usize>,
     /// Where the component's Jacobian columns come from (Auto: decided
     /// at the first Jacobian).
     columns: Columns,
@@ -248,6 +252,11 @@ impl Ports {
         if self.outputs.is_empty() {
             return Ok(());
         }
+        if let Some(first) = self.consecutive_outputs {
+            let values = &mut out[first..first + self.outputs.len()];
+            instance.get_real(&self.output_vrs, values)?;
+            return Ok(());
+        }
         instance.get_real(&self.output_vrs, &mut self.output_values)?;
         for (&k, &y) in self.outputs.iter().zip(&self.output_values) {
             out[k] = y;
@@ -275,10 +284,17 @@ impl Ports {
     #[inline(always)] // hot: every iteration after the first
     fn restore(&mut self, instance: &mut Instance) -> Result<(), FmuError> {
         let state = self.state.as_ref().expect("saved before stepping");
-        let restored = instance.set_state(state);
-        // after a failed fmi2SetFMUstate the FMU's state is unknown
-        self.in_saved_state = restored.is_ok().then(|| instance.changes());
-        restored.map(|_| ())
+        match instance.set_state(state) {
+            Ok(_) => {
+                self.in_saved_state = Some(instance.changes());
+                Ok(())
+            }
+            Err(e) => {
+                // after a failed fmi2SetFMUstate the FMU's state is unknown
+                self.in_saved_state = None;
+                Err(e)
+            }
+        }
     }
 }
 
@@ -509,6 +525,10 @@ impl StrongCoupling {
                         .map(|&k| system.connections[k].from.1)
                         .collect(),
                     output_values: vec![0.0; outputs.len()],
+                    consecutive_outputs: outputs
+                        .first()
+                        .copied()
+                        .filter(|_| outputs.windows(2).all(|k| k[1] == k[0] + 1)),
                     outputs,
                     columns,
                     differenced,
@@ -581,7 +601,6 @@ impl StrongCoupling {
     /// The Newton direction at U, every component just stepped on it:
     /// `(I − J)·ΔU = Y − U` solved into `direction`, or where I − J is
     /// singular the fixed-point direction `Y − U`.
-    #[inline(never)]
     fn newton_direction(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
         self.jacobian(system, t, h)?;
         // (I − J)·ΔU = Y − U (over the slices: the matrix iterators cost
@@ -641,10 +660,18 @@ impl StrongCoupling {
     #[inline(always)] // hot: at every Jacobian
     fn directional_columns(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         let ports = &self.ports[c];
-        // (sized for the component with the most outputs in `prepare`)
-        let out = &mut self.derivative[..ports.outputs.len()];
         let instance = &mut system.components[c].instance;
+        let rows = self.jac.nrows();
         for (&j, &known) in ports.inputs.iter().zip(&ports.input_vrs) {
+            if let Some(first) = ports.consecutive_outputs {
+                // straight into place: rows first.. of column j
+                let start = first + j * rows;
+                let column = &mut self.jac.as_mut_slice()[start..start + ports.outputs.len()];
+                instance.get_directional_derivative(&ports.output_vrs, &[known], &[1.0], column)?;
+                continue;
+            }
+            // (sized for the component with the most outputs in `prepare`)
+            let out = &mut self.derivative[..ports.outputs.len()];
             instance.get_directional_derivative(&ports.output_vrs, &[known], &[1.0], out)?;
             for (&k, d) in ports.outputs.iter().zip(out.iter()) {
                 self.jac[(k, j)] = *d;
