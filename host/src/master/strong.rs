@@ -607,12 +607,14 @@ impl StrongCoupling {
         // more than the few entries)
         let n = self.u.len();
         let a = self.newton_matrix.as_mut_slice();
-        for (a, j) in a.iter_mut().zip(self.jac.as_slice()) {
-            *a = -j;
-        }
         // the diagonal: every (n + 1)-th entry of the column-major slice
-        for diagonal in a.iter_mut().step_by(n + 1) {
-            *diagonal += 1.0;
+        let mut diagonal = 0;
+        for (i, (a, j)) in a.iter_mut().zip(self.jac.as_slice()).enumerate() {
+            *a = -j;
+            if i == diagonal {
+                *a += 1.0;
+                diagonal += n + 1;
+            }
         }
         for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
             *d = y - u;
@@ -963,7 +965,6 @@ impl StrongCoupling {
         let mut has_base = false;
         self.history.clear();
         let mut lambda = 1.0;
-        let mut worst = (f64::INFINITY, 0);
         let mut last_norm = f64::INFINITY;
         for iteration in 1..=self.max_iterations {
             for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
@@ -984,26 +985,25 @@ impl StrongCoupling {
             for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
                 ports.read_outputs(&mut c.instance, &mut self.y)?;
             }
-            worst = (0.0, 0);
+            // (which connection is the worst is asked only if the step fails)
+            let mut worst = 0.0;
             let mut norm = 0.0;
-            let interface = self.nominal.iter().zip(&self.u).zip(&self.y);
-            for (k, ((nominal, u), y)) in interface.enumerate() {
-                let tolerance = self.atol * nominal + self.rtol * u.abs().max(y.abs());
-                let ratio = (u - y).abs() / tolerance;
+            for ((&nominal, &u), &y) in self.nominal.iter().zip(&self.u).zip(&self.y) {
+                let ratio = scaled_mismatch(self.atol, self.rtol, nominal, u, y);
                 norm += ratio * ratio;
                 // a NaN is the worst, and stays it: nothing compares greater
-                if ratio.is_nan() || ratio > worst.0 {
-                    worst = (ratio, k);
+                if ratio.is_nan() || ratio > worst {
+                    worst = ratio;
                 }
             }
             let norm = norm.sqrt();
             last_norm = norm;
-            if worst.0 <= 1.0 {
+            if worst <= 1.0 {
                 self.report.steps += 1;
                 self.report.iterations += iteration;
                 self.report.max_iterations = self.report.max_iterations.max(iteration);
                 self.report.histogram[(iteration - 1).min(7)] += 1;
-                self.report.worst_accepted = self.report.worst_accepted.max(worst.0);
+                self.report.worst_accepted = self.report.worst_accepted.max(worst);
                 // Every component was just stepped on U; a ramped one has
                 // moved its inputs along the ramp.
                 for (ports, c) in self.ports.iter_mut().zip(&system.components) {
@@ -1044,6 +1044,19 @@ impl StrongCoupling {
                 }
             }
         }
+        // The connection of the worst mismatch of the last iteration (the
+        // first of equal ones, the last NaN), on the U and Y it was found
+        // on; the first if there was no iteration.
+        let mut worst = (0.0, 0);
+        if self.max_iterations > 0 {
+            let interface = self.nominal.iter().zip(&self.u).zip(&self.y);
+            for (k, ((&nominal, &u), &y)) in interface.enumerate() {
+                let ratio = scaled_mismatch(self.atol, self.rtol, nominal, u, y);
+                if ratio.is_nan() || ratio > worst.0 {
+                    worst = (ratio, k);
+                }
+            }
+        }
         let k = worst.1;
         Err(FmuError::NotConverged {
             time: t,
@@ -1058,6 +1071,14 @@ impl StrongCoupling {
             residual: last_norm,
         })
     }
+}
+
+/// `|R_k| = |U_k − Y_k|` over its tolerance `atol·nominal_k +
+/// rtol·max(|U_k|, |Y_k|)`: at most 1 where the step has converged.
+#[inline(always)]
+fn scaled_mismatch(atol: f64, rtol: f64, nominal: f64, u: f64, y: f64) -> f64 {
+    let tolerance = atol * nominal + rtol * u.abs().max(y.abs());
+    (u - y).abs() / tolerance
 }
 
 /// Solve `a·x = b` in place (`b` becomes `x`, `a` is overwritten) by
