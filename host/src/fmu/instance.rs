@@ -372,7 +372,7 @@ impl Instance {
     }
 
     /// One FMI call, [`Instance::begin`] and [`Instance::finish`] in one:
-    /// `call` checks its arguments (it may refuse, after the check for
+    /// `ffi` checks its arguments (it may refuse, after the check for
     /// `fmi2Fatal` as with `begin`) and calls the FMU on the component.
     /// Whether the instance is guarded is asked once, before the call, and
     /// each case has a path of its own: the unguarded one takes `fmi2OK`
@@ -381,18 +381,18 @@ impl Instance {
     fn call(
         &mut self,
         function: &'static str,
-        call: impl FnOnce(fmi2Component) -> Result<fmi2Status, FmuError>,
+        ffi: impl FnOnce(fmi2Component) -> Result<fmi2Status, FmuError>,
     ) -> Result<Status, FmuError> {
         if !function.starts_with("fmi2Get") {
             self.changes = self.changes.wrapping_add(1);
         }
         if self.guarded {
             let mark = self.begin_guarded(function)?;
-            let raw = call(self.component)?;
+            let raw = ffi(self.component)?;
             return self.finish_checked(function, mark, raw);
         }
         let mark = self.sink.mark();
-        match call(self.component)? {
+        match ffi(self.component)? {
             0 => Ok(Status::Ok), // fmi2OK
             raw => self.finish_checked(function, mark, raw),
         }
@@ -715,8 +715,8 @@ impl Instance {
     #[inline] // the hot path is a few instructions; the rest is in `step_failed`
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Status, FmuError> {
         let f = self.functions.do_step;
-        // SAFETY: plain values.
         match self.call(DO_STEP, |component| {
+            // SAFETY: plain values.
             Ok(unsafe { f(component, t, h, fmi2False) })
         }) {
             Err(e) => self.step_failed(e),
@@ -929,8 +929,8 @@ impl Instance {
         )?;
         self.own(F, state)?;
         let before = state.pointer;
-        // SAFETY: `state.pointer` is a live state of this instance.
         match self.call(F, |component| {
+            // SAFETY: `state.pointer` is a live state of this instance.
             Ok(unsafe { f(component, &mut state.pointer) })
         }) {
             // the usual case: updated in place
@@ -968,8 +968,10 @@ impl Instance {
         )?;
         self.own(F, state)?;
         let pointer = state.pointer;
-        // SAFETY: `state.pointer` is a live state of this instance.
-        self.call(F, |component| Ok(unsafe { f(component, pointer) }))
+        self.call(F, |component| {
+            // SAFETY: `state.pointer` is a live state of this instance.
+            Ok(unsafe { f(component, pointer) })
+        })
     }
 
     /// `fmi2FreeFMUstate`.

@@ -488,8 +488,12 @@ impl StrongCoupling {
                 let outputs: Vec<usize> = (0..n)
                     .filter(|&k| system.connections[k].from.0 == c)
                     .collect();
+                let inputs: Vec<usize> = (0..n)
+                    .filter(|&k| system.connections[k].to.0 == c)
+                    .collect();
                 let ramped = self.interpolate && cs.can_interpolate_inputs;
                 let (columns, differenced) = match self.jacobian {
+                    _ if inputs.is_empty() || outputs.is_empty() => (Columns::None, ""),
                     _ if ramped => (
                         Columns::Differenced,
                         "finite differences (rollback): its inputs ramp over the step, and fmi2GetDirectionalDerivative gives the sensitivity to held inputs",
@@ -505,14 +509,6 @@ impl StrongCoupling {
                         Columns::Differenced,
                         "finite differences (rollback): the FMU does not provide directional derivatives (providesDirectionalDerivative=\"false\")",
                     ),
-                };
-                let inputs: Vec<usize> = (0..n)
-                    .filter(|&k| system.connections[k].to.0 == c)
-                    .collect();
-                let columns = if inputs.is_empty() || outputs.is_empty() {
-                    Columns::None
-                } else {
-                    columns
                 };
                 Ports {
                     input_vrs: inputs
@@ -689,18 +685,17 @@ impl StrongCoupling {
         self.report.jacobians += 1;
         // Directional derivatives first: they need the step just taken.
         for c in 0..system.components.len() {
-            let columns = self.ports[c].columns;
-            match columns {
+            match self.ports[c].columns {
                 Columns::Directional => self.directional_columns(system, c)?,
-                // Auto: an FMU whose call fails is differenced instead.
-                Columns::Unchecked if self.directional_columns(system, c).is_err() => {
-                    self.ports[c].columns = Columns::Differenced;
-                    self.describe(
-                        c,
-                        "finite differences (fmi2GetDirectionalDerivative failed)",
-                    );
+                Columns::Unchecked => {
+                    // Auto: an FMU whose call fails is differenced instead.
+                    if self.directional_columns(system, c).is_err() {
+                        self.ports[c].columns = Columns::Differenced;
+                        let how = "finite differences (fmi2GetDirectionalDerivative failed)";
+                        self.describe(c, how);
+                    }
                 }
-                _ => {}
+                Columns::None | Columns::Differenced => {}
             }
         }
         for c in 0..system.components.len() {
