@@ -371,6 +371,33 @@ impl Instance {
         self.finish_checked(function, mark, raw)
     }
 
+    /// One FMI call, [`Instance::begin`] and [`Instance::finish`] in one:
+    /// `ffi` checks its arguments (it may refuse, after the check for
+    /// `fmi2Fatal` as with `begin`) and calls the FMU on the component.
+    /// Whether the instance is guarded is asked once, before the call, and
+    /// each case has a path of its own: the unguarded one takes `fmi2OK`
+    /// at once, without reading the instance again after the call.
+    #[inline(always)]
+    fn call(
+        &mut self,
+        function: &'static str,
+        ffi: impl FnOnce(fmi2Component) -> Result<fmi2Status, FmuError>,
+    ) -> Result<Status, FmuError> {
+        if !function.starts_with("fmi2Get") {
+            self.changes = self.changes.wrapping_add(1);
+        }
+        if self.guarded {
+            let mark = self.begin_guarded(function)?;
+            let raw = ffi(self.component)?;
+            return self.finish_checked(function, mark, raw);
+        }
+        let mark = self.sink.mark();
+        match ffi(self.component)? {
+            0 => Ok(Status::Ok), // fmi2OK
+            raw => self.finish_checked(function, mark, raw),
+        }
+    }
+
     #[cold]
     #[inline(never)]
     fn finish_checked(
@@ -510,31 +537,31 @@ impl Instance {
     }
 
     /// `fmi2GetReal`: `values[i]` = value of `vrs[i]`. Does not allocate.
+    #[inline] // a hot path of every master
     pub fn get_real(
         &mut self,
         vrs: &[ValueReference],
         values: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetReal";
-        let mark = self.begin(F)?;
-        same_length(F, "values", vrs.len(), values.len())?;
-        // SAFETY: both arrays hold `vrs.len()` elements.
-        let raw = unsafe {
-            (self.functions.get_real)(self.component, vrs.as_ptr(), vrs.len(), values.as_mut_ptr())
-        };
-        self.finish(F, mark, raw)
+        let f = self.functions.get_real;
+        self.call(F, |component| {
+            same_length(F, "values", vrs.len(), values.len())?;
+            // SAFETY: both arrays hold `vrs.len()` elements.
+            Ok(unsafe { f(component, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()) })
+        })
     }
 
     /// `fmi2SetReal`. Does not allocate.
+    #[inline] // a hot path of every master
     pub fn set_real(&mut self, vrs: &[ValueReference], values: &[f64]) -> Result<Status, FmuError> {
         const F: &str = "fmi2SetReal";
-        let mark = self.begin(F)?;
-        same_length(F, "values", vrs.len(), values.len())?;
-        // SAFETY: both arrays hold `vrs.len()` elements.
-        let raw = unsafe {
-            (self.functions.set_real)(self.component, vrs.as_ptr(), vrs.len(), values.as_ptr())
-        };
-        self.finish(F, mark, raw)
+        let f = self.functions.set_real;
+        self.call(F, |component| {
+            same_length(F, "values", vrs.len(), values.len())?;
+            // SAFETY: both arrays hold `vrs.len()` elements.
+            Ok(unsafe { f(component, vrs.as_ptr(), vrs.len(), values.as_ptr()) })
+        })
     }
 
     /// `fmi2GetInteger`. Does not allocate.
@@ -687,30 +714,29 @@ impl Instance {
     /// or why the FMU could not say.
     #[inline] // the hot path is a few instructions; the rest is in `step_failed`
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Status, FmuError> {
-        let mark = self.begin(DO_STEP)?;
-        // SAFETY: plain values.
-        let raw = unsafe { (self.functions.do_step)(self.component, t, h, fmi2False) };
-        if raw == 0 && !self.guarded {
-            return Ok(Status::Ok);
+        let f = self.functions.do_step;
+        match self.call(DO_STEP, |component| {
+            // SAFETY: plain values.
+            Ok(unsafe { f(component, t, h, fmi2False) })
+        }) {
+            Err(e) => self.step_failed(e),
+            ok => ok,
         }
-        self.step_failed(mark, raw)
     }
 
-    /// [`Instance::do_step`] for anything but `fmi2OK` without a time
-    /// limit: the status checked, a discarded step explained.
+    /// [`Instance::do_step`] that failed: a discarded step explained.
     #[cold]
     #[inline(never)]
-    fn step_failed(&mut self, mark: u64, raw: fmi2Status) -> Result<Status, FmuError> {
-        let mut result = self.finish_checked(DO_STEP, mark, raw);
-        if let Err(FmuError::Call {
+    fn step_failed(&mut self, mut e: FmuError) -> Result<Status, FmuError> {
+        if let FmuError::Call {
             status: Status::Discard,
             messages,
             ..
-        }) = &mut result
+        } = &mut e
         {
             messages.push(self.discard_report());
         }
-        result
+        Err(e)
     }
 
     /// After `fmi2DoStep` returned `fmi2Discard`: how far the step got and
@@ -824,22 +850,22 @@ impl Instance {
         let Some(f) = self.functions.get_directional_derivative else {
             return Err(not_supported(F, "providesDirectionalDerivative=\"true\""));
         };
-        let mark = self.begin(F)?;
-        same_length(F, "seed", knowns.len(), seed.len())?;
-        same_length(F, "out", unknowns.len(), out.len())?;
-        // SAFETY: each array holds as many elements as its length argument says.
-        let raw = unsafe {
-            f(
-                self.component,
-                unknowns.as_ptr(),
-                unknowns.len(),
-                knowns.as_ptr(),
-                knowns.len(),
-                seed.as_ptr(),
-                out.as_mut_ptr(),
-            )
-        };
-        self.finish(F, mark, raw)
+        self.call(F, |component| {
+            same_length(F, "seed", knowns.len(), seed.len())?;
+            same_length(F, "out", unknowns.len(), out.len())?;
+            // SAFETY: each array holds as many elements as its length argument says.
+            Ok(unsafe {
+                f(
+                    component,
+                    unknowns.as_ptr(),
+                    unknowns.len(),
+                    knowns.as_ptr(),
+                    knowns.len(),
+                    seed.as_ptr(),
+                    out.as_mut_ptr(),
+                )
+            })
+        })
     }
 
     fn own(&self, function: &'static str, state: &FmuState) -> Result<(), FmuError> {
@@ -902,20 +928,37 @@ impl Instance {
             "canGetAndSetFMUstate=\"true\"",
         )?;
         self.own(F, state)?;
-        let mark = self.begin(F)?;
         let before = state.pointer;
-        // SAFETY: `state.pointer` is a live state of this instance.
-        let raw = unsafe { f(self.component, &mut state.pointer) };
-        if state.pointer != before {
+        match self.call(F, |component| {
+            // SAFETY: `state.pointer` is a live state of this instance.
+            Ok(unsafe { f(component, &mut state.pointer) })
+        }) {
+            // the usual case: updated in place
+            Ok(status) if state.pointer == before => Ok(status),
+            result => self.updated_elsewhere(before, state.pointer, result),
+        }
+    }
+
+    /// The rest of [`Instance::update_state`] when the call failed or the
+    /// FMU put the state elsewhere: the list of states to free follows it.
+    #[cold]
+    #[inline(never)]
+    fn updated_elsewhere(
+        &mut self,
+        before: fmi2FMUstate,
+        now: fmi2FMUstate,
+        result: Result<Status, FmuError>,
+    ) -> Result<Status, FmuError> {
+        if now != before {
             if let Some(slot) = self.states.iter_mut().find(|p| **p == before) {
-                *slot = state.pointer;
+                *slot = now;
             }
         }
-        self.finish(F, mark, raw)
+        result
     }
 
     /// `fmi2SetFMUstate`: continue from `state`.
-    #[inline] // a hot path of the strong-coupling master
+    #[inline(always)] // a hot path of the strong-coupling master
     pub fn set_state(&mut self, state: &FmuState) -> Result<Status, FmuError> {
         const F: &str = "fmi2SetFMUstate";
         let f = self.state_function(
@@ -924,10 +967,11 @@ impl Instance {
             "canGetAndSetFMUstate=\"true\"",
         )?;
         self.own(F, state)?;
-        let mark = self.begin(F)?;
-        // SAFETY: `state.pointer` is a live state of this instance.
-        let raw = unsafe { f(self.component, state.pointer) };
-        self.finish(F, mark, raw)
+        let pointer = state.pointer;
+        self.call(F, |component| {
+            // SAFETY: `state.pointer` is a live state of this instance.
+            Ok(unsafe { f(component, pointer) })
+        })
     }
 
     /// `fmi2FreeFMUstate`.

@@ -163,7 +163,9 @@ impl std::fmt::Display for ConvergenceReport {
     }
 }
 
-/// Per-component index lists into the connection table.
+/// Per component: its index lists into the connection table, its saved
+/// state, and where its Jacobian columns come from. Kept together so that
+/// the loops of a step walk one list beside `System::components`.
 struct Ports {
     /// Connections whose input belongs to the component.
     inputs: Vec<usize>,
@@ -175,19 +177,42 @@ struct Ports {
     /// The values of `output_vrs` as last read (one `fmi2GetReal` per
     /// component instead of one per connection).
     output_values: Vec<f64>,
-    /// Directional derivatives trusted (Auto: decided at the first check).
-    directional: Option<bool>,
+    /// When `outputs` are consecutive connections `k0, k0 + 1, …` (a
+    /// component with one output, say): `k0`. Their values are then read
+    /// straight into place, without `output_values`.
+    consecutive_outputs: Option<usize>,
+    /// Where the component's Jacobian columns come from (Auto: decided
+    /// at the first Jacobian).
+    columns: Columns,
     /// Why the component is differenced, when that is decided up front.
     differenced: &'static str,
+    /// The convergence report says how the component's columns are
+    /// obtained (its entry is no longer "not needed").
+    reported: bool,
     /// Inputs ramp linearly over the step from their value at `t` to `U`
     /// (`fmi2SetRealInputDerivatives`) instead of holding `U`.
     ramped: bool,
+    /// The component's state at the start of the step being solved.
+    state: Option<FmuState>,
+    /// The component's change count ([`crate::fmu::Instance::changes`])
+    /// when its state was last saved into `state` or restored from there.
+    /// While the count stands still, the FMU is in that saved state, and
+    /// saving it again would change nothing (the step after a split, the
+    /// retry of a rejected adaptive step).
+    in_saved_state: Option<u64>,
+    /// With held inputs: the change count right after the component was
+    /// stepped on `u` in the iteration that converged. While the count
+    /// stands still (nothing but `fmi2Get…` calls since: the recorded
+    /// sample, the state saved), its inputs still hold `u`, which is also
+    /// the first iterate of the next step, and setting them again would
+    /// change nothing.
+    holds_u: Option<u64>,
 }
 
 impl Ports {
     /// Set the component's inputs from `u` (one value per connection):
     /// held, or `ramped` from `start` at `t` to `u` at `t + h`.
-    #[inline] // hot: every iteration of every step
+    #[inline(always)] // hot: every iteration of every step
     fn set_inputs(
         &self,
         instance: &mut Instance,
@@ -195,22 +220,41 @@ impl Ports {
         start: &[f64],
         h: f64,
     ) -> Result<(), FmuError> {
+        if self.ramped {
+            return self.set_ramped_inputs(instance, u, start, h);
+        }
         for (&k, &vr) in self.inputs.iter().zip(&self.input_vrs) {
-            if self.ramped {
-                instance.set_real(&[vr], &[start[k]])?;
-                instance.set_real_input_derivatives(&[vr], &[1], &[(u[k] - start[k]) / h])?;
-            } else {
-                instance.set_real(&[vr], &[u[k]])?;
-            }
+            instance.set_real(&[vr], &[u[k]])?;
+        }
+        Ok(())
+    }
+
+    /// [`Ports::set_inputs`] of a component whose inputs ramp.
+    #[inline(never)]
+    fn set_ramped_inputs(
+        &self,
+        instance: &mut Instance,
+        u: &[f64],
+        start: &[f64],
+        h: f64,
+    ) -> Result<(), FmuError> {
+        for (&k, &vr) in self.inputs.iter().zip(&self.input_vrs) {
+            instance.set_real(&[vr], &[start[k]])?;
+            instance.set_real_input_derivatives(&[vr], &[1], &[(u[k] - start[k]) / h])?;
         }
         Ok(())
     }
 
     /// Read the component's connected outputs into `out` (one value per
     /// connection), with one `fmi2GetReal` for all of them.
-    #[inline] // hot: every iteration of every step
+    #[inline(always)] // hot: every iteration of every step
     fn read_outputs(&mut self, instance: &mut Instance, out: &mut [f64]) -> Result<(), FmuError> {
         if self.outputs.is_empty() {
+            return Ok(());
+        }
+        if let Some(first) = self.consecutive_outputs {
+            let values = &mut out[first..first + self.outputs.len()];
+            instance.get_real(&self.output_vrs, values)?;
             return Ok(());
         }
         instance.get_real(&self.output_vrs, &mut self.output_values)?;
@@ -218,6 +262,84 @@ impl Ports {
             out[k] = y;
         }
         Ok(())
+    }
+
+    /// Save the component's state at the start of the step into `state`
+    /// (`fmi2GetFMUstate`), unless it is the saved one already.
+    #[inline] // hot: every step
+    fn save_state(&mut self, instance: &mut Instance) -> Result<(), FmuError> {
+        match &mut self.state {
+            Some(_) if self.in_saved_state == Some(instance.changes()) => return Ok(()),
+            Some(state) => {
+                instance.update_state(state)?;
+            }
+            None => self.state = Some(instance.get_state()?),
+        }
+        // fmi2GetFMUstate is a getter: the count has not moved
+        self.in_saved_state = Some(instance.changes());
+        Ok(())
+    }
+
+    /// Roll the component back to its saved state (`fmi2SetFMUstate`).
+    #[inline(always)] // hot: every iteration after the first
+    fn restore(&mut self, instance: &mut Instance) -> Result<(), FmuError> {
+        let state = self.state.as_ref().expect("saved before stepping");
+        match instance.set_state(state) {
+            Ok(_) => {
+                self.in_saved_state = Some(instance.changes());
+                Ok(())
+            }
+            Err(e) => {
+                // after a failed fmi2SetFMUstate the FMU's state is unknown
+                self.in_saved_state = None;
+                Err(e)
+            }
+        }
+    }
+}
+
+/// Where one component's columns of ∂Y/∂U come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Columns {
+    /// It has none: no connected inputs, or no connected outputs.
+    None,
+    /// `fmi2GetDirectionalDerivative` after the step.
+    Directional,
+    /// Finite differences (rollback and a perturbed step per input).
+    Differenced,
+    /// Auto: directional derivatives, to be checked against finite
+    /// differences at the first Jacobian.
+    Unchecked,
+}
+
+/// The last few residual norms of a step's Newton base points, oldest
+/// first (at most [`NONMONOTONE_MEMORY`]; a new one pushes the oldest
+/// out), kept in place of a vector so that nothing is allocated or moved
+/// through the heap.
+#[derive(Clone, Copy, Debug, Default)]
+struct RecentNorms {
+    norms: [f64; NONMONOTONE_MEMORY],
+    len: usize,
+}
+
+impl RecentNorms {
+    fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    fn push(&mut self, norm: f64) {
+        if self.len == NONMONOTONE_MEMORY {
+            self.norms.copy_within(1.., 0);
+            self.len -= 1;
+        }
+        self.norms[self.len] = norm;
+        self.len += 1;
+    }
+
+    /// The largest, 0 if there are none (NaNs are passed over, as
+    /// `f64::max` does), taken oldest first.
+    fn max(&self) -> f64 {
+        self.norms[..self.len].iter().copied().fold(0.0, f64::max)
     }
 }
 
@@ -246,20 +368,6 @@ pub struct StrongCoupling {
     range: Vec<f64>,
     report: ConvergenceReport,
     ports: Vec<Ports>,
-    states: Vec<Option<FmuState>>,
-    /// Per component: its change count ([`crate::fmu::Instance::changes`])
-    /// when its state was last saved into `states` or restored from there.
-    /// While the count stands still, the FMU is in that saved state, and
-    /// saving it again would change nothing (the step after a split, the
-    /// retry of a rejected adaptive step).
-    in_saved_state: Vec<Option<u64>>,
-    /// Per component with held inputs: its change count right after it was
-    /// stepped on `u` in the iteration that converged. While the count
-    /// stands still (nothing but `fmi2Get…` calls since: the recorded
-    /// sample, the state saved), its inputs still hold `u`, which is also
-    /// the first iterate of the next step, and setting them again would
-    /// change nothing.
-    holds_u: Vec<Option<u64>>,
     nominal: Vec<f64>,
     /// The interface values U; between steps, the last accepted ones.
     u: Vec<f64>,
@@ -267,8 +375,11 @@ pub struct StrongCoupling {
     y: Vec<f64>,
     column: Vec<f64>,
     // Work space of a step, kept so that a step allocates nothing:
-    /// ∂Y/∂U, then I − J factorised in place.
+    /// J = ∂Y/∂U, n × n. Only the blocks of the components' own inputs
+    /// and outputs are ever written: every entry outside them is zero.
     jac: DMatrix<f64>,
+    /// I − J, factorised in place.
+    newton_matrix: DMatrix<f64>,
     /// One component's directional derivatives.
     derivative: Vec<f64>,
     /// U perturbed for a finite difference.
@@ -277,7 +388,7 @@ pub struct StrongCoupling {
     /// NONMONOTONE_MEMORY base residual norms.
     base: Vec<f64>,
     direction: Vec<f64>,
-    history: Vec<f64>,
+    history: RecentNorms,
 }
 
 impl StrongCoupling {
@@ -300,20 +411,18 @@ impl StrongCoupling {
                 ..Default::default()
             },
             ports: Vec::new(),
-            states: Vec::new(),
-            in_saved_state: Vec::new(),
-            holds_u: Vec::new(),
             nominal: Vec::new(),
             u: Vec::new(),
             started: false,
             y: Vec::new(),
             column: Vec::new(),
             jac: DMatrix::zeros(0, 0),
+            newton_matrix: DMatrix::zeros(0, 0),
             derivative: Vec::new(),
             perturbed: Vec::new(),
             base: Vec::new(),
             direction: Vec::new(),
-            history: Vec::with_capacity(NONMONOTONE_MEMORY),
+            history: RecentNorms::default(),
         }
     }
 
@@ -379,25 +488,28 @@ impl StrongCoupling {
                 let outputs: Vec<usize> = (0..n)
                     .filter(|&k| system.connections[k].from.0 == c)
                     .collect();
-                let ramped = self.interpolate && cs.can_interpolate_inputs;
-                let (directional, differenced) = match self.jacobian {
-                    _ if ramped => (
-                        Some(false),
-                        "finite differences (rollback): its inputs ramp over the step, and fmi2GetDirectionalDerivative gives the sensitivity to held inputs",
-                    ),
-                    JacobianSource::Directional => (Some(true), ""),
-                    JacobianSource::FiniteDifference => {
-                        (Some(false), "finite differences (rollback)")
-                    }
-                    JacobianSource::Auto if cs.provides_directional_derivative => (None, ""),
-                    JacobianSource::Auto => (
-                        Some(false),
-                        "finite differences (rollback): the FMU does not provide directional derivatives (providesDirectionalDerivative=\"false\")",
-                    ),
-                };
                 let inputs: Vec<usize> = (0..n)
                     .filter(|&k| system.connections[k].to.0 == c)
                     .collect();
+                let ramped = self.interpolate && cs.can_interpolate_inputs;
+                let (columns, differenced) = match self.jacobian {
+                    _ if inputs.is_empty() || outputs.is_empty() => (Columns::None, ""),
+                    _ if ramped => (
+                        Columns::Differenced,
+                        "finite differences (rollback): its inputs ramp over the step, and fmi2GetDirectionalDerivative gives the sensitivity to held inputs",
+                    ),
+                    JacobianSource::Directional => (Columns::Directional, ""),
+                    JacobianSource::FiniteDifference => {
+                        (Columns::Differenced, "finite differences (rollback)")
+                    }
+                    JacobianSource::Auto if cs.provides_directional_derivative => {
+                        (Columns::Unchecked, "")
+                    }
+                    JacobianSource::Auto => (
+                        Columns::Differenced,
+                        "finite differences (rollback): the FMU does not provide directional derivatives (providesDirectionalDerivative=\"false\")",
+                    ),
+                };
                 Ports {
                     input_vrs: inputs
                         .iter()
@@ -409,10 +521,18 @@ impl StrongCoupling {
                         .map(|&k| system.connections[k].from.1)
                         .collect(),
                     output_values: vec![0.0; outputs.len()],
+                    consecutive_outputs: outputs
+                        .first()
+                        .copied()
+                        .filter(|_| outputs.windows(2).all(|k| k[1] == k[0] + 1)),
                     outputs,
-                    directional,
+                    columns,
                     differenced,
+                    reported: false,
                     ramped,
+                    state: None,
+                    in_saved_state: None,
+                    holds_u: None,
                 }
             })
             .collect();
@@ -432,9 +552,6 @@ impl StrongCoupling {
                     .unwrap_or(1.0)
             })
             .collect();
-        self.states = (0..system.components.len()).map(|_| None).collect();
-        self.in_saved_state = vec![None; system.components.len()];
-        self.holds_u = vec![None; system.components.len()];
         self.variable_steps = system.components.iter().all(|c| {
             c.fmu
                 .description()
@@ -443,7 +560,12 @@ impl StrongCoupling {
         });
         let most_outputs = self.ports.iter().map(|p| p.outputs.len()).max();
         self.derivative = vec![0.0; most_outputs.unwrap_or(0)];
+        self.jac = DMatrix::zeros(n, n);
+        self.newton_matrix = DMatrix::zeros(n, n);
         self.u = vec![0.0; n];
+        self.accepted = vec![0.0; n];
+        self.base = vec![0.0; n];
+        self.direction = vec![0.0; n];
         self.range = vec![0.0; n];
         self.started = false;
         self.y = vec![0.0; n];
@@ -455,160 +577,177 @@ impl StrongCoupling {
         Ok(())
     }
 
-    /// Save every component's state at the start of the step into
-    /// `states` (`fmi2GetFMUstate`), unless it is the saved one already.
+    /// Save every component's state at the start of the step
+    /// ([`Ports::save_state`]).
     fn save_states(&mut self, system: &mut System) -> Result<(), FmuError> {
-        let slots = self.states.iter_mut().zip(&mut self.in_saved_state);
-        for (c, (slot, in_saved)) in system.components.iter_mut().zip(slots) {
-            let changes = c.instance.changes();
-            match slot {
-                Some(_) if *in_saved == Some(changes) => continue,
-                Some(state) => {
-                    c.instance.update_state(state)?;
-                }
-                None => *slot = Some(c.instance.get_state()?),
-            }
-            // fmi2GetFMUstate is a getter: the count has not moved
-            *in_saved = Some(c.instance.changes());
+        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+            ports.save_state(&mut c.instance)?;
         }
         Ok(())
     }
 
-    /// Roll component `c` back to its saved state (`fmi2SetFMUstate`).
-    #[inline(always)] // a hot path, and small
-    fn restore(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
-        let state = self.states[c].as_ref().expect("saved before stepping");
-        let instance = &mut system.components[c].instance;
-        let restored = instance.set_state(state);
-        // after a failed fmi2SetFMUstate the FMU's state is unknown
-        self.in_saved_state[c] = restored.is_ok().then(|| instance.changes());
-        restored.map(|_| ())
+    /// Roll every component back to its saved state ([`Ports::restore`]).
+    fn restore_all(&mut self, system: &mut System) -> Result<(), FmuError> {
+        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+            ports.restore(&mut c.instance)?;
+        }
+        Ok(())
     }
 
-    /// Columns of ∂Y/∂U for the inputs of component `c`, by rolling back
-    /// and stepping with one input perturbed by δ = √ε·max(|U_j|, nominal_j).
+    /// The Newton direction at U, every component just stepped on it:
+    /// `(I − J)·ΔU = Y − U` solved into `direction`, or where I − J is
+    /// singular the fixed-point direction `Y − U`.
+    fn newton_direction(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
+        self.jacobian(system, t, h)?;
+        // (I − J)·ΔU = Y − U (over the slices: the matrix iterators cost
+        // more than the few entries)
+        let n = self.u.len();
+        let a = self.newton_matrix.as_mut_slice();
+        // the diagonal: every (n + 1)-th entry of the column-major slice
+        let mut diagonal = 0;
+        for (i, (a, j)) in a.iter_mut().zip(self.jac.as_slice()).enumerate() {
+            *a = -j;
+            if i == diagonal {
+                *a += 1.0;
+                diagonal += n + 1;
+            }
+        }
+        for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
+            *d = y - u;
+        }
+        if !solve_in_place(&mut self.newton_matrix, &mut self.direction) {
+            // I − J singular: the fixed-point direction.
+            for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
+                *d = y - u;
+            }
+        }
+        Ok(())
+    }
+
+    /// Columns of ∂Y/∂U for the inputs of component `c` into `self.jac`, by
+    /// rolling back and stepping with one input perturbed by
+    /// δ = √ε·max(|U_j|, nominal_j).
     fn difference_columns(
         &mut self,
         system: &mut System,
         c: usize,
         t: f64,
         h: f64,
-        jac: &mut DMatrix<f64>,
     ) -> Result<(), FmuError> {
         for i in 0..self.ports[c].inputs.len() {
             let j = self.ports[c].inputs[i];
             let delta = f64::EPSILON.sqrt() * self.u[j].abs().max(self.nominal[j]);
-            self.restore(system, c)?;
+            let instance = &mut system.components[c].instance;
+            self.ports[c].restore(instance)?;
             self.perturbed.clone_from(&self.u);
             self.perturbed[j] += delta;
-            let instance = &mut system.components[c].instance;
             self.ports[c].set_inputs(instance, &self.perturbed, &self.accepted, h)?;
             instance.do_step(t, h)?;
             self.report.difference_steps += 1;
             self.column.clone_from(&self.y);
             self.ports[c].read_outputs(instance, &mut self.column)?;
             for &k in &self.ports[c].outputs {
-                jac[(k, j)] = (self.column[k] - self.y[k]) / delta;
+                self.jac[(k, j)] = (self.column[k] - self.y[k]) / delta;
             }
         }
         Ok(())
     }
 
-    /// Columns of ∂Y/∂U for the inputs of component `c` from
+    /// Columns of ∂Y/∂U for the inputs of component `c` into `self.jac`, from
     /// `fmi2GetDirectionalDerivative`, called right after the step.
-    #[inline] // hot: at every Jacobian
-    fn directional_columns(
-        &mut self,
-        system: &mut System,
-        c: usize,
-        jac: &mut DMatrix<f64>,
-    ) -> Result<(), FmuError> {
+    #[inline(always)] // hot: at every Jacobian
+    fn directional_columns(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         let ports = &self.ports[c];
-        // (sized for the component with the most outputs in `prepare`)
-        let out = &mut self.derivative[..ports.outputs.len()];
         let instance = &mut system.components[c].instance;
+        let rows = self.jac.nrows();
         for (&j, &known) in ports.inputs.iter().zip(&ports.input_vrs) {
+            if let Some(first) = ports.consecutive_outputs {
+                // straight into place: rows first.. of column j
+                let start = first + j * rows;
+                let column = &mut self.jac.as_mut_slice()[start..start + ports.outputs.len()];
+                instance.get_directional_derivative(&ports.output_vrs, &[known], &[1.0], column)?;
+                continue;
+            }
+            // (sized for the component with the most outputs in `prepare`)
+            let out = &mut self.derivative[..ports.outputs.len()];
             instance.get_directional_derivative(&ports.output_vrs, &[known], &[1.0], out)?;
             for (&k, d) in ports.outputs.iter().zip(out.iter()) {
-                jac[(k, j)] = *d;
+                self.jac[(k, j)] = *d;
             }
         }
         Ok(())
     }
 
-    /// ∂Y/∂U, with every component stepped on `self.u` just before. Leaves
-    /// components that were differenced in a perturbed state (the next
-    /// iteration restores them).
-    /// `jac` is n × n and zero on entry.
-    fn jacobian(
-        &mut self,
-        system: &mut System,
-        t: f64,
-        h: f64,
-        jac: &mut DMatrix<f64>,
-    ) -> Result<(), FmuError> {
+    /// ∂Y/∂U into `self.jac`, with every component stepped on `self.u`
+    /// just before. Leaves components that were differenced in a perturbed
+    /// state (the next iteration restores them).
+    fn jacobian(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
         self.report.jacobians += 1;
         // Directional derivatives first: they need the step just taken.
         for c in 0..system.components.len() {
-            if self.ports[c].inputs.is_empty() || self.ports[c].outputs.is_empty() {
-                continue;
-            }
-            match self.ports[c].directional {
-                Some(true) => self.directional_columns(system, c, jac)?,
-                // Auto: an FMU whose call fails is differenced instead.
-                None => {
-                    if self.directional_columns(system, c, jac).is_err() {
-                        self.ports[c].directional = Some(false);
-                        self.report.jacobian_of[c].1 =
-                            "finite differences (fmi2GetDirectionalDerivative failed)";
+            match self.ports[c].columns {
+                Columns::Directional => self.directional_columns(system, c)?,
+                Columns::Unchecked => {
+                    // Auto: an FMU whose call fails is differenced instead.
+                    if self.directional_columns(system, c).is_err() {
+                        self.ports[c].columns = Columns::Differenced;
+                        let how = "finite differences (fmi2GetDirectionalDerivative failed)";
+                        self.describe(c, how);
                     }
                 }
-                Some(false) => {}
+                Columns::None | Columns::Differenced => {}
             }
         }
         for c in 0..system.components.len() {
-            if self.ports[c].inputs.is_empty() || self.ports[c].outputs.is_empty() {
-                continue;
-            }
-            match self.ports[c].directional {
-                Some(true) => {
-                    if self.report.jacobian_of[c].1 == "not needed" {
-                        self.report.jacobian_of[c].1 = "directional derivatives";
+            match self.ports[c].columns {
+                Columns::None => {}
+                Columns::Directional => {
+                    if !self.ports[c].reported {
+                        self.describe(c, "directional derivatives");
                     }
                 }
-                Some(false) => {
-                    self.difference_columns(system, c, t, h, jac)?;
-                    if self.report.jacobian_of[c].1 == "not needed" {
-                        self.report.jacobian_of[c].1 = self.ports[c].differenced;
+                Columns::Differenced => {
+                    self.difference_columns(system, c, t, h)?;
+                    if !self.ports[c].reported {
+                        self.describe(c, self.ports[c].differenced);
                     }
                 }
-                None => {
+                Columns::Unchecked => {
                     // Auto: compare with finite differences once.
-                    let mut reference = jac.clone();
-                    self.difference_columns(system, c, t, h, &mut reference)?;
+                    let directional = self.jac.clone();
+                    self.difference_columns(system, c, t, h)?;
                     let mut agree = true;
                     for &j in &self.ports[c].inputs {
                         for &k in &self.ports[c].outputs {
-                            let (a, b) = (jac[(k, j)], reference[(k, j)]);
+                            let (a, b) = (directional[(k, j)], self.jac[(k, j)]);
                             let scale = a.abs().max(b.abs()).max(1e-300);
                             if (a - b).abs() > 1e-3 * scale + 1e-12 {
                                 agree = false;
                             }
                         }
                     }
-                    self.ports[c].directional = Some(agree);
                     if agree {
-                        self.report.jacobian_of[c].1 =
-                            "directional derivatives (checked against finite differences)";
+                        self.ports[c].columns = Columns::Directional;
+                        self.describe(
+                            c,
+                            "directional derivatives (checked against finite differences)",
+                        );
+                        self.jac = directional;
                     } else {
-                        self.report.jacobian_of[c].1 =
-                            "finite differences (directional derivatives disagreed)";
-                        jac.copy_from(&reference);
+                        self.ports[c].columns = Columns::Differenced;
+                        self.describe(c, "finite differences (directional derivatives disagreed)");
                     }
                 }
             }
         }
         Ok(())
+    }
+
+    /// Say in the convergence report how component `c`'s Jacobian columns
+    /// are obtained (its entry is "not needed" until then).
+    fn describe(&mut self, c: usize, how: &'static str) {
+        self.report.jacobian_of[c].1 = how;
+        self.ports[c].reported = true;
     }
 }
 
@@ -698,9 +837,7 @@ impl StrongCoupling {
                         return solved;
                     }
                     self.report.rejected += 1;
-                    for c in 0..system.components.len() {
-                        self.restore(system, c)?;
-                    }
+                    self.restore_all(system)?;
                     self.u.copy_from_slice(&start);
                     let shrink = match estimate {
                         Some(error) => (0.9 / error).clamp(0.2, 0.5),
@@ -736,14 +873,22 @@ impl StrongCoupling {
         worst
     }
 
+    #[inline] // at every step, and only the first does anything
     fn ensure_started(&mut self, system: &mut System) -> Result<(), FmuError> {
-        if !self.started {
-            for c in 0..system.components.len() {
-                let instance = &mut system.components[c].instance;
-                self.ports[c].read_outputs(instance, &mut self.u)?;
-            }
-            self.started = true;
+        if self.started {
+            return Ok(());
         }
+        self.start(system)
+    }
+
+    /// U from the outputs at the start of the run.
+    #[cold]
+    #[inline(never)]
+    fn start(&mut self, system: &mut System) -> Result<(), FmuError> {
+        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+            ports.read_outputs(&mut c.instance, &mut self.u)?;
+        }
+        self.started = true;
         Ok(())
     }
 
@@ -751,6 +896,7 @@ impl StrongCoupling {
     /// with two half steps (recursively, at most `max_splits` times deep).
     /// The communication grid of the run is unchanged: the halves happen
     /// inside one macro step.
+    #[inline] // into every step; the split itself is out of line
     fn step_or_split(
         &mut self,
         system: &mut System,
@@ -759,22 +905,32 @@ impl StrongCoupling {
         depth: usize,
     ) -> Result<(), FmuError> {
         match self.solve(system, t, h) {
-            Err(e @ FmuError::NotConverged { .. }) => {
-                if depth >= self.max_splits || !self.variable_steps {
-                    return Err(e);
-                }
-                self.report.rejected += 1;
-                self.report.iterations += self.max_iterations;
-                for c in 0..system.components.len() {
-                    self.restore(system, c)?;
-                }
-                let u = self.accepted.clone();
-                self.u.copy_from_slice(&u);
-                self.step_or_split(system, t, 0.5 * h, depth + 1)?;
-                self.step_or_split(system, t + 0.5 * h, 0.5 * h, depth + 1)
-            }
+            Err(e @ FmuError::NotConverged { .. }) => self.split(system, t, h, depth, e),
             other => other,
         }
+    }
+
+    /// [`StrongCoupling::step_or_split`] after Newton failed on `[t, t + h]`
+    /// with `e`.
+    #[cold]
+    #[inline(never)]
+    fn split(
+        &mut self,
+        system: &mut System,
+        t: f64,
+        h: f64,
+        depth: usize,
+        e: FmuError,
+    ) -> Result<(), FmuError> {
+        if depth >= self.max_splits || !self.variable_steps {
+            return Err(e);
+        }
+        self.report.rejected += 1;
+        self.report.iterations += self.max_iterations;
+        self.restore_all(system)?;
+        self.u.copy_from_slice(&self.accepted);
+        self.step_or_split(system, t, 0.5 * h, depth + 1)?;
+        self.step_or_split(system, t + 0.5 * h, 0.5 * h, depth + 1)
     }
 
     fn solve(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
@@ -792,7 +948,7 @@ impl StrongCoupling {
         // a hysteretic law reads an input a rounding error below its last
         // one as a reversal.
         self.ensure_started(system)?;
-        self.accepted.clone_from(&self.u);
+        self.accepted.copy_from_slice(&self.u);
         // Damped Newton: from the base point `base` (where the Jacobian was
         // taken) try U = base + λ·direction, halving λ while the scaled
         // residual norm is not below the largest of the last
@@ -803,59 +959,50 @@ impl StrongCoupling {
         // makes at a reversal — is cut by halving.
         let mut has_base = false;
         self.history.clear();
-        self.direction.resize(n, 0.0);
         let mut lambda = 1.0;
-        let mut worst = (f64::INFINITY, 0);
         let mut last_norm = f64::INFINITY;
         for iteration in 1..=self.max_iterations {
-            for c in 0..system.components.len() {
+            for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+                let instance = &mut c.instance;
                 // (only a converged iteration leaves a mark, for the next step)
-                let holds_u =
-                    self.holds_u[c].take() == Some(system.components[c].instance.changes());
+                let holds_u = ports.holds_u.take() == Some(instance.changes());
                 if iteration > 1 {
-                    self.restore(system, c)?;
+                    ports.restore(instance)?;
                 } else if holds_u {
                     // the first iterate is the last accepted U, still set
                     continue;
                 }
-                let instance = &mut system.components[c].instance;
-                self.ports[c].set_inputs(instance, &self.u, &self.accepted, h)?;
+                ports.set_inputs(instance, &self.u, &self.accepted, h)?;
             }
             for c in &mut system.components {
                 c.instance.do_step(t, h)?;
             }
-            for c in 0..system.components.len() {
-                let instance = &mut system.components[c].instance;
-                self.ports[c].read_outputs(instance, &mut self.y)?;
+            for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
+                ports.read_outputs(&mut c.instance, &mut self.y)?;
             }
-            worst = (0.0, 0);
+            // (which connection is the worst is asked only if the step fails)
+            let mut worst = 0.0;
             let mut norm = 0.0;
-            let interface = self.nominal.iter().zip(&self.u).zip(&self.y);
-            for (k, ((nominal, u), y)) in interface.enumerate() {
-                let tolerance = self.atol * nominal + self.rtol * u.abs().max(y.abs());
-                let ratio = (u - y).abs() / tolerance;
+            for ((&nominal, &u), &y) in self.nominal.iter().zip(&self.u).zip(&self.y) {
+                let ratio = scaled_mismatch(self.atol, self.rtol, nominal, u, y);
                 norm += ratio * ratio;
-                if ratio.is_nan() || (!worst.0.is_nan() && ratio > worst.0) {
-                    worst = (ratio, k);
+                // a NaN is the worst, and stays it: nothing compares greater
+                if ratio.is_nan() || ratio > worst {
+                    worst = ratio;
                 }
             }
             let norm = norm.sqrt();
             last_norm = norm;
-            if worst.0 <= 1.0 {
+            if worst <= 1.0 {
                 self.report.steps += 1;
                 self.report.iterations += iteration;
                 self.report.max_iterations = self.report.max_iterations.max(iteration);
                 self.report.histogram[(iteration - 1).min(7)] += 1;
-                self.report.worst_accepted = self.report.worst_accepted.max(worst.0);
+                self.report.worst_accepted = self.report.worst_accepted.max(worst);
                 // Every component was just stepped on U; a ramped one has
                 // moved its inputs along the ramp.
-                for ((mark, ports), component) in self
-                    .holds_u
-                    .iter_mut()
-                    .zip(&self.ports)
-                    .zip(&system.components)
-                {
-                    *mark = (!ports.ramped).then(|| component.instance.changes());
+                for (ports, c) in self.ports.iter_mut().zip(&system.components) {
+                    ports.holds_u = (!ports.ramped).then(|| c.instance.changes());
                 }
                 return Ok(());
             }
@@ -866,7 +1013,7 @@ impl StrongCoupling {
                 Update::FixedPoint => self.u.copy_from_slice(&self.y),
                 Update::Newton => {
                     if has_base {
-                        let reference = self.history.iter().copied().fold(0.0, f64::max);
+                        let reference = self.history.max();
                         let sufficient =
                             norm.is_finite() && norm <= (1.0 - 1e-4 * lambda) * reference;
                         if !sufficient && lambda > 1.0 / 1024.0 {
@@ -881,39 +1028,27 @@ impl StrongCoupling {
                         }
                     }
                     // New base point: the components were just stepped on U.
-                    let mut jac = std::mem::replace(&mut self.jac, DMatrix::zeros(0, 0));
-                    if jac.shape() == (n, n) {
-                        jac.as_mut_slice().fill(0.0);
-                    } else {
-                        jac = DMatrix::zeros(n, n);
-                    }
-                    self.jacobian(system, t, h, &mut jac)?;
-                    // (I − J)·ΔU = Y − U (over the slice: the matrix
-                    // iterators cost more than the few entries)
-                    for x in jac.as_mut_slice() {
-                        *x = -*x;
-                    }
-                    for k in 0..n {
-                        jac[(k, k)] += 1.0;
-                        self.direction[k] = self.y[k] - self.u[k];
-                    }
-                    if !solve_in_place(&mut jac, &mut self.direction) {
-                        // I − J singular: the fixed-point direction.
-                        for ((d, y), u) in self.direction.iter_mut().zip(&self.y).zip(&self.u) {
-                            *d = y - u;
-                        }
-                    }
-                    self.jac = jac;
-                    self.base.clone_from(&self.u);
+                    self.newton_direction(system, t, h)?;
+                    self.base.copy_from_slice(&self.u);
                     has_base = true;
-                    if self.history.len() == NONMONOTONE_MEMORY {
-                        self.history.remove(0);
-                    }
                     self.history.push(norm);
                     lambda = 1.0;
                     for (u, d) in self.u.iter_mut().zip(&self.direction) {
                         *u += d;
                     }
+                }
+            }
+        }
+        // The connection of the worst mismatch of the last iteration (the
+        // first of equal ones, the last NaN), on the U and Y it was found
+        // on; the first if there was no iteration.
+        let mut worst = (0.0, 0);
+        if self.max_iterations > 0 {
+            let interface = self.nominal.iter().zip(&self.u).zip(&self.y);
+            for (k, ((&nominal, &u), &y)) in interface.enumerate() {
+                let ratio = scaled_mismatch(self.atol, self.rtol, nominal, u, y);
+                if ratio.is_nan() || ratio > worst.0 {
+                    worst = (ratio, k);
                 }
             }
         }
@@ -931,6 +1066,14 @@ impl StrongCoupling {
             residual: last_norm,
         })
     }
+}
+
+/// `|R_k| = |U_k − Y_k|` over its tolerance `atol·nominal_k +
+/// rtol·max(|U_k|, |Y_k|)`: at most 1 where the step has converged.
+#[inline(always)]
+fn scaled_mismatch(atol: f64, rtol: f64, nominal: f64, u: f64, y: f64) -> f64 {
+    let tolerance = atol * nominal + rtol * u.abs().max(y.abs());
+    (u - y).abs() / tolerance
 }
 
 /// Solve `a·x = b` in place (`b` becomes `x`, `a` is overwritten) by
@@ -1027,6 +1170,51 @@ fn solve_two(m: &mut [f64; 4], b: &mut [f64; 2]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn recent_norms_keep_what_a_vector_of_the_last_few_keeps() {
+        // the vector it replaces: remove the oldest when full, then push
+        let mut vector: Vec<f64> = Vec::new();
+        let mut recent = RecentNorms::default();
+        let values = [
+            3.0,
+            f64::NAN,
+            0.5,
+            7.0,
+            f64::INFINITY,
+            2.0,
+            0.0,
+            f64::NAN,
+            1e-300,
+            4.0,
+            9.0,
+            1.0,
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+            0.25,
+        ];
+        for (i, &x) in values.iter().enumerate() {
+            if i % 7 == 6 {
+                vector.clear();
+                recent.clear();
+            }
+            if vector.len() == NONMONOTONE_MEMORY {
+                vector.remove(0);
+            }
+            vector.push(x);
+            recent.push(x);
+            assert_eq!(recent.len, vector.len());
+            for (a, b) in recent.norms[..recent.len].iter().zip(&vector) {
+                assert_eq!(a.to_bits(), b.to_bits(), "{vector:?}");
+            }
+            let max = vector.iter().copied().fold(0.0, f64::max);
+            assert_eq!(recent.max().to_bits(), max.to_bits(), "{vector:?}");
+        }
+        recent.clear();
+        assert_eq!(recent.max(), 0.0);
+    }
 
     #[test]
     fn gaussian_elimination_pivots_and_refuses_singular_systems() {
