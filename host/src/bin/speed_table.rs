@@ -31,10 +31,11 @@
 //! 6. **`fricsim diagnose`** on the EMPS data: the command, timed.
 //!
 //! Every timed figure is the best of `--repeats` runs (the machine is
-//! shared; the best run is the one least disturbed), but FMPy's, which is
-//! run once (twenty seconds of Newton in Python take half a minute). `--quick` shortens
-//! every run (for the tests: the tables appear with every row, the numbers
-//! mean little) and skips `fricsim diagnose`.
+//! shared; the best run is the one least disturbed) after one run not
+//! counted ([`best_of`]), but FMPy's, which is run once (twenty seconds of
+//! Newton in Python take ten seconds). `--quick` shortens every run (for
+//! the tests: the tables appear with every row, the numbers mean little)
+//! and skips `fricsim diagnose`.
 //!
 //! `--update FILE` writes the tables between the markers [`BEGIN`] and
 //! [`END`] of FILE; without it they go to stdout. `scripts/bench.sh`
@@ -190,8 +191,14 @@ fn run(args: &Args) -> Result<(), String> {
     Ok(())
 }
 
-/// The shortest of `repeats` runs of `f` (each returns its own time, s).
+/// The shortest of `repeats` runs of `f` (each returns its own time, s),
+/// after one run that is not counted: a first run pays for what every
+/// later one finds ready (memory the process has not touched yet, whose
+/// page faults cost a large run as much as a third of its time; cold
+/// caches), and which side of a comparison pays it would otherwise
+/// depend on the order they run in.
 fn best_of(repeats: usize, mut f: impl FnMut() -> Result<f64, String>) -> Result<f64, String> {
+    f()?;
     let mut best = f64::INFINITY;
     for _ in 0..repeats {
         best = best.min(f()?);
@@ -961,8 +968,11 @@ fn sweep_speedup(root: &Path, sizes: &Sizes) -> Result<SweepRow, String> {
         master: "jacobi".into(),
     };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    // wall time of the best run, and the CPU time of that run
+    // wall time of the best run, and the CPU time of that run, after one
+    // run not counted (as `best_of`: each thread's first runs touch
+    // memory for the first time)
     let time = |threads: usize| -> Result<(f64, f64), String> {
+        run_all(&file, &plan, threads)?;
         let mut best = (f64::INFINITY, f64::NAN);
         for _ in 0..sizes.repeats {
             let (clock, cpu) = (Instant::now(), cpu_time());
@@ -1061,7 +1071,7 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
     let _ = writeln!(s, "{BEGIN}");
     let _ = writeln!(
         s,
-        "Generated {} by `{command}` on {}; {total:.0} s in all; each figure the best of {} run{} (FMPy's: one run); load average {:.2} at the start, {:.2} at the end (other work on the machine slows every figure, the parallel sweep most).\n",
+        "Generated {} by `{command}` on {}; {total:.0} s in all; each figure the best of {} run{} after one not counted (FMPy's: one run); load average {:.2} at the start, {:.2} at the end (other work on the machine slows every figure, the parallel sweep most).\n",
         today(),
         machine(),
         sizes.repeats,
