@@ -45,7 +45,13 @@ static NEXT_SLOT: AtomicUsize = AtomicUsize::new(0);
 /// prevented either.)
 #[inline]
 fn is_live(c: usize) -> bool {
-    (c != 0 && RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c)) || is_live_locked(c)
+    recently_live(c) || is_live_locked(c)
+}
+
+/// Whether `c` (not 0) is in [`RECENTLY_LIVE`]: a few loads, no lock.
+#[inline(always)]
+fn recently_live(c: usize) -> bool {
+    c != 0 && RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c)
 }
 
 /// The instance behind `c` for a call's fast path, if `c` is in
@@ -58,7 +64,7 @@ fn is_live(c: usize) -> bool {
 #[inline(always)]
 unsafe fn recent_instance<'a>(c: fmi2Component, allowed: u32) -> Option<&'a mut Instance> {
     let c = c as usize;
-    if c == 0 || !RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c) {
+    if !recently_live(c) {
         return None;
     }
     // SAFETY: a recently live address is a live instance, created by

@@ -118,15 +118,17 @@ pub struct ModelFactory {
     pub create: fn() -> Box<dyn Model>,
 }
 
-/// The five `Model` methods that only forward to a law with
-/// `write_state` / `state_len` / `write_state_into` / `state_from_slice`
-/// held in field `$law` of a `Clone` model: write
-/// `fmi2_cs::delegate_state!(law);` inside the `impl Model`.
+/// The `Model` methods of the state for a law with `state_len` /
+/// `write_state_into` / `state_from_slice` held in field `$law` of a
+/// `Clone` model (`save_state` appends what `write_state_into` writes):
+/// write `fmi2_cs::delegate_state!(law);` inside the `impl Model`.
 #[macro_export]
 macro_rules! delegate_state {
     ($law:ident) => {
         fn save_state(&self, out: &mut Vec<f64>) {
-            self.$law.write_state(out);
+            let start = out.len();
+            out.resize(start + self.$law.state_len(), 0.0);
+            self.$law.write_state_into(&mut out[start..]);
         }
 
         fn state_len(&self) -> Option<usize> {

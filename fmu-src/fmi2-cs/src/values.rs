@@ -56,26 +56,9 @@ impl Values {
         self.data.is_empty()
     }
 
-    /// Overwrite the values at `vrs` with those of `from` (the values of
-    /// another instance of the same model).
-    #[inline]
-    pub fn copy_at(&mut self, from: &[f64], vrs: &[u32]) {
-        copy_at(&mut self.data, from, vrs);
-    }
-
     /// Overwrite from a slice of the same length.
     pub fn copy_from_slice(&mut self, data: &[f64]) {
         self.data.copy_from_slice(data);
-    }
-}
-
-/// `to[vr] = from[vr]` for each `vr` of `vrs`: the few entries of a
-/// per-variable array that can differ (the inputs), with both arrays
-/// borrowed once rather than looked up through their owners per entry.
-#[inline]
-pub fn copy_at(to: &mut [f64], from: &[f64], vrs: &[u32]) {
-    for &vr in vrs {
-        to[vr as usize] = from[vr as usize];
     }
 }
 
@@ -100,7 +83,8 @@ impl Indices {
         }
     }
 
-    /// `to[vr] = from[vr]` for each value reference, as [`copy_at`] does.
+    /// `to[vr] = from[vr]` for each value reference: the few entries of a
+    /// per-variable table that can differ (the inputs).
     #[inline]
     pub fn copy(&self, to: &mut [f64], from: &[f64]) {
         // Both tables cut to the bound: an entry's one index check then
@@ -125,18 +109,20 @@ impl std::ops::Deref for Indices {
 mod tests {
     use super::*;
 
-    /// [`Indices::copy`] is [`copy_at`], in any order of the value
-    /// references, and refuses tables shorter than them (a panic, as an
-    /// index out of bounds is).
+    /// [`Indices::copy`] copies exactly the entries of its value
+    /// references, in any order of them, and refuses tables shorter than
+    /// them (a panic, as an index out of bounds is).
     #[test]
-    fn indices_copy_as_copy_at_does() {
+    fn indices_copy_copies_exactly_their_entries() {
         let from: Vec<f64> = (0..20).map(|k| k as f64 + 0.5).collect();
         for vrs in [vec![], vec![0], vec![17, 3, 4, 0], vec![19, 1]] {
             let indices = Indices::new(vrs.clone());
             assert_eq!(&*indices, &vrs[..]);
             let (mut a, mut b) = (vec![-1.0; 20], vec![-1.0; 20]);
             indices.copy(&mut a, &from);
-            copy_at(&mut b, &from, &vrs);
+            for &vr in &vrs {
+                b[vr as usize] = from[vr as usize];
+            }
             assert_eq!(a, b);
         }
         let indices = Indices::new(vec![2, 5]);

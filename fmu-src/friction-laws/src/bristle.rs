@@ -469,36 +469,15 @@ impl Bristle {
         self.move_to(x.at(h));
     }
 
-    /// State: `[x, x_ref, dir, lo, hi, N, rng (8 values: the four 64-bit
-    /// words as 32-bit halves, exact integers), d[0..N], relax[0..N]]`.
-    /// Lossless; every value is finite. Appended to `out`.
-    pub fn write_state(&self, out: &mut Vec<f64>) {
-        let n = self.p.n_bristles;
-        let v = out;
-        v.reserve(14 + 2 * n);
-        v.extend_from_slice(&[
-            self.x,
-            self.x_ref,
-            f64::from(self.dir),
-            self.lo as f64,
-            self.hi as f64,
-            n as f64,
-        ]);
-        for w in self.rng.state() {
-            v.push((w >> 32) as f64);
-            v.push((w & 0xffff_ffff) as f64);
-        }
-        v.extend_from_slice(&self.d);
-        v.extend_from_slice(&self.relax);
-    }
-
     /// The number of values of the state: `14 + 2·N`.
     pub fn state_len(&self) -> usize {
         14 + self.d.len() + self.relax.len()
     }
 
-    /// The state of [`Bristle::write_state`] into `out`, of
-    /// [`Bristle::state_len`] values.
+    /// The state `[x, x_ref, dir, lo, hi, N, rng (8 values: the four 64-bit
+    /// words as 32-bit halves, exact integers), d[0..N], relax[0..N]]` into
+    /// `out`, of [`Bristle::state_len`] values. Lossless; every value is
+    /// finite.
     pub fn write_state_into(&self, out: &mut [f64]) {
         assert_eq!(out.len(), self.state_len(), "bristle state length");
         let (head, rest) = out.split_at_mut(14);
@@ -520,12 +499,12 @@ impl Bristle {
 
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        let mut v = Vec::new();
-        self.write_state(&mut v);
+        let mut v = vec![0.0; self.state_len()];
+        self.write_state_into(&mut v);
         v
     }
 
-    /// Restores a state written by [`Bristle::write_state`] for the same
+    /// Restores a state written by [`Bristle::write_state_into`] for the same
     /// number of bristles.
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
         let n = self.p.n_bristles;

@@ -329,19 +329,13 @@ impl Bristle2D {
         self.z = [z0 * u[0] / n, z0 * u[1] / n];
     }
 
-    /// State `[z1, z2]`, appended to `out` (no allocation once `out` has room).
-    pub fn write_state(&self, out: &mut Vec<f64>) {
-        out.extend_from_slice(&[self.z[0], self.z[1]]);
-    }
-
     /// The number of values of the state (2).
     #[inline]
     pub fn state_len(&self) -> usize {
         2
     }
 
-    /// The state of [`Bristle2D::write_state`] into `out`, of
-    /// [`Bristle2D::state_len`] values.
+    /// The state `[z1, z2]` into `out`, of [`Bristle2D::state_len`] values.
     #[inline]
     pub fn write_state_into(&self, out: &mut [f64]) {
         out.copy_from_slice(&[self.z[0], self.z[1]]);
@@ -349,8 +343,8 @@ impl Bristle2D {
 
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        let mut v = Vec::new();
-        self.write_state(&mut v);
+        let mut v = vec![0.0; self.state_len()];
+        self.write_state_into(&mut v);
         v
     }
 

@@ -123,19 +123,14 @@ impl ResetIntegrator {
         }
     }
 
-    /// State `[z]`, appended to `out` (no allocation once `out` has room).
-    pub fn write_state(&self, out: &mut Vec<f64>) {
-        out.extend_from_slice(&[self.z]);
-    }
-
     /// The number of values of the state (1).
     #[inline]
     pub fn state_len(&self) -> usize {
         1
     }
 
-    /// The state of [`ResetIntegrator::write_state`] into `out`, of
-    /// [`ResetIntegrator::state_len`] values.
+    /// The state `[z]` into `out`, of [`ResetIntegrator::state_len`]
+    /// values.
     #[inline]
     pub fn write_state_into(&self, out: &mut [f64]) {
         out.copy_from_slice(&[self.z]);
@@ -143,8 +138,8 @@ impl ResetIntegrator {
 
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        let mut v = Vec::new();
-        self.write_state(&mut v);
+        let mut v = vec![0.0; self.state_len()];
+        self.write_state_into(&mut v);
         v
     }
 

@@ -850,19 +850,14 @@ impl Rig1D {
         }
     }
 
-    /// The state, appended to `out` (no allocation once `out` has room).
-    pub fn write_state(&self, out: &mut Vec<f64>) {
-        out.extend_from_slice(&[self.t, self.x, self.xd, self.xi]);
-    }
-
     /// The number of values of the state (4).
     #[inline]
     pub fn state_len(&self) -> usize {
         4
     }
 
-    /// The state of [`Rig1D::write_state`] into `out`, of
-    /// [`Rig1D::state_len`] values.
+    /// The state `[t, x, ẋ, ξ]` (ξ the controller's integral) into `out`,
+    /// of [`Rig1D::state_len`] values.
     #[inline]
     pub fn write_state_into(&self, out: &mut [f64]) {
         out.copy_from_slice(&[self.t, self.x, self.xd, self.xi]);
@@ -870,8 +865,8 @@ impl Rig1D {
 
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        let mut v = Vec::new();
-        self.write_state(&mut v);
+        let mut v = vec![0.0; self.state_len()];
+        self.write_state_into(&mut v);
         v
     }
 

@@ -144,19 +144,13 @@ impl Rig2D {
         }
     }
 
-    /// The state of both axes, appended to `out`.
-    pub fn write_state(&self, out: &mut Vec<f64>) {
-        self.axes[0].write_state(out);
-        self.axes[1].write_state(out);
-    }
-
     /// The number of values of the state (both axes').
     #[inline]
     pub fn state_len(&self) -> usize {
         self.axes[0].state_len() + self.axes[1].state_len()
     }
 
-    /// The state of [`Rig2D::write_state`] into `out`, of
+    /// The state of both axes, one after the other, into `out`, of
     /// [`Rig2D::state_len`] values.
     #[inline]
     pub fn write_state_into(&self, out: &mut [f64]) {
@@ -167,8 +161,8 @@ impl Rig2D {
 
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
-        let mut v = Vec::new();
-        self.write_state(&mut v);
+        let mut v = vec![0.0; self.state_len()];
+        self.write_state_into(&mut v);
         v
     }
 
