@@ -4,6 +4,6 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 ./build-fmu.sh
-cargo test --workspace --release
+cargo test --workspace --profile release-test
 scripts/setup-venv.sh
 .venv/bin/python -m pytest tests -q

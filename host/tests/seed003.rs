@@ -15,7 +15,7 @@
 //!
 //! The LuGre parameters of the example are generated here from the CSV
 //! (`slider_parameters`); a test keeps `examples/slider_seed003.ssv` equal
-//! to them, and `FRICSIM_REGENERATE=1 cargo test --release -p fricsim
+//! to them, and `FRICSIM_REGENERATE=1 cargo test --profile release-test -p fricsim
 //! --test seed003` rewrites it.
 
 mod seed_examples;
@@ -234,7 +234,7 @@ fn slider_parameters_are_generated_from_the_measured_data() {
     }
     assert!(
         std::fs::read_to_string(&path).unwrap() == text,
-        "examples/slider_seed003.ssv differs from the data: FRICSIM_REGENERATE=1 cargo test --release -p fricsim --test seed003"
+        "examples/slider_seed003.ssv differs from the data: FRICSIM_REGENERATE=1 cargo test --profile release-test -p fricsim --test seed003"
     );
     // The table reproduces the measurements at the points that lie on the
     // grid (0 and 270 mm) and stays within their range.
