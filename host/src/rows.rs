@@ -7,6 +7,14 @@
 //! work in a macro step. Here a new row is a few more numbers at the end
 //! of one buffer, and reading stays as natural: `rows[i][k]`,
 //! `rows.last()`, `for row in &rows`.
+//!
+//! A run that needs only a summary (`fricsim sweep`: the last row and each
+//! column's RMS) records into a table that keeps its last rows only
+//! ([`Rows::windowed`]): when its buffer is full, the rows but the last are
+//! folded into per-column sums of squares and the buffer is used again.
+//! A 20 s run at 1e-4 s then holds about 100 kB instead of 19 MB, so
+//! parallel runs neither wait on fresh memory nor share the memory bus
+//! for numbers nobody reads.
 
 use std::ops::{Index, IndexMut};
 
@@ -22,12 +30,27 @@ pub struct Rows {
     /// them are zeros: rows made ready ahead ([`Rows::with_capacity`]), so
     /// that a new row costs no filling with zeros, one row at a time.
     values: Vec<f64>,
+    /// For a table that keeps its last rows only ([`Rows::windowed`]):
+    /// what the rows folded out of it leave behind.
+    folded: Option<Box<Folded>>,
+}
+
+/// The rows a [`Rows::windowed`] table no longer holds.
+#[derive(Clone, Debug, PartialEq)]
+struct Folded {
+    /// How many.
+    rows: usize,
+    /// Per column, `Σ y²` over them, summed in row order.
+    square_sums: Vec<f64>,
 }
 
 impl PartialEq for Rows {
     /// The same rows (the zeros made ready ahead do not count).
     fn eq(&self, other: &Rows) -> bool {
-        self.width == other.width && self.len == other.len && self.as_flat() == other.as_flat()
+        self.width == other.width
+            && self.len == other.len
+            && self.as_flat() == other.as_flat()
+            && self.folded == other.folded
     }
 }
 
@@ -37,6 +60,7 @@ impl std::fmt::Debug for Rows {
             .field("width", &self.width)
             .field("len", &self.len)
             .field("values", &self.as_flat())
+            .field("folded", &self.folded)
             .finish()
     }
 }
@@ -48,6 +72,7 @@ impl Rows {
             width,
             len: 0,
             values: Vec::new(),
+            folded: None,
         }
     }
 
@@ -59,6 +84,27 @@ impl Rows {
             width,
             len: 0,
             values: vec![0.0; width * rows],
+            folded: None,
+        }
+    }
+
+    /// No rows yet, each of `width` numbers, keeping at most the last
+    /// `window` of them (at least 2): when the buffer is full, every row
+    /// but the last is folded into per-column sums of squares
+    /// ([`Rows::square_sums`]) and counted ([`Rows::rows_pushed`]), and no
+    /// longer read. [`Rows::last`] and [`Rows::pop`] work as in any table,
+    /// so a run records into it as into any other.
+    ///
+    /// # Panics
+    /// If `window` is below 2.
+    pub fn windowed(width: usize, window: usize) -> Rows {
+        assert!(window >= 2, "a window of {window} rows: at least 2");
+        Rows {
+            folded: Some(Box::new(Folded {
+                rows: 0,
+                square_sums: vec![0.0; width],
+            })),
+            ..Rows::with_capacity(width, window)
         }
     }
 
@@ -79,9 +125,33 @@ impl Rows {
         self.width
     }
 
-    /// Number of rows.
+    /// Number of rows held (of a [`Rows::windowed`] table: since the last
+    /// fold).
     pub fn len(&self) -> usize {
         self.len
+    }
+
+    /// Number of rows pushed and not popped: [`Rows::len`], and the rows
+    /// a [`Rows::windowed`] table folded out.
+    pub fn rows_pushed(&self) -> usize {
+        self.len + self.folded.as_ref().map_or(0, |f| f.rows)
+    }
+
+    /// Per column, `Σ y²` over every row pushed and not popped, summed in
+    /// row order (the rows folded out of a [`Rows::windowed`] table
+    /// included): the same numbers, bit for bit, from a windowed table as
+    /// from one that kept every row.
+    pub fn square_sums(&self) -> Vec<f64> {
+        let mut sums = match &self.folded {
+            Some(f) => f.square_sums.clone(),
+            None => vec![0.0; self.width],
+        };
+        for row in self {
+            for (sum, y) in sums.iter_mut().zip(row) {
+                *sum += y * y;
+            }
+        }
+        sums
     }
 
     pub fn is_empty(&self) -> bool {
@@ -123,22 +193,50 @@ impl Rows {
     /// row is built elsewhere and copied).
     #[inline] // once per communication point, a few instructions
     pub fn push_zeros(&mut self) -> &mut [f64] {
-        let start = self.len * self.width;
-        let end = start + self.width;
-        if self.values.len() < end {
-            // no row made ready: one more (the numbers after `end` are
-            // zeros still)
-            self.values.resize(end, 0.0);
+        let mut start = self.len * self.width;
+        if self.values.len() < start + self.width {
+            start = self.make_room();
         }
+        let end = start + self.width;
         self.len += 1;
         &mut self.values[start..end]
     }
 
-    /// Remove the last row, if any.
+    /// Room for one more row when none is made ready; where it starts. A
+    /// [`Rows::windowed`] table folds every row but the last out of its
+    /// full buffer and moves the last to the front; any other grows by
+    /// one row (the numbers after the rows are zeros still).
+    #[cold]
+    #[inline(never)]
+    fn make_room(&mut self) -> usize {
+        let width = self.width;
+        let Some(folded) = self.folded.as_deref_mut() else {
+            let start = self.len * width;
+            self.values.resize(start + width, 0.0);
+            return start;
+        };
+        // len ≥ 2 here: the window holds at least two rows, and only a full
+        // buffer lacks room (width > 0, or nothing would be missing)
+        let kept = self.len - 1;
+        for row in self.values[..kept * width].chunks_exact(width) {
+            for (sum, y) in folded.square_sums.iter_mut().zip(row) {
+                *sum += y * y;
+            }
+        }
+        folded.rows += kept;
+        self.values.copy_within(kept * width..self.len * width, 0);
+        self.values[width..].fill(0.0);
+        self.len = 1;
+        width
+    }
+
+    /// Remove the last row, if any (its numbers become zeros made ready
+    /// for the next row).
     pub fn pop(&mut self) {
         if self.len > 0 {
             self.len -= 1;
-            self.values.truncate(self.len * self.width);
+            let start = self.len * self.width;
+            self.values[start..start + self.width].fill(0.0);
         }
     }
 
@@ -265,6 +363,81 @@ mod tests {
         assert_eq!(Rows::from_rows(2, [[1.0, 2.0], [3.0, 4.0]]), rows);
         rows[1][0] = 7.0;
         assert_eq!(rows[1], [7.0, 4.0]);
+    }
+
+    /// Rows that make every fold's sum round differently from a plain
+    /// one: of mixed sizes and signs.
+    fn test_row(i: usize) -> [f64; 3] {
+        let x = i as f64;
+        [x.sin() * 1e3, 1.0 / (1.0 + x), -x * 0.1 + 1e-7 * x * x]
+    }
+
+    #[test]
+    fn a_windowed_table_keeps_its_last_rows_and_sums_the_others_bit_for_bit() {
+        for window in [2, 3, 7] {
+            for n in [0, 1, 2, 3, 6, 7, 8, 20, 21, 50] {
+                let mut full = Rows::new(3);
+                let mut windowed = Rows::windowed(3, window);
+                for i in 0..n {
+                    full.push_row(&test_row(i));
+                    windowed.push_zeros().copy_from_slice(&test_row(i));
+                    assert_eq!(windowed.last(), full.last(), "window {window}, row {i}");
+                    assert!(windowed.len() <= window && windowed.len() >= 1);
+                }
+                assert_eq!(windowed.rows_pushed(), n, "window {window}");
+                assert_eq!(full.rows_pushed(), n);
+                // the same sums bit for bit, as the full table's in row order
+                let mut expected = [0.0f64; 3];
+                for row in &full {
+                    for (e, y) in expected.iter_mut().zip(row) {
+                        *e += y * y;
+                    }
+                }
+                let got = windowed.square_sums();
+                assert_eq!(
+                    got.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                    expected.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                    "window {window}, {n} rows"
+                );
+                assert_eq!(full.square_sums(), expected);
+                // the rows held are the full table's last ones
+                let held: Vec<&[f64]> = windowed.iter().collect();
+                let tail: Vec<&[f64]> = full.iter().skip(n - windowed.len()).collect();
+                assert_eq!(held, tail);
+            }
+        }
+    }
+
+    #[test]
+    fn a_windowed_table_pops_as_any_table() {
+        // a row read and then refused (a NaN row) is popped right after it
+        // was pushed, also when that push folded the window
+        let mut full = Rows::new(3);
+        let mut windowed = Rows::windowed(3, 3);
+        for i in 0..12 {
+            full.push_row(&test_row(i));
+            windowed.push_row(&test_row(i));
+            if i % 4 == 3 {
+                full.pop();
+                windowed.pop();
+                assert_eq!(windowed.last(), full.last(), "row {i}");
+                assert_eq!(
+                    windowed.push_zeros(),
+                    [0.0; 3],
+                    "a popped row's numbers are zeros"
+                );
+                windowed.pop();
+            }
+        }
+        assert_eq!(windowed.rows_pushed(), full.rows_pushed());
+        assert_eq!(windowed.square_sums(), full.square_sums());
+        assert_eq!(windowed.last(), full.last());
+    }
+
+    #[test]
+    #[should_panic(expected = "a window of 1 rows: at least 2")]
+    fn a_window_of_one_row_is_refused() {
+        Rows::windowed(3, 1);
     }
 
     #[test]

@@ -85,6 +85,8 @@ pub struct System {
 /// component has seen no call that could have changed it.
 struct Recording {
     rows: Rows,
+    /// Rows kept at most ([`System::keep_last_rows`]); `None`: every row.
+    window: Option<usize>,
     /// Per component, its [`Instance::changes`] when the last row was read;
     /// [`NOT_READ`] where the last row cannot be used (none read, or
     /// discarded).
@@ -218,6 +220,7 @@ impl System {
             connections: Vec::new(),
             recording: Recording {
                 rows: Rows::new(0),
+                window: None,
                 changes: Vec::new(),
             },
             targets: Vec::new(),
@@ -499,11 +502,31 @@ impl System {
     }
 
     /// Start a new recording with room for `rows` rows (the rows read so
-    /// far are dropped).
+    /// far are dropped); with [`System::keep_last_rows`] set below `rows`,
+    /// a [`Rows::windowed`] one.
     pub fn start_recording(&mut self, rows: usize) {
         let recording = &mut self.recording;
-        recording.rows = Rows::with_capacity(recording.rows.width(), rows);
+        let width = recording.rows.width();
+        recording.rows = match recording.window {
+            Some(window) if window < rows => Rows::windowed(width, window),
+            _ => Rows::with_capacity(width, rows),
+        };
         recording.invalidate();
+    }
+
+    /// Let the recordings started from now on keep only their last
+    /// `window` rows (at least 2), the others summed into
+    /// [`Rows::square_sums`] and counted in [`Rows::rows_pushed`]: for runs
+    /// of which only a summary is kept (`fricsim sweep`). `None` (the
+    /// default): every row is kept.
+    ///
+    /// # Panics
+    /// If `window` is below 2.
+    pub fn keep_last_rows(&mut self, window: Option<usize>) {
+        if let Some(w) = window {
+            assert!(w >= 2, "a window of {w} rows: at least 2");
+        }
+        self.recording.window = window;
     }
 
     /// Read every recorded output into a new row of the recording, one

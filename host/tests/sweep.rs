@@ -118,6 +118,24 @@ fn a_grid_gives_one_row_per_point_with_the_numbers_of_fricsim_run() {
     // the file's own k is 2: compare the (1e5, 2) row
     let expected = &last[column(&run_header, "friction.F")];
     assert_eq!(&rows[2][f], expected, "sweep and run disagree");
+    // and the RMS over all 5001 points, bit for bit, though a sweep's run
+    // keeps only its last rows (the others folded into sums as it goes)
+    for signal in ["rig.x", "rig.v", "friction.F", "friction.z"] {
+        let k = column(&run_header, signal);
+        let sum: f64 = run_rows
+            .iter()
+            .map(|r| r[k].parse::<f64>().unwrap())
+            .fold(0.0, |s, y| s + y * y);
+        let rms = (sum / run_rows.len() as f64).sqrt();
+        let swept: f64 = rows[2][column(&header, &format!("rms:{signal}"))]
+            .parse()
+            .unwrap();
+        assert_eq!(
+            swept.to_bits(),
+            rms.to_bits(),
+            "rms:{signal}: sweep {swept}, run {rms}"
+        );
+    }
     // the parameters matter: k = 4 pulls harder
     let spring = column(&header, "final:rig.F_spring");
     let (k2, k4): (f64, f64) = (

@@ -69,7 +69,9 @@ pub fn by_name(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
 pub struct Run {
     pub columns: Vec<String>,
     pub time: Vec<f64>,
-    /// `rows[i][k]`: column `k` at `time[i]`.
+    /// `rows[i][k]`: column `k` at `time[i]`; under
+    /// [`System::keep_last_rows`] the last rows only (`rows[i]` at
+    /// `time[rows.rows_pushed() - rows.len() + i]`).
     pub rows: Rows,
     pub error: Option<String>,
 }
