@@ -382,7 +382,7 @@ mod tests {
                     full.push_row(&test_row(i));
                     windowed.push_zeros().copy_from_slice(&test_row(i));
                     assert_eq!(windowed.last(), full.last(), "window {window}, row {i}");
-                    assert!(windowed.len() <= window && windowed.len() >= 1);
+                    assert!(windowed.len() <= window && !windowed.is_empty());
                 }
                 assert_eq!(windowed.rows_pushed(), n, "window {window}");
                 assert_eq!(full.rows_pushed(), n);
