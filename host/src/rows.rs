@@ -217,14 +217,15 @@ impl Rows {
         };
         // len ≥ 2 here: the window holds at least two rows, and only a full
         // buffer lacks room (width > 0, or nothing would be missing)
-        let kept = self.len - 1;
-        for row in self.values[..kept * width].chunks_exact(width) {
+        let folding = self.len - 1;
+        for row in self.values[..folding * width].chunks_exact(width) {
             for (sum, y) in folded.square_sums.iter_mut().zip(row) {
                 *sum += y * y;
             }
         }
-        folded.rows += kept;
-        self.values.copy_within(kept * width..self.len * width, 0);
+        folded.rows += folding;
+        self.values
+            .copy_within(folding * width..self.len * width, 0);
         self.values[width..].fill(0.0);
         self.len = 1;
         width
@@ -365,8 +366,8 @@ mod tests {
         assert_eq!(rows[1], [7.0, 4.0]);
     }
 
-    /// Rows that make every fold's sum round differently from a plain
-    /// one: of mixed sizes and signs.
+    /// Rows of mixed sizes and signs: sums of their squares taken in
+    /// another order than row order would differ in their last bits.
     fn test_row(i: usize) -> [f64; 3] {
         let x = i as f64;
         [x.sin() * 1e3, 1.0 / (1.0 + x), -x * 0.1 + 1e-7 * x * x]
