@@ -1044,20 +1044,36 @@ impl Instance {
 
     /// Restore `snap` (one of this instance's saved states): all or nothing.
     pub fn restore(&mut self, snap: &Snapshot) -> Result<(), String> {
-        self.step_state_current = false;
         if self.same_parameters(snap) {
-            restore_in_place(
-                &mut *self.model,
-                &mut self.values,
-                &mut self.slopes,
-                &self.inputs,
-                self.sloped,
-                snap,
-            )?;
-        } else {
-            self.restore_other(snap)?;
+            return self.restore_same_parameters(SnapshotAt::Given(snap));
         }
+        self.step_state_current = false;
+        self.restore_other(snap)?;
         self.restored(snap.sloped, snap.initialized, snap.time, snap.state);
+        Ok(())
+    }
+
+    /// The usual rollback: `snap`, taken with the parameters the instance
+    /// has now, restored where it lies (given, or in the saved list, which
+    /// the restore does not write and so may lend the snapshot).
+    #[inline(always)]
+    fn restore_same_parameters(&mut self, at: SnapshotAt<'_>) -> Result<(), String> {
+        let snap = match at {
+            SnapshotAt::Given(snap) => snap,
+            SnapshotAt::Saved(i) => &*self.saved_states[i],
+        };
+        self.step_state_current = false;
+        restore_in_place(
+            &mut *self.model,
+            &mut self.values,
+            &mut self.slopes,
+            &self.inputs,
+            self.sloped,
+            snap,
+        )?;
+        let (sloped, initialized, time, state) =
+            (snap.sloped, snap.initialized, snap.time, snap.state);
+        self.restored(sloped, initialized, time, state);
         Ok(())
     }
 
@@ -1203,22 +1219,7 @@ impl Instance {
         if !self.same_parameters(snap) {
             return self.restore_saved_other(i);
         }
-        // `Instance::restore` of the usual rollback, with the snapshot left
-        // in the list: borrowed beside the fields the restore writes, none
-        // of which is the list.
-        self.step_state_current = false;
-        restore_in_place(
-            &mut *self.model,
-            &mut self.values,
-            &mut self.slopes,
-            &self.inputs,
-            self.sloped,
-            snap,
-        )?;
-        let (sloped, initialized, time, state) =
-            (snap.sloped, snap.initialized, snap.time, snap.state);
-        self.restored(sloped, initialized, time, state);
-        Ok(())
+        self.restore_same_parameters(SnapshotAt::Saved(i))
     }
 
     /// [`Instance::restore_saved`] of any other of the saved snapshots, at
@@ -1286,6 +1287,14 @@ impl Instance {
 /// writes its state with [`Model::save_state`] only: no buffer has this
 /// length.
 const VEC_STATE: usize = usize::MAX;
+
+/// Where [`Instance::restore_same_parameters`] finds its snapshot.
+enum SnapshotAt<'a> {
+    /// Given by the caller.
+    Given(&'a Snapshot),
+    /// At this index of the instance's saved list.
+    Saved(usize),
+}
 
 /// The complete state of `model` into `out`, replacing what it held, with
 /// `len` the model's [`Instance::state_len`]. The usual case is one
