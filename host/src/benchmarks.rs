@@ -16,6 +16,34 @@ pub fn splice(path: &Path, begin: &str, end: &str, block: Option<&str>) -> Resul
         }
         Err(e) => return Err(format!("{}: {e}", path.display())),
     };
+    let generated = marked(path, &text, begin, end)?;
+    let Some(block) = block else {
+        return Ok(());
+    };
+    let mut out = String::with_capacity(text.len() + block.len());
+    out.push_str(&text[..generated.start]);
+    out.push_str(block.trim_end_matches('\n'));
+    out.push_str(&text[generated.end..]);
+    std::fs::write(path, out).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The generated part of `path`, from the marker `begin` through the
+/// marker `end`, as [`splice`] writes it: what a published table is read
+/// from. A missing file or missing markers are refused.
+pub fn generated_part(path: &Path, begin: &str, end: &str) -> Result<String, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let generated = marked(path, &text, begin, end)?;
+    Ok(text[generated].to_string())
+}
+
+/// Where in `text` (the contents of `path`) the generated part is: from
+/// the marker `begin` through the marker `end`.
+fn marked(
+    path: &Path,
+    text: &str,
+    begin: &str,
+    end: &str,
+) -> Result<std::ops::Range<usize>, String> {
     let (Some(b), Some(e)) = (text.find(begin), text.find(end)) else {
         return Err(format!(
             "{}: the markers `{begin}` and `{end}` are missing: add them where the table goes",
@@ -28,14 +56,7 @@ pub fn splice(path: &Path, begin: &str, end: &str, block: Option<&str>) -> Resul
             path.display()
         ));
     }
-    let Some(block) = block else {
-        return Ok(());
-    };
-    let mut out = String::with_capacity(text.len() + block.len());
-    out.push_str(&text[..b]);
-    out.push_str(block.trim_end_matches('\n'));
-    out.push_str(&text[e + end.len()..]);
-    std::fs::write(path, out).map_err(|e| format!("{}: {e}", path.display()))
+    Ok(b..e + end.len())
 }
 
 /// The options every BENCHMARKS.md program has: where the repository is

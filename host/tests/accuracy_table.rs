@@ -4,7 +4,11 @@
 //! it updates and keep the rest, refuse a file without markers, and the
 //! entries must say what the runs did: the lagged loops of Jacobi and
 //! Gauss–Seidel chatter on the stiff cases, strong coupling does not.
-//! Nothing here depends on how fast the machine is.
+//! And its check (`--check`): the rows of BENCHMARKS.md's error table at
+//! h = 1e-2 and 1e-3 s, recomputed at their published duration, must be
+//! what BENCHMARKS.md publishes, entry for entry (the published figures
+//! stay reproducible), and an entry altered in a copy must be refused and
+//! named. Nothing here depends on how fast the machine is.
 
 mod common;
 
@@ -24,16 +28,33 @@ const MASTERS: [&str; 5] = [
     "adaptive",
 ];
 
-fn table(args: &[&str], update: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_accuracy-table"))
-        .args(args)
-        .arg("--root")
-        .arg(common::repository())
-        .arg("--update")
-        .arg(update)
-        .output()
-        .unwrap()
+/// `accuracy-table ARGS --root REPOSITORY`.
+fn program(args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_accuracy-table"));
+    command.args(args).arg("--root").arg(common::repository());
+    command
 }
+
+fn table(args: &[&str], update: &Path) -> Output {
+    program(args).arg("--update").arg(update).output().unwrap()
+}
+
+/// `accuracy-table --check FILE ARGS`: the published error table of FILE
+/// against a fresh run.
+fn check(args: &[&str], file: &Path) -> Output {
+    program(args).arg("--check").arg(file).output().unwrap()
+}
+
+/// The repository's own BENCHMARKS.md.
+fn benchmarks() -> std::path::PathBuf {
+    common::repository().join("BENCHMARKS.md")
+}
+
+const CASES: [&str; 3] = [
+    "stick-slip, σ0 = 1e5 N/m",
+    "stick-slip, σ0 = 1e7 N/m",
+    "seed 000 piezo push",
+];
 
 /// A percentage entry as a fraction ("0.0433 %" → 4.33e-4).
 fn percent(entry: &str) -> f64 {
@@ -83,11 +104,7 @@ fn quick_mode_writes_its_table_between_the_markers_and_keeps_the_rest() {
     for heading in [ERRORS, WALL] {
         let header = cells(&text, heading, "case");
         assert_eq!(&header[3..], &MASTERS, "{text}");
-        for case in [
-            "stick-slip, σ0 = 1e5 N/m",
-            "stick-slip, σ0 = 1e7 N/m",
-            "seed 000 piezo push",
-        ] {
+        for case in CASES {
             let row = cells(&text, heading, case);
             assert_eq!(row.len(), 3 + MASTERS.len(), "{row:?}");
             assert_eq!(row[1], "1e-3");
@@ -190,5 +207,119 @@ fn unknown_masters_and_cases_are_refused_before_anything_runs() {
     assert!(
         !file.exists(),
         "nothing is written when the arguments are wrong"
+    );
+}
+
+#[test]
+fn the_published_rows_at_1e2_and_1e3_match_a_fresh_run() {
+    let output = check(&["--steps", "1e-2,1e-3"], &benchmarks());
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        output.status.success(),
+        "BENCHMARKS.md's error table is not what the code gives (regenerate it with scripts/accuracy-table.sh):\n{stdout}\n{stderr}"
+    );
+    // Every case at both steps, at the published duration: the simulated
+    // time and points are compared too (3 cases × 2 steps × 6 entries).
+    for case in CASES {
+        for h in ["1e-2", "1e-3"] {
+            common::assert_message(
+                &stdout,
+                &[&format!("  {case}, h = {h} s: 6 entries as published")],
+            );
+        }
+    }
+    common::assert_message(&stdout, &["all 36 entries as published"]);
+}
+
+/// The row of `case` at step `h` in the error table of `text`, and the
+/// line it is on.
+fn error_row<'a>(text: &'a str, case: &str, h: &str) -> (&'a str, Vec<&'a str>) {
+    let prefix = format!("| {case} | {h} | ");
+    let line = text[text.find(ERRORS).unwrap()..]
+        .lines()
+        .find(|l| l.starts_with(&prefix))
+        .unwrap_or_else(|| panic!("no row {prefix:?} in the error table"));
+    (
+        line,
+        line.trim_matches('|').split('|').map(str::trim).collect(),
+    )
+}
+
+#[test]
+fn an_altered_published_entry_is_refused_and_named() {
+    let text = std::fs::read_to_string(benchmarks()).unwrap();
+    let case = "stick-slip, σ0 = 1e7 N/m";
+    let column = cells(&text, ERRORS, "case")
+        .iter()
+        .position(|c| *c == "newton")
+        .unwrap();
+    let (line, mut row) = error_row(&text, case, "1e-2");
+    let published = row[column];
+    let altered = if published == "9.99 %" {
+        "9.98 %"
+    } else {
+        "9.99 %"
+    };
+    row[column] = altered;
+    let altered_line = format!("| {} |", row.join(" | "));
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("BENCHMARKS.md");
+    std::fs::write(&file, text.replacen(line, &altered_line, 1)).unwrap();
+
+    let output = check(&["--steps", "1e-2"], &file);
+    assert!(!output.status.success(), "the altered entry was accepted");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    common::assert_message(
+        &stderr,
+        &[
+            "BENCHMARKS.md",
+            "1 of 18 entries of the error table differ from a fresh run",
+            &format!("{case}, h = 1e-2 s, newton: published `{altered}`, fresh `{published}`"),
+        ],
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    common::assert_message(
+        &stdout,
+        &[
+            &format!("{case}, h = 1e-2 s: 1 of 6 entries differ"),
+            "seed 000 piezo push, h = 1e-2 s: 6 entries as published",
+        ],
+    );
+}
+
+#[test]
+fn a_missing_row_table_or_marker_is_named_before_anything_runs() {
+    let text = std::fs::read_to_string(benchmarks()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("BENCHMARKS.md");
+    let refused = |contents: &str, args: &[&str], parts: &[&str]| {
+        std::fs::write(&file, contents).unwrap();
+        let output = check(args, &file);
+        assert!(!output.status.success(), "{contents}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        common::assert_message(&stderr, parts);
+        assert!(!stderr.contains("reference in"), "something ran: {stderr}");
+    };
+    let (line, _) = error_row(&text, "seed 000 piezo push", "1e-2");
+    refused(
+        &text.replacen(&format!("{line}\n"), "", 1),
+        &["--steps", "1e-2,1e-3"],
+        &["no row for seed 000 piezo push, h = 1e-2 s"],
+    );
+    refused(
+        &text,
+        &["--steps", "1e-1", "--cases", "seed000"],
+        &["no row for seed 000 piezo push, h = 1e-1 s"],
+    );
+    refused(
+        &text.replacen(ERRORS, "**Errors**", 1),
+        &["--steps", "1e-2"],
+        &["no error table", ERRORS],
+    );
+    refused(
+        &text.replacen(BEGIN, "", 1),
+        &["--steps", "1e-2"],
+        &["markers", BEGIN],
     );
 }
