@@ -4,10 +4,9 @@
 //! feedthrough), so the output is evaluated at the current input without
 //! committing the move; `fmi2DoStep` commits it.
 
-use crate::param_err;
+use crate::{input_ramp, param_err};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use friction_laws::bristle::{Bristle, BristleParams};
-use friction_laws::Ramp;
 
 pub mod vr {
     pub const X: u32 = 0;
@@ -149,8 +148,7 @@ impl Model for BristleFmu {
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        self.law
-            .step(Ramp::new(values.real(vr::X), slopes[vr::X as usize]), h);
+        self.law.step(input_ramp(values, slopes, vr::X), h);
         Ok(())
     }
 

@@ -2,10 +2,9 @@
 //! (Wijata et al. 2016), with the equations derived in MODELS.md "Two-
 //! dimensional bristle"; exact for piecewise-constant slip velocity.
 
-use crate::param_err;
+use crate::{input_ramp, param_err};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use friction_laws::bristle2d::{Bristle2D, Bristle2DParams};
-use friction_laws::Ramp;
 
 pub mod vr {
     pub const V1: u32 = 0;
@@ -165,7 +164,7 @@ impl Model for Bristle2DFmu {
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        let ramp = |i: u32| Ramp::new(values.real(i), slopes[i as usize]);
+        let ramp = |i| input_ramp(values, slopes, i);
         self.law.step(ramp(vr::V1), ramp(vr::V2), h);
         Ok(())
     }

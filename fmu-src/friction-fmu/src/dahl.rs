@@ -1,10 +1,9 @@
 //! `Dahl.fmu`: the Dahl law (seed 001 eq. 2–3, 16–17; MODELS.md "Dahl"),
 //! integrated exactly in the displacement domain for every α.
 
-use crate::param_err;
+use crate::{input_ramp, param_err, sliding_velocity_input};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use friction_laws::dahl::{Dahl, DahlParams};
-use friction_laws::Ramp;
 
 pub mod vr {
     pub const V: u32 = 0;
@@ -17,14 +16,7 @@ pub mod vr {
 }
 
 static VARIABLES: [Variable; 7] = [
-    Variable::input(
-        vr::V,
-        "v",
-        0.0,
-        "m/s",
-        1e-3,
-        "Sliding velocity of the body relative to the surface",
-    ),
+    sliding_velocity_input(vr::V),
     Variable::output(
         vr::F,
         "F",
@@ -117,8 +109,7 @@ impl Model for DahlFmu {
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        self.law
-            .step(Ramp::new(values.real(vr::V), slopes[vr::V as usize]), h);
+        self.law.step(input_ramp(values, slopes, vr::V), h);
         Ok(())
     }
 

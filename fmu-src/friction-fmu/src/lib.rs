@@ -12,7 +12,8 @@ pub mod in_process;
 pub mod lugre;
 pub mod reset_integrator;
 
-use fmi2_cs::{Model, ModelFactory, ModelInfo};
+use fmi2_cs::{Model, ModelFactory, ModelInfo, Values, Variable};
+use friction_laws::Ramp;
 use std::sync::LazyLock;
 
 /// Every model this binary holds.
@@ -60,6 +61,26 @@ pub const GENERATION_TOOL: &str = concat!("friction-fmu ", env!("CARGO_PKG_VERSI
 /// Convert a law's parameter error into the message the FMI layer logs.
 fn param_err(e: friction_laws::ParamError) -> String {
     e.to_string()
+}
+
+/// The input `v` of the laws driven by the sliding velocity (Dahl, LuGre,
+/// reset integrator), at value reference `vr`.
+const fn sliding_velocity_input(vr: u32) -> Variable {
+    Variable::input(
+        vr,
+        "v",
+        0.0,
+        "m/s",
+        1e-3,
+        "Sliding velocity of the body relative to the surface",
+    )
+}
+
+/// Input `vr` over the step: `u(τ) = u + (du/dt)·τ`, from its value and its
+/// slope (zero when not set).
+#[inline]
+fn input_ramp(values: &Values, slopes: &[f64], vr: u32) -> Ramp {
+    Ramp::new(values.real(vr), slopes[vr as usize])
 }
 
 #[cfg(test)]

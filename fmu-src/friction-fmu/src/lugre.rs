@@ -4,7 +4,7 @@
 //! position-dependent levels (a table of scale factors over `x`), and the
 //! normal-force form.
 
-use crate::param_err;
+use crate::{param_err, sliding_velocity_input};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use friction_laws::lugre::{LuGre, LuGreInputs, LuGreParams, TABLE_POINTS};
 use friction_laws::Ramp;
@@ -42,14 +42,7 @@ const INPUTS: &[u32] = &[vr::V, vr::X, vr::FN];
 fn variables() -> Vec<Variable> {
     let d = LuGreParams::default();
     let mut v = vec![
-        Variable::input(
-            vr::V,
-            "v",
-            0.0,
-            "m/s",
-            1e-3,
-            "Sliding velocity of the body relative to the surface",
-        ),
+        sliding_velocity_input(vr::V),
         Variable::input(
             vr::X,
             "x",

@@ -1,10 +1,9 @@
 //! `ResetIntegrator.fmu`: the 1-D reset integrator (Haessig & Friedland
 //! 1991; MODELS.md "Reset integrator"), integrated exactly.
 
-use crate::param_err;
+use crate::{input_ramp, param_err, sliding_velocity_input};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use friction_laws::reset_integrator::{ResetIntegrator, ResetParams};
-use friction_laws::Ramp;
 
 pub mod vr {
     pub const V: u32 = 0;
@@ -18,14 +17,7 @@ pub mod vr {
 }
 
 static VARIABLES: [Variable; 8] = [
-    Variable::input(
-        vr::V,
-        "v",
-        0.0,
-        "m/s",
-        1e-3,
-        "Sliding velocity of the body relative to the surface",
-    ),
+    sliding_velocity_input(vr::V),
     Variable::output(
         vr::F,
         "F",
@@ -114,8 +106,7 @@ impl Model for ResetFmu {
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        self.law
-            .step(Ramp::new(values.real(vr::V), slopes[vr::V as usize]), h);
+        self.law.step(input_ramp(values, slopes, vr::V), h);
         Ok(())
     }
 

@@ -11,6 +11,7 @@
 
 use crate::error::require_positive;
 use crate::interval::{displacement, one_sign_pieces, sign_on};
+use crate::state::one_value_state;
 use crate::{ParamError, Ramp};
 
 /// Dahl parameters: rest stiffness `sigma` (N/m), Coulomb level `fc` (N),
@@ -119,47 +120,8 @@ impl Dahl {
         }
     }
 
-    /// The number of values of the state (1).
-    #[inline]
-    pub fn state_len(&self) -> usize {
-        1
-    }
-
-    /// The state `[F]` into `out`, of [`Dahl::state_len`] values.
-    #[inline]
-    pub fn write_state_into(&self, out: &mut [f64]) {
-        out.copy_from_slice(&[self.f]);
-    }
-
-    /// The same state as a new vector.
-    pub fn state_to_vec(&self) -> Vec<f64> {
-        let mut v = vec![0.0; self.state_len()];
-        self.write_state_into(&mut v);
-        v
-    }
-
-    /// Restores `[F]` (any finite value).
-    /// (Inlined into a caller, the messages out of line.)
-    #[inline]
-    pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
-        match s {
-            [f] if f.is_finite() => {
-                self.f = *f;
-                Ok(())
-            }
-            _ => Err(state_refused(s)),
-        }
-    }
-}
-
-/// Why [`Dahl::state_from_slice`] refused `s`.
-#[cold]
-#[inline(never)]
-fn state_refused(s: &[f64]) -> String {
-    match s {
-        [f] => format!("Dahl state F = {f} is not finite"),
-        _ => format!("Dahl state has 1 value, got {}", s.len()),
-    }
+    // The state: the force F, any finite value.
+    one_value_state!("Dahl", "F", f);
 }
 
 /// Exact Dahl update of `F` over a displacement `u ≥ 0` in direction `s = ±1`.

@@ -18,6 +18,7 @@ mod interval;
 pub mod lugre;
 pub mod reset_integrator;
 pub mod rng;
+mod state;
 
 pub use error::ParamError;
 

@@ -7,6 +7,7 @@
 
 use crate::error::{require_non_negative, require_positive};
 use crate::interval::{displacement, one_sign_pieces, sign_on};
+use crate::state::one_value_state;
 use crate::{ParamError, Ramp};
 
 /// Reset-integrator parameters: stiffness `sigma0` (N/m), damping `sigma1`
@@ -123,48 +124,8 @@ impl ResetIntegrator {
         }
     }
 
-    /// The number of values of the state (1).
-    #[inline]
-    pub fn state_len(&self) -> usize {
-        1
-    }
-
-    /// The state `[z]` into `out`, of [`ResetIntegrator::state_len`]
-    /// values.
-    #[inline]
-    pub fn write_state_into(&self, out: &mut [f64]) {
-        out.copy_from_slice(&[self.z]);
-    }
-
-    /// The same state as a new vector.
-    pub fn state_to_vec(&self) -> Vec<f64> {
-        let mut v = vec![0.0; self.state_len()];
-        self.write_state_into(&mut v);
-        v
-    }
-
-    /// Restores `[z]` (finite).
-    /// (Inlined into a caller, the messages out of line.)
-    #[inline]
-    pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
-        match s {
-            [z] if z.is_finite() => {
-                self.z = *z;
-                Ok(())
-            }
-            _ => Err(state_refused(s)),
-        }
-    }
-}
-
-/// Why [`ResetIntegrator::state_from_slice`] refused `s`.
-#[cold]
-#[inline(never)]
-fn state_refused(s: &[f64]) -> String {
-    match s {
-        [z] => format!("reset-integrator state z = {z} is not finite"),
-        _ => format!("reset-integrator state has 1 value, got {}", s.len()),
-    }
+    // The state: the bristle strain z, any finite value.
+    one_value_state!("reset-integrator", "z", z);
 }
 
 #[cfg(test)]
