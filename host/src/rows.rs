@@ -12,7 +12,8 @@
 //! column's RMS) records into a table that keeps its last rows only
 //! ([`Rows::windowed`]): when its buffer is full, the rows but the last are
 //! folded into per-column sums of squares and the buffer is used again.
-//! A 20 s run at 1e-4 s then holds about 100 kB instead of 19 MB, so
+//! A 20 s run at 1e-4 s then holds about 100 kB instead of 19 MB (and
+//! the times of the rows it holds only, [`crate::master::Run::time`]), so
 //! parallel runs neither wait on fresh memory nor share the memory bus
 //! for numbers nobody reads.
 
@@ -134,7 +135,19 @@ impl Rows {
     /// Number of rows pushed and not popped: [`Rows::len`], and the rows
     /// a [`Rows::windowed`] table folded out.
     pub fn rows_pushed(&self) -> usize {
-        self.len + self.folded.as_ref().map_or(0, |f| f.rows)
+        self.len + self.rows_folded()
+    }
+
+    /// Whether the table keeps its last rows only ([`Rows::windowed`]).
+    pub fn is_windowed(&self) -> bool {
+        self.folded.is_some()
+    }
+
+    /// Number of rows a [`Rows::windowed`] table folded out (0 for any
+    /// other): row `i` held is row `rows_folded() + i` of those pushed
+    /// (counting from 0).
+    pub fn rows_folded(&self) -> usize {
+        self.folded.as_ref().map_or(0, |f| f.rows)
     }
 
     /// Per column, `Σ y²` over every row pushed and not popped, summed in
@@ -387,6 +400,8 @@ mod tests {
                 }
                 assert_eq!(windowed.rows_pushed(), n, "window {window}");
                 assert_eq!(full.rows_pushed(), n);
+                assert_eq!(windowed.rows_folded(), n - windowed.len());
+                assert_eq!(full.rows_folded(), 0);
                 // the same sums bit for bit, as the full table's in row order
                 let mut expected = [0.0f64; 3];
                 for row in &full {

@@ -117,10 +117,11 @@ pub fn seed_ports(file: &SystemFile) -> Result<Vec<String>, String> {
         .collect())
 }
 
-/// Rows a sweep's run keeps ([`crate::system::System::keep_last_rows`]):
-/// about 100 kB for a dozen columns, where a 20 s run at 1e-4 s would
-/// hold 19 MB; each fold of the window's rows into the RMS sums reads
-/// rows still in the cache.
+/// Rows a sweep's run keeps ([`crate::system::System::keep_last_rows`]),
+/// and with them their times only ([`crate::master::Run::time`]): about
+/// 100 kB for a dozen columns, where a 20 s run at 1e-4 s would hold
+/// 19 MB of rows and 1.6 MB of times; each fold of the window's rows into
+/// the RMS sums reads rows still in the cache.
 const SWEEP_WINDOW: usize = 1024;
 
 /// What a sweep runs: the grid points, the time grid and the master.

@@ -517,8 +517,9 @@ impl System {
     /// Let the recordings started from now on keep only their last
     /// `window` rows (at least 2), the others summed into
     /// [`Rows::square_sums`] and counted in [`Rows::rows_pushed`]: for runs
-    /// of which only a summary is kept (`fricsim sweep`). `None` (the
-    /// default): every row is kept.
+    /// of which only a summary is kept (`fricsim sweep`). Such a run keeps
+    /// the times of those rows only ([`crate::master::Run::time`]). `None`
+    /// (the default): every row is kept.
     ///
     /// # Panics
     /// If `window` is below 2.

@@ -214,6 +214,33 @@ fn a_nan_output_stops_the_run_and_names_the_fmu_that_produced_it() {
     assert!(!error.contains("friction"), "{error}");
 }
 
+#[test]
+fn a_windowed_run_that_stops_keeps_the_times_of_its_last_rows() {
+    // as a sweep's run: the rows before the failure, the last of them
+    // only, each at its time; with a window of 10 the row of the NaN
+    // folds the window and is then dropped
+    let rig = rig();
+    for fault in [belt::ERROR, belt::NAN_STATE] {
+        let mut system = coupled(&rig, fault, false);
+        let full = simulate(&mut system, &mut Jacobi::default(), H, 1.0).unwrap();
+        assert_stopped_at_the_fault(&full);
+        let width = full.rows.width();
+        for window in [2, 3, 4, 9, 10, 11] {
+            let mut system = coupled(&rig, fault, false);
+            system.keep_last_rows(Some(window));
+            let run = simulate(&mut system, &mut Jacobi::default(), H, 1.0).unwrap();
+            assert_eq!(run.error, full.error, "window {window}");
+            assert_eq!(run.rows.rows_pushed(), FAULT_STEP, "window {window}");
+            let first = run.rows.rows_folded();
+            assert!(run.rows.len() <= window, "window {window}");
+            assert_eq!(run.time.len(), run.rows.len(), "window {window}");
+            assert_eq!(run.time, full.time[first..], "window {window}");
+            assert_eq!(run.rows.as_flat(), &full.rows.as_flat()[first * width..]);
+            assert_eq!(*run.time.last().unwrap(), (FAULT_STEP - 1) as f64 * H);
+        }
+    }
+}
+
 /// `fricsim cosim` with the rig failing: exit status 1, the message on
 /// stderr, the CSV with the rows so far.
 fn cosim(rig: &Rig, fault: i32, out: &Path) -> (Option<i32>, String) {

@@ -1,9 +1,12 @@
 //! `fricsim sweep`: one row per grid point (and seed), the same numbers as
 //! `fricsim run` for the same parameters, wrong axes refused before
-//! anything runs. Nothing here depends on how fast the machine is.
+//! anything runs; a sweep's run, which keeps its last rows only, keeps
+//! their times only. Nothing here depends on how fast the machine is.
 
 mod common;
 
+use fricsim::master::{by_name, communication_time, simulate_with, NoObserver, Run};
+use fricsim::ssp::SystemFile;
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -212,5 +215,94 @@ fn wrong_axes_are_refused_before_anything_runs() {
         assert!(!output.status.success(), "{all:?}");
         common::assert_message(&String::from_utf8_lossy(&output.stderr), &[message]);
         assert!(!out.exists(), "{all:?} wrote a table");
+    }
+}
+
+/// The macro step of [`stick_slip`], s.
+const H: f64 = 1e-4;
+
+/// The stick-slip benchmark from `start` for `steps` macro steps of [`H`]
+/// with Jacobi, keeping the last `window` rows (`None`: all).
+fn stick_slip(start: f64, steps: usize, window: Option<usize>) -> Run {
+    common::lugre_fmu(); // dist/ is built
+    let file = SystemFile::open(common::repository().join("examples/stick_slip.ssd")).unwrap();
+    let mut system = file.build(start).unwrap();
+    system.keep_last_rows(window);
+    let stop = start + steps as f64 * H;
+    let mut master = by_name("jacobi").unwrap();
+    let run = simulate_with(
+        &mut system,
+        master.as_mut(),
+        start,
+        H,
+        stop,
+        &mut NoObserver,
+    )
+    .unwrap();
+    assert!(run.error.is_none(), "{:?}", run.error);
+    run
+}
+
+fn bits(values: &[f64]) -> Vec<u64> {
+    values.iter().map(|x| x.to_bits()).collect()
+}
+
+#[test]
+fn a_windowed_run_keeps_the_times_of_its_rows_only() {
+    let (start, steps) = (0.25, 517);
+    let full = stick_slip(start, steps, None);
+    // every communication point, from the start to the stop time
+    assert_eq!(full.rows.len(), steps + 1);
+    assert_eq!(full.rows.rows_folded(), 0);
+    assert_eq!(full.time.len(), steps + 1);
+    assert_eq!(full.time[0].to_bits(), start.to_bits());
+    assert_eq!(full.time[1].to_bits(), (start + H).to_bits());
+    assert_eq!(
+        full.time[steps].to_bits(),
+        (start + steps as f64 * H).to_bits()
+    );
+    // the rows are at their times: the actuator point moves at 0.1 m/s
+    // from where it is at the start (a row one step off would be 1e-5 m
+    // off)
+    let x_act = full.columns.iter().position(|c| c == "rig.x_act").unwrap();
+    for (t, row) in full.time.iter().zip(&full.rows) {
+        assert!(
+            (row[x_act] - 0.1 * (t - start)).abs() < 1e-12,
+            "x_act {} at t = {t}",
+            row[x_act]
+        );
+    }
+    // window 518 holds every row (not windowed); 517 folds once at the end
+    for window in [2, 3, 7, 100, 517, 518, 1024] {
+        let run = stick_slip(start, steps, Some(window));
+        let kept = run.rows.len();
+        assert!(kept <= window, "window {window}: {kept} rows");
+        assert_eq!(run.rows.rows_pushed(), steps + 1, "window {window}");
+        // no more times than rows: those of the rows kept, bit for bit
+        // those of the full run at the same communication points
+        let first = run.rows.rows_folded();
+        assert_eq!(first + kept, steps + 1, "window {window}");
+        assert_eq!(run.time.len(), kept, "window {window}");
+        assert_eq!(
+            bits(&run.time),
+            bits(&full.time[first..]),
+            "window {window}"
+        );
+        assert_eq!(
+            run.rows.as_flat(),
+            &full.rows.as_flat()[first * full.rows.width()..]
+        );
+        for (i, &t) in run.time.iter().enumerate() {
+            assert_eq!(
+                t.to_bits(),
+                communication_time(start, H, first + i).to_bits()
+            );
+        }
+        // the run ends at the stop time
+        assert_eq!(
+            run.time.last().unwrap().to_bits(),
+            full.time[steps].to_bits(),
+            "window {window}"
+        );
     }
 }

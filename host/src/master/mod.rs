@@ -68,10 +68,14 @@ pub fn by_name(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
 /// whether it stopped early (the rows kept are those computed before).
 pub struct Run {
     pub columns: Vec<String>,
+    /// The time of each row: `rows[i]` is at `time[i]`, as many times as
+    /// rows. In a run of [`simulate_with`] from `start` in steps of `h`,
+    /// communication point `j` is at `start + j·h` ([`communication_time`]).
     pub time: Vec<f64>,
-    /// `rows[i][k]`: column `k` at `time[i]`; under
-    /// [`System::keep_last_rows`] the last rows only (`rows[i]` at
-    /// `time[rows.rows_pushed() - rows.len() + i]`).
+    /// `rows[i][k]`: column `k` at `time[i]`. Under
+    /// [`System::keep_last_rows`] the last rows only, and `time` theirs:
+    /// `rows[i]` is communication point `rows.rows_folded() + i`, so that
+    /// a windowed run holds no more times than rows.
     pub rows: Rows,
     pub error: Option<String>,
 }
@@ -179,6 +183,24 @@ pub fn step_count(start: f64, h: f64, stop: f64) -> usize {
     ((stop - start) / h).round().max(0.0) as usize
 }
 
+/// The time of communication point `j` of a run from `start` in steps of
+/// `h`: `start + j·h`, counted from the start (never summed), as
+/// [`simulate_with`] steps; point 0 is `start` itself.
+pub fn communication_time(start: f64, h: f64, j: usize) -> f64 {
+    if j == 0 {
+        start
+    } else {
+        counted(start, h, j)
+    }
+}
+
+/// `start + j·h`: where step `j` of [`simulate_with`] starts (and step
+/// `j - 1` ends).
+#[inline(always)]
+fn counted(start: f64, h: f64, j: usize) -> f64 {
+    start + j as f64 * h
+}
+
 /// [`simulate`] from `start` (t = start + n·h; the system must have been
 /// set up at `start`), with `observer` consulted at each communication
 /// point: as FMPy does, external inputs are applied at the start time in
@@ -200,18 +222,75 @@ pub fn simulate_with(
     system.propagate(&mut buffer)?;
     let columns = system.columns();
     let n = step_count(start, h, stop);
-    let mut time = Vec::with_capacity(n + 1);
     system.start_recording(n + 1);
     system.sample()?;
-    time.push(start);
-    let mut error = None;
+    let (error, time) = if system.recorded().is_windowed() {
+        // nothing stored as the run steps: the times of the rows kept
+        // follow from their number when it ends
+        (
+            step_all(system, master, observer, start, h, n, &mut ()),
+            None,
+        )
+    } else {
+        let mut time = Vec::with_capacity(n + 1);
+        time.push(start);
+        let error = step_all(system, master, observer, start, h, n, &mut time);
+        (error, Some(time))
+    };
+    let rows = system.take_recording();
+    let time = time.unwrap_or_else(|| {
+        (rows.rows_folded()..rows.rows_pushed())
+            .map(|j| communication_time(start, h, j))
+            .collect()
+    });
+    Ok(Run {
+        columns,
+        time,
+        rows,
+        error,
+    })
+}
+
+/// Where [`step_all`] puts the time of each communication point it
+/// completes: a run that keeps every row stores them as it goes
+/// (`Vec<f64>`), a windowed one nothing (`()`), so that neither does work
+/// per step that it has no use for.
+trait Times {
+    fn push(&mut self, t: f64);
+}
+
+impl Times for Vec<f64> {
+    #[inline(always)]
+    fn push(&mut self, t: f64) {
+        Vec::push(self, t);
+    }
+}
+
+impl Times for () {
+    #[inline(always)]
+    fn push(&mut self, _: f64) {}
+}
+
+/// The `n` steps of [`simulate_with`] from `start`, after the row of
+/// point 0: a row per communication point completed, its time to
+/// `times`; why the run stopped early, if it did.
+#[inline(always)] // the run's loop, one copy per kind of `times`
+fn step_all(
+    system: &mut System,
+    master: &mut dyn MasterAlgorithm,
+    observer: &mut dyn Observer,
+    start: f64,
+    h: f64,
+    n: usize,
+    times: &mut impl Times,
+) -> Option<String> {
     let between_steps = observer.between_steps();
     // t = start + i·h, each counted from the start; the step's end is the
     // next step's start, so each is computed once
-    let mut t_next = start + 0.0 * h; // as start + i·h for i = 0
+    let mut t_next = counted(start, h, 0);
     for i in 0..n {
         let t = t_next;
-        t_next = start + (i + 1) as f64 * h;
+        t_next = counted(start, h, i + 1);
         let stepped = if between_steps {
             observer.before_step(system, t, false)
         } else {
@@ -219,12 +298,10 @@ pub fn simulate_with(
         }
         .and_then(|()| master.step(system, t, t_next - t));
         if let Err(e) = stepped {
-            error = Some(format!("at t = {t}: {e}"));
-            break;
+            return Some(format!("at t = {t}: {e}"));
         }
         if let Err(e) = system.sample() {
-            error = Some(format!("at t = {t_next}: {e}"));
-            break;
+            return Some(format!("at t = {t_next}: {e}"));
         }
         // the usual case first: a row of numbers
         let row = system.recorded().last().unwrap_or_default();
@@ -232,21 +309,15 @@ pub fn simulate_with(
             .then(|| non_finite(system, row))
             .flatten()
         {
-            error = Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
             system.discard_last_sample();
-            break;
+            return Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
         }
-        time.push(t_next);
+        times.push(t_next);
         if between_steps {
             observer.after_step(i + 1, n);
         }
     }
-    Ok(Run {
-        columns,
-        time,
-        rows: system.take_recording(),
-        error,
-    })
+    None
 }
 
 #[cfg(test)]
