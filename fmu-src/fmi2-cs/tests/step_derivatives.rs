@@ -7,9 +7,12 @@
 //! as before.
 
 use fmi2_cs::instance::Instance;
-use fmi2_cs::logger::Logger;
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, VarType, Variable};
+use fmi2_cs::{Model, ModelInfo, Values, VarType, Variable};
 use std::sync::{Arc, Mutex};
+
+#[path = "support/toy_instance.rs"]
+mod toy_instance;
+use toy_instance::{initialized, toy_info};
 
 const U: u32 = 0;
 const W: u32 = 1;
@@ -87,26 +90,15 @@ impl Model for Toy {
 
 /// An initialized instance of the toy (`c` = 3), and what it is asked.
 fn instance(supplies: bool) -> (Instance, Asked) {
-    let variables = Box::leak(Box::new([
-        Variable::input(U, "u", 0.0, "", NOMINAL_U, "input"),
-        Variable::input(W, "w", 0.0, "", NOMINAL_W, "input"),
-        Variable::output(Y, "y", "", "s + c*u", &[U]),
-        Variable::parameter(C, "c", 3.0, "", "feedthrough"),
-    ]));
-    let info = Box::leak(Box::new(ModelInfo {
-        model_name: "Toy",
-        model_identifier: "Toy",
-        guid: "{toy}",
-        description: "test model",
-        source: "test",
-        variables,
-        default_experiment: DefaultExperiment {
-            start_time: 0.0,
-            stop_time: 1.0,
-            step_size: 0.1,
-        },
-        capabilities: Capabilities::FULL,
-    }));
+    let info = toy_info(
+        "Toy",
+        vec![
+            Variable::input(U, "u", 0.0, "", NOMINAL_U, "input"),
+            Variable::input(W, "w", 0.0, "", NOMINAL_W, "input"),
+            Variable::output(Y, "y", "", "s + c*u", &[U]),
+            Variable::parameter(C, "c", 3.0, "", "feedthrough"),
+        ],
+    );
     let asked = Asked::default();
     let model = Box::new(Toy {
         info,
@@ -115,12 +107,7 @@ fn instance(supplies: bool) -> (Instance, Asked) {
         supplies,
         asked: asked.clone(),
     });
-    let logger = Logger::new(None, std::ptr::null_mut(), "probe", false);
-    let mut fmu = Instance::new(info, model, "probe", logger);
-    fmu.setup_experiment(0.0, None).unwrap();
-    fmu.enter_initialization_mode().unwrap();
-    fmu.exit_initialization_mode().unwrap();
-    (fmu, asked)
+    (initialized(info, model), asked)
 }
 
 const H: f64 = 0.125;

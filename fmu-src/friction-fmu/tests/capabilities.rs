@@ -141,28 +141,24 @@ fn directional_derivatives_agree_with_finite_differences() {
     );
 }
 
-/// LuGre with every option: direction-dependent levels, a Stribeck
-/// exponent ≠ 2, velocity-dependent micro-damping, the normal-force form
-/// and a position table.
-const LUGRE_OPTIONS: &[(&str, f64)] = &[
-    ("direction_dependent", 1.0),
-    ("Fc_neg", 0.7),
-    ("Fs_neg", 1.9),
-    ("stribeck_exponent", 1.4),
-    ("vd", 2e-3),
-    ("normal_force_form", 1.0),
-    ("position_dependent", 1.0),
-    ("n_table", 3.0),
-    ("x_table[1]", 0.0),
-    ("x_table[2]", 0.5),
-    ("x_table[3]", 1.0),
-    ("scale_pos[1]", 1.0),
-    ("scale_pos[2]", 1.3),
-    ("scale_pos[3]", 0.8),
-    ("scale_neg[1]", 1.2),
-    ("scale_neg[2]", 0.9),
-    ("scale_neg[3]", 1.1),
-];
+/// LuGre with every option: `LUGRE_TABLE`'s position table (and one for
+/// v < 0), direction-dependent levels, a Stribeck exponent ≠ 2,
+/// velocity-dependent micro-damping and the normal-force form.
+fn lugre_options() -> Vec<(&'static str, f64)> {
+    let mut p = LUGRE_TABLE.to_vec();
+    p.extend([
+        ("direction_dependent", 1.0),
+        ("Fc_neg", 0.7),
+        ("Fs_neg", 1.9),
+        ("stribeck_exponent", 1.4),
+        ("vd", 2e-3),
+        ("normal_force_form", 1.0),
+        ("scale_neg[1]", 1.2),
+        ("scale_neg[2]", 0.9),
+        ("scale_neg[3]", 1.1),
+    ]);
+    p
+}
 
 /// The law the LuGre FMU runs with `params` set (by name).
 fn lugre_law(params: &[(&str, f64)]) -> LuGre {
@@ -184,7 +180,8 @@ fn lugre_law(params: &[(&str, f64)]) -> LuGre {
 fn lugre_held_step_derivatives_are_the_laws_closed_form() {
     let h = 1e-4;
     let mut compared = 0;
-    for params in [&[][..], LUGRE_OPTIONS] {
+    let options = lugre_options();
+    for params in [&[][..], &options] {
         for (v, x, fn_) in [
             (2e-3, 0.2, 3.0),
             (-4e-4, 0.7, 3.0),
@@ -243,7 +240,7 @@ fn lugre_held_step_derivatives_are_the_laws_closed_form() {
 #[test]
 fn lugre_directional_derivatives_fall_back_to_the_differences() {
     let h = 1e-4;
-    let mut fmu = Fmu::new("LuGre", LUGRE_OPTIONS);
+    let mut fmu = Fmu::new("LuGre", &lugre_options());
     for k in 0..30 {
         fmu.set("v", 1e-4 * (k as f64).sin());
         fmu.set("x", 0.3);

@@ -188,15 +188,8 @@ fn default_mode_matches_the_first_version_to_rounding() {
         ],
     ];
     let damped = Rig1DParams {
-        m: 0.5,
-        c: 0.3,
-        k: 20.0,
-        x0: 0.01,
-        v0: -0.02,
-        v_a: 0.05,
-        x_a0: 0.001,
-        v_surface: 0.01,
-        ..Default::default()
+        dither: Sinusoid::OFF,
+        ..damped_on_a_moving_surface()
     };
     for (p, h, n, golden) in [
         (Rig1DParams::default(), 1e-3, 3000usize, &BENCHMARK),
@@ -869,26 +862,29 @@ fn invalid_parameters_are_refused_with_name_and_value() {
     }
 }
 
+/// A damped rig in the plain mode, started off its rest point, on a belt
+/// with a dither.
+fn damped_on_a_moving_surface() -> Rig1DParams {
+    Rig1DParams {
+        m: 0.5,
+        c: 0.3,
+        k: 20.0,
+        x0: 0.01,
+        v0: -0.02,
+        v_a: 0.05,
+        x_a0: 0.001,
+        v_surface: 0.01,
+        dither: Sinusoid::new(1e-4, 30.0),
+        ..Default::default()
+    }
+}
+
 /// The plain mode's step (no controller, drive or actuator sinusoid) is
 /// the general path's arithmetic, bit for bit, with ramped inputs, steps of
 /// several lengths and a dither, damped and undamped.
 #[test]
 fn plain_step_is_the_general_step_bit_for_bit() {
-    for p in [
-        Rig1DParams::default(),
-        Rig1DParams {
-            m: 0.5,
-            c: 0.3,
-            k: 20.0,
-            x0: 0.01,
-            v0: -0.02,
-            v_a: 0.05,
-            x_a0: 0.001,
-            v_surface: 0.01,
-            dither: Sinusoid::new(1e-4, 30.0),
-            ..Default::default()
-        },
-    ] {
+    for p in [Rig1DParams::default(), damped_on_a_moving_surface()] {
         let mut plain = Rig1D::new(p).unwrap();
         let mut general = Rig1D::new(p).unwrap();
         assert!(plain.plain);
@@ -950,12 +946,7 @@ fn held_step_sensitivity_to_the_friction_force_matches_differences() {
         c: 3.0,
         k: 5e4,
         x0: 1e-3,
-        v0: -0.02,
-        v_a: 0.05,
-        x_a0: 0.001,
-        v_surface: 0.01,
-        dither: Sinusoid::new(1e-4, 30.0),
-        ..Default::default()
+        ..damped_on_a_moving_surface()
     };
     let mut compared = 0;
     for p in [soft, stiff] {
