@@ -22,12 +22,17 @@ const C: u32 = 3;
 const NOMINAL_U: f64 = 0.5;
 const NOMINAL_W: f64 = 2.0;
 
+/// The value of w at which the toy's answer for w is NaN (a model's
+/// arithmetic that overflowed).
+const OVERFLOW: f64 = 13.0;
+
 /// What the toy was asked: (output, input, h, spread).
 type Asked = Arc<Mutex<Vec<(u32, u32, f64, f64)>>>;
 
 /// `ṡ = u + w` (the inputs ramped with their slopes), `y = s + c·u`: over
 /// a held step `∂y/∂u = h + c`, `∂y/∂w = h`. The `u` entry is declined
-/// where `|u| ≤ spread` (a kink at 0, as LuGre's `|v|`).
+/// where `|u| ≤ spread` (a kink at 0, as LuGre's `|v|`); the `w` entry is
+/// NaN at `w =` [`OVERFLOW`].
 #[derive(Clone)]
 struct Toy {
     info: &'static ModelInfo,
@@ -79,6 +84,7 @@ impl Model for Toy {
         self.asked.lock().unwrap().push((output, input, h, spread));
         match (output, input) {
             (Y, U) if values.real(U).abs() > spread => Some(h + self.c),
+            (Y, W) if values.real(W) == OVERFLOW => Some(f64::NAN),
             (Y, W) => Some(h),
             _ => None,
         }
@@ -222,5 +228,18 @@ fn without_a_held_step_the_differences_decide() {
     // the next held step: asked again
     fmu.do_step(2.0 * H, H).unwrap();
     assert_eq!(derivative(&mut fmu, &[U], &[1.0]), H + K);
+    assert_eq!(asked.lock().unwrap().len(), 1);
+}
+
+/// An answer that is not finite is refused, naming the output, as the
+/// differences' are.
+#[test]
+fn a_step_derivative_that_is_not_finite_is_refused() {
+    let (mut fmu, asked, _) = stepped(true, 0.8, OVERFLOW);
+    let mut d = [0.0];
+    let err = fmu
+        .directional_derivative(&[Y], &[W], &[1.0], &mut d)
+        .unwrap_err();
+    assert!(err.contains("the directional derivative of y"), "{err}");
     assert_eq!(asked.lock().unwrap().len(), 1);
 }
