@@ -75,6 +75,8 @@ pub struct Instance {
     state_len: usize,
     /// The model's [`Model::supplies_partial_derivatives`], asked once.
     supplies_partial_derivatives: bool,
+    /// The model's [`Model::supplies_step_derivatives`], asked once.
+    supplies_step_derivatives: bool,
     /// Per value reference, what the hot paths check ([`flag`]): the type,
     /// the causality, when it may be set. One byte per variable, so that a
     /// get or set validates its value references with one load each; the
@@ -205,6 +207,7 @@ impl Instance {
         let needs_step_replay = model.needs_step_replay();
         let state_len = model.state_len().unwrap_or(VEC_STATE);
         let supplies_partial_derivatives = model.supplies_partial_derivatives();
+        let supplies_step_derivatives = model.supplies_step_derivatives();
         let inputs: Vec<u32> = info
             .variables
             .iter()
@@ -256,6 +259,7 @@ impl Instance {
             needs_step_replay,
             state_len,
             supplies_partial_derivatives,
+            supplies_step_derivatives,
             flags,
             nominals,
             checked_get: (VarType::Real, Vec::new(), false),
@@ -822,7 +826,9 @@ impl Instance {
     /// inputs held over that step, state change included: what a strongly
     /// coupled master needs. Otherwise (before the first step, or after new
     /// inputs were set) it is the direct-feedthrough derivative at the
-    /// current state. A model may supply J itself; else it is obtained by
+    /// current state. A model may supply J itself, at any time
+    /// ([`Model::partial_derivative`]) or after a step with every input
+    /// held ([`Model::step_partial_derivative`]); else it is obtained by
     /// central differences along `dv_known`, replaying the step from the
     /// saved pre-step state.
     #[inline]
@@ -931,6 +937,19 @@ impl Instance {
             dv_unknown.iter_mut().for_each(|d| *d = 0.0);
             return Ok(());
         }
+        // Right after a step with every input held, the model's own step
+        // sensitivities where it gives every entry (written as it goes:
+        // the differences below overwrite every entry otherwise).
+        if self.supplies_step_derivatives
+            && self.replay.valid
+            && self.replay.held
+            && self.step_analytic(unknowns, knowns, dv_known, eps, dv_unknown)
+        {
+            if all_finite(dv_unknown) {
+                return Ok(());
+            }
+            return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
+        }
         if self.central_differences(knowns, dv_known, eps, unknowns, dv_unknown)? {
             Ok(())
         } else {
@@ -953,6 +972,42 @@ impl Instance {
             let mut acc = 0.0;
             for (k, dv) in knowns.iter().zip(dv_known) {
                 match self.model.partial_derivative(&self.values, *u, *k) {
+                    Some(d) => acc += d * dv,
+                    None => return false,
+                }
+            }
+            *out = acc;
+        }
+        true
+    }
+
+    /// `dv_unknown = J · dv_known` with J the model's step sensitivities
+    /// ([`Model::step_partial_derivative`]) of the last step, which held
+    /// every input, if it gives every entry (else `false`, `dv_unknown`
+    /// partly written). Input `k` is asked with the half-width `eps·|dv_k|`
+    /// over which [`Instance::central_differences`] would move it (a known
+    /// with a zero seed moves nothing there and adds nothing here).
+    #[inline(never)]
+    fn step_analytic(
+        &self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        eps: f64,
+        dv_unknown: &mut [f64],
+    ) -> bool {
+        let h = self.replay.h;
+        for (out, &u) in dv_unknown.iter_mut().zip(unknowns) {
+            let mut acc = 0.0;
+            for (&k, &dv) in knowns.iter().zip(dv_known) {
+                if dv == 0.0 {
+                    continue;
+                }
+                let spread = eps * dv.abs();
+                match self
+                    .model
+                    .step_partial_derivative(&self.values, u, k, h, spread)
+                {
                     Some(d) => acc += d * dv,
                     None => return false,
                 }

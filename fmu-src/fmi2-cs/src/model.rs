@@ -97,6 +97,43 @@ pub trait Model: Send {
         true
     }
 
+    /// The step sensitivity `∂ output(t + h) / ∂ input` of the last step,
+    /// computed by the model itself: called right after a step of length
+    /// `h` over which every input was held at its value in `values` (no
+    /// slopes, nothing set since), with the model in the state after it.
+    /// With the step map `x⁺ = Φ_h(x, u)` and the output equation
+    /// `y = g(x, u)`, it is
+    ///
+    /// ```text
+    /// ∂y/∂u = ∂g/∂x(x⁺, u) · ∂Φ_h/∂u(x, u) + ∂g/∂u(x⁺, u),
+    /// ```
+    ///
+    /// the state change over the step and the direct feedthrough together:
+    /// what the layer otherwise obtains by central differences of the
+    /// replayed step, `(y(u + δ) − y(u − δ)) / 2δ`, with the input moved by
+    /// `δ = spread`. `None` lets those differences decide: for any
+    /// output/input pair the model has no closed form for, and wherever
+    /// the step map is not smooth over `[u − spread, u + spread]` (a kink
+    /// such as `|v|` at 0, where the differences average the two sides).
+    /// Asked only if [`Model::supplies_step_derivatives`].
+    fn step_partial_derivative(
+        &self,
+        _values: &Values,
+        _output: u32,
+        _input: u32,
+        _h: f64,
+        _spread: f64,
+    ) -> Option<f64> {
+        None
+    }
+
+    /// Whether [`Model::step_partial_derivative`] may answer `Some` at
+    /// all: `false` (the default) and the layer never asks it. Asked once,
+    /// when the instance is created.
+    fn supplies_step_derivatives(&self) -> bool {
+        false
+    }
+
     /// Whether the layer must keep a copy of the pre-step state so that it can
     /// replay the step for directional derivatives. Models whose
     /// `partial_derivative` covers every output/input pair return `false`.

@@ -5,8 +5,11 @@
 //! its last bits.
 
 use fmi2_cs::instance::Instance;
-use fmi2_cs::logger::Logger;
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi2_cs::{Model, ModelInfo, Values, Variable};
+
+#[path = "support/toy_instance.rs"]
+mod toy_instance;
+use toy_instance::{initialized, toy_info};
 
 const U: u32 = 0;
 const Y: u32 = 1;
@@ -47,32 +50,15 @@ impl Model for Linear {
 fn instance(nominal: Option<f64>) -> Instance {
     let mut u = Variable::input(U, "u", 0.0, "", 1.0, "input");
     u.nominal = nominal;
-    let variables = Box::leak(Box::new([
-        u,
-        Variable::output(Y, "y", "", "k*u", &[U]),
-        Variable::parameter(K, "k", 3.0, "", "gain"),
-    ]));
-    let info = Box::leak(Box::new(ModelInfo {
-        model_name: "Linear",
-        model_identifier: "Linear",
-        guid: "{linear}",
-        description: "test model",
-        source: "test",
-        variables,
-        default_experiment: DefaultExperiment {
-            start_time: 0.0,
-            stop_time: 1.0,
-            step_size: 0.1,
-        },
-        capabilities: Capabilities::FULL,
-    }));
-    let model = Box::new(Linear { info, k: 0.0 });
-    let logger = Logger::new(None, std::ptr::null_mut(), "probe", false);
-    let mut fmu = Instance::new(info, model, "probe", logger);
-    fmu.setup_experiment(0.0, None).unwrap();
-    fmu.enter_initialization_mode().unwrap();
-    fmu.exit_initialization_mode().unwrap();
-    fmu
+    let info = toy_info(
+        "Linear",
+        vec![
+            u,
+            Variable::output(Y, "y", "", "k*u", &[U]),
+            Variable::parameter(K, "k", 3.0, "", "gain"),
+        ],
+    );
+    initialized(info, Box::new(Linear { info, k: 0.0 }))
 }
 
 #[test]

@@ -6,7 +6,7 @@
 
 use crate::{param_err, sliding_velocity_input};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
-use friction_laws::lugre::{LuGre, LuGreInputs, LuGreParams, TABLE_POINTS};
+use friction_laws::lugre::{HeldInput, LuGre, LuGreInputs, LuGreParams, TABLE_POINTS};
 use friction_laws::Ramp;
 use std::sync::LazyLock;
 
@@ -347,9 +347,43 @@ impl Model for LuGreFmu {
 
     fmi2_cs::delegate_state!(law);
 
-    /// Directional derivatives by replaying the step: no partial derivatives.
+    /// Directional derivatives by replaying the step (or, after a held
+    /// step, from the closed form below): no partial derivatives.
     fn supplies_partial_derivatives(&self) -> bool {
         false
+    }
+
+    /// ∂F/∂u and ∂z/∂u (u = v, x, Fn) after a held step: the law's
+    /// closed form of the exact held update
+    /// ([`LuGre::held_step_sensitivity`]), which declines at the kinks of
+    /// the step map (|v| ≤ spread, a table point or Fn = 0 within the
+    /// spread). `sliding` is not differentiable: `None`.
+    fn step_partial_derivative(
+        &self,
+        values: &Values,
+        output: u32,
+        input: u32,
+        h: f64,
+        spread: f64,
+    ) -> Option<f64> {
+        let input = match input {
+            vr::V => HeldInput::V,
+            vr::X => HeldInput::X,
+            vr::FN => HeldInput::Fn,
+            _ => return None,
+        };
+        if output != vr::F && output != vr::Z {
+            return None;
+        }
+        let (v, x, fn_) = Self::inputs(values);
+        let d = self
+            .law
+            .held_step_sensitivity(input, v, x, fn_, h, spread)?;
+        Some(if output == vr::F { d.force } else { d.z })
+    }
+
+    fn supplies_step_derivatives(&self) -> bool {
+        true
     }
 
     /// dz/dt from the state equation; dF/dt = σ0·ż + σ1·z̈ + σ2·v̇ with

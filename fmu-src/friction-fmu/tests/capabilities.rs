@@ -1,11 +1,14 @@
 //! The capabilities every friction FMU declares, checked through the C ABI:
-//! directional derivatives against finite differences, FMU states that
+//! directional derivatives against finite differences (and LuGre's, after
+//! a held step, against the law's closed form), FMU states that
 //! reproduce a run bit for bit (in memory and serialized, in a fresh
 //! instance), step-size independence with interpolated inputs, output
 //! derivatives, and invalid parameters (issue 2).
 
 mod common;
 use common::Fmu;
+use friction_laws::lugre::{HeldInput, LuGre, LuGreInputs};
+use friction_laws::Ramp;
 use std::f64::consts::PI;
 
 /// An input signal: its name and its value at time t.
@@ -136,6 +139,133 @@ fn directional_derivatives_agree_with_finite_differences() {
         &[("v1", 1e-6), ("v2", 1e-6)],
         h,
     );
+}
+
+/// LuGre with every option: `LUGRE_TABLE`'s position table (and one for
+/// v < 0), direction-dependent levels, a Stribeck exponent ≠ 2,
+/// velocity-dependent micro-damping and the normal-force form.
+fn lugre_options() -> Vec<(&'static str, f64)> {
+    let mut p = LUGRE_TABLE.to_vec();
+    p.extend([
+        ("direction_dependent", 1.0),
+        ("Fc_neg", 0.7),
+        ("Fs_neg", 1.9),
+        ("stribeck_exponent", 1.4),
+        ("vd", 2e-3),
+        ("normal_force_form", 1.0),
+        ("scale_neg[1]", 1.2),
+        ("scale_neg[2]", 0.9),
+        ("scale_neg[3]", 1.1),
+    ]);
+    p
+}
+
+/// The law the LuGre FMU runs with `params` set (by name).
+fn lugre_law(params: &[(&str, f64)]) -> LuGre {
+    let info = &*friction_fmu::lugre::INFO;
+    let mut values = fmi2_cs::Values::from_start(info.variables);
+    for (name, value) in params {
+        let v = info.variables.iter().find(|v| v.name == *name).unwrap();
+        values.set(v.vr, *value);
+    }
+    LuGre::new(friction_fmu::lugre::LuGreFmu::params(&values)).unwrap()
+}
+
+/// After a step with every input held, LuGre's directional derivatives of
+/// F and z with respect to v, x and Fn are the law's closed form
+/// (`LuGre::held_step_sensitivity`, asked with the spread the differences
+/// would use) bit for bit, sticking and sliding, both directions; and
+/// they agree with differences taken outside the FMU.
+#[test]
+fn lugre_held_step_derivatives_are_the_laws_closed_form() {
+    let h = 1e-4;
+    let mut compared = 0;
+    let options = lugre_options();
+    for params in [&[][..], &options] {
+        for (v, x, fn_) in [
+            (2e-3, 0.2, 3.0),
+            (-4e-4, 0.7, 3.0),
+            (1e-6, 0.05, 25.0),
+            (-0.05, 2.0, 1.0),
+        ] {
+            let mut fmu = Fmu::new("LuGre", params);
+            for _ in 0..30 {
+                fmu.set("v", v);
+                fmu.set("x", x);
+                fmu.set("Fn", fn_);
+                fmu.step(h);
+            }
+            let mut law = lugre_law(params);
+            law.set_z(fmu.get("z"));
+            let held = LuGreInputs {
+                v: Ramp::constant(v),
+                x: Ramp::constant(x),
+                fn_: Ramp::constant(fn_),
+            };
+            law.step(&held, h);
+            fmu.step(h);
+            for (input, u, which) in [
+                ("v", v, HeldInput::V),
+                ("x", x, HeldInput::X),
+                ("Fn", fn_, HeldInput::Fn),
+            ] {
+                let spread = 1e-6 * u.abs().max(fmu.var(input).nominal.unwrap());
+                let want = law
+                    .held_step_sensitivity(which, v, x, fn_, h, spread)
+                    .unwrap();
+                for (output, want) in [("F", want.force), ("z", want.z)] {
+                    let got = fmu.directional_derivative(output, input);
+                    assert_eq!(
+                        got.to_bits(),
+                        (0.0 + want).to_bits(),
+                        "d{output}/d{input} at v {v}: {got:e} vs {want:e}"
+                    );
+                    compared += 1;
+                }
+            }
+            let (j, fd) = fmu.step_sensitivity("F", "v", h);
+            assert!(
+                (j - fd).abs() <= 1e-6 * fd.abs(),
+                "dF/dv at v {v}: {j:e} vs {fd:e}"
+            );
+        }
+    }
+    assert_eq!(compared, 2 * 4 * 3 * 2);
+}
+
+/// Where LuGre's closed form declines (|v| within the spread of the
+/// differences: the kink of |v| at 0) and after a step with input slopes,
+/// the directional derivative is the layer's central differences of the
+/// replayed step, bit for bit as before.
+#[test]
+fn lugre_directional_derivatives_fall_back_to_the_differences() {
+    let h = 1e-4;
+    let mut fmu = Fmu::new("LuGre", &lugre_options());
+    for k in 0..30 {
+        fmu.set("v", 1e-4 * (k as f64).sin());
+        fmu.set("x", 0.3);
+        fmu.step(h);
+    }
+    // |v| ≤ 1e-6·nominal (1e-3): the differences straddle v = 0
+    for v in [4e-10, -1e-9, 0.0] {
+        fmu.set("v", v);
+        for output in ["F", "z"] {
+            let (j, fd) = fmu.step_derivative_and_differences(output, "v", h);
+            assert_eq!(j.to_bits(), fd.to_bits(), "d{output}/dv at v {v}");
+        }
+    }
+    // a step with slopes: not the held update
+    fmu.set("v", 2e-3);
+    for (input, slope) in [("v", 0.5), ("x", 1e-2), ("Fn", -2.0)] {
+        fmu.set_slope(input, slope);
+        let (j, fd) = fmu.step_derivative_and_differences("F", "v", h);
+        assert_eq!(j.to_bits(), fd.to_bits(), "slope on {input}");
+        fmu.set("v", 2e-3);
+    }
+    // held again: the closed form, which the differences approach
+    let (j, fd) = fmu.step_derivative_and_differences("F", "v", h);
+    assert!((j - fd).abs() <= 1e-6 * fd.abs(), "{j:e} vs {fd:e}");
+    assert_ne!(j.to_bits(), fd.to_bits());
 }
 
 #[test]

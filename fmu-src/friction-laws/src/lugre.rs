@@ -221,6 +221,27 @@ pub struct LuGreInputs {
     pub fn_: Ramp,
 }
 
+/// The input a step sensitivity ([`LuGre::held_step_sensitivity`]) is
+/// taken with respect to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HeldInput {
+    /// The sliding velocity `v`.
+    V,
+    /// The position `x` (the level table).
+    X,
+    /// The normal force `Fn`.
+    Fn,
+}
+
+/// `∂z⁺/∂u` and `∂F⁺/∂u` after a held step ([`LuGre::held_step_sensitivity`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepSensitivity {
+    /// Of the deflection `z` (m per unit of the input).
+    pub z: f64,
+    /// Of the force `F` (N per unit of the input).
+    pub force: f64,
+}
+
 /// LuGre state: the mean bristle deflection `z` (m).
 #[derive(Clone, Debug)]
 pub struct LuGre {
@@ -340,6 +361,14 @@ impl LuGre {
 
     /// [`LuGre::g_unit`] without [`LuGre::level`].
     fn g_unit_computed(&self, w: f64, dir: f64, x: f64) -> f64 {
+        let (fc, fs, e) = self.stribeck_terms(w, dir);
+        self.scale(dir, x) * (fc + (fs - fc) * exp_neg(e))
+    }
+
+    /// The levels `(Fc', Fs')` of direction `dir` and the exponent
+    /// `e = (w/vs)^δ` of the Stribeck term `exp(−e)`.
+    #[inline(always)]
+    fn stribeck_terms(&self, w: f64, dir: f64) -> (f64, f64, f64) {
         let p = &self.p;
         let (fc, fs) = if dir < 0.0 && p.direction_dependent {
             (p.fc_neg, p.fs_neg)
@@ -352,7 +381,49 @@ impl LuGre {
         } else {
             r.powf(p.stribeck_exponent)
         };
-        self.scale(dir, x) * (fc + (fs - fc) * exp_neg(e))
+        (fc, fs, e)
+    }
+
+    /// For `w > 0`: the level per unit normal force `g = scale·G(w)` of
+    /// [`LuGre::g_unit`] (bit for bit), its slope `∂g/∂w`, and `G(w)`, the
+    /// level before the position scale. With `e = (w/vs)^δ`,
+    /// `G = Fc' + (Fs' − Fc')·e^(−e)` and
+    /// `∂g/∂w = −scale·(Fs' − Fc')·e^(−e)·δ·e/w` (`d e/d w = δ·e/w`).
+    fn level_and_slope(&self, w: f64, dir: f64, x: f64) -> (f64, f64, f64) {
+        let (fc, fs, e) = self.stribeck_terms(w, dir);
+        let decay = exp_neg(e);
+        let scale = self.scale(dir, x);
+        let unscaled = fc + (fs - fc) * decay;
+        // (e^(−e) is 0 far above vs, where e·δ/w may overflow)
+        let slope = if decay == 0.0 {
+            0.0
+        } else {
+            -scale * (fs - fc) * decay * (self.p.stribeck_exponent * e / w)
+        };
+        (scale * unscaled, slope, unscaled)
+    }
+
+    /// `∂scale/∂x` of the position table of direction `dir` at `x`: the
+    /// slope of the table segment `x` lies in, 0 beyond the ends; `None`
+    /// where a table point lies in `[x − spread, x + spread]` (a kink of the
+    /// piecewise-linear scale).
+    fn scale_slope(&self, dir: f64, x: f64, spread: f64) -> Option<f64> {
+        let p = &self.p;
+        let n = p.n_table.clamp(2, TABLE_POINTS);
+        let xs = &p.x_table[..n];
+        if xs.iter().any(|&xi| (xi - x).abs() <= spread) || x.is_nan() {
+            return None;
+        }
+        if x < xs[0] || x > xs[n - 1] {
+            return Some(0.0);
+        }
+        let s = if dir < 0.0 && p.direction_dependent {
+            &p.scale_neg
+        } else {
+            &p.scale_pos
+        };
+        let i = xs.partition_point(|&xi| xi <= x);
+        Some((s[i] - s[i - 1]) / (xs[i] - xs[i - 1]))
     }
 
     /// Stribeck level `g(v)` (N) with the direction, position and
@@ -514,6 +585,121 @@ impl LuGre {
         self.z = zss + (self.z - zss) * exp_neg(lambda * h);
     }
 
+    /// The step sensitivity of the outputs `z` and `F` after a step of
+    /// length `h` over which the inputs `v`, `x`, `Fn` were held (the exact
+    /// update of [`LuGre::step`] with constant inputs), with respect to one
+    /// of those inputs: `∂z⁺/∂u` and `∂F⁺/∂u`, the state change over the
+    /// step and the direct feedthrough together. `self` is the state after
+    /// that step. `None` where the step map is not smooth over
+    /// `[u − spread, u + spread]` (`u = v`: `|v| ≤ spread`, the kink of
+    /// `|v|` at 0, or `v` NaN; `u = x`: a point of the position table in
+    /// that interval; `u = Fn` in the normal-force form: `Fn ≤ spread`, the
+    /// kink of `max(Fn, 0)`).
+    ///
+    /// The held update (seed 001 eq. 9–10 at constant inputs, integrated
+    /// exactly): with `w = |v|`, `s = sgn v`, `g = g(w, s, x)` the level per
+    /// unit `Fn` (direction and position scale included),
+    ///
+    /// ```text
+    /// zss = s·g/σ0,   λ = σ0·w/g,   E = e^(−λh),   z⁺ = zss + (z − zss)·E,
+    /// ```
+    ///
+    /// and the output (seed 001 eq. 11, seed 002 eq. 1)
+    /// `F⁺ = (σ0·z⁺ + σ1(v)·ż⁺ + σ2·v)·φ(Fn)`, `ż⁺ = v − λ·z⁺`,
+    /// `σ1(v) = σ1·e^(−(v/vd)²)`, `φ(Fn) = max(Fn, 0)` (1 outside the
+    /// normal-force form). Differentiating, with `z⁺ − zss = (z − zss)·E`
+    /// (so the pre-step `z` is not needed):
+    ///
+    /// ```text
+    /// ∂z⁺/∂u = (∂zss/∂u)·(1 − E) − h·(∂λ/∂u)·(z⁺ − zss)
+    /// ∂ż⁺/∂u = [u = v] − (∂λ/∂u)·z⁺ − λ·∂z⁺/∂u
+    /// ∂F⁺/∂u = (σ0·∂z⁺/∂u + σ1′(v)·ż⁺·[u = v] + σ1(v)·∂ż⁺/∂u + σ2·[u = v])·φ
+    /// ```
+    ///
+    /// with, for `u = v` (`g′ = ∂g/∂w`, [`LuGre::level_and_slope`]):
+    /// `∂zss/∂v = g′/σ0`, `∂λ/∂v = σ0·s·(g − w·g′)/g²`,
+    /// `σ1′(v) = −2·v/vd²·σ1(v)`; for `u = x` (`g = scale(x)·G(w)`):
+    /// `∂g/∂x = scale′(x)·G`, `∂zss/∂x = s·∂g/∂x/σ0`, `∂λ/∂x = −λ·∂g/∂x/g`;
+    /// for `u = Fn`: `∂z⁺/∂Fn = 0`, `∂F⁺/∂Fn = F⁺/φ` (φ′ = 1 for `Fn > 0`).
+    /// At `v = 0` the step changes nothing and `F = σ0·z·φ`: `∂/∂x` is 0.
+    pub fn held_step_sensitivity(
+        &self,
+        input: HeldInput,
+        v: f64,
+        x: f64,
+        fn_: f64,
+        h: f64,
+        spread: f64,
+    ) -> Option<StepSensitivity> {
+        let p = &self.p;
+        let zero = StepSensitivity { z: 0.0, force: 0.0 };
+        let z = self.z;
+        let x_slope = match input {
+            HeldInput::Fn => {
+                if !p.normal_force_form {
+                    return Some(zero);
+                }
+                if fn_.is_nan() || fn_ <= spread {
+                    return None;
+                }
+                let zd = self.z_rate(z, v, x, fn_);
+                return Some(StepSensitivity {
+                    z: 0.0,
+                    force: self.force_at_rate(z, v, zd, 1.0),
+                });
+            }
+            HeldInput::V => {
+                if v.is_nan() || v.abs() <= spread {
+                    return None;
+                }
+                0.0
+            }
+            HeldInput::X => {
+                if v.is_nan() {
+                    return None;
+                }
+                if !p.position_dependent || v == 0.0 {
+                    return Some(zero);
+                }
+                self.scale_slope(v, x, spread)?
+            }
+        };
+        let by_v = input == HeldInput::V;
+        let s = if v > 0.0 { 1.0 } else { -1.0 };
+        let w = v.abs();
+        let (g, dg_dw, unscaled) = self.level_and_slope(w, s, x);
+        let sigma0 = p.sigma0;
+        let zss = g * s / sigma0;
+        let lambda = sigma0 * w / g;
+        let lh = lambda * h;
+        // 1 − E, exact for small λh too (1 to the last bit beyond λh = 40)
+        let settled = if lh > 40.0 { 1.0 } else { -(-lh).exp_m1() };
+        let (dzss, dlambda) = if by_v {
+            (dg_dw / sigma0, sigma0 * s * (g - w * dg_dw) / (g * g))
+        } else {
+            let dg = x_slope * unscaled;
+            (s * dg / sigma0, -lambda * dg / g)
+        };
+        let dz = dzss * settled - h * dlambda * (z - zss);
+        let direct = if by_v { 1.0 } else { 0.0 };
+        let dzd = direct - dlambda * z - lambda * dz;
+        let s1 = self.sigma1_at(v);
+        let mut df = sigma0 * dz + s1 * dzd;
+        if by_v {
+            let zd = self.z_rate_at_level(z, v, g);
+            let ds1 = if p.vd > 0.0 {
+                -2.0 * v / (p.vd * p.vd) * s1
+            } else {
+                0.0
+            };
+            df += ds1 * zd + p.sigma2;
+        }
+        Some(StepSensitivity {
+            z: dz,
+            force: df * self.fn_factor(fn_),
+        })
+    }
+
     /// Sub-stepped integration over `[a, b]` on which `sgn v = s ≠ 0`.
     fn integrate_piece(&mut self, inp: &LuGreInputs, a: f64, b: f64, s: f64) {
         let v = inp.v;
@@ -600,6 +786,9 @@ fn exp_neg(a: f64) -> f64 {
         (-a).exp()
     }
 }
+
+#[cfg(test)]
+mod step_sensitivity_tests;
 
 #[cfg(test)]
 mod tests {

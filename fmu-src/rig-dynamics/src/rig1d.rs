@@ -361,6 +361,20 @@ impl Rig1DInputs {
     }
 }
 
+/// `∂/∂F` of the state and outputs after a step with the friction force
+/// `F` held ([`Rig1D::held_step_sensitivity`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepSensitivity {
+    /// Of the position `x` (and `x_rel`), m/N.
+    pub x: f64,
+    /// Of the velocity `ẋ` (and the slip velocity `v`), m/(N·s).
+    pub xd: f64,
+    /// Of the acceleration output, direct feedthrough included, 1/kg.
+    pub acceleration: f64,
+    /// Of the spring force `k·(x_a − x)`.
+    pub spring_force: f64,
+}
+
 /// The state at one instant: position, velocity, velocity-error integral.
 #[derive(Clone, Copy, Debug)]
 struct Point {
@@ -597,11 +611,58 @@ impl Rig1D {
 
     /// Advance by `h` with inputs u(τ) = u + du·τ, τ ∈ [0, h].
     pub fn step(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
-        if self.plain && self.omega * h <= OMEGA_H_MAX {
+        if self.steps_plainly(h) {
             self.step_plain(u, du, h);
         } else {
             self.step_general(u, du, h);
         }
+    }
+
+    /// Whether [`Rig1D::step`] over `h` takes [`Rig1D::step_plain`]: the
+    /// plain mode, and one sub-step (ω·h ≤ [`OMEGA_H_MAX`]).
+    #[inline(always)]
+    fn steps_plainly(&self, h: f64) -> bool {
+        self.plain && self.omega * h <= OMEGA_H_MAX
+    }
+
+    /// The step sensitivity to the friction force of the last step, of
+    /// length `h`, if it took the plain path ([`Rig1D::step_plain`]; else
+    /// `None`) with `F` held over it: `∂/∂F` of the state after the step
+    /// and of the outputs linear in it and in `F`.
+    ///
+    /// The step is one Gauss–Legendre step of the linear system
+    /// `(x, ẋ)' = L·(x, ẋ) + (0, (k·x_a(t) + F_ext − F)/m)` (no controller,
+    /// no drive force), `x⁺ = x + h/2·S₀`, `ẋ⁺ = ẋ + h/2·S₁` with the stage
+    /// sums `S = Q⁻¹·(b¹ + b² + (√3/6)·P·(b¹ − b²))`
+    /// (`gauss_legendre::linear_stage_sums`), linear in the right-hand
+    /// sides `b^j` at the two stages. A held `F` enters both as
+    /// `∂b^j/∂F = (0, −1/m)`, so `∂S/∂F` is the same stage sums of
+    /// `((0, −1/m), (0, −1/m))` and
+    ///
+    /// ```text
+    /// ∂x⁺/∂F = h/2·∂S₀/∂F,   ∂ẋ⁺/∂F = h/2·∂S₁/∂F,
+    /// ```
+    ///
+    /// whatever the state (the step is affine in it and in `F`). The
+    /// outputs: the slip velocity `v = ẋ − v_s(t)` and `v_body` take
+    /// `∂ẋ⁺/∂F`, the position `x` and `x_rel` take `∂x⁺/∂F`, the spring
+    /// force `−k·∂x⁺/∂F`, the acceleration `(−k·∂x⁺/∂F − c·∂ẋ⁺/∂F − 1)/m`
+    /// (its direct feedthrough `−F/m` included). `F_ext` enters with the
+    /// opposite sign.
+    pub fn held_step_sensitivity(&self, h: f64) -> Option<StepSensitivity> {
+        if !self.steps_plainly(h) {
+            return None;
+        }
+        let p = &self.p;
+        let b = -1.0 / p.m;
+        let sums = linear_stage_sums(h, self.linear, [0.0, b, 0.0, b]);
+        let (x, xd) = (h * 0.5 * sums[0], h * 0.5 * sums[1]);
+        Some(StepSensitivity {
+            x,
+            xd,
+            acceleration: (-p.k * x - p.c * xd - 1.0) / p.m,
+            spring_force: -p.k * x,
+        })
     }
 
     /// [`Rig1D::step`] in the plain mode with one sub-step: what the general

@@ -551,9 +551,46 @@ impl Model for Rig1DFmu {
 
     fmi2_cs::delegate_state!(rig);
 
-    /// Directional derivatives by replaying the step: no partial derivatives.
+    /// Directional derivatives by replaying the step (or, after a held
+    /// step in the plain mode, from the closed form below): no partial
+    /// derivatives.
     fn supplies_partial_derivatives(&self) -> bool {
         false
+    }
+
+    /// ∂y/∂F and ∂y/∂F_ext after a held step that took the plain path: the
+    /// rig's closed form ([`Rig1D::held_step_sensitivity`]; the step is
+    /// linear in the forces, smooth for any spread). The outputs that do
+    /// not depend on the forces in that mode (the prescribed actuator
+    /// point, no drive force, no controller) have 0. Any other input, and
+    /// every other mode: `None`.
+    fn step_partial_derivative(
+        &self,
+        _values: &Values,
+        output: u32,
+        input: u32,
+        h: f64,
+        _spread: f64,
+    ) -> Option<f64> {
+        // F is applied as −F, F_ext as +F_ext
+        let sign = match input {
+            vr::F => 1.0,
+            vr::F_EXT => -1.0,
+            _ => return None,
+        };
+        let d = self.rig.held_step_sensitivity(h)?;
+        Some(match output {
+            vr::X | vr::X_REL => sign * d.x,
+            vr::V | vr::V_BODY => sign * d.xd,
+            vr::A => sign * d.acceleration,
+            vr::F_SPRING => sign * d.spring_force,
+            vr::X_ACT | vr::F_DRIVE | vr::U_CTRL | vr::F_CTRL => 0.0,
+            _ => return None,
+        })
+    }
+
+    fn supplies_step_derivatives(&self) -> bool {
+        true
     }
 
     /// Every input value is accepted (no `check_input`).

@@ -1,11 +1,14 @@
 //! The rig FMUs through the C ABI: directional derivatives of the outputs
 //! with respect to the friction input against finite differences by state
-//! rollback, FMU states that reproduce a run bit for bit (in memory and
+//! rollback (and Rig1D's, after a held step in the plain mode, against the
+//! rig's closed form), FMU states that reproduce a run bit for bit (in memory and
 //! serialized, in a fresh instance), output derivatives, the EMPS loop's
 //! command, Rig2D's free oscillation, and invalid parameters.
 
 mod common;
 use common::{last_error, Fmu};
+use rig_dynamics::rig1d::{Rig1D, Rig1DParams};
+use rig_dynamics::signals::Sinusoid;
 use std::f64::consts::PI;
 
 /// A case: model, parameter assignments (by name), and an output name or
@@ -113,6 +116,116 @@ fn step_sensitivities_to_the_friction_force_agree_with_finite_differences() {
         let (j, fd, ..) = sensitivity("Rig2D", &[], &forces, "v1", "F2", h);
         assert_eq!((j, fd), (0.0, 0.0));
     }
+}
+
+/// A fallback case: parameter assignments, step, input.
+type Fallback<'a> = (&'a [(&'a str, f64)], f64, &'a str);
+
+/// Rig1D's outputs.
+const RIG1D_OUTPUTS: [&str; 10] = [
+    "x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl",
+];
+
+/// A damped Rig1D on a moving, dithered surface: the plain mode.
+const PLAIN: &[(&str, f64)] = &[
+    ("c", 0.3),
+    ("v_surface", 0.01),
+    ("dither_amp", 1e-4),
+    ("dither_freq", 30.0),
+];
+
+/// After a held step in the plain mode (one Gauss–Legendre step, linear in
+/// the forces), Rig1D's directional derivatives with respect to F and
+/// F_ext are the rig's closed form (`Rig1D::held_step_sensitivity`) bit
+/// for bit, every output, and agree with differences outside the FMU.
+#[test]
+fn rig1d_held_step_derivatives_are_the_rigs_closed_form() {
+    let p = Rig1DParams {
+        c: 0.3,
+        v_surface: 0.01,
+        dither: Sinusoid::new(1e-4, 30.0),
+        ..Rig1DParams::default()
+    };
+    for h in [1e-4, 1e-2] {
+        let mut fmu = Fmu::new("Rig1D", PLAIN);
+        for k in 0..30 {
+            fmu.set("F", 0.3 * (k as f64).sin());
+            fmu.set("F_ext", 0.1);
+            fmu.step(h);
+        }
+        let d = Rig1D::new(p).unwrap().held_step_sensitivity(h).unwrap();
+        let by_f = [
+            d.x,
+            d.xd,
+            d.acceleration,
+            d.spring_force,
+            0.0,
+            d.x,
+            d.xd,
+            0.0,
+            0.0,
+            0.0,
+        ];
+        for (input, sign) in [("F", 1.0), ("F_ext", -1.0)] {
+            for (output, want) in RIG1D_OUTPUTS.iter().zip(by_f) {
+                let got = fmu.directional_derivative(output, input);
+                assert_eq!(
+                    got.to_bits(),
+                    (0.0 + sign * want).to_bits(),
+                    "h {h}: d{output}/d{input} {got:e} vs {want:e}"
+                );
+            }
+        }
+        for output in ["v", "x", "a"] {
+            let r = with_scale(&mut fmu, output, "F", h);
+            assert_close(&format!("Rig1D d{output}/dF, h = {h}"), r, 1e-6);
+        }
+    }
+}
+
+/// Where the rig has no closed form (sub-steps: ω·h > 0.02; a mode other
+/// than the plain one; other inputs) and after a step with input slopes,
+/// the directional derivative is the layer's central differences of the
+/// replayed step, bit for bit as before.
+#[test]
+fn rig1d_directional_derivatives_fall_back_to_the_differences() {
+    let cases: [Fallback; 5] = [
+        // ω = √2: two sub-steps at h = 0.02
+        (PLAIN, 0.02, "F"),
+        // the built-in drive force is not the plain mode
+        (&[("drive_amp", 0.5), ("drive_freq", 1.0)], 1e-3, "F"),
+        // nor the controller
+        (&[("control", 1.0), ("ctrl_kp", 40.0)], 1e-3, "F_ext"),
+        // nor the actuator point from its input
+        (&[("actuator", 1.0)], 1e-3, "x_act_in"),
+        // an input other than the forces (here without effect)
+        (PLAIN, 1e-3, "x_ref"),
+    ];
+    for (params, h, input) in cases {
+        let mut fmu = Fmu::new("Rig1D", params);
+        for k in 0..30 {
+            fmu.set(input, 0.3 * (k as f64).sin());
+            fmu.step(h);
+        }
+        for output in ["v", "x", "a"] {
+            let (j, fd) = fmu.step_derivative_and_differences(output, input, h);
+            assert_eq!(j.to_bits(), fd.to_bits(), "{params:?}: d{output}/d{input}");
+        }
+    }
+    // the plain mode with slopes on the forces
+    let mut fmu = Fmu::new("Rig1D", PLAIN);
+    for (input, slope) in [("F", 2.0), ("F_ext", -1.0)] {
+        fmu.set(input, 0.2);
+        fmu.set_slope(input, slope);
+        let (j, fd) = fmu.step_derivative_and_differences("v", "F", 1e-3);
+        assert_eq!(j.to_bits(), fd.to_bits(), "slope on {input}");
+    }
+    // held again: the closed form, which the differences approach
+    fmu.set("F", 0.2);
+    fmu.set("F_ext", 0.2);
+    let (j, fd) = fmu.step_derivative_and_differences("v", "F", 1e-3);
+    assert!((j - fd).abs() <= 1e-6 * fd.abs(), "{j:e} vs {fd:e}");
+    assert_ne!(j.to_bits(), fd.to_bits());
 }
 
 /// Quasi-static mode (seed 000): x = x_act + (F_ext − F)/k, so ∂x/∂F = −1/k

@@ -52,7 +52,7 @@ use fricsim::ssp::{SystemFile, Value};
 use fricsim::sweep::{grid, run_all, Axis, Plan};
 use friction_laws::bristle::{Bristle, BristleParams};
 use friction_laws::dahl::{Dahl, DahlParams};
-use friction_laws::lugre::{LuGre, LuGreInputs, LuGreParams};
+use friction_laws::lugre::{HeldInput, LuGre, LuGreInputs, LuGreParams};
 use friction_laws::Ramp;
 use rig_dynamics::rig1d::{Rig1D, Rig1DInputs, Rig1DParams};
 use std::fmt::Write as _;
@@ -677,8 +677,11 @@ impl StickSlipModel {
     /// interface values U = (v into LuGre, F into the rig) held over the
     /// step, both laws stepped from their state at t (cloned, as
     /// `fmi2GetFMUstate` saves it), Newton on U − Y(U) = 0 with
-    /// J = ∂Y/∂U by central differences of a replayed step (what the FMUs'
-    /// `fmi2GetDirectionalDerivative` does after a step), until
+    /// J = ∂Y/∂U the step sensitivity of each law (what the FMUs'
+    /// `fmi2GetDirectionalDerivative` gives after a step): its closed form
+    /// where the law has one ([`Rig1D::held_step_sensitivity`],
+    /// [`LuGre::held_step_sensitivity`]), else central differences of a
+    /// replayed step, until
     /// |U_k − Y_k| ≤ atol_k + rtol·max(|U_k|, |Y_k|). Returns the wall time,
     /// the final force and the mean iterations per step.
     fn monolithic_newton(&self, h: f64, stop: f64) -> Result<(f64, f64, f64), String> {
@@ -725,20 +728,35 @@ impl StickSlipModel {
                         Self::record(&mut recording, t, &rig, &lugre, u[1], y[1]);
                         continue 'steps;
                     }
-                    // ∂(rig.v)/∂F and ∂(friction.F)/∂v, central differences
+                    // ∂(rig.v)/∂F and ∂(friction.F)/∂v of the step just
+                    // taken: the laws' closed forms where they answer, as
+                    // the FMUs' directional derivatives, else central
+                    // differences over the half-width the closed form was
+                    // asked for
                     let dv_df = {
                         let d = f64::EPSILON.cbrt() * u[1].abs().max(1.0);
-                        let (mut a, mut b) = (rig0.clone(), rig0.clone());
-                        step_rig(&mut a, u[1] + d);
-                        step_rig(&mut b, u[1] - d);
-                        (a.slip_velocity() - b.slip_velocity()) / (2.0 * d)
+                        match rig.held_step_sensitivity(h) {
+                            Some(s) => s.xd,
+                            None => {
+                                let (mut a, mut b) = (rig0.clone(), rig0.clone());
+                                step_rig(&mut a, u[1] + d);
+                                step_rig(&mut b, u[1] - d);
+                                (a.slip_velocity() - b.slip_velocity()) / (2.0 * d)
+                            }
+                        }
                     };
                     let df_dv = {
                         let d = f64::EPSILON.cbrt() * u[0].abs().max(1e-3);
-                        let (mut a, mut b) = (lugre0.clone(), lugre0.clone());
-                        step_lugre(&mut a, u[0] + d);
-                        step_lugre(&mut b, u[0] - d);
-                        (a.force(u[0] + d, 0.0, 0.0) - b.force(u[0] - d, 0.0, 0.0)) / (2.0 * d)
+                        match lugre.held_step_sensitivity(HeldInput::V, u[0], 0.0, 0.0, h, d) {
+                            Some(s) => s.force,
+                            None => {
+                                let (mut a, mut b) = (lugre0.clone(), lugre0.clone());
+                                step_lugre(&mut a, u[0] + d);
+                                step_lugre(&mut b, u[0] - d);
+                                (a.force(u[0] + d, 0.0, 0.0) - b.force(u[0] - d, 0.0, 0.0))
+                                    / (2.0 * d)
+                            }
+                        }
                     };
                     // (I − J)·ΔU = Y − U with J = [[0, dv_df], [df_dv, 0]]
                     let r = [y[0] - u[0], y[1] - u[1]];

@@ -248,6 +248,39 @@ impl Fmu {
         (self.directional_derivative(output, input), fd)
     }
 
+    /// From the current state, with the inputs (and slopes) as set: a
+    /// step of `h`, then (J, FD): J the FMU's ∂output/∂input right after
+    /// it, FD the layer's central differences of that step written out
+    /// here (rolled back with fmi2SetFMUstate, `input` moved from its value
+    /// before the step by ±ε, ε = 1e-6·max(|u|, nominal) of its value u
+    /// after the step, stepped, `output` read): what the layer answers
+    /// where the model gives no step sensitivity. Leaves the FMU after the
+    /// unperturbed step.
+    pub fn step_derivative_and_differences(
+        &mut self,
+        output: &str,
+        input: &str,
+        h: f64,
+    ) -> (f64, f64) {
+        let (t0, s0) = (self.t, self.state());
+        let u0 = self.get(input);
+        self.step(h);
+        let j = self.directional_derivative(output, input);
+        let nominal = self.var(input).nominal.unwrap_or(1.0);
+        let eps = 1e-6 * self.get(input).abs().max(nominal);
+        let mut y_at = |e: f64| {
+            self.restore(s0, t0);
+            self.set(input, u0 + e);
+            self.step(h);
+            self.get(output)
+        };
+        let fd = (y_at(eps) - y_at(-eps)) / (2.0 * eps);
+        self.restore(s0, t0);
+        self.set(input, u0);
+        self.step(h);
+        (j, fd)
+    }
+
     pub fn output_derivative(&self, output: &str) -> f64 {
         let o = self.var(output).vr;
         let mut d = f64::NAN;

@@ -188,15 +188,8 @@ fn default_mode_matches_the_first_version_to_rounding() {
         ],
     ];
     let damped = Rig1DParams {
-        m: 0.5,
-        c: 0.3,
-        k: 20.0,
-        x0: 0.01,
-        v0: -0.02,
-        v_a: 0.05,
-        x_a0: 0.001,
-        v_surface: 0.01,
-        ..Default::default()
+        dither: Sinusoid::OFF,
+        ..damped_on_a_moving_surface()
     };
     for (p, h, n, golden) in [
         (Rig1DParams::default(), 1e-3, 3000usize, &BENCHMARK),
@@ -869,26 +862,29 @@ fn invalid_parameters_are_refused_with_name_and_value() {
     }
 }
 
+/// A damped rig in the plain mode, started off its rest point, on a belt
+/// with a dither.
+fn damped_on_a_moving_surface() -> Rig1DParams {
+    Rig1DParams {
+        m: 0.5,
+        c: 0.3,
+        k: 20.0,
+        x0: 0.01,
+        v0: -0.02,
+        v_a: 0.05,
+        x_a0: 0.001,
+        v_surface: 0.01,
+        dither: Sinusoid::new(1e-4, 30.0),
+        ..Default::default()
+    }
+}
+
 /// The plain mode's step (no controller, drive or actuator sinusoid) is
 /// the general path's arithmetic, bit for bit, with ramped inputs, steps of
 /// several lengths and a dither, damped and undamped.
 #[test]
 fn plain_step_is_the_general_step_bit_for_bit() {
-    for p in [
-        Rig1DParams::default(),
-        Rig1DParams {
-            m: 0.5,
-            c: 0.3,
-            k: 20.0,
-            x0: 0.01,
-            v0: -0.02,
-            v_a: 0.05,
-            x_a0: 0.001,
-            v_surface: 0.01,
-            dither: Sinusoid::new(1e-4, 30.0),
-            ..Default::default()
-        },
-    ] {
+    for p in [Rig1DParams::default(), damped_on_a_moving_surface()] {
         let mut plain = Rig1D::new(p).unwrap();
         let mut general = Rig1D::new(p).unwrap();
         assert!(plain.plain);
@@ -934,4 +930,113 @@ fn refused_states_are_named_and_written_states_agree() {
     let mut s = vec![f64::NAN; rig.state_len()];
     rig.write_state_into(&mut s);
     assert_eq!(s, rig.state_to_vec());
+}
+
+/// The plain step's sensitivity to a held friction force against central
+/// differences of the step itself (linear in F: exact up to the rounding
+/// of the differences, ten times ε·|y|/d of each output), damped and
+/// undamped, stiff and soft, with a moving surface and F_ext, at steps up
+/// to the plain path's limit ω·h = 0.02; and `None` beyond it and in
+/// every other mode.
+#[test]
+fn held_step_sensitivity_to_the_friction_force_matches_differences() {
+    let soft = Rig1DParams::default();
+    let stiff = Rig1DParams {
+        m: 0.2,
+        c: 3.0,
+        k: 5e4,
+        x0: 1e-3,
+        ..damped_on_a_moving_surface()
+    };
+    let mut compared = 0;
+    for p in [soft, stiff] {
+        let omega = Rig1D::new(p).unwrap().omega;
+        for h in [1e-5, 1e-4, 1e-3, 0.0199 / omega] {
+            let mut rig = Rig1D::new(p).unwrap();
+            let u = |friction: f64| Rig1DInputs {
+                friction,
+                f_ext: 0.1,
+                ..Default::default()
+            };
+            // somewhere along a run
+            for i in 0..50 {
+                rig.step(&u(0.3 * (i as f64).sin()), &no_inputs(), h);
+            }
+            let before = rig.clone();
+            let f = 0.4;
+            rig.step(&u(f), &no_inputs(), h);
+            if omega * h > OMEGA_H_MAX {
+                // sub-stepped (the stiff rig at 1e-4 s and 1e-3 s)
+                assert_eq!(rig.held_step_sensitivity(h), None);
+                continue;
+            }
+            let s = rig.held_step_sensitivity(h).expect("the plain path");
+            // the outputs after a step with F + k·d held
+            let outputs = |k: f64, d: f64| {
+                let mut r = before.clone();
+                let u = u(f + k * d);
+                r.step(&u, &no_inputs(), h);
+                [
+                    r.position(&u),
+                    r.velocity(),
+                    r.slip_velocity(),
+                    r.relative_displacement(&u),
+                    r.acceleration(&u),
+                    r.spring_force(&u),
+                ]
+            };
+            let d = 1e-3;
+            let (a, b) = (outputs(1.0, d), outputs(-1.0, d));
+            let got = [s.x, s.xd, s.xd, s.x, s.acceleration, s.spring_force];
+            for k in 0..6 {
+                let fd = (a[k] - b[k]) / (2.0 * d);
+                let noise = 10.0 * f64::EPSILON * a[k].abs().max(b[k].abs()) / d;
+                assert!(
+                    (got[k] - fd).abs() <= 1e-9 * fd.abs() + noise,
+                    "output {k}, h {h}: {:e} vs differences {fd:e} (noise {noise:e})",
+                    got[k]
+                );
+                compared += 1;
+            }
+            // ∂ẋ⁺/∂F ≈ −h/m, ∂x⁺/∂F ≈ −h²/2m while ω·h is small
+            if h <= 1e-4 {
+                assert!((s.xd + h / p.m).abs() <= 1e-3 * h / p.m, "{s:?}");
+                assert!((s.x + h * h / (2.0 * p.m)).abs() <= 1e-3 * h * h / p.m);
+            }
+            // beyond the plain path's one sub-step: no answer
+            assert_eq!(rig.held_step_sensitivity(0.021 / omega), None);
+        }
+    }
+    assert_eq!(compared, (4 + 2) * 6);
+    // the modes that do not take the plain path
+    for p in [
+        Rig1DParams {
+            m: 0.0,
+            c: 1.0,
+            ..soft
+        },
+        Rig1DParams {
+            act_sine: Sinusoid::new(1e-3, 2.0),
+            ..soft
+        },
+        Rig1DParams {
+            drive: DriveForce {
+                f_step: 0.5,
+                ..Default::default()
+            },
+            ..soft
+        },
+        Rig1DParams {
+            control: Controller {
+                mode: Control::BuiltIn,
+                kp: 10.0,
+                ..Default::default()
+            },
+            ..soft
+        },
+    ] {
+        let mut rig = Rig1D::new(p).unwrap();
+        rig.step(&no_inputs(), &no_inputs(), 1e-4);
+        assert_eq!(rig.held_step_sensitivity(1e-4), None, "{p:?}");
+    }
 }

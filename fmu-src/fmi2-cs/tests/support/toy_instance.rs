@@ -1,0 +1,38 @@
+//! The description and an initialized instance of a toy model, for the
+//! tests of the layer on a model of their own
+//! (`fmi2-cs/tests/directional_scale.rs`, `step_derivatives.rs`).
+//! Included with `#[path]`.
+
+use fmi2_cs::instance::Instance;
+use fmi2_cs::logger::Logger;
+use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Variable};
+
+/// A model description of `variables` named `name` (kept for the
+/// process, as a model's static description is).
+pub fn toy_info(name: &'static str, variables: Vec<Variable>) -> &'static ModelInfo {
+    Box::leak(Box::new(ModelInfo {
+        model_name: name,
+        model_identifier: name,
+        guid: Box::leak(format!("{{{name}}}").into_boxed_str()),
+        description: "test model",
+        source: "test",
+        variables: Box::leak(variables.into_boxed_slice()),
+        default_experiment: DefaultExperiment {
+            start_time: 0.0,
+            stop_time: 1.0,
+            step_size: 0.1,
+        },
+        capabilities: Capabilities::FULL,
+    }))
+}
+
+/// An instance of `model` (of `info`), through initialization mode into
+/// step mode at t = 0.
+pub fn initialized(info: &'static ModelInfo, model: Box<dyn Model>) -> Instance {
+    let logger = Logger::new(None, std::ptr::null_mut(), "probe", false);
+    let mut fmu = Instance::new(info, model, "probe", logger);
+    fmu.setup_experiment(0.0, None).unwrap();
+    fmu.enter_initialization_mode().unwrap();
+    fmu.exit_initialization_mode().unwrap();
+    fmu
+}
