@@ -882,8 +882,8 @@ impl Instance {
             return None;
         }
         // ε as the general path's loop makes it from its one known (|u| is
-        // finite, `e` never NaN); an infinite one (all zero there) is left
-        // to it
+        // finite, so ε is never NaN); an infinite one (all zero there) is
+        // left to it
         let (x, nominal) = (self.values.real(k).abs(), self.nominals[k as usize]);
         let scale = if x > nominal { x } else { nominal };
         let eps = FD_RELATIVE_STEP * scale / dv.abs();
@@ -910,7 +910,7 @@ impl Instance {
         Some(self.check_finite(unknowns, dv_unknown, "the directional derivative of "))
     }
 
-    /// [`Instance::directional_derivative`] but for
+    /// [`Instance::directional_derivative`] outside
     /// [`Instance::held_step_one`]'s case: the arguments checked, then
     /// [`Instance::directional_checked`] (out of line: the usual case's
     /// frame stays small).
