@@ -763,6 +763,32 @@ pub unsafe fn get_directional_derivative(
 ) -> fmi2Status {
     unsafe {
         call!(c, "fmi2GetDirectionalDerivative", |inst| {
+            // A master's usual call, one output by one input: the checks of
+            // `in_slice` and `out_slice` for one element each (non-null,
+            // aligned), without building the slices through `Result`s;
+            // anything else, or any doubt, takes them below.
+            if n_unknown == 1
+                && n_known == 1
+                && !unknown.is_null()
+                && unknown.is_aligned()
+                && !known.is_null()
+                && known.is_aligned()
+                && !dv_known.is_null()
+                && dv_known.is_aligned()
+                && !dv_unknown.is_null()
+                && dv_unknown.is_aligned()
+            {
+                // (inside the function's `unsafe` block) non-null and
+                // aligned, one element each: the FMI contract
+                let (unknowns, knowns, seeds, out) = (
+                    std::slice::from_ref(&*unknown),
+                    std::slice::from_ref(&*known),
+                    std::slice::from_ref(&*dv_known),
+                    std::slice::from_mut(&mut *dv_unknown),
+                );
+                inst.directional_derivative(unknowns, knowns, seeds, out)?;
+                return Ok(fmi2Status::fmi2OK);
+            }
             let unknowns = in_slice(unknown, n_unknown, "vUnknown_ref[]")?;
             let knowns = in_slice(known, n_known, "vKnown_ref[]")?;
             let seeds = in_slice(dv_known, n_known, "dvKnown[]")?;

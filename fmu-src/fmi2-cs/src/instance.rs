@@ -831,8 +831,91 @@ impl Instance {
     /// held ([`Model::step_partial_derivative`]); else it is obtained by
     /// central differences along `dv_known`, replaying the step from the
     /// saved pre-step state.
-    #[inline]
+    #[inline(always)]
     pub fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        if let Some(result) = self.held_step_one(unknowns, knowns, dv_known, dv_unknown) {
+            return result;
+        }
+        self.directional_general(unknowns, knowns, dv_known, dv_unknown)
+    }
+
+    /// [`Instance::directional_derivative`] in the case of a strongly
+    /// coupled master, one output by one input with a non-zero seed right
+    /// after a step that held every input, from the model's step
+    /// sensitivity: the checks and the arithmetic of
+    /// [`Instance::directional_general`] for that case (the same value
+    /// reference checks through the flag bytes, the same perturbation `ε`,
+    /// the same sum, the same finiteness check and message), written out
+    /// for one entry without the loops. `None` (nothing done, nothing
+    /// written) in any other case, which the general path takes.
+    #[inline(always)]
+    fn held_step_one(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Option<Result<(), String>> {
+        let ([u], [k], [dv], [out]) = (unknowns, knowns, dv_known, &mut *dv_unknown) else {
+            return None;
+        };
+        let (u, k, dv) = (*u, *k, *dv);
+        let fu = self.flags.get(u as usize).copied().unwrap_or(0);
+        let fk = self.flags.get(k as usize).copied().unwrap_or(0);
+        let (output, input) = (flag::REAL | flag::OUTPUT, flag::REAL | flag::INPUT);
+        let usual = fu & output == output
+            && fk & input == input
+            && dv.is_finite()
+            && dv != 0.0
+            && self.initialized
+            && !self.supplies_partial_derivatives
+            && self.supplies_step_derivatives
+            && self.replay.valid
+            && self.replay.held;
+        if !usual {
+            return None;
+        }
+        // ε as the general path's loop makes it from its one known (|u| is
+        // finite, so ε is never NaN); an infinite one (all zero there) is
+        // left to it
+        let (x, nominal) = (self.values.real(k).abs(), self.nominals[k as usize]);
+        let scale = if x > nominal { x } else { nominal };
+        let eps = FD_RELATIVE_STEP * scale / dv.abs();
+        if !eps.is_finite() {
+            return None;
+        }
+        let spread = eps * dv.abs();
+        let h = self.replay.h;
+        let Some(d) = self
+            .model
+            .step_partial_derivative(&self.values, u, k, h, spread)
+        else {
+            // the model does not give it here: the differences, as the
+            // general path after `step_analytic`
+            return Some(self.differences_checked(unknowns, knowns, dv_known, eps, dv_unknown));
+        };
+        // (the general path's sum from 0: 0 + d·dv, which is +0 where d·dv is -0)
+        let mut acc = 0.0;
+        acc += d * dv;
+        *out = acc;
+        if acc.is_finite() {
+            return Some(Ok(()));
+        }
+        Some(self.check_finite(unknowns, dv_unknown, "the directional derivative of "))
+    }
+
+    /// [`Instance::directional_derivative`] outside
+    /// [`Instance::held_step_one`]'s case: the arguments checked, then
+    /// [`Instance::directional_checked`] (out of line: the usual case's
+    /// frame stays small).
+    #[inline(never)]
+    fn directional_general(
         &mut self,
         unknowns: &[u32],
         knowns: &[u32],
@@ -950,6 +1033,20 @@ impl Instance {
             }
             return self.check_finite(unknowns, dv_unknown, "the directional derivative of ");
         }
+        self.differences_checked(unknowns, knowns, dv_known, eps, dv_unknown)
+    }
+
+    /// [`Instance::central_differences`] with perturbation `eps` into
+    /// `dv_unknown`, checked finite.
+    #[inline(never)]
+    fn differences_checked(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        eps: f64,
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
         if self.central_differences(knowns, dv_known, eps, unknowns, dv_unknown)? {
             Ok(())
         } else {
