@@ -845,6 +845,18 @@ impl Instance {
         self.directional_general(unknowns, knowns, dv_known, dv_unknown)
     }
 
+    /// The perturbation ε along a seed `dv ≠ 0` of input `k` that moves the
+    /// input by [`FD_RELATIVE_STEP`] of its scale max(|u|, nominal): what
+    /// the central differences use, and the half-width `ε·|dv|` a model's
+    /// step sensitivity is asked over. (`max` as a comparison: |u| is
+    /// finite, a NaN nominal is -inf in `nominals`, so ε is never NaN.)
+    #[inline(always)]
+    fn perturbation(&self, k: u32, dv: f64) -> f64 {
+        let (u, nominal) = (self.values.real(k).abs(), self.nominals[k as usize]);
+        let scale = if u > nominal { u } else { nominal };
+        FD_RELATIVE_STEP * scale / dv.abs()
+    }
+
     /// [`Instance::directional_derivative`] in the case of a strongly
     /// coupled master, one output by one input with a non-zero seed right
     /// after a step that held every input, from the model's step
@@ -881,12 +893,9 @@ impl Instance {
         if !usual {
             return None;
         }
-        // ε as the general path's loop makes it from its one known (|u| is
-        // finite, so ε is never NaN); an infinite one (all zero there) is
-        // left to it
-        let (x, nominal) = (self.values.real(k).abs(), self.nominals[k as usize]);
-        let scale = if x > nominal { x } else { nominal };
-        let eps = FD_RELATIVE_STEP * scale / dv.abs();
+        // ε as the general path's loop makes it from its one known; an
+        // infinite one (all zero there) is left to it
+        let eps = self.perturbation(k, dv);
         if !eps.is_finite() {
             return None;
         }
@@ -1005,12 +1014,7 @@ impl Instance {
         let mut eps = f64::INFINITY;
         for (k, dv) in knowns.iter().zip(dv_known) {
             if *dv != 0.0 {
-                // (`max` and `min` as comparisons: |u| is finite, a NaN
-                // nominal is -inf in `nominals`, and `e` is never NaN, so
-                // there is no NaN case to take)
-                let (u, nominal) = (self.values.real(*k).abs(), self.nominals[*k as usize]);
-                let scale = if u > nominal { u } else { nominal };
-                let e = FD_RELATIVE_STEP * scale / dv.abs();
+                let e = self.perturbation(*k, *dv);
                 if e < eps {
                     eps = e;
                 }
