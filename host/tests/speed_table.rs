@@ -100,3 +100,58 @@ fn quick_mode_writes_every_table_between_its_markers() {
         );
     }
 }
+
+/// `--only SIDE --repeats N` (the profiling and A/B-timing mode): one line
+/// per side with the best time and the final force, the same on both
+/// sides of the boundary and for any number of repeats.
+#[test]
+fn only_mode_prints_the_best_of_its_repeats_and_the_final_force() {
+    common::lugre_fmu(); // dist/ is built
+    let force_of = |side: &str, repeats: &str| {
+        let output = Command::new(env!("CARGO_BIN_EXE_speed-table"))
+            .args([
+                "--only",
+                side,
+                "--stop",
+                "0.5",
+                "--repeats",
+                repeats,
+                "--root",
+            ])
+            .arg(common::repository())
+            .output()
+            .unwrap();
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let text = String::from_utf8(output.stdout).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 1, "{text}");
+        assert!(lines[0].starts_with(&format!("{side} jacobi: ")), "{text}");
+        let ms: f64 = lines[0][format!("{side} jacobi: ").len()..]
+            .split(" ms")
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(ms > 0.0, "{text}");
+        let force: f64 = lines[0]
+            .rsplit("final friction.F ")
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        force
+    };
+    let host = force_of("host", "1");
+    assert!(host.is_finite() && host != 0.0, "{host}");
+    assert_eq!(force_of("host", "3"), host);
+    assert!((force_of("monolithic", "2") - host).abs() < 1e-9);
+    let refused = Command::new(env!("CARGO_BIN_EXE_speed-table"))
+        .args(["--only", "fmpy"])
+        .output()
+        .unwrap();
+    assert!(!refused.status.success());
+}
