@@ -406,7 +406,7 @@ impl Instance {
             }
         } else if vrs.len() >= Self::REMEMBERED
             && self.checked_get.0 == t
-            && self.checked_get.1 == vrs
+            && same_list(&self.checked_get.1, vrs)
         {
             self.checked_get.2
         } else {
@@ -1577,6 +1577,17 @@ fn step_size_refused(h: f64) -> String {
 #[inline(never)]
 fn step_failed(t: f64, h: f64, why: String) -> String {
     format!("step from t = {t} over h = {h} failed: {why}")
+}
+
+/// Whether lists `a` and `b` of value references are equal; a list of two
+/// (the outputs of a friction law, say) compared inline, which is cheaper
+/// than the call to `memcmp` that compares longer ones.
+#[inline(always)]
+fn same_list(a: &[u32], b: &[u32]) -> bool {
+    match (a, b) {
+        ([a0, a1], [b0, b1]) => (a0 ^ b0) | (a1 ^ b1) == 0,
+        _ => a == b,
+    }
 }
 
 /// No NaN or infinity in `values`: `x·0` is 0 for every finite `x` and NaN
