@@ -457,8 +457,26 @@ pub unsafe fn get_real(
 ) -> fmi2Status {
     unsafe {
         call!(c, "fmi2GetReal", |inst| {
-            let vrs = in_slice(vr, n, "vr[]")?;
-            let out = out_slice(value, n, "value[]")?;
+            // The checks of `in_slice` and `out_slice` (a plausible length,
+            // both arrays non-null and aligned) in one test for the usual
+            // call; anything else takes them one by one, with their
+            // messages (and accepts NULL for no values).
+            let (vrs, out) = if n != 0
+                && n <= MAX_ARRAY_LENGTH
+                && !vr.is_null()
+                && vr.is_aligned()
+                && !value.is_null()
+                && value.is_aligned()
+            {
+                // (inside the function's `unsafe` block) non-null,
+                // aligned, of a bounded length: the FMI contract
+                (
+                    std::slice::from_raw_parts(vr, n),
+                    std::slice::from_raw_parts_mut(value, n),
+                )
+            } else {
+                (in_slice(vr, n, "vr[]")?, out_slice(value, n, "value[]")?)
+            };
             inst.get(VarType::Real, vrs, out)?;
             Ok(fmi2Status::fmi2OK)
         })
