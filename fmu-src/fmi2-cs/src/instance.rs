@@ -529,9 +529,22 @@ impl Instance {
     /// if `vr` has no value.
     #[inline(always)]
     fn store_one(&mut self, f: u8, vr: u32, value: f64) -> bool {
-        let Some(slot) = self.values.as_mut_slice().get_mut(vr as usize) else {
+        if vr as usize >= self.values.len() {
             return false;
-        };
+        }
+        // SAFETY: just checked
+        unsafe { self.store_unchecked(f, vr, value) };
+        true
+    }
+
+    /// [`Instance::store_one`] without the check of `vr`.
+    ///
+    /// # Safety
+    /// `vr` has a value: it is below `values.len()`.
+    #[inline(always)]
+    unsafe fn store_unchecked(&mut self, f: u8, vr: u32, value: f64) {
+        // SAFETY: the caller's
+        let slot = unsafe { self.values.as_mut_slice().get_unchecked_mut(vr as usize) };
         let input = f & flag::INPUT != 0;
         if !input || *slot != value {
             self.replay.valid = false;
@@ -541,7 +554,6 @@ impl Instance {
         }
         *slot = value;
         self.outputs_dirty = true;
-        true
     }
 
     /// [`Instance::set`] of one Real value in the step loop's case only: a
@@ -555,10 +567,16 @@ impl Instance {
         let (_, want) = self.settable(VarType::Real);
         let f = self.flags.get(vr as usize).copied().unwrap_or(0);
         // (bit 7 is CHECKED in a settable variable's byte)
-        f & want == want
-            && f & flag::CHECKED == 0
-            && value.is_finite()
-            && self.store_one(f, vr, value)
+        if f & want != want || f & flag::CHECKED != 0 || !value.is_finite() {
+            return false;
+        }
+        debug_assert_eq!(self.values.len(), self.flags.len());
+        // SAFETY: `f` is not 0, so `vr` is a known value reference (found
+        // in `flags`), and `values` has one entry per variable, as `flags`
+        // (both built from `info.variables`; reset and restore keep the
+        // length)
+        unsafe { self.store_unchecked(f, vr, value) };
+        true
     }
 
     #[inline(never)]
