@@ -417,19 +417,12 @@ impl Instance {
         }
         let data = self.values.as_slice();
         debug_assert_eq!(data.len(), self.flags.len());
-        // x·0 is 0 for a finite x, NaN otherwise; so is the sum
-        let mut zero = 0.0;
-        for (o, &vr) in out.iter_mut().zip(vrs) {
-            // SAFETY: every vr was found in `flags` above (a known value
-            // reference: `flags.get(vr)` had the type bit, and a list in
-            // `checked_get` passed `check_get`), and `values` has one entry
-            // per variable, as `flags` (both built from `info.variables`;
-            // reset and restore keep the length).
-            let x = unsafe { *data.get_unchecked(vr as usize) };
-            *o = x;
-            zero += x * 0.0;
-        }
-        if zero == 0.0 {
+        // SAFETY: every vr was found in `flags` above (a known value
+        // reference: `flags.get(vr)` had the type bit, and a list in
+        // `checked_get` passed `check_get`), and `values` has one entry
+        // per variable, as `flags` (both built from `info.variables`;
+        // reset and restore keep the length).
+        if unsafe { gather(data, vrs, out) } {
             Ok(())
         } else {
             self.check_finite(vrs, out, "")
@@ -1597,6 +1590,47 @@ fn step_failed(t: f64, h: f64, why: String) -> String {
     format!("step from t = {t} over h = {h} failed: {why}")
 }
 
+/// `out[k] = data[vrs[k]]` for each `k` (of the shorter of `out` and
+/// `vrs`); whether every value copied is finite (as [`all_finite`]). Two
+/// at a time, checked in two lanes, the last pair overlapping the one
+/// before for an odd length (the same value copied and counted twice):
+/// no loop for a remainder.
+///
+/// # Safety
+/// Every entry of `vrs` is an index of `data`.
+#[inline(always)]
+unsafe fn gather(data: &[f64], vrs: &[u32], out: &mut [f64]) -> bool {
+    let n = out.len().min(vrs.len());
+    // SAFETY (each access): `k` and `k + 1` below `n`, so within `vrs`
+    // and `out`; `vrs[k]` within `data` (the caller's)
+    let at = |k: usize| unsafe { *data.get_unchecked(*vrs.get_unchecked(k) as usize) };
+    if n < 2 {
+        return match n {
+            0 => true,
+            _ => {
+                let x = at(0);
+                unsafe { *out.get_unchecked_mut(0) = x };
+                x * 0.0 == 0.0
+            }
+        };
+    }
+    let to = out.as_mut_ptr();
+    let mut lanes = [0.0; 2];
+    let mut pair = |k: usize| {
+        let x = [at(k), at(k + 1)];
+        unsafe { *(to.add(k) as *mut [f64; 2]) = x };
+        lanes[0] += x[0] * 0.0;
+        lanes[1] += x[1] * 0.0;
+    };
+    let mut k = 0;
+    while k + 2 < n {
+        pair(k);
+        k += 2;
+    }
+    pair(n - 2);
+    lanes[0] + lanes[1] == 0.0
+}
+
 /// Whether lists `a` and `b` of value references are equal; a list of two
 /// (the outputs of a friction law, say) compared inline, which is cheaper
 /// than the call to `memcmp` that compares longer ones.
@@ -1661,6 +1695,32 @@ mod tests {
                     assert!(!all_finite(&values), "{values:?}");
                     values[n - 1 - k] = -bad;
                     assert!(!all_finite(&values), "{values:?}");
+                }
+            }
+        }
+    }
+
+    /// [`gather`] of lists of every length up to 9 (no remainder, an odd
+    /// one, one value, none), in any order and with repeated entries,
+    /// copies exactly `data[vrs[k]]` into `out[k]` and nothing else, and
+    /// finds a NaN or an infinity at any place of the list.
+    #[test]
+    fn gather_copies_each_value_and_finds_every_non_finite_one() {
+        let data: Vec<f64> = (0..12).map(|k| k as f64 * 1.5 - 4.0).collect();
+        for n in 0..10u32 {
+            let vrs: Vec<u32> = (0..n).map(|k| (k * 7 + n) % 12).collect();
+            let mut out = vec![f64::NAN; n as usize + 1];
+            // SAFETY: every entry of `vrs` is below 12
+            assert!(unsafe { gather(&data, &vrs, &mut out[..n as usize]) });
+            let expected: Vec<f64> = vrs.iter().map(|&vr| data[vr as usize]).collect();
+            assert_eq!(out[..n as usize], expected[..], "{vrs:?}");
+            assert!(out[n as usize].is_nan(), "written past the list");
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for &vr in &vrs {
+                    let mut data = data.clone();
+                    data[vr as usize] = bad;
+                    // SAFETY: as above
+                    assert!(!unsafe { gather(&data, &vrs, &mut out) }, "{vrs:?}");
                 }
             }
         }
