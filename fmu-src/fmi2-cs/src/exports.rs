@@ -169,16 +169,28 @@ unsafe fn call_named(
     outcome.unwrap_or_else(|payload| {
         // SAFETY: as above; the closure's reference ended with the unwind.
         let instance = unsafe { &mut *instance };
-        let message = panic_message(&*payload);
-        let function = function();
-        let _ = catch_unwind(AssertUnwindSafe(|| {
-            instance.state = State::Fatal;
-            instance
-                .logger
-                .fatal(&format!("{function}: internal error (panic): {message}"));
-        }));
-        fmi2Status::fmi2Fatal
+        panicked(instance, function(), payload)
     })
+}
+
+/// A call of `function` on `instance` panicked with `payload`: the
+/// instance is `Fatal`, the panic logged (out of line: the calls' own code
+/// keeps no registers for it).
+#[cold]
+#[inline(never)]
+fn panicked(
+    instance: &mut Instance,
+    function: &str,
+    payload: Box<dyn std::any::Any + Send>,
+) -> fmi2Status {
+    let message = panic_message(&*payload);
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        instance.state = State::Fatal;
+        instance
+            .logger
+            .fatal(&format!("{function}: internal error (panic): {message}"));
+    }));
+    fmi2Status::fmi2Fatal
 }
 
 /// [`call_allowed`] of a function the instance's state does not allow:
