@@ -750,9 +750,11 @@ impl Instance {
 
     #[inline]
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<fmi2Status, String> {
-        // (comparisons with NaN are false: NaN fails both checks, and
-        // h <= f64::MAX refuses +inf)
-        if !(h > 0.0 && h <= f64::MAX) {
+        // h > 0 and finite, in one comparison: the bits of the positive
+        // finite doubles, from the least subnormal to f64::MAX, are the
+        // integers 1 ..= f64::MAX.to_bits(), in order; 0 is 0, and a sign
+        // bit (a negative h or -0), an infinity or a NaN make them larger
+        if h.to_bits().wrapping_sub(1) >= f64::MAX.to_bits() {
             return Err(step_size_refused(h));
         }
         // self.time is finite
