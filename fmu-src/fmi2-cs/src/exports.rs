@@ -258,6 +258,16 @@ pub unsafe fn out_slice<'a, T>(ptr: *mut T, n: usize, what: &str) -> Result<&'a 
     Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
 }
 
+/// Whether `a` and `b` are both non-null and aligned for their types, as
+/// [`in_slice`] and [`out_slice`] check them: the alignment bits of both
+/// in one test, then each address against NULL.
+#[inline(always)]
+fn both_usable<A, B>(a: *const A, b: *const B) -> bool {
+    let (a, b) = (a as usize, b as usize);
+    let misaligned = (a & (std::mem::align_of::<A>() - 1)) | (b & (std::mem::align_of::<B>() - 1));
+    misaligned == 0 && a != 0 && b != 0
+}
+
 /// Why [`in_slice`] or [`out_slice`] refused an array (null, too long, or
 /// misaligned, checked in that order).
 #[cold]
@@ -473,13 +483,7 @@ pub unsafe fn get_real(
             // both arrays non-null and aligned) in one test for the usual
             // call; anything else takes them one by one, with their
             // messages (and accepts NULL for no values).
-            let (vrs, out) = if n != 0
-                && n <= MAX_ARRAY_LENGTH
-                && !vr.is_null()
-                && vr.is_aligned()
-                && !value.is_null()
-                && value.is_aligned()
-            {
+            let (vrs, out) = if n != 0 && n <= MAX_ARRAY_LENGTH && both_usable(vr, value) {
                 // (inside the function's `unsafe` block) non-null,
                 // aligned, of a bounded length: the FMI contract
                 (
@@ -598,7 +602,7 @@ pub unsafe fn set_real(
     // general path, nothing changed, which checks everything in order and
     // reports.
     const ALLOWED: u32 = crate::state_machine::allowed_mask("fmi2SetReal");
-    if n == 1 && !vr.is_null() && vr.is_aligned() && !value.is_null() && value.is_aligned() {
+    if n == 1 && both_usable(vr, value) {
         // SAFETY: as `call_allowed`
         if let Some(inst) = unsafe { recent_instance(c, ALLOWED) } {
             // SAFETY: non-null and aligned, one element each (FMI contract)
