@@ -1710,9 +1710,10 @@ mod tests {
     fn gather_copies_each_value_and_finds_every_non_finite_one() {
         let data: Vec<f64> = (0..12).map(|k| k as f64 * 1.5 - 4.0).collect();
         for n in 0..10u32 {
-            let vrs: Vec<u32> = (0..n).map(|k| (k * 7 + n) % 12).collect();
+            let vrs: Vec<u32> = (0..n).map(|k| (k * 7 + n) % 6 * 2).collect();
             let mut out = vec![f64::NAN; n as usize + 1];
-            // SAFETY: every entry of `vrs` is below 12
+            // SAFETY: every entry of `vrs` is below 12 (and one of six:
+            // repeated in lists longer than six)
             assert!(unsafe { gather(&data, &vrs, &mut out[..n as usize]) });
             let expected: Vec<f64> = vrs.iter().map(|&vr| data[vr as usize]).collect();
             assert_eq!(out[..n as usize], expected[..], "{vrs:?}");
