@@ -169,16 +169,28 @@ unsafe fn call_named(
     outcome.unwrap_or_else(|payload| {
         // SAFETY: as above; the closure's reference ended with the unwind.
         let instance = unsafe { &mut *instance };
-        let message = panic_message(&*payload);
-        let function = function();
-        let _ = catch_unwind(AssertUnwindSafe(|| {
-            instance.state = State::Fatal;
-            instance
-                .logger
-                .fatal(&format!("{function}: internal error (panic): {message}"));
-        }));
-        fmi2Status::fmi2Fatal
+        panicked(instance, function(), payload)
     })
+}
+
+/// A call of `function` on `instance` panicked with `payload`: the
+/// instance is `Fatal`, the panic logged (out of line: the calls' own code
+/// keeps no registers for it).
+#[cold]
+#[inline(never)]
+fn panicked(
+    instance: &mut Instance,
+    function: &str,
+    payload: Box<dyn std::any::Any + Send>,
+) -> fmi2Status {
+    let message = panic_message(&*payload);
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        instance.state = State::Fatal;
+        instance
+            .logger
+            .fatal(&format!("{function}: internal error (panic): {message}"));
+    }));
+    fmi2Status::fmi2Fatal
 }
 
 /// [`call_allowed`] of a function the instance's state does not allow:
@@ -244,6 +256,16 @@ pub unsafe fn out_slice<'a, T>(ptr: *mut T, n: usize, what: &str) -> Result<&'a 
     }
     // SAFETY: as above.
     Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
+}
+
+/// Whether `a` and `b` are both non-null and aligned for their types, as
+/// [`in_slice`] and [`out_slice`] check them: the alignment bits of both
+/// in one test, then each address against NULL.
+#[inline(always)]
+fn both_usable<A, B>(a: *const A, b: *const B) -> bool {
+    let (a, b) = (a as usize, b as usize);
+    let misaligned = (a & (std::mem::align_of::<A>() - 1)) | (b & (std::mem::align_of::<B>() - 1));
+    misaligned == 0 && a != 0 && b != 0
 }
 
 /// Why [`in_slice`] or [`out_slice`] refused an array (null, too long, or
@@ -457,8 +479,20 @@ pub unsafe fn get_real(
 ) -> fmi2Status {
     unsafe {
         call!(c, "fmi2GetReal", |inst| {
-            let vrs = in_slice(vr, n, "vr[]")?;
-            let out = out_slice(value, n, "value[]")?;
+            // The checks of `in_slice` and `out_slice` (a plausible length,
+            // both arrays non-null and aligned) in one test for the usual
+            // call; anything else takes them one by one, with their
+            // messages (and accepts NULL for no values).
+            let (vrs, out) = if n != 0 && n <= MAX_ARRAY_LENGTH && both_usable(vr, value) {
+                // (inside the function's `unsafe` block) non-null,
+                // aligned, of a bounded length: the FMI contract
+                (
+                    std::slice::from_raw_parts(vr, n),
+                    std::slice::from_raw_parts_mut(value, n),
+                )
+            } else {
+                (in_slice(vr, n, "vr[]")?, out_slice(value, n, "value[]")?)
+            };
             inst.get(VarType::Real, vrs, out)?;
             Ok(fmi2Status::fmi2OK)
         })
@@ -568,7 +602,7 @@ pub unsafe fn set_real(
     // general path, nothing changed, which checks everything in order and
     // reports.
     const ALLOWED: u32 = crate::state_machine::allowed_mask("fmi2SetReal");
-    if n == 1 && !vr.is_null() && vr.is_aligned() && !value.is_null() && value.is_aligned() {
+    if n == 1 && both_usable(vr, value) {
         // SAFETY: as `call_allowed`
         if let Some(inst) = unsafe { recent_instance(c, ALLOWED) } {
             // SAFETY: non-null and aligned, one element each (FMI contract)

@@ -406,7 +406,7 @@ impl Instance {
             }
         } else if vrs.len() >= Self::REMEMBERED
             && self.checked_get.0 == t
-            && self.checked_get.1 == vrs
+            && same_list(&self.checked_get.1, vrs)
         {
             self.checked_get.2
         } else {
@@ -417,19 +417,12 @@ impl Instance {
         }
         let data = self.values.as_slice();
         debug_assert_eq!(data.len(), self.flags.len());
-        // x·0 is 0 for a finite x, NaN otherwise; so is the sum
-        let mut zero = 0.0;
-        for (o, &vr) in out.iter_mut().zip(vrs) {
-            // SAFETY: every vr was found in `flags` above (a known value
-            // reference: `flags.get(vr)` had the type bit, and a list in
-            // `checked_get` passed `check_get`), and `values` has one entry
-            // per variable, as `flags` (both built from `info.variables`;
-            // reset and restore keep the length).
-            let x = unsafe { *data.get_unchecked(vr as usize) };
-            *o = x;
-            zero += x * 0.0;
-        }
-        if zero == 0.0 {
+        // SAFETY: every vr was found in `flags` above (a known value
+        // reference: `flags.get(vr)` had the type bit, and a list in
+        // `checked_get` passed `check_get`), and `values` has one entry
+        // per variable, as `flags` (both built from `info.variables`;
+        // reset and restore keep the length).
+        if unsafe { gather(data, vrs, out) } {
             Ok(())
         } else {
             self.check_finite(vrs, out, "")
@@ -529,9 +522,22 @@ impl Instance {
     /// if `vr` has no value.
     #[inline(always)]
     fn store_one(&mut self, f: u8, vr: u32, value: f64) -> bool {
-        let Some(slot) = self.values.as_mut_slice().get_mut(vr as usize) else {
+        if vr as usize >= self.values.len() {
             return false;
-        };
+        }
+        // SAFETY: just checked
+        unsafe { self.store_unchecked(f, vr, value) };
+        true
+    }
+
+    /// [`Instance::store_one`] without the check of `vr`.
+    ///
+    /// # Safety
+    /// `vr` has a value: it is below `values.len()`.
+    #[inline(always)]
+    unsafe fn store_unchecked(&mut self, f: u8, vr: u32, value: f64) {
+        // SAFETY: the caller's
+        let slot = unsafe { self.values.as_mut_slice().get_unchecked_mut(vr as usize) };
         let input = f & flag::INPUT != 0;
         if !input || *slot != value {
             self.replay.valid = false;
@@ -541,7 +547,6 @@ impl Instance {
         }
         *slot = value;
         self.outputs_dirty = true;
-        true
     }
 
     /// [`Instance::set`] of one Real value in the step loop's case only: a
@@ -555,10 +560,16 @@ impl Instance {
         let (_, want) = self.settable(VarType::Real);
         let f = self.flags.get(vr as usize).copied().unwrap_or(0);
         // (bit 7 is CHECKED in a settable variable's byte)
-        f & want == want
-            && f & flag::CHECKED == 0
-            && value.is_finite()
-            && self.store_one(f, vr, value)
+        if f & want != want || f & flag::CHECKED != 0 || !value.is_finite() {
+            return false;
+        }
+        debug_assert_eq!(self.values.len(), self.flags.len());
+        // SAFETY: `f` is not 0, so `vr` is a known value reference (found
+        // in `flags`), and `values` has one entry per variable, as `flags`
+        // (both built from `info.variables`; reset and restore keep the
+        // length)
+        unsafe { self.store_unchecked(f, vr, value) };
+        true
     }
 
     #[inline(never)]
@@ -739,9 +750,11 @@ impl Instance {
 
     #[inline]
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<fmi2Status, String> {
-        // (comparisons with NaN are false: NaN fails both checks, and
-        // h <= f64::MAX refuses +inf)
-        if !(h > 0.0 && h <= f64::MAX) {
+        // h > 0 and finite, in one comparison: the bits of the positive
+        // finite doubles, from the least subnormal to f64::MAX, are the
+        // integers 1 ..= f64::MAX.to_bits(), in order; 0 is 0, and a sign
+        // bit (a negative h or -0), an infinity or a NaN make them larger
+        if h.to_bits().wrapping_sub(1) >= f64::MAX.to_bits() {
             return Err(step_size_refused(h));
         }
         // self.time is finite
@@ -1579,9 +1592,140 @@ fn step_failed(t: f64, h: f64, why: String) -> String {
     format!("step from t = {t} over h = {h} failed: {why}")
 }
 
+/// `out[k] = data[vrs[k]]` for each `k` (of the shorter of `out` and
+/// `vrs`); whether every value copied is finite (as [`all_finite`]). Two
+/// at a time, checked in two lanes, the last pair overlapping the one
+/// before for an odd length (the same value copied and counted twice):
+/// no loop for a remainder.
+///
+/// # Safety
+/// Every entry of `vrs` is an index of `data`.
+#[inline(always)]
+unsafe fn gather(data: &[f64], vrs: &[u32], out: &mut [f64]) -> bool {
+    let n = out.len().min(vrs.len());
+    // SAFETY (each access): `k` and `k + 1` below `n`, so within `vrs`
+    // and `out`; `vrs[k]` within `data` (the caller's)
+    let at = |k: usize| unsafe { *data.get_unchecked(*vrs.get_unchecked(k) as usize) };
+    if n < 2 {
+        return match n {
+            0 => true,
+            _ => {
+                let x = at(0);
+                unsafe { *out.get_unchecked_mut(0) = x };
+                x * 0.0 == 0.0
+            }
+        };
+    }
+    let to = out.as_mut_ptr();
+    let mut lanes = [0.0; 2];
+    let mut pair = |k: usize| {
+        let x = [at(k), at(k + 1)];
+        unsafe { *(to.add(k) as *mut [f64; 2]) = x };
+        lanes[0] += x[0] * 0.0;
+        lanes[1] += x[1] * 0.0;
+    };
+    let mut k = 0;
+    while k + 2 < n {
+        pair(k);
+        k += 2;
+    }
+    pair(n - 2);
+    lanes[0] + lanes[1] == 0.0
+}
+
+/// Whether lists `a` and `b` of value references are equal; a list of two
+/// (the outputs of a friction law, say) compared inline, which is cheaper
+/// than the call to `memcmp` that compares longer ones.
+#[inline(always)]
+fn same_list(a: &[u32], b: &[u32]) -> bool {
+    match (a, b) {
+        ([a0, a1], [b0, b1]) => (a0 ^ b0) | (a1 ^ b1) == 0,
+        _ => a == b,
+    }
+}
+
 /// No NaN or infinity in `values`: `x·0` is 0 for every finite `x` and NaN
-/// otherwise, and a sum with a NaN is NaN.
+/// otherwise, and a sum with a NaN is NaN. Summed two at a time in two
+/// lanes (the order does not change whether a NaN is among the terms),
+/// the last pair overlapping the one before for an odd length (an entry
+/// counted twice changes nothing): a model state of a few values takes
+/// no loop for the remainder.
 #[inline]
 fn all_finite(values: &[f64]) -> bool {
-    values.iter().fold(0.0, |zero, x| zero + x * 0.0) == 0.0
+    let n = values.len();
+    if n < 2 {
+        return values.first().is_none_or(|x| x * 0.0 == 0.0);
+    }
+    let mut lanes = [0.0; 2];
+    let mut add = |k: usize| {
+        let pair = &values[k..k + 2];
+        lanes[0] += pair[0] * 0.0;
+        lanes[1] += pair[1] * 0.0;
+    };
+    let mut k = 0;
+    while k + 2 < n {
+        add(k);
+        k += 2;
+    }
+    add(n - 2);
+    lanes[0] + lanes[1] == 0.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`all_finite`] of every length up to 9 (no remainder, an odd one,
+    /// the one-value path, the empty list), with a NaN or an infinity at
+    /// each place, alone or with others, and with finite extremes only.
+    #[test]
+    fn all_finite_finds_every_non_finite_entry() {
+        for n in 0..10 {
+            let finite: Vec<f64> = (0..n)
+                .map(|k| match k % 4 {
+                    0 => f64::MAX,
+                    1 => -0.0,
+                    2 => f64::MIN_POSITIVE / 4.0,
+                    _ => -1.5e300,
+                })
+                .collect();
+            assert!(all_finite(&finite), "{finite:?}");
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for k in 0..n {
+                    let mut values = finite.clone();
+                    values[k] = bad;
+                    assert!(!all_finite(&values), "{values:?}");
+                    values[n - 1 - k] = -bad;
+                    assert!(!all_finite(&values), "{values:?}");
+                }
+            }
+        }
+    }
+
+    /// [`gather`] of lists of every length up to 9 (no remainder, an odd
+    /// one, one value, none), in any order and with repeated entries,
+    /// copies exactly `data[vrs[k]]` into `out[k]` and nothing else, and
+    /// finds a NaN or an infinity at any place of the list.
+    #[test]
+    fn gather_copies_each_value_and_finds_every_non_finite_one() {
+        let data: Vec<f64> = (0..12).map(|k| k as f64 * 1.5 - 4.0).collect();
+        for n in 0..10u32 {
+            let vrs: Vec<u32> = (0..n).map(|k| (k * 7 + n) % 6 * 2).collect();
+            let mut out = vec![f64::NAN; n as usize + 1];
+            // SAFETY: every entry of `vrs` is below 12 (and one of six:
+            // repeated in lists longer than six)
+            assert!(unsafe { gather(&data, &vrs, &mut out[..n as usize]) });
+            let expected: Vec<f64> = vrs.iter().map(|&vr| data[vr as usize]).collect();
+            assert_eq!(out[..n as usize], expected[..], "{vrs:?}");
+            assert!(out[n as usize].is_nan(), "written past the list");
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for &vr in &vrs {
+                    let mut data = data.clone();
+                    data[vr as usize] = bad;
+                    // SAFETY: as above
+                    assert!(!unsafe { gather(&data, &vrs, &mut out) }, "{vrs:?}");
+                }
+            }
+        }
+    }
 }

@@ -1,0 +1,96 @@
+//! The communication step size of `fmi2DoStep`: every positive finite
+//! size is taken, down to the least subnormal and up to `f64::MAX`; zero,
+//! negative, infinite and NaN sizes are refused with the message, and the
+//! instance stays where it was.
+
+use fmi2_cs::instance::Instance;
+use fmi2_cs::{Model, ModelInfo, Values, Variable};
+
+#[path = "support/toy_instance.rs"]
+mod toy_instance;
+use toy_instance::{initialized, toy_info};
+
+/// `ṡ = 0`: any step size leaves a finite state.
+#[derive(Clone)]
+struct Still {
+    info: &'static ModelInfo,
+    s: f64,
+}
+
+impl Model for Still {
+    fn info(&self) -> &'static ModelInfo {
+        self.info
+    }
+    fn initialize(&mut self, _: &Values) -> Result<(), String> {
+        Ok(())
+    }
+    fn compute_outputs(&self, v: &mut Values) {
+        v.set(1, self.s);
+    }
+    fn do_step(&mut self, _: &Values, _: &[f64], _: f64) -> Result<(), String> {
+        Ok(())
+    }
+    fn save_state(&self, out: &mut Vec<f64>) {
+        out.push(self.s);
+    }
+    fn restore_state(&mut self, s: &[f64]) -> Result<(), String> {
+        self.s = s[0];
+        Ok(())
+    }
+    fn clone_model(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
+}
+
+fn instance() -> Instance {
+    let info = toy_info(
+        "Still",
+        vec![
+            Variable::input(0, "u", 0.0, "", 1.0, "input"),
+            Variable::output(1, "y", "", "the state", &[]),
+        ],
+    );
+    initialized(info, Box::new(Still { info, s: 0.0 }))
+}
+
+#[test]
+fn every_positive_finite_step_size_and_no_other() {
+    for h in [
+        f64::from_bits(1),
+        f64::MIN_POSITIVE,
+        1e-4,
+        1.0,
+        1e300,
+        f64::MAX,
+    ] {
+        let mut fmu = instance();
+        fmu.do_step(0.0, h)
+            .unwrap_or_else(|e| panic!("h = {h:e}: {e}"));
+        assert_eq!(fmu.time, h);
+    }
+    let mut fmu = instance();
+    for h in [
+        0.0,
+        -0.0,
+        -f64::from_bits(1),
+        -1e-4,
+        f64::MIN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        -f64::NAN,
+        f64::from_bits(0x7ff0_0000_0000_0001),
+        f64::from_bits(u64::MAX),
+    ] {
+        let e = fmu.do_step(0.0, h).unwrap_err();
+        assert_eq!(
+            e,
+            format!("communicationStepSize must be finite and > 0 but was {h}"),
+            "{h:e}"
+        );
+        assert_eq!(fmu.time, 0.0);
+    }
+    // and the instance steps on
+    fmu.do_step(0.0, 0.5).unwrap();
+    assert_eq!(fmu.time, 0.5);
+}
