@@ -324,12 +324,19 @@ impl LuGre {
 
     /// Position scale factor: piecewise-linear interpolation of the table
     /// for direction `dir` (`< 0` uses `scale_neg` when direction-dependent),
-    /// constant beyond the ends.
+    /// constant beyond the ends; 1 without the table (decided here, inline,
+    /// so that a law without a table does not call out for its 1).
+    #[inline(always)]
     fn scale(&self, dir: f64, x: f64) -> f64 {
-        let p = &self.p;
-        if !p.position_dependent {
+        if !self.p.position_dependent {
             return 1.0;
         }
+        self.table_scale(dir, x)
+    }
+
+    /// [`LuGre::scale`] with the table.
+    fn table_scale(&self, dir: f64, x: f64) -> f64 {
+        let p = &self.p;
         let n = p.n_table.clamp(2, TABLE_POINTS);
         let s = if dir < 0.0 && p.direction_dependent {
             &p.scale_neg

@@ -361,6 +361,32 @@ impl Rig1DInputs {
     }
 }
 
+/// Every output of the rig at one instant ([`Rig1D::outputs`]), each the
+/// value of the single-output function of the same name.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rig1DOutputs {
+    /// [`Rig1D::position`].
+    pub position: f64,
+    /// [`Rig1D::slip_velocity`].
+    pub slip_velocity: f64,
+    /// [`Rig1D::acceleration`].
+    pub acceleration: f64,
+    /// [`Rig1D::spring_force`].
+    pub spring_force: f64,
+    /// [`Rig1D::actuator_position`].
+    pub actuator_position: f64,
+    /// [`Rig1D::relative_displacement`].
+    pub relative_displacement: f64,
+    /// [`Rig1D::velocity`].
+    pub velocity: f64,
+    /// [`Rig1D::drive_force`].
+    pub drive_force: f64,
+    /// [`Rig1D::control_command`].
+    pub control_command: f64,
+    /// [`Rig1D::control_force`].
+    pub control_force: f64,
+}
+
 /// `∂/∂F` of the state and outputs after a step with the friction force
 /// `F` held ([`Rig1D::held_step_sensitivity`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -568,6 +594,51 @@ impl Rig1D {
             + self.drive_force()
             + self.control_force(u))
             / self.p.m
+    }
+
+    /// Every output at once, each bit for bit what its single-output
+    /// function above gives: the same operations in the same order, but the
+    /// quantities several outputs share (the drive force F_d(t), the
+    /// actuator point x_a(t), the position, the spring force, the command)
+    /// computed once instead of once per output that uses them.
+    #[inline]
+    pub fn outputs(&self, u: &Rig1DInputs) -> Rig1DOutputs {
+        let p = &self.p;
+        let t = self.t;
+        let drive_force = p.drive.value(t);
+        let actuator_position = self.actuator_at(t, u.x_act);
+        // x = x_a + (F_ext − F + F_d)/k in the quasi-static mode with c = 0
+        let position = if p.m == 0.0 && p.c == 0.0 {
+            actuator_position + (u.f_ext - u.friction + drive_force) / p.k
+        } else {
+            self.x
+        };
+        let spring_force = p.k * (actuator_position - position);
+        let (control_command, control_force) = if p.control.on() {
+            let command = self.control_command(u);
+            (command, p.control.gain * command)
+        } else {
+            (0.0, 0.0)
+        };
+        // m·ẍ = k(x_a − x) − c·ẋ + F_ext − F + F_d + F_ctrl; 0 when m = 0
+        let acceleration = if p.m == 0.0 {
+            0.0
+        } else {
+            (spring_force - p.c * self.xd + u.f_ext - u.friction + drive_force + control_force)
+                / p.m
+        };
+        Rig1DOutputs {
+            position,
+            slip_velocity: self.xd - self.surface_velocity(t),
+            acceleration,
+            spring_force,
+            actuator_position,
+            relative_displacement: position - self.surface_position(t),
+            velocity: self.xd,
+            drive_force,
+            control_command,
+            control_force,
+        }
     }
 
     /// dx/dt now, the inputs moving at `du`: ẋ (m > 0), or the rate of the

@@ -493,25 +493,27 @@ impl Model for Rig1DFmu {
         Ok(())
     }
 
+    /// The ten outputs from [`Rig1D::outputs`] (what the monolithic loop of
+    /// `speed-table` records too), the values the single-output functions
+    /// of `compute_outputs_of` give.
     fn compute_outputs(&self, v: &mut Values) {
-        let u = inputs(v.as_slice());
-        let rig = &self.rig;
+        let y = self.rig.outputs(&inputs(v.as_slice()));
         // the last output's entry checked once covers the other nine
         const LAST: usize = vr::F_CTRL as usize;
         let Some(out) = v.as_mut_slice().get_mut(..=LAST) else {
             unreachable!("a value table holds every variable")
         };
         let mut set = |output: u32, x: f64| out[output as usize] = x;
-        set(vr::X, rig.position(&u));
-        set(vr::V, rig.slip_velocity());
-        set(vr::A, rig.acceleration(&u));
-        set(vr::F_SPRING, rig.spring_force(&u));
-        set(vr::X_ACT, rig.actuator_position(&u));
-        set(vr::X_REL, rig.relative_displacement(&u));
-        set(vr::V_BODY, rig.velocity());
-        set(vr::F_DRIVE, rig.drive_force());
-        set(vr::U_CTRL, rig.control_command(&u));
-        set(vr::F_CTRL, rig.control_force(&u));
+        set(vr::X, y.position);
+        set(vr::V, y.slip_velocity);
+        set(vr::A, y.acceleration);
+        set(vr::F_SPRING, y.spring_force);
+        set(vr::X_ACT, y.actuator_position);
+        set(vr::X_REL, y.relative_displacement);
+        set(vr::V_BODY, y.velocity);
+        set(vr::F_DRIVE, y.drive_force);
+        set(vr::U_CTRL, y.control_command);
+        set(vr::F_CTRL, y.control_force);
     }
 
     /// The outputs asked for only (a directional derivative wants v, say):

@@ -636,18 +636,20 @@ impl StickSlipModel {
             friction: force_in,
             ..Default::default()
         };
+        // all ten at once, as the FMU's `compute_outputs` computes them
+        let y = rig.outputs(&u);
         recording.time.push(t);
         recording.rows.push_zeros().copy_from_slice(&[
-            rig.position(&u),
-            rig.slip_velocity(),
-            rig.acceleration(&u),
-            rig.spring_force(&u),
-            rig.actuator_position(&u),
-            rig.relative_displacement(&u),
-            rig.velocity(),
-            rig.drive_force(),
-            rig.control_command(&u),
-            rig.control_force(&u),
+            y.position,
+            y.slip_velocity,
+            y.acceleration,
+            y.spring_force,
+            y.actuator_position,
+            y.relative_displacement,
+            y.velocity,
+            y.drive_force,
+            y.control_command,
+            y.control_force,
             friction_force,
             lugre.z(),
         ]);

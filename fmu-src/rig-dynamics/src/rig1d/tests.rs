@@ -1040,3 +1040,163 @@ fn held_step_sensitivity_to_the_friction_force_matches_differences() {
         assert_eq!(rig.held_step_sensitivity(1e-4), None, "{p:?}");
     }
 }
+
+/// `outputs` gives each output bit for bit as its single-output function
+/// does, in every mode of the rig: the default (plain) mode, a damped rig
+/// on a dithered belt, the actuator sinusoid and the actuator input, the
+/// drive step (before, at and after t_step) and sinusoid, the built-in and
+/// the input reference of the controller with and without saturation, the
+/// quasi-static modes (c = 0: position fed through; c > 0), over states
+/// reached by stepping and states set directly (signed zeros included),
+/// and inputs of both signs, zeros of both signs among them.
+#[test]
+fn all_outputs_at_once_are_the_single_outputs_bit_for_bit() {
+    let pd = Controller {
+        mode: Control::BuiltIn,
+        kp: 40.0,
+        kd: 3.0,
+        ki: 5.0,
+        ff: 0.7,
+        gain: 2.0,
+        u_max: 0.0,
+        reference: Reference {
+            x0: 0.01,
+            v0: 2e-3,
+            sine: Sinusoid::new(1e-3, 0.8),
+        },
+    };
+    let sets = [
+        Rig1DParams::default(),
+        damped_on_a_moving_surface(),
+        Rig1DParams {
+            act_sine: Sinusoid::new(2e-3, 5.0),
+            dither: Sinusoid::new(1e-4, 30.0),
+            v_surface: -0.02,
+            ..damped_on_a_moving_surface()
+        },
+        Rig1DParams {
+            actuator: Actuator::Input,
+            act_sine: Sinusoid::new(2e-3, 5.0), // unused with the input
+            drive: DriveForce {
+                f_step: 0.7,
+                t_step: 0.05,
+                sine: Sinusoid::new(0.3, 1.0),
+            },
+            ..damped_on_a_moving_surface()
+        },
+        Rig1DParams {
+            control: pd,
+            ..damped_on_a_moving_surface()
+        },
+        Rig1DParams {
+            control: Controller { u_max: 0.05, ..pd },
+            drive: DriveForce {
+                f_step: -0.4,
+                t_step: 0.02,
+                sine: Sinusoid::OFF,
+            },
+            ..damped_on_a_moving_surface()
+        },
+        emps(10.0),
+        emps(0.5),
+        Rig1DParams {
+            m: 0.0,
+            c: 0.0,
+            k: 1e3,
+            v_a: 8.25e-8,
+            drive: DriveForce {
+                f_step: 0.5,
+                t_step: 0.03,
+                sine: Sinusoid::new(0.2, 3.0),
+            },
+            dither: Sinusoid::new(1e-6, 50.0),
+            ..Default::default()
+        },
+        Rig1DParams {
+            m: 0.0,
+            c: 0.0,
+            k: 1e3,
+            actuator: Actuator::Input,
+            ..Default::default()
+        },
+        Rig1DParams {
+            m: 0.0,
+            c: 2.0,
+            k: 50.0,
+            act_sine: Sinusoid::new(1e-3, 2.0),
+            drive: DriveForce {
+                f_step: 0.1,
+                t_step: 0.0,
+                sine: Sinusoid::OFF,
+            },
+            ..Default::default()
+        },
+    ];
+    let bits = |y: &Rig1DOutputs| {
+        [
+            y.position,
+            y.slip_velocity,
+            y.acceleration,
+            y.spring_force,
+            y.actuator_position,
+            y.relative_displacement,
+            y.velocity,
+            y.drive_force,
+            y.control_command,
+            y.control_force,
+        ]
+        .map(f64::to_bits)
+    };
+    let check = |rig: &Rig1D, u: &Rig1DInputs, what: &str| {
+        let single = Rig1DOutputs {
+            position: rig.position(u),
+            slip_velocity: rig.slip_velocity(),
+            acceleration: rig.acceleration(u),
+            spring_force: rig.spring_force(u),
+            actuator_position: rig.actuator_position(u),
+            relative_displacement: rig.relative_displacement(u),
+            velocity: rig.velocity(),
+            drive_force: rig.drive_force(),
+            control_command: rig.control_command(u),
+            control_force: rig.control_force(u),
+        };
+        assert_eq!(bits(&rig.outputs(u)), bits(&single), "{what}: {u:?}");
+    };
+    // inputs of both signs, signed zeros, and ones that cancel
+    let inputs = |k: usize| {
+        let s = [0.0, -0.0, 0.3, -1.7, 1e-9, 2.5][k % 6];
+        Rig1DInputs {
+            friction: s,
+            f_ext: [-0.0, 0.0, -0.3, 0.9, s][k % 5],
+            x_act: [0.0, -0.0, 1e-3, -2e-3][k % 4],
+            x_ref: [-0.0, 0.0, 0.02, -0.01][(k / 2) % 4],
+            v_ref: [0.0, -0.0, 1e-3, -4e-3][(k / 3) % 4],
+        }
+    };
+    for (n, p) in sets.iter().enumerate() {
+        let mut rig = Rig1D::new(*p).unwrap();
+        for i in 0..300 {
+            let u = inputs(i);
+            let du = Rig1DInputs {
+                friction: 3.0 * (i as f64).cos(),
+                f_ext: -0.5,
+                x_act: 0.1,
+                x_ref: 2e-3,
+                v_ref: 0.01 * (i as f64).sin(),
+            };
+            rig.step(&u, &du, 5e-4);
+            for k in 0..6 {
+                check(&rig, &inputs(i + k), &format!("set {n}, step {i}"));
+            }
+        }
+        // states set directly: zeros of both signs, the drive step's instant
+        for t in [0.0, -0.0, p.drive.t_step, 0.25] {
+            for (x, xd, xi) in [(0.0, 0.0, 0.0), (-0.0, -0.0, -0.0), (0.03, -0.2, 1e-3)] {
+                rig.state_from_slice(&[t, x, xd, xi]).unwrap();
+                for k in 0..30 {
+                    check(&rig, &inputs(k), &format!("set {n}, t {t}, x {x}"));
+                }
+            }
+        }
+    }
+}
