@@ -16,6 +16,13 @@ pub trait MasterAlgorithm {
     fn report(&self) -> Option<String> {
         None
     }
+    /// The Jacobi master, if this is it: [`simulate_with`] then runs its
+    /// step inlined into the run's loop instead of calling it through the
+    /// trait object at every macro step (the call and the reloading of the
+    /// system after it are a fair share of the host's work in a step).
+    fn as_jacobi(&mut self) -> Option<&mut jacobi::Jacobi> {
+        None
+    }
 }
 
 /// The master algorithms by their command-line names.
@@ -163,6 +170,26 @@ fn all_finite(values: &[f64]) -> bool {
     lanes.iter().sum::<f64>() + rest == 0.0
 }
 
+/// Whether the sum of `values` is finite, which it is only if every value
+/// is: a NaN or an infinity among the terms makes the sum NaN or infinite
+/// (∞ + x = ∞ for finite x, ∞ − ∞ = NaN, NaN + x = NaN). The converse does
+/// not hold (finite values may overflow in the sum), so `false` is to be
+/// looked into with [`all_finite`]; `true` settles it with one addition
+/// per value, where [`all_finite`] needs two operations. Summed in four
+/// independent lanes, as [`all_finite`] is.
+fn sum_is_finite(values: &[f64]) -> bool {
+    let mut chunks = values.chunks_exact(4);
+    let mut lanes = [0.0; 4];
+    for chunk in &mut chunks {
+        for (lane, x) in lanes.iter_mut().zip(chunk) {
+            *lane += x;
+        }
+    }
+    let rest = chunks.remainder().iter().sum::<f64>();
+    let sum = lanes.iter().sum::<f64>() + rest;
+    sum.is_finite()
+}
+
 /// Initialise, then step with a fixed macro step `h` from 0 to `stop`;
 /// time is counted (t = n·h), never summed. An FMU error, or a NaN or
 /// infinite output after a step, stops the run and is reported with the
@@ -224,25 +251,14 @@ pub fn simulate_with(
     let n = step_count(start, h, stop);
     system.start_recording(n + 1);
     system.sample()?;
-    let (error, time) = if system.recorded().is_windowed() {
-        // nothing stored as the run steps: the times of the rows kept
-        // follow from their number when it ends
-        (
-            step_all(system, master, observer, start, h, n, &mut ()),
-            None,
-        )
-    } else {
-        let mut time = Vec::with_capacity(n + 1);
-        time.push(start);
-        let error = step_all(system, master, observer, start, h, n, &mut time);
-        (error, Some(time))
+    let error = match master.as_jacobi() {
+        Some(jacobi) => step_all(system, jacobi, observer, start, h, n),
+        None => step_all(system, master, observer, start, h, n),
     };
+    // the times of the rows kept follow from their number: nothing is
+    // stored for them as the run steps
     let rows = system.take_recording();
-    let time = time.unwrap_or_else(|| {
-        (rows.rows_folded()..rows.rows_pushed())
-            .map(|j| communication_time(start, h, j))
-            .collect()
-    });
+    let time = communication_times(start, h, rows.rows_folded()..rows.rows_pushed());
     Ok(Run {
         columns,
         time,
@@ -251,46 +267,54 @@ pub fn simulate_with(
     })
 }
 
-/// Where [`step_all`] puts the time of each communication point it
-/// completes: a run that keeps every row stores them as it goes
-/// (`Vec<f64>`), a windowed one nothing (`()`), so that neither does work
-/// per step that it has no use for.
-trait Times {
-    fn push(&mut self, t: f64);
-}
-
-impl Times for Vec<f64> {
-    #[inline(always)]
-    fn push(&mut self, t: f64) {
-        Vec::push(self, t);
+/// [`communication_time`] of each point of `points`, computed as
+/// [`step_all`] does: `start + j·h` with the count `j` carried as a float
+/// (exact: `j < 2⁵³`), so that no count is converted one by one.
+#[inline(never)] // a loop of its own, apart from the run's
+fn communication_times(start: f64, h: f64, points: std::ops::Range<usize>) -> Vec<f64> {
+    let mut times = vec![0.0; points.len()];
+    // two points at a time (counts j and j + 1, each exact), side by side
+    let mut j = [points.start as f64, points.start as f64 + 1.0];
+    let mut pairs = times.chunks_exact_mut(2);
+    for pair in &mut pairs {
+        for (t, j) in pair.iter_mut().zip(&mut j) {
+            *t = start + *j * h;
+            *j += 2.0;
+        }
     }
-}
-
-impl Times for () {
-    #[inline(always)]
-    fn push(&mut self, _: f64) {}
+    if let [t] = pairs.into_remainder() {
+        *t = start + j[0] * h;
+    }
+    if let (0, Some(first)) = (points.start, times.first_mut()) {
+        *first = start;
+    }
+    times
 }
 
 /// The `n` steps of [`simulate_with`] from `start`, after the row of
-/// point 0: a row per communication point completed, its time to
-/// `times`; why the run stopped early, if it did.
-#[inline(always)] // the run's loop, one copy per kind of `times`
-fn step_all(
+/// point 0: a row per communication point completed; why the run stopped
+/// early, if it did. One copy for the Jacobi master, its step inlined, one
+/// for any other, called through the trait object.
+#[inline(never)]
+fn step_all<M: MasterAlgorithm + ?Sized>(
     system: &mut System,
-    master: &mut dyn MasterAlgorithm,
+    master: &mut M,
     observer: &mut dyn Observer,
     start: f64,
     h: f64,
     n: usize,
-    times: &mut impl Times,
 ) -> Option<String> {
     let between_steps = observer.between_steps();
     // t = start + i·h, each counted from the start; the step's end is the
-    // next step's start, so each is computed once
+    // next step's start, so each is computed once. The count i is carried
+    // as a float too: i + 1.0 is exact (i < 2⁵³), the same number as
+    // `(i + 1) as f64` without converting it at every step.
     let mut t_next = counted(start, h, 0);
+    let mut next = 0.0;
     for i in 0..n {
         let t = t_next;
-        t_next = counted(start, h, i + 1);
+        next += 1.0;
+        t_next = start + next * h;
         let stepped = if between_steps {
             observer.before_step(system, t, false)
         } else {
@@ -300,19 +324,19 @@ fn step_all(
         if let Err(e) = stepped {
             return Some(format!("at t = {t}: {e}"));
         }
-        if let Err(e) = system.sample() {
-            return Some(format!("at t = {t_next}: {e}"));
+        let finite = match system.sample_with(sum_is_finite) {
+            Ok(finite) => finite,
+            Err(e) => return Some(format!("at t = {t_next}: {e}")),
+        };
+        // the usual case first: a row of numbers (a row whose sum is
+        // not finite is looked at value by value)
+        if !finite {
+            let row = system.recorded().last().unwrap_or_default();
+            if let Some(e) = non_finite(system, row) {
+                system.discard_last_sample();
+                return Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
+            }
         }
-        // the usual case first: a row of numbers
-        let row = system.recorded().last().unwrap_or_default();
-        if let Some(e) = (!all_finite(row))
-            .then(|| non_finite(system, row))
-            .flatten()
-        {
-            system.discard_last_sample();
-            return Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
-        }
-        times.push(t_next);
         if between_steps {
             observer.after_step(i + 1, n);
         }
