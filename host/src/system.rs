@@ -29,6 +29,10 @@ pub struct Component {
     /// [`System::propagate`] sets them in one `fmi2SetReal`, from the
     /// next `inputs.len()` values it has read (see [`System::plan`]).
     inputs: Vec<ValueReference>,
+    /// Where the values of `inputs` are in a recorded row, if they are
+    /// there one after the other in the same order (see
+    /// [`System::step_jacobi`]); `0..0` without inputs.
+    columns: std::ops::Range<usize>,
     /// Its [`Instance::changes`] when [`System::sample`] read the last row,
     /// [`NOT_READ`] where that row cannot be used (none read, or
     /// discarded): while the count stands there, the row holds what
@@ -85,6 +89,12 @@ pub struct System {
     /// Room for the values of `sources`, for the Jacobi master's step
     /// ([`System::step_jacobi`]).
     values: Vec<f64>,
+    /// Whether every connected input reads a recorded output and each
+    /// component's inputs are read from one run of a row's columns
+    /// ([`Component::columns`]): then, while the last row read can be
+    /// used for every component, [`System::step_jacobi`] sets the inputs
+    /// straight from that row.
+    direct: bool,
 }
 
 /// What [`System::sample`] has read: one row of every component's
@@ -244,6 +254,7 @@ impl System {
                 output_vrs: outputs.iter().map(|(_, vr)| *vr).collect(),
                 outputs,
                 inputs: Vec::new(),
+                columns: 0..0,
                 sampled: NOT_READ,
             });
         }
@@ -256,6 +267,7 @@ impl System {
             },
             sources: Vec::new(),
             values: Vec::new(),
+            direct: false,
         };
         for (from, to) in connections {
             let (fi, fv) = find(&system.components, from)?;
@@ -404,9 +416,33 @@ impl System {
     /// the values of the communication point, so it does not matter that
     /// one has stepped before the next one's inputs are set). Inlined into
     /// the run's loop.
+    ///
+    /// The usual case: every input reads a recorded output, each
+    /// component's from consecutive columns, and no component has seen a
+    /// call since the last row was read (nothing happened between the
+    /// steps). Then that row holds every value to be set, at the same
+    /// time: the inputs are set from it, with no copy.
     #[inline(always)]
     pub(crate) fn step_jacobi(&mut self, t: f64, h: f64) -> Result<(), FmuError> {
         let last = self.recording.rows.last().unwrap_or_default();
+        if self.direct
+            && self
+                .components
+                .iter()
+                .all(|c| c.sampled == c.instance.changes())
+        {
+            // every component sampled into the last row since the plan
+            // (which forgets the samples before it): a row of the planned
+            // width, holding every column of `columns`
+            for c in &mut self.components {
+                let now = &last[c.columns.clone()];
+                if !now.is_empty() {
+                    c.instance.set_real(&c.inputs, now)?;
+                }
+                c.instance.do_step(t, h)?;
+            }
+            return Ok(());
+        }
         gather(&mut self.components, last, &self.sources, &mut self.values)?;
         let mut values = &self.values[..];
         for c in &mut self.components {
@@ -434,7 +470,9 @@ impl System {
         // per component, its connected inputs in connection order; their
         // sources one after the other in the same order
         self.sources.clear();
+        self.direct = true;
         for to in 0..self.components.len() {
+            let first = self.sources.len();
             let mut inputs = Vec::new();
             for connection in self.connections.iter().filter(|c| c.to.0 == to) {
                 let (from, output) = connection.from;
@@ -450,7 +488,20 @@ impl System {
                     column,
                 });
             }
-            self.components[to].inputs = inputs;
+            // the columns of its inputs' values, if they follow one another
+            let start = self.sources.get(first).map_or(0, |s| s.column);
+            let consecutive = self.sources[first..]
+                .iter()
+                .enumerate()
+                .all(|(k, s)| s.column != NOT_RECORDED && s.column == start + k);
+            self.direct &= consecutive;
+            let c = &mut self.components[to];
+            c.columns = if consecutive {
+                start..start + inputs.len()
+            } else {
+                0..0
+            };
+            c.inputs = inputs;
         }
         self.values = vec![0.0; self.sources.len()];
         forget_sampled(&mut self.components);

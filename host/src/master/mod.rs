@@ -170,13 +170,28 @@ fn all_finite(values: &[f64]) -> bool {
     lanes.iter().sum::<f64>() + rest == 0.0
 }
 
-/// Whether the sum of `values` is finite, which it is only if every value
-/// is: a NaN or an infinity among the terms makes the sum NaN or infinite
-/// (∞ + x = ∞ for finite x, ∞ − ∞ = NaN, NaN + x = NaN). The converse does
-/// not hold (finite values may overflow in the sum), so `false` is to be
-/// looked into with [`all_finite`]; `true` settles it with one addition
-/// per value, where [`all_finite`] needs two operations. Summed in four
-/// independent lanes, as [`all_finite`] is.
+/// [`all_finite`], cheaper when it holds (the usual case): the sum of
+/// `values` is finite only if every value is, since a NaN or an infinity
+/// among the terms makes the sum NaN or infinite (∞ + x = ∞ for finite x,
+/// ∞ − ∞ = NaN, NaN + x = NaN). That takes one addition per value where
+/// [`all_finite`] takes two operations. The converse does not hold
+/// (finite values may overflow in the sum), so a sum that is not finite
+/// is settled by [`all_finite`].
+#[inline(always)] // into the run's loop
+fn row_is_finite(values: &[f64]) -> bool {
+    sum_is_finite(values) || values_are_finite(values)
+}
+
+/// [`all_finite`], out of the run's loop: the rare case.
+#[cold]
+#[inline(never)]
+fn values_are_finite(values: &[f64]) -> bool {
+    all_finite(values)
+}
+
+/// Whether the sum of `values` is finite (see [`row_is_finite`]), summed
+/// in four independent lanes, as [`all_finite`] does.
+#[inline(always)]
 fn sum_is_finite(values: &[f64]) -> bool {
     let mut chunks = values.chunks_exact(4);
     let mut lanes = [0.0; 4];
@@ -324,12 +339,11 @@ fn step_all<M: MasterAlgorithm + ?Sized>(
         if let Err(e) = stepped {
             return Some(format!("at t = {t}: {e}"));
         }
-        let finite = match system.sample_with(sum_is_finite) {
+        let finite = match system.sample_with(row_is_finite) {
             Ok(finite) => finite,
             Err(e) => return Some(format!("at t = {t_next}: {e}")),
         };
-        // the usual case first: a row of numbers (a row whose sum is
-        // not finite is looked at value by value)
+        // the usual case first: a row of numbers
         if !finite {
             let row = system.recorded().last().unwrap_or_default();
             if let Some(e) = non_finite(system, row) {
@@ -346,7 +360,7 @@ fn step_all<M: MasterAlgorithm + ?Sized>(
 
 #[cfg(test)]
 mod tests {
-    use super::all_finite;
+    use super::{all_finite, communication_time, communication_times, row_is_finite};
 
     #[test]
     fn all_finite_finds_a_nan_or_infinity_anywhere() {
@@ -363,5 +377,59 @@ mod tests {
             }
         }
         assert!(all_finite(&[f64::MAX, -f64::MAX, f64::MIN_POSITIVE]));
+    }
+
+    #[test]
+    fn row_is_finite_is_all_finite_also_where_the_sum_overflows() {
+        let big = [f64::MAX, f64::MAX / 2.0, -f64::MAX, 1e308, 1e308, -1e-300];
+        for n in 0..14 {
+            let values: Vec<f64> = (0..n).map(|i| (i as f64 - 5.5) * 1e3).collect();
+            assert!(row_is_finite(&values), "{values:?}");
+            for k in 0..n {
+                // finite values whose sum is not: still a row of numbers
+                for x in big {
+                    let mut v = values.clone();
+                    v[k] = x;
+                    v[(k + 1) % n] = x;
+                    assert_eq!(row_is_finite(&v), all_finite(&v), "{v:?}");
+                    assert!(row_is_finite(&v), "{v:?}");
+                }
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut v = values.clone();
+                    v[k] = bad;
+                    assert!(!row_is_finite(&v), "{v:?}");
+                    // an infinity of the other sign elsewhere: ∞ − ∞ = NaN
+                    v[(k + 5) % n] = if bad == f64::INFINITY {
+                        f64::NEG_INFINITY
+                    } else {
+                        v[(k + 5) % n]
+                    };
+                    assert!(!row_is_finite(&v), "{v:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_times_of_the_rows_are_their_communication_times_bit_for_bit() {
+        for (start, h) in [(0.0, 1e-4), (0.0, 0.1), (1.5, 1e-3), (-2.0, 1.0 / 3.0)] {
+            for points in [
+                0..0,
+                0..1,
+                0..2,
+                0..7,
+                0..200_001,
+                3..4,
+                5..12,
+                99_990..100_001,
+            ] {
+                let times = communication_times(start, h, points.clone());
+                assert_eq!(times.len(), points.len());
+                for (t, j) in times.iter().zip(points) {
+                    let expected = communication_time(start, h, j);
+                    assert_eq!(t.to_bits(), expected.to_bits(), "{start} + {j}·{h}");
+                }
+            }
+        }
     }
 }
