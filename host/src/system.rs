@@ -29,10 +29,10 @@ pub struct Component {
     /// [`System::propagate`] sets them in one `fmi2SetReal`, from the
     /// next `inputs.len()` values it has read (see [`System::plan`]).
     inputs: Vec<ValueReference>,
-    /// Where the values of `inputs` are in a recorded row, if they are
+    /// Where the values of `inputs` start in a recorded row, if they are
     /// there one after the other in the same order (see
-    /// [`System::step_jacobi`]); `0..0` without inputs.
-    columns: std::ops::Range<usize>,
+    /// [`System::step_jacobi`]); 0 without inputs.
+    first_column: usize,
     /// Its [`Instance::changes`] when [`System::sample`] read the last row,
     /// [`NOT_READ`] where that row cannot be used (none read, or
     /// discarded): while the count stands there, the row holds what
@@ -91,7 +91,7 @@ pub struct System {
     values: Vec<f64>,
     /// Whether every connected input reads a recorded output and each
     /// component's inputs are read from one run of a row's columns
-    /// ([`Component::columns`]): then, while the last row read can be
+    /// (from [`Component::first_column`] on): then, while the last row read can be
     /// used for every component, [`System::step_jacobi`] sets the inputs
     /// straight from that row.
     direct: bool,
@@ -254,7 +254,7 @@ impl System {
                 output_vrs: outputs.iter().map(|(_, vr)| *vr).collect(),
                 outputs,
                 inputs: Vec::new(),
-                columns: 0..0,
+                first_column: 0,
                 sampled: NOT_READ,
             });
         }
@@ -433,9 +433,10 @@ impl System {
         {
             // every component sampled into the last row since the plan
             // (which forgets the samples before it): a row of the planned
-            // width, holding every column of `columns`
+            // width, holding every column the inputs read
             for c in &mut self.components {
-                let now = &last[c.columns.clone()];
+                let start = c.first_column;
+                let now = &last[start..start + c.inputs.len()];
                 if !now.is_empty() {
                     c.instance.set_real(&c.inputs, now)?;
                 }
@@ -496,11 +497,7 @@ impl System {
                 .all(|(k, s)| s.column != NOT_RECORDED && s.column == start + k);
             self.direct &= consecutive;
             let c = &mut self.components[to];
-            c.columns = if consecutive {
-                start..start + inputs.len()
-            } else {
-                0..0
-            };
+            c.first_column = if consecutive { start } else { 0 };
             c.inputs = inputs;
         }
         self.values = vec![0.0; self.sources.len()];
