@@ -266,9 +266,11 @@ pub fn simulate_with(
     let n = step_count(start, h, stop);
     system.start_recording(n + 1);
     system.sample()?;
-    let error = match master.as_jacobi() {
-        Some(jacobi) => step_all(system, jacobi, observer, start, h, n),
-        None => step_all(system, master, observer, start, h, n),
+    let error = match (master.as_jacobi(), observer.between_steps()) {
+        (Some(jacobi), false) => step_all::<_, false>(system, jacobi, observer, start, h, n),
+        (Some(jacobi), true) => step_all::<_, true>(system, jacobi, observer, start, h, n),
+        (None, false) => step_all::<_, false>(system, master, observer, start, h, n),
+        (None, true) => step_all::<_, true>(system, master, observer, start, h, n),
     };
     // the times of the rows kept follow from their number: nothing is
     // stored for them as the run steps
@@ -309,9 +311,11 @@ fn communication_times(start: f64, h: f64, points: std::ops::Range<usize>) -> Ve
 /// The `n` steps of [`simulate_with`] from `start`, after the row of
 /// point 0: a row per communication point completed; why the run stopped
 /// early, if it did. One copy for the Jacobi master, its step inlined, one
-/// for any other, called through the trait object.
+/// for any other, called through the trait object; each in two, with and
+/// without the observer's calls between the steps
+/// ([`Observer::between_steps`], `BETWEEN_STEPS`).
 #[inline(never)]
-fn step_all<M: MasterAlgorithm + ?Sized>(
+fn step_all<M: MasterAlgorithm + ?Sized, const BETWEEN_STEPS: bool>(
     system: &mut System,
     master: &mut M,
     observer: &mut dyn Observer,
@@ -319,18 +323,15 @@ fn step_all<M: MasterAlgorithm + ?Sized>(
     h: f64,
     n: usize,
 ) -> Option<String> {
-    let between_steps = observer.between_steps();
     // t = start + i·h, each counted from the start; the step's end is the
-    // next step's start, so each is computed once. The count i is carried
-    // as a float too: i + 1.0 is exact (i < 2⁵³), the same number as
-    // `(i + 1) as f64` without converting it at every step.
+    // next step's start, so each is computed once. The count converted as
+    // a signed integer (one instruction; without the sign, several): the
+    // same number, the count being far below 2⁶³.
     let mut t_next = counted(start, h, 0);
-    let mut next = 0.0;
     for i in 0..n {
         let t = t_next;
-        next += 1.0;
-        t_next = start + next * h;
-        let stepped = if between_steps {
+        t_next = start + (i + 1) as i64 as f64 * h;
+        let stepped = if BETWEEN_STEPS {
             observer.before_step(system, t, false)
         } else {
             Ok(())
@@ -351,7 +352,7 @@ fn step_all<M: MasterAlgorithm + ?Sized>(
                 return Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
             }
         }
-        if between_steps {
+        if BETWEEN_STEPS {
             observer.after_step(i + 1, n);
         }
     }
