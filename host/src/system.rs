@@ -90,10 +90,10 @@ pub struct System {
     /// ([`System::step_jacobi`]).
     values: Vec<f64>,
     /// Whether every connected input reads a recorded output and each
-    /// component's inputs are read from one run of a row's columns
-    /// (from [`Component::first_column`] on): then, while the last row read can be
-    /// used for every component, [`System::step_jacobi`] sets the inputs
-    /// straight from that row.
+    /// component's inputs are read from one run of a row's columns (from
+    /// [`Component::first_column`] on): then, while the last row read can
+    /// be used for every component, [`System::step_jacobi`] sets the
+    /// inputs straight from that row.
     direct: bool,
 }
 
