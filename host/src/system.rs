@@ -421,16 +421,16 @@ impl System {
     /// component's from consecutive columns, and no component has seen a
     /// call since the last row was read (nothing happened between the
     /// steps). Then that row holds every value to be set, at the same
-    /// time: the inputs are set from it, with no copy.
+    /// time: the inputs are set from it, with no copy. `sampled`: the
+    /// caller knows the last row to have been read right before, with no
+    /// call since ([`System::sample`] notes every component's count as it
+    /// reads it), and the counts need not be compared.
     #[inline(always)]
-    pub(crate) fn step_jacobi(&mut self, t: f64, h: f64) -> Result<(), FmuError> {
+    pub(crate) fn step_jacobi(&mut self, t: f64, h: f64, sampled: bool) -> Result<(), FmuError> {
         let last = self.recording.rows.last().unwrap_or_default();
-        if self.direct
-            && self
-                .components
-                .iter()
-                .all(|c| c.sampled == c.instance.changes())
-        {
+        let unchanged = |c: &Component| c.sampled == c.instance.changes();
+        debug_assert!(!sampled || self.components.iter().all(unchanged));
+        if self.direct && (sampled || self.components.iter().all(unchanged)) {
             // every component sampled into the last row since the plan
             // (which forgets the samples before it): a row of the planned
             // width, holding every column the inputs read

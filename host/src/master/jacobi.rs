@@ -15,7 +15,7 @@ impl MasterAlgorithm for Jacobi {
 
     #[inline(always)] // into the run's loop (see `MasterAlgorithm::as_jacobi`)
     fn step(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
-        system.step_jacobi(t, h)
+        system.step_jacobi(t, h, false)
     }
 
     fn as_jacobi(&mut self) -> Option<&mut Jacobi> {

@@ -308,6 +308,42 @@ fn communication_times(start: f64, h: f64, points: std::ops::Range<usize>) -> Ve
     times
 }
 
+/// How [`step_all`] advances the system by one macro step: any master
+/// through [`MasterAlgorithm::step`], the Jacobi master's step inlined.
+trait Advance {
+    /// [`MasterAlgorithm::step`] from `t` over `h`. `sampled`: the last
+    /// row was read by [`System::sample`] right before, with no call to any
+    /// component since (so that every recorded output in it is what the
+    /// FMUs would answer).
+    fn advance(
+        &mut self,
+        system: &mut System,
+        t: f64,
+        h: f64,
+        sampled: bool,
+    ) -> Result<(), FmuError>;
+}
+
+impl Advance for dyn MasterAlgorithm + '_ {
+    #[inline(always)]
+    fn advance(&mut self, system: &mut System, t: f64, h: f64, _: bool) -> Result<(), FmuError> {
+        self.step(system, t, h)
+    }
+}
+
+impl Advance for jacobi::Jacobi {
+    #[inline(always)]
+    fn advance(
+        &mut self,
+        system: &mut System,
+        t: f64,
+        h: f64,
+        sampled: bool,
+    ) -> Result<(), FmuError> {
+        system.step_jacobi(t, h, sampled)
+    }
+}
+
 /// The `n` steps of [`simulate_with`] from `start`, after the row of
 /// point 0: a row per communication point completed; why the run stopped
 /// early, if it did. One copy for the Jacobi master, its step inlined, one
@@ -315,7 +351,7 @@ fn communication_times(start: f64, h: f64, points: std::ops::Range<usize>) -> Ve
 /// without the observer's calls between the steps
 /// ([`Observer::between_steps`], `BETWEEN_STEPS`).
 #[inline(never)]
-fn step_all<M: MasterAlgorithm + ?Sized, const BETWEEN_STEPS: bool>(
+fn step_all<M: Advance + ?Sized, const BETWEEN_STEPS: bool>(
     system: &mut System,
     master: &mut M,
     observer: &mut dyn Observer,
@@ -336,7 +372,10 @@ fn step_all<M: MasterAlgorithm + ?Sized, const BETWEEN_STEPS: bool>(
         } else {
             Ok(())
         }
-        .and_then(|()| master.step(system, t, t_next - t));
+        // without the observer, nothing comes between the row read at the
+        // end of the last step (or by `simulate_with` before the first)
+        // and this step
+        .and_then(|()| master.advance(system, t, t_next - t, !BETWEEN_STEPS));
         if let Err(e) = stepped {
             return Some(format!("at t = {t}: {e}"));
         }
