@@ -202,7 +202,7 @@ fn sum_is_finite(values: &[f64]) -> bool {
     }
     let rest = chunks.remainder().iter().sum::<f64>();
     let sum = lanes.iter().sum::<f64>() + rest;
-    sum.is_finite()
+    sum * 0.0 == 0.0 // 0 for a finite sum, NaN otherwise
 }
 
 /// Initialise, then step with a fixed macro step `h` from 0 to `stop`;
