@@ -206,13 +206,17 @@ impl Rows {
     /// row is built elsewhere and copied).
     #[inline] // once per communication point, a few instructions
     pub fn push_zeros(&mut self) -> &mut [f64] {
-        let mut start = self.len * self.width;
-        if self.values.len() < start + self.width {
-            start = self.make_room();
+        let start = self.len * self.width;
+        let end = start.wrapping_add(self.width);
+        // the usual case: a row made ready (the test also spares the
+        // slicing its own)
+        if start <= end && end <= self.values.len() {
+            self.len += 1;
+            return &mut self.values[start..end];
         }
-        let end = start + self.width;
+        let start = self.make_room();
         self.len += 1;
-        &mut self.values[start..end]
+        &mut self.values[start..start + self.width]
     }
 
     /// Room for one more row when none is made ready; where it starts. A

@@ -25,6 +25,19 @@ pub struct Component {
     /// The value references of `outputs`, in order: [`System::sample`]
     /// reads them in one `fmi2GetReal` call.
     output_vrs: Vec<ValueReference>,
+    /// The component's connected inputs, in connection order:
+    /// [`System::propagate`] sets them in one `fmi2SetReal`, from the
+    /// next `inputs.len()` values it has read (see [`System::plan`]).
+    inputs: Vec<ValueReference>,
+    /// Where the values of `inputs` start in a recorded row, if they are
+    /// there one after the other in the same order (see
+    /// [`System::step_jacobi`]); 0 without inputs.
+    first_column: usize,
+    /// Its [`Instance::changes`] when [`System::sample`] read the last row,
+    /// [`NOT_READ`] where that row cannot be used (none read, or
+    /// discarded): while the count stands there, the row holds what
+    /// `fmi2GetReal` would answer for the outputs it recorded.
+    sampled: u64,
 }
 
 impl Component {
@@ -66,61 +79,87 @@ pub struct System {
     /// The connections, fixed when the system is built (what
     /// [`System::propagate`] does is planned from them then).
     pub connections: Vec<Connection>,
-    /// The rows [`System::sample`] read, and how [`System::propagate`]
-    /// finds a connected output in the last one.
+    /// The rows [`System::sample`] read.
     recording: Recording,
-    /// The connections grouped by the component they lead to, in the order
-    /// in which those components first appear in `connections`: one
-    /// `fmi2SetReal` per component sets all its connected inputs.
-    targets: Vec<Target>,
-    /// Where each input of `targets` reads its value, one after the other
-    /// in the same order (one per connection).
+    /// Where each connected input reads its value, one per connection:
+    /// the inputs of the first component that has any (in connection
+    /// order), then those of the next, as the components'
+    /// [`Component::inputs`] follow one another.
     sources: Vec<Source>,
+    /// Room for the values of `sources`, for the Jacobi master's step
+    /// ([`System::step_jacobi`]).
+    values: Vec<f64>,
+    /// Whether every connected input reads a recorded output and each
+    /// component's inputs are read from one run of a row's columns (from
+    /// [`Component::first_column`] on): then, while the last row read can
+    /// be used for every component, [`System::step_jacobi`] sets the
+    /// inputs straight from that row.
+    direct: bool,
 }
 
 /// What [`System::sample`] has read: one row of every component's
-/// recorded outputs per call, and each component's [`Instance::changes`]
-/// when the last row was read, so that [`System::propagate`] can take an
-/// output from that row instead of asking the FMU again while the
-/// component has seen no call that could have changed it.
+/// recorded outputs per call (with each component's [`Instance::changes`]
+/// then in [`Component::sampled`], so that [`System::propagate`] can take
+/// an output from the last row instead of asking the FMU again while the
+/// component has seen no call that could have changed it).
 struct Recording {
     rows: Rows,
     /// Rows kept at most ([`System::keep_last_rows`]); `None`: every row.
     window: Option<usize>,
-    /// Per component, its [`Instance::changes`] when the last row was read;
-    /// [`NOT_READ`] where the last row cannot be used (none read, or
-    /// discarded).
-    changes: Vec<u64>,
 }
 
-/// In [`Recording::changes`]: the last row is not to be used. A count
+/// In [`Component::sampled`]: the last row is not to be used. A count
 /// that [`Instance::changes`] does not reach (one more per FMI call).
 const NOT_READ: u64 = u64::MAX;
 
-impl Recording {
-    /// Output `column` of `last` (the last row), if component `c` has seen
-    /// no call since it was read that could have changed it.
-    #[inline]
-    fn value(&self, last: &[f64], component: &Component, c: usize, column: usize) -> Option<f64> {
-        if self.changes[c] != component.instance.changes() {
-            return None;
-        }
-        last.get(column).copied()
-    }
+/// In [`Source::column`]: the output is not recorded (no row has it).
+const NOT_RECORDED: usize = usize::MAX;
 
-    /// Forget the last row's reading: no value is taken from it any more.
-    fn invalidate(&mut self) {
-        self.changes.fill(NOT_READ);
+/// Forget the last row's reading: no value is taken from it any more.
+fn forget_sampled(components: &mut [Component]) {
+    for c in components {
+        c.sampled = NOT_READ;
     }
 }
 
-/// The connected inputs of one component, for [`System::propagate`].
-struct Target {
-    /// The component the inputs belong to.
-    component: usize,
-    /// Its connected inputs, in connection order; their sources are the
-    /// next `inputs.len()` entries of [`System::sources`].
-    inputs: Vec<ValueReference>,
+/// Read every component's recorded outputs into `row`, one `fmi2GetReal`
+/// per component, one after the other (`row` holds as many values as
+/// they have), and note each component's [`Instance::changes`] then.
+#[inline(always)] // into the run's loop
+fn read_outputs(components: &mut [Component], row: &mut [f64]) -> Result<(), FmuError> {
+    let mut rest = row;
+    for c in components {
+        let (values, after) = rest.split_at_mut(c.output_vrs.len());
+        c.instance.get_real(&c.output_vrs, values)?;
+        c.sampled = c.instance.changes();
+        rest = after;
+    }
+    Ok(())
+}
+
+/// Read every connected output, one per `sources`, into `values` (as
+/// many). An output recorded in `last` (the last row read) of a component
+/// that has seen no call since that row was read ([`Component::sampled`])
+/// is taken from the row; any other is asked for with `fmi2GetReal`.
+#[inline(always)] // into the Jacobi master's step
+fn gather(
+    components: &mut [Component],
+    last: &[f64],
+    sources: &[Source],
+    values: &mut [f64],
+) -> Result<(), FmuError> {
+    for (slot, source) in values.iter_mut().zip(sources) {
+        let from = &mut components[source.component];
+        *slot = match last.get(source.column) {
+            Some(&x) if from.sampled == from.instance.changes() => x,
+            _ => {
+                let mut x = [0.0];
+                from.instance.get_real(&[source.output], &mut x)?;
+                x[0]
+            }
+        };
+    }
+    Ok(())
 }
 
 /// The output a connected input reads.
@@ -128,8 +167,9 @@ struct Source {
     /// The source component and output.
     component: usize,
     output: ValueReference,
-    /// The output's column in a recorded row, if it is recorded.
-    column: Option<usize>,
+    /// The output's column in a recorded row; [`NOT_RECORDED`] if it is
+    /// not recorded.
+    column: usize,
 }
 
 fn split_port(port: &str) -> Result<(&str, &str), SystemError> {
@@ -213,6 +253,9 @@ impl System {
                 instance,
                 output_vrs: outputs.iter().map(|(_, vr)| *vr).collect(),
                 outputs,
+                inputs: Vec::new(),
+                first_column: 0,
+                sampled: NOT_READ,
             });
         }
         let mut system = System {
@@ -221,10 +264,10 @@ impl System {
             recording: Recording {
                 rows: Rows::new(0),
                 window: None,
-                changes: Vec::new(),
             },
-            targets: Vec::new(),
             sources: Vec::new(),
+            values: Vec::new(),
+            direct: false,
         };
         for (from, to) in connections {
             let (fi, fv) = find(&system.components, from)?;
@@ -347,42 +390,69 @@ impl System {
 
     /// Copy every connected output to its input: first every value is
     /// read, then each component's connected inputs are set in one
-    /// `fmi2SetReal`. An output recorded in the last row [`System::sample`]
-    /// read, of a component that has seen no call since that could have
-    /// changed it, is taken from that row instead of being asked for again.
-    /// `buffer` is room for the values, one per connection.
+    /// `fmi2SetReal`, component after component. An output recorded in
+    /// the last row [`System::sample`] read, of a component that has seen
+    /// no call since that could have changed it, is taken from that row
+    /// instead of being asked for again. `buffer` is room for the values,
+    /// one per connection.
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
-        self.propagate_inline(buffer)
+        let last = self.recording.rows.last().unwrap_or_default();
+        gather(&mut self.components, last, &self.sources, buffer)?;
+        let mut values = &buffer[..self.sources.len()];
+        for c in &mut self.components {
+            let (now, rest) = values.split_at(c.inputs.len());
+            if !now.is_empty() {
+                c.instance.set_real(&c.inputs, now)?;
+            }
+            values = rest;
+        }
+        Ok(())
     }
 
-    /// [`System::propagate`] inlined into the caller: the Jacobi master's
-    /// step, where the call itself is a fair share of the host's work (the
-    /// run's start calls the one above).
+    /// The Jacobi master's step from `t` over `h`: [`System::propagate`]
+    /// (every value read before any is set), and each component's
+    /// `fmi2DoStep` right after its inputs are set, in one pass over the
+    /// components (the components step independently of one another on
+    /// the values of the communication point, so it does not matter that
+    /// one has stepped before the next one's inputs are set). Inlined into
+    /// the run's loop.
+    ///
+    /// The usual case: every input reads a recorded output, each
+    /// component's from consecutive columns, and no component has seen a
+    /// call since the last row was read (nothing happened between the
+    /// steps). Then that row holds every value to be set, at the same
+    /// time: the inputs are set from it, with no copy. `sampled`: the
+    /// caller knows the last row to have been read right before, with no
+    /// call since ([`System::sample`] notes every component's count as it
+    /// reads it), and the counts need not be compared.
     #[inline(always)]
-    pub(crate) fn propagate_inline(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
-        let recording = &self.recording;
-        let last = recording.rows.last().unwrap_or_default();
-        for (slot, source) in buffer.iter_mut().zip(&self.sources) {
-            let from = &mut self.components[source.component];
-            let known = source
-                .column
-                .and_then(|column| recording.value(last, from, source.component, column));
-            *slot = match known {
-                Some(x) => x,
-                None => {
-                    let mut x = [0.0];
-                    from.instance.get_real(&[source.output], &mut x)?;
-                    x[0]
+    pub(crate) fn step_jacobi(&mut self, t: f64, h: f64, sampled: bool) -> Result<(), FmuError> {
+        let last = self.recording.rows.last().unwrap_or_default();
+        let unchanged = |c: &Component| c.sampled == c.instance.changes();
+        debug_assert!(!sampled || self.components.iter().all(unchanged));
+        if self.direct && (sampled || self.components.iter().all(unchanged)) {
+            // every component sampled into the last row since the plan
+            // (which forgets the samples before it): a row of the planned
+            // width, holding every column the inputs read
+            for c in &mut self.components {
+                let start = c.first_column;
+                let now = &last[start..start + c.inputs.len()];
+                if !now.is_empty() {
+                    c.instance.set_real(&c.inputs, now)?;
                 }
-            };
+                c.instance.do_step(t, h)?;
+            }
+            return Ok(());
         }
-        let mut values = &buffer[..self.sources.len()];
-        for target in &self.targets {
-            let (now, rest) = values.split_at(target.inputs.len());
-            self.components[target.component]
-                .instance
-                .set_real(&target.inputs, now)?;
+        gather(&mut self.components, last, &self.sources, &mut self.values)?;
+        let mut values = &self.values[..];
+        for c in &mut self.components {
+            let (now, rest) = values.split_at(c.inputs.len());
+            if !now.is_empty() {
+                c.instance.set_real(&c.inputs, now)?;
+            }
             values = rest;
+            c.instance.do_step(t, h)?;
         }
         Ok(())
     }
@@ -398,17 +468,12 @@ impl System {
             offsets.push(width);
             width += c.output_vrs.len();
         }
-        // connection order within each target, targets in order of first
-        // appearance
-        let mut order: Vec<usize> = Vec::new();
-        for connection in &self.connections {
-            if !order.contains(&connection.to.0) {
-                order.push(connection.to.0);
-            }
-        }
-        self.targets.clear();
+        // per component, its connected inputs in connection order; their
+        // sources one after the other in the same order
         self.sources.clear();
-        for to in order {
+        self.direct = true;
+        for to in 0..self.components.len() {
+            let first = self.sources.len();
             let mut inputs = Vec::new();
             for connection in self.connections.iter().filter(|c| c.to.0 == to) {
                 let (from, output) = connection.from;
@@ -416,7 +481,7 @@ impl System {
                     .output_vrs
                     .iter()
                     .position(|vr| *vr == output)
-                    .map(|i| offsets[from] + i);
+                    .map_or(NOT_RECORDED, |i| offsets[from] + i);
                 inputs.push(connection.to.1);
                 self.sources.push(Source {
                     component: from,
@@ -424,13 +489,20 @@ impl System {
                     column,
                 });
             }
-            self.targets.push(Target {
-                component: to,
-                inputs,
-            });
+            // the columns of its inputs' values, if they follow one another
+            let start = self.sources.get(first).map_or(0, |s| s.column);
+            let consecutive = self.sources[first..]
+                .iter()
+                .enumerate()
+                .all(|(k, s)| s.column != NOT_RECORDED && s.column == start + k);
+            self.direct &= consecutive;
+            let c = &mut self.components[to];
+            c.first_column = if consecutive { start } else { 0 };
+            c.inputs = inputs;
         }
+        self.values = vec![0.0; self.sources.len()];
+        forget_sampled(&mut self.components);
         let recording = &mut self.recording;
-        recording.changes = vec![NOT_READ; self.components.len()];
         if recording.rows.width() != width {
             recording.rows = Rows::new(width);
         }
@@ -511,7 +583,7 @@ impl System {
             Some(window) if window < rows => Rows::windowed(width, window),
             _ => Rows::with_capacity(width, rows),
         };
-        recording.invalidate();
+        forget_sampled(&mut self.components);
     }
 
     /// Let the recordings started from now on keep only their last
@@ -533,22 +605,21 @@ impl System {
     /// Read every recorded output into a new row of the recording, one
     /// `fmi2GetReal` per component, in [`System::columns`] order. If a
     /// call fails, no row is added.
-    #[inline(always)] // into the run's loop: once per macro step, whatever the master
     pub fn sample(&mut self) -> Result<(), FmuError> {
-        let recording = &mut self.recording;
-        let row = recording.rows.push_zeros();
-        let mut from = 0;
-        for (c, changes) in self.components.iter_mut().zip(&mut recording.changes) {
-            let to = from + c.output_vrs.len();
-            if let Err(e) = c.instance.get_real(&c.output_vrs, &mut row[from..to]) {
-                recording.rows.pop();
-                recording.invalidate(); // nothing sampled to reuse
-                return Err(e);
-            }
-            *changes = c.instance.changes();
-            from = to;
+        self.sample_with(|_| ())
+    }
+
+    /// [`System::sample`], inlined into the run's loop (once per macro
+    /// step, whatever the master): what `look` finds in the new row.
+    #[inline(always)]
+    pub(crate) fn sample_with<R>(&mut self, look: impl FnOnce(&[f64]) -> R) -> Result<R, FmuError> {
+        let row = self.recording.rows.push_zeros();
+        if let Err(e) = read_outputs(&mut self.components, row) {
+            self.recording.rows.pop();
+            forget_sampled(&mut self.components); // nothing sampled to reuse
+            return Err(e);
         }
-        Ok(())
+        Ok(look(row))
     }
 
     /// The rows read so far: one per [`System::sample`] since the
@@ -561,13 +632,13 @@ impl System {
     /// with a NaN); [`System::propagate`] then asks the FMUs again.
     pub fn discard_last_sample(&mut self) {
         self.recording.rows.pop();
-        self.recording.invalidate();
+        forget_sampled(&mut self.components);
     }
 
     /// The rows read so far; the recording starts over empty.
     pub fn take_recording(&mut self) -> Rows {
         let width = self.recording.rows.width();
-        self.recording.invalidate();
+        forget_sampled(&mut self.components);
         std::mem::replace(&mut self.recording.rows, Rows::new(width))
     }
 }

@@ -6,21 +6,19 @@ use crate::system::System;
 use crate::FmuError;
 
 #[derive(Default)]
-pub struct Jacobi {
-    buffer: Vec<f64>,
-}
+pub struct Jacobi {}
 
 impl MasterAlgorithm for Jacobi {
     fn name(&self) -> &'static str {
         "jacobi"
     }
 
+    #[inline(always)] // into the run's loop (see `MasterAlgorithm::as_jacobi`)
     fn step(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
-        self.buffer.resize(system.connections.len(), 0.0);
-        system.propagate_inline(&mut self.buffer)?;
-        for c in &mut system.components {
-            c.instance.do_step(t, h)?;
-        }
-        Ok(())
+        system.step_jacobi(t, h, false)
+    }
+
+    fn as_jacobi(&mut self) -> Option<&mut Jacobi> {
+        Some(self)
     }
 }

@@ -16,6 +16,13 @@ pub trait MasterAlgorithm {
     fn report(&self) -> Option<String> {
         None
     }
+    /// The Jacobi master, if this is it: [`simulate_with`] then runs its
+    /// step inlined into the run's loop instead of calling it through the
+    /// trait object at every macro step (the call and the reloading of the
+    /// system after it are a fair share of the host's work in a step).
+    fn as_jacobi(&mut self) -> Option<&mut jacobi::Jacobi> {
+        None
+    }
 }
 
 /// The master algorithms by their command-line names.
@@ -163,6 +170,41 @@ fn all_finite(values: &[f64]) -> bool {
     lanes.iter().sum::<f64>() + rest == 0.0
 }
 
+/// [`all_finite`], cheaper when it holds (the usual case): the sum of
+/// `values` is finite only if every value is, since a NaN or an infinity
+/// among the terms makes the sum NaN or infinite (∞ + x = ∞ for finite x,
+/// ∞ − ∞ = NaN, NaN + x = NaN). That takes one addition per value where
+/// [`all_finite`] takes two operations. The converse does not hold
+/// (finite values may overflow in the sum), so a sum that is not finite
+/// is settled by [`all_finite`].
+#[inline(always)] // into the run's loop
+fn row_is_finite(values: &[f64]) -> bool {
+    sum_is_finite(values) || values_are_finite(values)
+}
+
+/// [`all_finite`], out of the run's loop: the rare case.
+#[cold]
+#[inline(never)]
+fn values_are_finite(values: &[f64]) -> bool {
+    all_finite(values)
+}
+
+/// Whether the sum of `values` is finite (see [`row_is_finite`]), summed
+/// in four independent lanes, as [`all_finite`] does.
+#[inline(always)]
+fn sum_is_finite(values: &[f64]) -> bool {
+    let mut chunks = values.chunks_exact(4);
+    let mut lanes = [0.0; 4];
+    for chunk in &mut chunks {
+        for (lane, x) in lanes.iter_mut().zip(chunk) {
+            *lane += x;
+        }
+    }
+    let rest = chunks.remainder().iter().sum::<f64>();
+    let sum = lanes.iter().sum::<f64>() + rest;
+    sum * 0.0 == 0.0 // 0 for a finite sum, NaN otherwise
+}
+
 /// Initialise, then step with a fixed macro step `h` from 0 to `stop`;
 /// time is counted (t = n·h), never summed. An FMU error, or a NaN or
 /// infinite output after a step, stops the run and is reported with the
@@ -224,25 +266,16 @@ pub fn simulate_with(
     let n = step_count(start, h, stop);
     system.start_recording(n + 1);
     system.sample()?;
-    let (error, time) = if system.recorded().is_windowed() {
-        // nothing stored as the run steps: the times of the rows kept
-        // follow from their number when it ends
-        (
-            step_all(system, master, observer, start, h, n, &mut ()),
-            None,
-        )
-    } else {
-        let mut time = Vec::with_capacity(n + 1);
-        time.push(start);
-        let error = step_all(system, master, observer, start, h, n, &mut time);
-        (error, Some(time))
+    let error = match (master.as_jacobi(), observer.between_steps()) {
+        (Some(jacobi), false) => step_all::<_, false>(system, jacobi, observer, start, h, n),
+        (Some(jacobi), true) => step_all::<_, true>(system, jacobi, observer, start, h, n),
+        (None, false) => step_all::<_, false>(system, master, observer, start, h, n),
+        (None, true) => step_all::<_, true>(system, master, observer, start, h, n),
     };
+    // the times of the rows kept follow from their number: nothing is
+    // stored for them as the run steps
     let rows = system.take_recording();
-    let time = time.unwrap_or_else(|| {
-        (rows.rows_folded()..rows.rows_pushed())
-            .map(|j| communication_time(start, h, j))
-            .collect()
-    });
+    let time = communication_times(start, h, rows.rows_folded()..rows.rows_pushed());
     Ok(Run {
         columns,
         time,
@@ -251,69 +284,114 @@ pub fn simulate_with(
     })
 }
 
-/// Where [`step_all`] puts the time of each communication point it
-/// completes: a run that keeps every row stores them as it goes
-/// (`Vec<f64>`), a windowed one nothing (`()`), so that neither does work
-/// per step that it has no use for.
-trait Times {
-    fn push(&mut self, t: f64);
+/// [`communication_time`] of each point of `points`, computed as
+/// [`step_all`] does: `start + j·h` with the count `j` carried as a float
+/// (exact: `j < 2⁵³`), so that no count is converted one by one.
+#[inline(never)] // a loop of its own, apart from the run's
+fn communication_times(start: f64, h: f64, points: std::ops::Range<usize>) -> Vec<f64> {
+    let mut times = vec![0.0; points.len()];
+    // two points at a time (counts j and j + 1, each exact), side by side
+    let mut j = [points.start as f64, points.start as f64 + 1.0];
+    let mut pairs = times.chunks_exact_mut(2);
+    for pair in &mut pairs {
+        for (t, j) in pair.iter_mut().zip(&mut j) {
+            *t = start + *j * h;
+            *j += 2.0;
+        }
+    }
+    if let [t] = pairs.into_remainder() {
+        *t = start + j[0] * h;
+    }
+    if let (0, Some(first)) = (points.start, times.first_mut()) {
+        *first = start;
+    }
+    times
 }
 
-impl Times for Vec<f64> {
+/// How [`step_all`] advances the system by one macro step: any master
+/// through [`MasterAlgorithm::step`], the Jacobi master's step inlined.
+trait Advance {
+    /// [`MasterAlgorithm::step`] from `t` over `h`. `sampled`: the last
+    /// row was read by [`System::sample`] right before, with no call to any
+    /// component since (so that every recorded output in it is what the
+    /// FMUs would answer).
+    fn advance(
+        &mut self,
+        system: &mut System,
+        t: f64,
+        h: f64,
+        sampled: bool,
+    ) -> Result<(), FmuError>;
+}
+
+impl Advance for dyn MasterAlgorithm + '_ {
     #[inline(always)]
-    fn push(&mut self, t: f64) {
-        Vec::push(self, t);
+    fn advance(&mut self, system: &mut System, t: f64, h: f64, _: bool) -> Result<(), FmuError> {
+        self.step(system, t, h)
     }
 }
 
-impl Times for () {
+impl Advance for jacobi::Jacobi {
     #[inline(always)]
-    fn push(&mut self, _: f64) {}
+    fn advance(
+        &mut self,
+        system: &mut System,
+        t: f64,
+        h: f64,
+        sampled: bool,
+    ) -> Result<(), FmuError> {
+        system.step_jacobi(t, h, sampled)
+    }
 }
 
 /// The `n` steps of [`simulate_with`] from `start`, after the row of
-/// point 0: a row per communication point completed, its time to
-/// `times`; why the run stopped early, if it did.
-#[inline(always)] // the run's loop, one copy per kind of `times`
-fn step_all(
+/// point 0: a row per communication point completed; why the run stopped
+/// early, if it did. One copy for the Jacobi master, its step inlined, one
+/// for any other, called through the trait object; each in two, with and
+/// without the observer's calls between the steps
+/// ([`Observer::between_steps`], `BETWEEN_STEPS`).
+#[inline(never)]
+fn step_all<M: Advance + ?Sized, const BETWEEN_STEPS: bool>(
     system: &mut System,
-    master: &mut dyn MasterAlgorithm,
+    master: &mut M,
     observer: &mut dyn Observer,
     start: f64,
     h: f64,
     n: usize,
-    times: &mut impl Times,
 ) -> Option<String> {
-    let between_steps = observer.between_steps();
     // t = start + i·h, each counted from the start; the step's end is the
-    // next step's start, so each is computed once
+    // next step's start, so each is computed once. The count converted as
+    // a signed integer (one instruction; without the sign, several): the
+    // same number, the count being far below 2⁶³.
     let mut t_next = counted(start, h, 0);
     for i in 0..n {
         let t = t_next;
-        t_next = counted(start, h, i + 1);
-        let stepped = if between_steps {
+        t_next = start + (i + 1) as i64 as f64 * h;
+        let stepped = if BETWEEN_STEPS {
             observer.before_step(system, t, false)
         } else {
             Ok(())
         }
-        .and_then(|()| master.step(system, t, t_next - t));
+        // without the observer, nothing comes between the row read at the
+        // end of the last step (or by `simulate_with` before the first)
+        // and this step
+        .and_then(|()| master.advance(system, t, t_next - t, !BETWEEN_STEPS));
         if let Err(e) = stepped {
             return Some(format!("at t = {t}: {e}"));
         }
-        if let Err(e) = system.sample() {
-            return Some(format!("at t = {t_next}: {e}"));
-        }
+        let finite = match system.sample_with(row_is_finite) {
+            Ok(finite) => finite,
+            Err(e) => return Some(format!("at t = {t_next}: {e}")),
+        };
         // the usual case first: a row of numbers
-        let row = system.recorded().last().unwrap_or_default();
-        if let Some(e) = (!all_finite(row))
-            .then(|| non_finite(system, row))
-            .flatten()
-        {
-            system.discard_last_sample();
-            return Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
+        if !finite {
+            let row = system.recorded().last().unwrap_or_default();
+            if let Some(e) = non_finite(system, row) {
+                system.discard_last_sample();
+                return Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
+            }
         }
-        times.push(t_next);
-        if between_steps {
+        if BETWEEN_STEPS {
             observer.after_step(i + 1, n);
         }
     }
@@ -322,7 +400,7 @@ fn step_all(
 
 #[cfg(test)]
 mod tests {
-    use super::all_finite;
+    use super::{all_finite, communication_time, communication_times, row_is_finite};
 
     #[test]
     fn all_finite_finds_a_nan_or_infinity_anywhere() {
@@ -339,5 +417,59 @@ mod tests {
             }
         }
         assert!(all_finite(&[f64::MAX, -f64::MAX, f64::MIN_POSITIVE]));
+    }
+
+    #[test]
+    fn row_is_finite_is_all_finite_also_where_the_sum_overflows() {
+        let big = [f64::MAX, f64::MAX / 2.0, -f64::MAX, 1e308, 1e308, -1e-300];
+        for n in 0..14 {
+            let values: Vec<f64> = (0..n).map(|i| (i as f64 - 5.5) * 1e3).collect();
+            assert!(row_is_finite(&values), "{values:?}");
+            for k in 0..n {
+                // finite values whose sum is not: still a row of numbers
+                for x in big {
+                    let mut v = values.clone();
+                    v[k] = x;
+                    v[(k + 1) % n] = x;
+                    assert_eq!(row_is_finite(&v), all_finite(&v), "{v:?}");
+                    assert!(row_is_finite(&v), "{v:?}");
+                }
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut v = values.clone();
+                    v[k] = bad;
+                    assert!(!row_is_finite(&v), "{v:?}");
+                    // an infinity of the other sign elsewhere: ∞ − ∞ = NaN
+                    v[(k + 5) % n] = if bad == f64::INFINITY {
+                        f64::NEG_INFINITY
+                    } else {
+                        v[(k + 5) % n]
+                    };
+                    assert!(!row_is_finite(&v), "{v:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_times_of_the_rows_are_their_communication_times_bit_for_bit() {
+        for (start, h) in [(0.0, 1e-4), (0.0, 0.1), (1.5, 1e-3), (-2.0, 1.0 / 3.0)] {
+            for points in [
+                0..0,
+                0..1,
+                0..2,
+                0..7,
+                0..200_001,
+                3..4,
+                5..12,
+                99_990..100_001,
+            ] {
+                let times = communication_times(start, h, points.clone());
+                assert_eq!(times.len(), points.len());
+                for (t, j) in times.iter().zip(points) {
+                    let expected = communication_time(start, h, j);
+                    assert_eq!(t.to_bits(), expected.to_bits(), "{start} + {j}·{h}");
+                }
+            }
+        }
     }
 }
