@@ -22,9 +22,10 @@ Masters, as host/src/master/ implements them, with the same FMI calls in
 the same order as the host makes them, so that the comparison is of the
 two callers, not of two call sequences:
 
-- jacobi: at each communication point every input is set from the
-  connected output recorded there (no output is read twice), then every
-  FMU stepped over [t, t + h].
+- jacobi: at each communication point, component by component in the
+  system's order, the component's connected inputs are set in one
+  fmi2SetReal from the outputs recorded there (no output is read twice),
+  then it is stepped over [t, t + h].
 - newton: strong coupling. The unknowns are the connected inputs U, held
   over the step; stepping every FMU from its state at t gives the outputs
   Y(U); Newton solves R(U) = U − Y(U) = 0 with J = ∂Y/∂U from
@@ -107,10 +108,18 @@ def run(spec):
             c.set_parameters()
         started = time.perf_counter()
 
+        # per component, in the system's order: its connected inputs and
+        # the links that feed them (one fmi2SetReal per component, as the
+        # host sets them)
+        feeds = [(c, [inp for _, _, dst, inp in links if dst is c],
+                  [k for k, (_, _, dst, _) in enumerate(links) if dst is c])
+                 for c in components]
+
         def propagate():
             values = [src.fmu.getReal([out])[0] for src, out, _, _ in links]
-            for (_, _, dst, inp), value in zip(links, values):
-                dst.fmu.setReal([inp], [value])
+            for c, inputs, ks in feeds:
+                if inputs:
+                    c.fmu.setReal(inputs, [values[k] for k in ks])
 
         propagate()
         for c in components:
@@ -123,6 +132,8 @@ def run(spec):
             first[c.name] = k
             k += len(c.outputs)
         columns = [first[src.name] + src.outputs.index(out) for src, out, _, _ in links]
+        # per component: its inputs and the recorded columns they take
+        steps = [(c, inputs, [columns[k] for k in ks]) for c, inputs, ks in feeds]
         counts = {"iterations": 0, "jacobians": 0}
         newton = None
         if master == "newton":
@@ -133,9 +144,9 @@ def run(spec):
             t = i * h
             if newton is None:
                 row = rows[-1]
-                for (_, _, dst, inp), column in zip(links, columns):
-                    dst.fmu.setReal([inp], [row[column]])
-                for c in components:
+                for c, inputs, cols in steps:
+                    if inputs:
+                        c.fmu.setReal(inputs, [row[k] for k in cols])
                     c.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
             else:
                 newton.step(t, h)

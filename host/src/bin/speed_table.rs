@@ -79,7 +79,7 @@ struct Args {
     /// little), fricsim diagnose skipped.
     #[arg(long)]
     quick: bool,
-    /// Timed runs per figure; the best counts [default: 3, quick: 1, with
+    /// Timed runs per figure; the best counts [default: 5, quick: 1, with
     /// `--only`: 1].
     #[arg(long)]
     repeats: Option<usize>,
@@ -140,7 +140,7 @@ fn run(args: &Args) -> Result<(), String> {
         }
     } else {
         Sizes {
-            repeats: args.repeats.unwrap_or(3),
+            repeats: args.repeats.unwrap_or(5),
             law_steps: 200_000,
             host_stop: 20.0,
             sweep_runs: 16,
@@ -214,6 +214,23 @@ fn best_of(repeats: usize, mut f: impl FnMut() -> Result<f64, String>) -> Result
         best = best.min(f()?);
     }
     Ok(best)
+}
+
+/// [`best_of`] of two runs taken in turns (`f`, `g`, `f`, `g`, …, after
+/// one untimed run of each): the best time of each.
+fn best_of_alternating(
+    repeats: usize,
+    mut f: impl FnMut() -> Result<f64, String>,
+    mut g: impl FnMut() -> Result<f64, String>,
+) -> Result<(f64, f64), String> {
+    f()?;
+    g()?;
+    let (mut best_f, mut best_g) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..repeats {
+        best_f = best_f.min(f()?);
+        best_g = best_g.min(g()?);
+    }
+    Ok((best_f, best_g))
 }
 
 /// Wall time of `f`, s.
@@ -295,27 +312,30 @@ fn host_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<HostTable, St
     let model = StickSlipModel::from_file(&file)?;
     let mut rows = Vec::new();
     for master in ["jacobi", "newton"] {
-        let mut host_final = f64::NAN;
-        let mut host_iterations = 0.0;
-        let host = best_of(sizes.repeats, || {
-            let (wall, force, algorithm) = host_run(&file, master, h, stop)?;
-            host_final = force;
-            if let Some(report) = algorithm.report() {
-                host_iterations = mean_iterations(&report);
-            }
-            Ok(wall)
-        })?;
-        let mut mono_final = f64::NAN;
-        let mut mono_iterations = 0.0;
-        let monolithic = best_of(sizes.repeats, || {
-            let (wall, force, iterations) = match master {
-                "jacobi" => model.monolithic_jacobi(h, stop),
-                _ => model.monolithic_newton(h, stop)?,
-            };
-            mono_final = force;
-            mono_iterations = iterations;
-            Ok(wall)
-        })?;
+        let (mut host_final, mut host_iterations) = (f64::NAN, 0.0);
+        let (mut mono_final, mut mono_iterations) = (f64::NAN, 0.0);
+        // the two sides alternate, so that a slow spell of the machine
+        // weighs on both alike and not on their ratio
+        let (host, monolithic) = best_of_alternating(
+            sizes.repeats,
+            || {
+                let (wall, force, algorithm) = host_run(&file, master, h, stop)?;
+                host_final = force;
+                if let Some(report) = algorithm.report() {
+                    host_iterations = mean_iterations(&report);
+                }
+                Ok(wall)
+            },
+            || {
+                let (wall, force, iterations) = match master {
+                    "jacobi" => model.monolithic_jacobi(h, stop),
+                    _ => model.monolithic_newton(h, stop)?,
+                };
+                mono_final = force;
+                mono_iterations = iterations;
+                Ok(wall)
+            },
+        )?;
         let mut fmpy_final = f64::NAN;
         let fmpy = fmpy_run(&file, python, master, h, stop).map(|(wall, force)| {
             fmpy_final = force;
