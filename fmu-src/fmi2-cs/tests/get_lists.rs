@@ -52,16 +52,7 @@ impl Model for Toy {
         self.s += v.real(U) * h;
         Ok(())
     }
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.push(self.s);
-    }
-    fn restore_state(&mut self, s: &[f64]) -> Result<(), String> {
-        self.s = s[0];
-        Ok(())
-    }
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    toy_instance::one_value_toy_state!();
 }
 
 const NAMES: [&str; OUTPUTS + 1] = ["", "y1", "y2", "y3", "y4", "y5", "y6"];

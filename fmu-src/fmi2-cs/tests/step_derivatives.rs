@@ -60,16 +60,7 @@ impl Model for Toy {
         self.s += h * rate + 0.5 * h * h * ramp;
         Ok(())
     }
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.push(self.s);
-    }
-    fn restore_state(&mut self, s: &[f64]) -> Result<(), String> {
-        self.s = s[0];
-        Ok(())
-    }
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    toy_instance::one_value_toy_state!();
     fn supplies_partial_derivatives(&self) -> bool {
         false
     }

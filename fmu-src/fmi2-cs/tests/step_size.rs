@@ -30,16 +30,7 @@ impl Model for Still {
     fn do_step(&mut self, _: &Values, _: &[f64], _: f64) -> Result<(), String> {
         Ok(())
     }
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.push(self.s);
-    }
-    fn restore_state(&mut self, s: &[f64]) -> Result<(), String> {
-        self.s = s[0];
-        Ok(())
-    }
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    toy_instance::one_value_toy_state!();
 }
 
 fn instance() -> Instance {

@@ -1,6 +1,7 @@
 //! The description and an initialized instance of a toy model, for the
 //! tests of the layer on a model of their own
-//! (`fmi2-cs/tests/directional_scale.rs`, `step_derivatives.rs`).
+//! (`fmi2-cs/tests/directional_scale.rs`, `get_lists.rs`,
+//! `step_derivatives.rs`, `step_size.rs`).
 //! Included with `#[path]`.
 
 use fmi2_cs::instance::Instance;
@@ -36,3 +37,25 @@ pub fn initialized(info: &'static ModelInfo, model: Box<dyn Model>) -> Instance 
     fmu.exit_initialization_mode().unwrap();
     fmu
 }
+
+/// The state methods of a toy model whose state is its field `s` alone
+/// (`save_state`, `restore_state`, and `clone_model` of a `Clone` model),
+/// written inside its `impl Model` block. (Not every test including this
+/// file has such a model.)
+#[allow(unused_macros)]
+macro_rules! one_value_toy_state {
+    () => {
+        fn save_state(&self, out: &mut Vec<f64>) {
+            out.push(self.s);
+        }
+        fn restore_state(&mut self, s: &[f64]) -> Result<(), String> {
+            self.s = s[0];
+            Ok(())
+        }
+        fn clone_model(&self) -> Box<dyn Model> {
+            Box::new(self.clone())
+        }
+    };
+}
+#[allow(unused_imports)]
+pub(crate) use one_value_toy_state;
