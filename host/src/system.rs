@@ -162,6 +162,29 @@ fn gather(
     Ok(())
 }
 
+/// Set the values [`gather`] read: each component's connected inputs in
+/// one `fmi2SetReal` from the next `inputs.len()` of `values`, component
+/// after component; with `step = Some((t, h))`, each component stepped
+/// from `t` over `h` right after its inputs are set (the Jacobi master).
+#[inline(always)] // `step` is a constant at each call
+fn set_gathered(
+    components: &mut [Component],
+    mut values: &[f64],
+    step: Option<(f64, f64)>,
+) -> Result<(), FmuError> {
+    for c in components {
+        let (now, rest) = values.split_at(c.inputs.len());
+        if !now.is_empty() {
+            c.instance.set_real(&c.inputs, now)?;
+        }
+        values = rest;
+        if let Some((t, h)) = step {
+            c.instance.do_step(t, h)?;
+        }
+    }
+    Ok(())
+}
+
 /// The output a connected input reads.
 struct Source {
     /// The source component and output.
@@ -398,15 +421,7 @@ impl System {
     pub fn propagate(&mut self, buffer: &mut [f64]) -> Result<(), FmuError> {
         let last = self.recording.rows.last().unwrap_or_default();
         gather(&mut self.components, last, &self.sources, buffer)?;
-        let mut values = &buffer[..self.sources.len()];
-        for c in &mut self.components {
-            let (now, rest) = values.split_at(c.inputs.len());
-            if !now.is_empty() {
-                c.instance.set_real(&c.inputs, now)?;
-            }
-            values = rest;
-        }
-        Ok(())
+        set_gathered(&mut self.components, &buffer[..self.sources.len()], None)
     }
 
     /// The Jacobi master's step from `t` over `h`: [`System::propagate`]
@@ -445,16 +460,7 @@ impl System {
             return Ok(());
         }
         gather(&mut self.components, last, &self.sources, &mut self.values)?;
-        let mut values = &self.values[..];
-        for c in &mut self.components {
-            let (now, rest) = values.split_at(c.inputs.len());
-            if !now.is_empty() {
-                c.instance.set_real(&c.inputs, now)?;
-            }
-            values = rest;
-            c.instance.do_step(t, h)?;
-        }
-        Ok(())
+        set_gathered(&mut self.components, &self.values, Some((t, h)))
     }
 
     /// Work out, from the components' recorded outputs and the

@@ -240,7 +240,9 @@ pub fn communication_time(start: f64, h: f64, j: usize) -> f64 {
 /// `j - 1` ends).
 #[inline(always)]
 fn counted(start: f64, h: f64, j: usize) -> f64 {
-    start + j as f64 * h
+    // `j` converted as a signed integer (one instruction; without the
+    // sign, several): the same number, a count being far below 2⁶³
+    start + j as i64 as f64 * h
 }
 
 /// [`simulate`] from `start` (t = start + n·h; the system must have been
@@ -360,13 +362,11 @@ fn step_all<M: Advance + ?Sized, const BETWEEN_STEPS: bool>(
     n: usize,
 ) -> Option<String> {
     // t = start + i·h, each counted from the start; the step's end is the
-    // next step's start, so each is computed once. The count converted as
-    // a signed integer (one instruction; without the sign, several): the
-    // same number, the count being far below 2⁶³.
+    // next step's start, so each is computed once
     let mut t_next = counted(start, h, 0);
     for i in 0..n {
         let t = t_next;
-        t_next = start + (i + 1) as i64 as f64 * h;
+        t_next = counted(start, h, i + 1);
         let stepped = if BETWEEN_STEPS {
             observer.before_step(system, t, false)
         } else {
