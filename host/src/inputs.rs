@@ -28,6 +28,9 @@ pub struct InputTable {
     pub time: Vec<f64>,
     /// Column name and values, one per row.
     pub columns: Vec<(String, Vec<f64>)>,
+    /// The file's line of each row (1 is the header; comment lines are
+    /// skipped), for messages about a row.
+    pub lines: Vec<u64>,
 }
 
 impl InputTable {
@@ -73,6 +76,7 @@ impl InputTable {
                 .iter()
                 .map(|h| (h.clone(), Vec::new()))
                 .collect(),
+            lines: Vec::new(),
         };
         for record in reader.records() {
             let record = record.map_err(|e| format!("{shown}: {e}"))?;
@@ -107,6 +111,7 @@ impl InputTable {
                 }
             }
             table.time.push(row[0]);
+            table.lines.push(line);
             for (column, x) in table.columns.iter_mut().zip(&row[1..]) {
                 column.1.push(*x);
             }

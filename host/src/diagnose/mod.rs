@@ -32,6 +32,7 @@ pub mod fit;
 pub mod localise;
 pub mod model;
 pub mod problem;
+pub mod quality;
 pub mod report;
 pub mod sim;
 pub mod suite;
@@ -41,7 +42,7 @@ use model::{Effect, FrictionModel};
 use problem::{FrictionData, Measured, Setup};
 use rayon::prelude::*;
 use serde::Serialize;
-use sim::{co_simulate, system_parameters, ChannelResiduals, FrictionSim};
+use sim::{co_simulate, co_simulate_robust, co_simulate_with, system_parameters, ChannelResiduals, FrictionSim};
 use std::path::Path;
 use std::time::Instant;
 
@@ -191,6 +192,9 @@ pub struct CandidateScore {
     pub gain: f64,
     /// One-sided p-value of the paired test against the current model.
     pub p_value: f64,
+    /// Whether the held-out mean square drops by more than the current
+    /// model's step error squared ([`drop_beyond_step_error`]).
+    pub beyond_step_error: bool,
     /// RMS of the law's force against the force the data imply (N), training.
     pub force_rms: f64,
     pub fit_evaluations: usize,
@@ -203,6 +207,9 @@ pub struct CandidateScore {
 #[derive(Clone, Debug, Serialize)]
 pub struct FoundEffect {
     pub name: Effect,
+    /// `added` (the model lacked it) or `re-sized` (the nominal had it,
+    /// at other values).
+    pub action: &'static str,
     pub meaning: &'static str,
     /// Its parameters after the refit: name → value.
     pub parameters: serde_json::Map<String, serde_json::Value>,
@@ -229,17 +236,31 @@ pub struct Diagnosis {
     pub channels: Vec<ChannelSummary>,
     /// Held-out RMS of the nominal system as given (normalised).
     pub nominal_rms: f64,
-    /// Held-out RMS of the nominal model with its parameters refitted.
+    /// The nominal's levels refitted, and whether that was kept.
+    pub refit: RefitDecision,
+    /// Held-out RMS of the baseline: the refitted nominal when kept, else
+    /// the nominal as given.
     pub baseline_rms: f64,
     /// Held-out RMS of the final model.
     pub final_rms: f64,
     pub effects: Vec<FoundEffect>,
     /// Every candidate tried, per round.
     pub rounds: Vec<Vec<CandidateScore>>,
+    /// The final error is above [`UNEXPLAINED_FACTOR`] × `floor_rms`.
     pub unexplained: bool,
-    /// Held-out RMS of the measurement noise estimated from the data
-    /// (normalised like the others).
+    /// Held-out RMS of the measurement noise estimated from the data, its
+    /// quantisation included (normalised like the others).
     pub noise_floor_rms: f64,
+    /// The co-simulation's own step error on the held-out samples (twice
+    /// the RMS change of the final model's channels when the step is
+    /// halved: a first-order bound).
+    pub step_error_rms: f64,
+    /// √(noise² + step error²): what no model of the library can go below.
+    pub floor_rms: f64,
+    /// Spikes, dropouts, gaps and saturation found in the files.
+    pub data_quality: DataQuality,
+    /// Co-simulations that needed a smaller step or another master.
+    pub fallbacks: Vec<String>,
     /// Where the remaining discrepancy lies (the localisation of the final
     /// residual).
     pub residual_pattern: localise::Localisation,
@@ -265,6 +286,36 @@ pub struct Diagnosis {
     #[serde(skip)]
     pub plots: PlotData,
 }
+
+/// The nominal's levels refitted (Fc, Fc_neg or the position scales, from
+/// three starts) and tested against the nominal as given on the held-out
+/// data by the same test as the effects: kept only when it beats the given
+/// model, so that the diagnosis never ends worse than the model it was
+/// given.
+#[derive(Clone, Debug, Serialize)]
+pub struct RefitDecision {
+    pub heldout_rms: f64,
+    pub gain: f64,
+    pub p_value: f64,
+    pub threshold: f64,
+    pub kept: bool,
+    /// RMS of the law's force against the force the data imply (N).
+    pub force_rms: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<String>,
+}
+
+/// What [`quality::inspect`] found in each file.
+#[derive(Clone, Debug, Serialize)]
+pub struct DataQuality {
+    pub data: quality::Quality,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heldout: Option<quality::Quality>,
+}
+
+/// The remaining error is "unexplained" above this many times the floor
+/// (noise and step error).
+pub const UNEXPLAINED_FACTOR: f64 = 2.0;
 
 /// Per measured channel: RMS in its unit, nominal / baseline / final.
 #[derive(Clone, Debug, Serialize)]
@@ -506,12 +557,11 @@ pub fn diagnose(
      -> Result<Scored, String> {
         let mut merged: Option<ChannelResiduals> = None;
         let mut picked = Vec::new();
+        let mut notes = Vec::new();
         for (fold, model) in folds.iter().zip(models) {
             let params = system_parameters(file, &setup, model);
-            let r = co_simulate(system, &params, &setup, held.data)?;
-            if let Some(e) = &r.incomplete {
-                return Err(format!("the co-simulation stopped early: {e}"));
-            }
+            let (r, note) = co_simulate_robust(system, &params, &setup, held.data)?;
+            notes.extend(note);
             let mine = (fold.held)(&r);
             match &mut merged {
                 None => merged = Some(r),
@@ -537,20 +587,40 @@ pub fn diagnose(
             residuals,
             picked,
             q,
+            fallback: (!notes.is_empty()).then(|| notes.join("; ")),
         })
+    };
+    // the simulated channels of `models` at the held-out samples, co-simulated
+    // at half the step (no fallback): the co-simulation's own step error
+    let simulated_at_half_step = |system: &mut crate::system::System,
+                                  models: &[FrictionModel]|
+     -> Result<Vec<Vec<f64>>, String> {
+        let mut out: Option<Vec<Vec<f64>>> = None;
+        for (fold, model) in folds.iter().zip(models) {
+            let params = system_parameters(file, &setup, model);
+            let r = co_simulate_with(system, &params, held.data, &setup.master, 0.5 * setup.step)?;
+            if let Some(e) = &r.incomplete {
+                return Err(e.clone());
+            }
+            let mine = (fold.held)(&r);
+            let o = out.get_or_insert_with(|| r.simulated.clone());
+            for &k in &mine {
+                for c in 0..o.len() {
+                    o[c][k] = r.simulated[c][k];
+                }
+            }
+        }
+        out.ok_or_else(|| "no fold".to_string())
     };
 
     // refine a model on the output error of the training samples `pick`
     // ([`fit::polish`])
-    let polish = |model: &FrictionModel, pick: &Picker| -> fit::Fitted {
-        let train_residuals = |m: &FrictionModel| -> Option<nalgebra::DVector<f64>> {
+    // the normalised output residuals of `m` on the training samples `pick`
+    let train_residuals = |m: &FrictionModel, pick: &Picker| -> Option<nalgebra::DVector<f64>> {
             // a system of its own (an FMU instance stays on its thread)
             let mut system = file.build(0.0).ok()?;
             let params = system_parameters(file, &setup, m);
-            let r = co_simulate(&mut system, &params, &setup, &train).ok()?;
-            if r.incomplete.is_some() {
-                return None;
-            }
+            let (r, _) = co_simulate_robust(&mut system, &params, &setup, &train).ok()?;
             let picked = pick(&r);
             let channels = scales.len();
             let norm = ((picked.len() * channels) as f64).sqrt();
@@ -561,12 +631,29 @@ pub fn diagnose(
                     (0..channels).map(move |c| r.residuals[c][s] / scales[c] / norm)
                 }),
             ))
-        };
+    };
+    let polish = |model: &FrictionModel, pick: &Picker| -> fit::Fitted {
         let mut residual = |models: &[FrictionModel]| -> Vec<Option<nalgebra::DVector<f64>>> {
-            models.par_iter().map(train_residuals).collect()
+            models.par_iter().map(|m| train_residuals(m, pick)).collect()
         };
         let budget = POLISH_ITERATIONS * (model.free().len() + 1) + 1;
         fit::polish(model, &mut residual, budget)
+    };
+    // fit by output error alone, for an effect the force the data imply
+    // cannot show (presliding: its hysteresis lives in the stick, which the
+    // force fits leave out): the starts scored by co-simulating the
+    // training samples `pick`, then the best refined ([`fit::polish`])
+    let fit_output_error = |starts: &[FrictionModel], pick: &Picker| -> fit::Fitted {
+        let costs: Vec<f64> = starts
+            .par_iter()
+            .map(|m| train_residuals(m, pick).map_or(f64::INFINITY, |r| r.norm_squared()))
+            .collect();
+        let best = (0..starts.len())
+            .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
+            .unwrap_or(0);
+        let mut fitted = polish(&starts[best], pick);
+        fitted.evaluations += starts.len();
+        fitted
     };
     let every_sample: Picker = Box::new(all_samples);
     // the model reported: fitted on every training interval (the fold's
@@ -579,6 +666,20 @@ pub fn diagnose(
         }
         let mut sim = FrictionSim::new(&setup.friction_fmu)?;
         Ok(fit::fit(starts, &mut sim, &d_train, &all_intervals).model)
+    };
+    // fit `starts` (per fold: built from that fold's model) on each fold by
+    // output error alone ([`fit_output_error`])
+    let fit_folds_output_error = |starts: &(dyn Fn(&FrictionModel) -> Vec<FrictionModel> + Sync),
+                                  base: &[FrictionModel]|
+     -> (Vec<FrictionModel>, f64, usize) {
+        let fitted: Vec<fit::Fitted> = folds
+            .iter()
+            .zip(base)
+            .map(|(fold, b)| fit_output_error(&starts(b), &fold.train))
+            .collect();
+        let rms = fitted.iter().map(|f| f.rms).sum::<f64>() / fitted.len() as f64;
+        let evaluations = fitted.iter().map(|f| f.evaluations).sum();
+        (fitted.into_iter().map(|f| f.model).collect(), rms, evaluations)
     };
     // fit `starts` (per fold: built from that fold's model) on each fold
     let fit_folds = |starts: &(dyn Fn(&FrictionModel) -> Vec<FrictionModel> + Sync),
@@ -607,24 +708,22 @@ pub fn diagnose(
         ))
     };
 
-    // nominal as given, then refitted
+    // the nominal as given: always a baseline, and the one kept unless its
+    // levels refitted beat it on held-out data
     let mut sim = FrictionSim::new(&setup.friction_fmu)?;
     let nominal_folds = vec![setup.nominal.clone(); folds.len()];
-    let nominal_scored =
-        score(&mut system, &nominal_folds).map_err(|e| format!("the nominal system: {e}"))?;
-    let (baseline_folds, _, _) = fit_folds(&|m: &FrictionModel| vec![m.clone()], &nominal_folds)?;
-    let baseline_model = fit_whole(std::slice::from_ref(&setup.nominal), &baseline_folds)?;
-    let baseline_scored = score(&mut system, &baseline_folds)
-        .map_err(|e| format!("the refitted nominal system: {e}"))?;
+    let nominal_scored = score(&mut system, &nominal_folds).map_err(|e| {
+        format!("the nominal system as given cannot be co-simulated on {}: {e}", held.data.label)
+    })?;
     // the groups of the acceptance test: the held-out blocks when there
     // are at least `groups` of them (each block an independent trial,
     // `--blocks`), else `groups` runs of consecutive held-out samples
     let group: Vec<usize> = {
-        let picked = &baseline_scored.picked;
+        let picked = &nominal_scored.picked;
         let n = picked.len();
         let by_block: Vec<usize> = picked
             .iter()
-            .map(|&k| blocks.block(held.data.time[baseline_scored.residuals.samples[k]]))
+            .map(|&k| blocks.block(held.data.time[nominal_scored.residuals.samples[k]]))
             .collect();
         let held_blocks = 1 + by_block.windows(2).filter(|w| w[0] != w[1]).count();
         if heldout_file.is_none() && held_blocks >= options.groups {
@@ -633,6 +732,47 @@ pub fn diagnose(
             let g = options.groups.clamp(2, n.max(2));
             (0..n).map(|i| i * g / n.max(1)).collect()
         }
+    };
+    // the levels refitted (the effects' own parameters stay as given: an
+    // effect that is off is a candidate of its own), from the nominal and
+    // from levels 20 % lower and 25 % higher
+    let level_starts =
+        |m: &FrictionModel| -> Vec<FrictionModel> { [1.0, 0.8, 1.25].map(|f| m.scaled_levels(f)).to_vec() };
+    let (refit_folds, refit_force_rms, _) = fit_folds(&level_starts, &nominal_folds)?;
+    let refit_model = fit_whole(&level_starts(&setup.nominal), &refit_folds)?;
+    let refit_scored = score(&mut system, &refit_folds);
+    let refit_threshold = options.alpha;
+    let refit = match &refit_scored {
+        Ok(scored) => {
+            let (gain, p_value) = nested_test(&nominal_scored, scored, &scales, &group);
+            let heldout_rms = mean(&scored.q).sqrt();
+            let nominal_step_error = simulated_at_half_step(&mut system, &nominal_folds)
+                .map_or(0.0, |half| step_error_floor(&nominal_scored, &half, &scales));
+            RefitDecision {
+                heldout_rms,
+                gain,
+                p_value,
+                threshold: refit_threshold,
+                kept: p_value < refit_threshold
+                    && gain >= options.min_gain
+                    && drop_beyond_step_error(&nominal_scored, heldout_rms, nominal_step_error),
+                force_rms: refit_force_rms,
+                failure: None,
+            }
+        }
+        Err(e) => RefitDecision {
+            heldout_rms: f64::INFINITY,
+            gain: f64::NEG_INFINITY,
+            p_value: 1.0,
+            threshold: refit_threshold,
+            kept: false,
+            force_rms: refit_force_rms,
+            failure: Some(e.clone()),
+        },
+    };
+    let (baseline_model, baseline_folds, baseline_scored) = match refit_scored {
+        Ok(scored) if refit.kept => (refit_model.clone(), refit_folds, scored),
+        _ => (setup.nominal.clone(), nominal_folds.clone(), nominal_scored.clone()),
     };
 
     let mut current = baseline_model.clone();
@@ -662,8 +802,11 @@ pub fn diagnose(
         additions
             .par_iter()
             .map(|added| {
-                let (models, force_rms, evaluations) =
-                    fit_folds(&addition_starts(added), current_folds)?;
+                let (models, force_rms, evaluations) = if added.contains(&Effect::Presliding) {
+                    fit_folds_output_error(&addition_starts(added), current_folds)
+                } else {
+                    fit_folds(&addition_starts(added), current_folds)?
+                };
                 let mut system = file.build(0.0).map_err(|e| e.to_string())?;
                 // a candidate whose co-simulation fails is rejected, not fatal
                 let scored = score(&mut system, &models);
@@ -682,7 +825,7 @@ pub fn diagnose(
             .candidates
             .iter()
             .copied()
-            .filter(|&e| !current.has(e))
+            .filter(|&e| current.can_try(e))
             .filter(|&e| e != Effect::NormalLoad || d_train.normal_force_measured)
             .filter(|&e| e != Effect::PositionDependent || context.travel > 1e-9)
             .collect();
@@ -705,6 +848,11 @@ pub fn diagnose(
         }
         let mut accepted = None;
         let mut singles_tried = Vec::new();
+        // what halving the step changes in the current model's outputs: a
+        // drop of the error smaller than that may be a compensation of the
+        // co-simulation's step error, not physics
+        let current_step_error = simulated_at_half_step(&mut system, &current_folds)
+            .map_or(0.0, |half| step_error_floor(&current_scored, &half, &scales));
         for additions in [singles, pairs] {
             if additions.is_empty() {
                 continue;
@@ -725,6 +873,11 @@ pub fn diagnose(
                     heldout_rms,
                     gain,
                     p_value,
+                    beyond_step_error: drop_beyond_step_error(
+                        &current_scored,
+                        heldout_rms,
+                        current_step_error,
+                    ),
                     force_rms: t.force_rms,
                     fit_evaluations: t.evaluations,
                     failure,
@@ -733,9 +886,11 @@ pub fn diagnose(
             let best = (0..round.len())
                 .min_by(|&i, &j| round[i].heldout_rms.total_cmp(&round[j].heldout_rms));
             rounds.push(round.clone());
-            if let Some(k) =
-                best.filter(|&k| round[k].p_value < threshold && round[k].gain >= options.min_gain)
-            {
+            if let Some(k) = best.filter(|&k| {
+                round[k].p_value < threshold
+                    && round[k].gain >= options.min_gain
+                    && round[k].beyond_step_error
+            }) {
                 accepted = Some((tried, k, round[k].p_value, threshold));
                 break;
             }
@@ -749,7 +904,11 @@ pub fn diagnose(
             Ok(s) => (t.models, s),
             Err(e) => return Err(format!("accepted {} without a score: {e}", label(&t.added))),
         };
-        let mut whole = fit_whole(&addition_starts(&t.added)(&current), &models)?;
+        let mut whole = if t.added.contains(&Effect::Presliding) && folds.len() > 1 {
+            fit_output_error(&addition_starts(&t.added)(&current), &every_sample).model
+        } else {
+            fit_whole(&addition_starts(&t.added)(&current), &models)?
+        };
         // refine the accepted models on the output error of their training data
         let polish_started = Instant::now();
         if options.polish {
@@ -802,6 +961,11 @@ pub fn diagnose(
             );
             effects.push(FoundEffect {
                 name: effect,
+                action: if current.shows(effect, &context) {
+                    "re-sized"
+                } else {
+                    "added"
+                },
                 meaning: effect.meaning(),
                 parameters: effect_parameters(&model, effect),
                 rms_before: mean(&current_scored.q).sqrt(),
@@ -816,9 +980,22 @@ pub fn diagnose(
         }
     }
 
-    // the remaining discrepancy against the noise floor
+    // the remaining discrepancy against what no model can go below: the
+    // measurement noise (and quantisation) and the co-simulation's own
+    // step error
     let noise = noise_floor(held.data, &current_scored, &scales);
+    let numerical = match simulated_at_half_step(&mut system, &current_folds) {
+        Ok(half) => step_error_floor(&current_scored, &half, &scales),
+        Err(_) => 0.0,
+    };
+    let floor = (noise * noise + numerical * numerical).sqrt();
     let final_rms = mean(&current_scored.q).sqrt();
+    let mut fallbacks: Vec<String> = Vec::new();
+    for (what, scored) in [("the nominal as given", &nominal_scored), ("the final model", &current_scored)] {
+        if let Some(note) = &scored.fallback {
+            fallbacks.push(format!("{what}: {note}"));
+        }
+    }
     let before_f = run_force(&mut sim, &baseline_model, held.friction)?;
     let after_f = run_force(&mut sim, &current, held.friction)?;
     let residual_pattern = localise::localise(held.friction, &held.intervals, &after_f);
@@ -855,10 +1032,18 @@ pub fn diagnose(
         friction_component: setup.friction_name.clone(),
         channels,
         nominal_rms: mean(&nominal_scored.q).sqrt(),
+        refit,
         baseline_rms: mean(&baseline_scored.q).sqrt(),
         final_rms,
-        unexplained: final_rms > 2.0 * noise,
+        unexplained: final_rms > UNEXPLAINED_FACTOR * floor,
         noise_floor_rms: noise,
+        step_error_rms: numerical,
+        floor_rms: floor,
+        data_quality: DataQuality {
+            data: train.quality.clone(),
+            heldout: heldout_file.as_ref().map(|h| h.quality.clone()),
+        },
+        fallbacks,
         residual_pattern,
         baseline_pattern,
         effects,
@@ -903,6 +1088,8 @@ pub struct Scored {
     picked: Vec<usize>,
     /// Normalised squared residual per held-out sample.
     q: Vec<f64>,
+    /// The co-simulation needed a fallback ([`sim::co_simulate_robust`]).
+    fallback: Option<String>,
 }
 
 fn mean(x: &[f64]) -> f64 {
@@ -933,7 +1120,12 @@ fn starts(current: &FrictionModel, effect: Effect, context: &model::Context) -> 
     let base = current.with(effect, context);
     match effect {
         Effect::Stribeck => {
-            let mut s = Vec::new();
+            // re-sized: from its own values too
+            let mut s = if current.has(Effect::Stribeck) {
+                vec![base.clone()]
+            } else {
+                Vec::new()
+            };
             for vs in [0.03, 0.1, 0.3, 1.0] {
                 for excess in [0.05, 0.2] {
                     let mut m = base.clone();
@@ -945,22 +1137,29 @@ fn starts(current: &FrictionModel, effect: Effect, context: &model::Context) -> 
             }
             s
         }
-        Effect::Presliding => [1e-4, 1e-3, 1e-2, 3e-2]
-            .iter()
-            .map(|&d| {
+        // presliding distances Fc/σ0 from half the position resolution the
+        // data show to 3 % of the travel, and the model's own (σ1 following
+        // σ0, [`FrictionModel::with_sigma0`])
+        Effect::Presliding => {
+            let r = context.position_resolution;
+            let mut s = vec![base.clone()];
+            for d in [0.5 * r, 2.0 * r, 8.0 * r, 32.0 * r, 128.0 * r, 512.0 * r]
+                .into_iter()
+                .chain([1e-2 * context.travel, 3e-2 * context.travel])
+            {
+                s.push(base.with_sigma0(base.fc / d));
+            }
+            s
+        }
+        Effect::Viscous => {
+            let mut s = vec![base.clone()];
+            for r in [0.01, 0.1] {
                 let mut m = base.clone();
-                m.sigma0 = m.fc / (d * context.travel);
-                m
-            })
-            .collect(),
-        Effect::Viscous => [0.01, 0.1]
-            .iter()
-            .map(|&r| {
-                let mut m = base.clone();
-                m.sigma2 = r * m.fc / context.speed_scale;
-                m
-            })
-            .collect(),
+                m.sigma2 += r * m.fc / context.speed_scale;
+                s.push(m);
+            }
+            s
+        }
         _ => vec![base],
     }
 }
@@ -1062,9 +1261,40 @@ fn noise_floor(data: &Measured, scored: &Scored, scales: &[f64]) -> f64 {
         }
         d2.sort_by(f64::total_cmp);
         let sigma = d2[d2.len() / 2] / 0.6745 / 6f64.sqrt();
+        // a quantised channel is off by up to half its step even where
+        // its second differences are zero: uniform error of step/√12
+        let sigma = sigma.max(quality::quantum(values) / 12f64.sqrt());
         q += (sigma / scales[c]).powi(2);
     }
     (q / scales.len().max(1) as f64).sqrt()
+}
+
+/// Whether a candidate of held-out RMS `candidate_rms` lowers the mean
+/// square of `current` by more than the square of the co-simulation's step
+/// error (`step_error`, [`step_error_floor`]): at most that much of the
+/// error can be the integration's, which a parameter change can partly
+/// compensate.
+fn drop_beyond_step_error(current: &Scored, candidate_rms: f64, step_error: f64) -> bool {
+    mean(&current.q) - candidate_rms * candidate_rms > step_error * step_error
+}
+
+/// The co-simulation's step error on the held-out samples: twice the RMS of
+/// the normalised change of the simulated channels when the step is halved
+/// (for a first-order error e(h) = 2·(y(h) − y(h/2)); higher orders need
+/// less).
+fn step_error_floor(scored: &Scored, half: &[Vec<f64>], scales: &[f64]) -> f64 {
+    let sim = &scored.residuals.simulated;
+    let q: f64 = scored
+        .picked
+        .iter()
+        .map(|&k| {
+            (0..scales.len())
+                .map(|c| ((sim[c][k] - half[c][k]) / scales[c]).powi(2))
+                .sum::<f64>()
+                / scales.len().max(1) as f64
+        })
+        .sum();
+    2.0 * (q / scored.picked.len().max(1) as f64).sqrt()
 }
 
 fn effect_parameters(
@@ -1157,6 +1387,7 @@ mod tests {
                 residuals: vec![residuals],
                 incomplete: None,
             },
+            fallback: None,
         }
     }
 

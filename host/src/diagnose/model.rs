@@ -12,12 +12,30 @@
 //! | `direction_dependent` | Fc_neg, Fs_neg (and scale_neg) for v < 0 | Fc_neg (or the negative scales) |
 //! | `normal_load` | normal-force form: F ∝ the input Fn | (the levels, per newton of Fn) |
 //!
+//! **Added or re-sized.** Every effect whose nominal can already hold it
+//! (viscous with σ2 > 0, Stribeck with Fs > Fc, presliding with a finite
+//! σ0) is a candidate all the same: for a nominal that has it, the
+//! candidate frees its parameters from their nominal values (re-sizes it),
+//! so that a nominal off from the data only in that effect is diagnosed as
+//! such instead of being absorbed by the baseline refit, which frees the
+//! levels only ([`FrictionModel::freed`]). Whether a nominal has
+//! presliding is decided from the data: its presliding distance Fc/σ0
+//! against the position resolution the measurements show
+//! ([`Context::position_resolution`]).
+//!
+//! **σ1 follows σ0.** Wherever σ0 is fitted, σ1 moves with it at a
+//! constant damping ratio of the bristle-mass oscillation
+//! (σ1 ∝ √σ0, ζ = σ1 / (2·√(σ0·m)) held at the nominal's): a presliding
+//! re-sized from a stiff to a soft contact (or back) keeps its damping
+//! instead of becoming over- or under-damped by orders of magnitude
+//! (Canudas de Wit et al. 1995 choose σ1 that way, near critical).
+//!
 //! Parameters are fitted through transforms that keep them physical:
 //! levels, stiffness, speeds and scales are `exp(θ)` (> 0), the Stribeck
 //! excess `Fs/Fc − 1` is `exp(θ)` (Fs > Fc), σ2 is `exp(θ)` (> 0).
 
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 
 /// A physically named effect of the candidate library.
@@ -86,8 +104,8 @@ impl fmt::Display for Effect {
     }
 }
 
-/// A presliding distance Fc/σ0 below this is a stiff (Coulomb-like) law:
-/// the presliding effect counts as absent.
+/// Without a measured position to judge from, a presliding distance Fc/σ0
+/// below this is a stiff (Coulomb-like) law: presliding counts as absent.
 pub const STIFF_PRESLIDING_DISTANCE: f64 = 1e-6;
 
 /// Knots of the position table when `position_dependent` is added.
@@ -114,6 +132,10 @@ pub struct FrictionModel {
     pub x_table: Vec<f64>,
     pub scale_pos: Vec<f64>,
     pub scale_neg: Vec<f64>,
+    /// The effects whose parameters are fitted (added or re-sized by the
+    /// diagnosis): the levels are always free, an effect's own parameters
+    /// only once it is here. Empty for the nominal as given.
+    pub freed: BTreeSet<Effect>,
 }
 
 /// The LuGre parameter names diagnose reads from the nominal FMU.
@@ -156,6 +178,7 @@ impl FrictionModel {
             x_table: Vec::new(),
             scale_pos: Vec::new(),
             scale_neg: Vec::new(),
+            freed: BTreeSet::new(),
         };
         if m.position_dependent {
             let n = get("n_table")? as usize;
@@ -189,14 +212,72 @@ impl FrictionModel {
         Effect::ALL.into_iter().filter(|e| self.has(*e)).collect()
     }
 
+    /// Whether the model has `effect` as the data can see it: for
+    /// presliding, a presliding distance Fc/σ0 at least the position
+    /// resolution of the measurements (finer, and it is a stiff contact
+    /// for these data); the others as [`FrictionModel::has`].
+    pub fn shows(&self, effect: Effect, context: &Context) -> bool {
+        match effect {
+            Effect::Presliding => self.presliding_distance() >= context.position_resolution,
+            e => self.has(e),
+        }
+    }
+
+    /// Fc/σ0 (m; per newton cancels in the normal-force form).
+    pub fn presliding_distance(&self) -> f64 {
+        self.fc / self.sigma0
+    }
+
+    /// Whether `effect` can be tried on this model: not yet freed, and for
+    /// the structural effects (position, direction, normal load) not yet
+    /// part of it; viscous, Stribeck and presliding are re-sized when the
+    /// model has them.
+    pub fn can_try(&self, effect: Effect) -> bool {
+        !self.freed.contains(&effect)
+            && match effect {
+                Effect::Viscous | Effect::Stribeck | Effect::Presliding => true,
+                e => !self.has(e),
+            }
+    }
+
+    /// Every level (Fc, Fs, and those of the negative direction) times
+    /// `factor`, the Stribeck ratio kept: a start of the levels' refit.
+    pub fn scaled_levels(&self, factor: f64) -> FrictionModel {
+        let mut m = self.clone();
+        for x in [&mut m.fc, &mut m.fs, &mut m.fc_neg, &mut m.fs_neg] {
+            *x *= factor;
+        }
+        m
+    }
+
+    /// σ0 set to `sigma0`, with σ1 scaled by √(σ0 ratio): the damping ratio
+    /// of the bristle-mass oscillation held (module doc).
+    pub fn with_sigma0(&self, sigma0: f64) -> FrictionModel {
+        let mut m = self.clone();
+        m.sigma1 = self.sigma1 * (sigma0 / self.sigma0).sqrt();
+        m.sigma0 = sigma0;
+        m
+    }
+
     /// The model with `effect` switched on at a neutral start (it changes
     /// nothing yet, or very little, until fitted): σ2 small, Fs just above
     /// Fc with vs from `context`, σ0 giving a presliding distance of a
     /// thousandth of the travel, unit scales on knots spread over the
     /// travel, equal levels for both directions, levels per unit of the
     /// mean normal force.
+    ///
+    /// When the model shows the effect already (viscous, Stribeck,
+    /// presliding), it is only freed, at its present values: re-sized.
     pub fn with(&self, effect: Effect, context: &Context) -> FrictionModel {
         let mut m = self.clone();
+        m.freed.insert(effect);
+        if matches!(
+            effect,
+            Effect::Viscous | Effect::Stribeck | Effect::Presliding
+        ) && self.shows(effect, context)
+        {
+            return m;
+        }
         match effect {
             Effect::Viscous => m.sigma2 = 1e-3 * m.fc / context.speed_scale,
             Effect::Stribeck => {
@@ -204,7 +285,7 @@ impl FrictionModel {
                 m.fs_neg = m.fc_neg * 1.01;
                 m.vs = 0.1 * context.speed_scale;
             }
-            Effect::Presliding => m.sigma0 = m.fc / (1e-3 * context.travel),
+            Effect::Presliding => m = m.with_sigma0(m.fc / (1e-3 * context.travel)),
             Effect::PositionDependent => {
                 let k = context.position_knots.max(2);
                 m.position_dependent = true;
@@ -258,8 +339,9 @@ impl FrictionModel {
         nab - n0 > (na - n0) + (nb - n0)
     }
 
-    /// The free parameters of this model (the nominal levels and those of
-    /// every effect it has), as transformed coordinates θ.
+    /// The free parameters of this model (the levels and those of every
+    /// effect freed, [`FrictionModel::freed`]), as transformed coordinates
+    /// θ.
     pub fn free(&self) -> Vec<Free> {
         let mut f = Vec::new();
         // levels: carried by the scales when position-dependent (a common
@@ -277,14 +359,14 @@ impl FrictionModel {
                 f.push(Free::FcNeg);
             }
         }
-        if self.has(Effect::Viscous) {
+        if self.freed.contains(&Effect::Viscous) {
             f.push(Free::Sigma2);
         }
-        if self.has(Effect::Stribeck) {
+        if self.freed.contains(&Effect::Stribeck) {
             f.push(Free::StribeckExcess);
             f.push(Free::Vs);
         }
-        if self.has(Effect::Presliding) {
+        if self.freed.contains(&Effect::Presliding) {
             f.push(Free::Sigma0);
         }
         f
@@ -319,7 +401,10 @@ impl FrictionModel {
                 Free::Sigma2 => m.sigma2 = x,
                 Free::StribeckExcess => new_excess = x,
                 Free::Vs => m.vs = x,
-                Free::Sigma0 => m.sigma0 = x,
+                Free::Sigma0 => {
+                    m.sigma1 = self.sigma1 * (x / self.sigma0).sqrt();
+                    m.sigma0 = x;
+                }
                 Free::ScalePos(i) => m.scale_pos[*i] = x,
                 Free::ScaleNeg(i) => m.scale_neg[*i] = x,
             }
@@ -381,6 +466,7 @@ impl FrictionModel {
             ],
             Effect::Presliding => vec![
                 ("sigma0".into(), self.sigma0, "N/m"),
+                ("sigma1".into(), self.sigma1, "N.s/m"),
                 ("presliding_distance".into(), self.fc / self.sigma0, "m"),
             ],
             Effect::PositionDependent => {
@@ -459,6 +545,11 @@ pub struct Context {
     /// Mean normal force (N), 1 when not measured.
     pub mean_normal_force: f64,
     pub position_knots: usize,
+    /// The smallest position change the measurements resolve (m): the
+    /// encoder's step or the noise, whichever is larger
+    /// ([`super::quality::resolution`]); [`STIFF_PRESLIDING_DISTANCE`]
+    /// when the position is not measured.
+    pub position_resolution: f64,
 }
 
 #[cfg(test)]
@@ -489,6 +580,7 @@ mod tests {
             travel: 0.27,
             mean_normal_force: 1.0,
             position_knots: 6,
+            position_resolution: 1e-6,
         };
         let mut interacting = Vec::new();
         for (i, &a) in Effect::ALL.iter().enumerate() {

@@ -22,6 +22,7 @@
 //! when they are connected to the rig's `v` and `x`.
 
 use super::model::{Context, FrictionModel};
+use super::quality::{self, Quality};
 use crate::fmu::model_description::{Causality, VariableKind};
 use crate::fmu::{Fmu, Instance};
 use crate::inputs::InputTable;
@@ -42,6 +43,10 @@ pub struct Measured {
     pub inputs: Vec<(String, Vec<f64>)>,
     /// Measured output channels.
     pub outputs: Vec<(String, Vec<f64>)>,
+    /// Spikes, dropouts, gaps and saturation found in the file (spikes and
+    /// dropouts already repaired in the columns above), and the rows left
+    /// out of scores and fits ([`super::quality`]).
+    pub quality: Quality,
 }
 
 impl Measured {
@@ -50,8 +55,26 @@ impl Measured {
     /// samples, a time that does not increase overall, and a file with no
     /// output to compare.
     pub fn read(path: &Path, system: &System) -> Result<Measured, String> {
-        let table = InputTable::read(path)?;
+        let mut table = InputTable::read(path)?;
         let shown = path.display().to_string();
+        let quality = quality::inspect(&table.time, &mut table.columns, &table.lines);
+        if quality.excluded_samples as f64 > quality::MAX_FLAGGED_SHARE * table.time.len() as f64 {
+            let first: Vec<String> = quality
+                .findings
+                .iter()
+                .take(5)
+                .map(|f| f.describe(&shown))
+                .collect();
+            return Err(format!(
+                "{shown}: too damaged for a diagnosis: {} of its {} samples are flagged ({} spikes, {} dropouts, {} saturated columns); first: {}",
+                quality.excluded_samples,
+                table.time.len(),
+                quality.spikes,
+                quality.dropouts,
+                quality.saturated,
+                first.join("; ")
+            ));
+        }
         if table.time.len() < MIN_SAMPLES {
             return Err(format!(
                 "{shown}: {} samples; diagnose needs at least {MIN_SAMPLES}",
@@ -111,6 +134,7 @@ impl Measured {
             time: table.time,
             inputs,
             outputs,
+            quality,
         })
     }
 
@@ -128,6 +152,7 @@ impl Measured {
             path: self.label.clone().into(),
             time: self.time.clone(),
             columns: self.inputs.clone(),
+            lines: Vec::new(),
         }
     }
 }
@@ -208,6 +233,9 @@ pub struct FrictionData {
     pub f: Vec<f64>,
     /// How the force was obtained, in words.
     pub source: String,
+    /// What the measured position resolves (m, [`quality::resolution`]),
+    /// when the law's position comes from a measured column.
+    pub position_resolution: Option<f64>,
     /// Whether a normal force is measured (and varies).
     pub normal_force_measured: bool,
     /// Whether the interval's force is trusted for fitting: not within the
@@ -435,6 +463,14 @@ impl Setup {
         };
         let v = law_input("v")?;
         let x = law_input("x")?;
+        let position_resolution = data
+            .column(&format!("{f}.x"))
+            .or_else(|| {
+                self.rig
+                    .as_ref()
+                    .and_then(|(r, _)| data.column(&format!("{r}.x")))
+            })
+            .map(quality::resolution);
         let fn_ = law_input("Fn")?;
         let normal_force_measured = data.column(&format!("{f}.Fn")).is_some()
             && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
@@ -444,7 +480,9 @@ impl Setup {
             (
                 (0..m).map(|j| col[end[j]]).collect(),
                 format!("measured `{f}.F`"),
-                vec![true; m],
+                (0..m)
+                    .map(|j| !data.quality.excluded[end[j]] && !data.quality.after_gap[end[j]])
+                    .collect(),
             )
         } else {
             let (force, source) =
@@ -452,8 +490,15 @@ impl Setup {
             // one more sample for the central difference of the velocities
             let edge = window_half_width(time, smooth) + 1;
             let stuck = STICK_SPEED_FRACTION * rms(&v);
+            let near_bad = near_flagged(&data.quality, edge);
             let trusted = (0..m)
-                .map(|j| start_of(j) >= edge && end[j] + edge < n && v[j].abs() >= stuck)
+                .map(|j| {
+                    start_of(j) >= edge
+                        && end[j] + edge < n
+                        && v[j].abs() >= stuck
+                        && !near_bad[end[j]]
+                        && !near_bad[start_of(j)]
+                })
                 .collect();
             (force, source, trusted)
         };
@@ -466,6 +511,7 @@ impl Setup {
             fn_,
             f: force,
             source,
+            position_resolution,
             normal_force_measured,
             trusted,
         })
@@ -567,8 +613,28 @@ impl Setup {
             travel: (x_max - x_min).max(1e-9),
             mean_normal_force: if mean_fn > 0.0 { mean_fn } else { 1.0 },
             position_knots,
+            position_resolution: d
+                .position_resolution
+                .filter(|r| *r > 0.0)
+                .unwrap_or(super::model::STIFF_PRESLIDING_DISTANCE),
         }
     }
+}
+
+/// Rows within `edge` samples of a flagged row (spike, dropout,
+/// saturation) or of a gap: the smoothing window and the acceleration's
+/// difference reach them.
+fn near_flagged(q: &Quality, edge: usize) -> Vec<bool> {
+    let n = q.excluded.len();
+    let mut near = vec![false; n];
+    for k in 0..n {
+        if q.excluded[k] || q.after_gap[k] {
+            let lo = k.saturating_sub(edge + 1);
+            let hi = (k + edge + 1).min(n - 1);
+            near[lo..=hi].iter_mut().for_each(|x| *x = true);
+        }
+    }
+    near
 }
 
 /// Below this fraction of the RMS speed, an interval of inverse-dynamics

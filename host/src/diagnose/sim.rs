@@ -158,36 +158,94 @@ pub fn system_parameters(
 }
 
 /// Co-simulate `system` (restarted with `parameters`) over the file's time
-/// span with its inputs, and compare with its measured channels.
+/// span with its inputs, and compare with its measured channels (the rows
+/// [`super::quality`] left out are not compared).
 pub fn co_simulate(
     system: &mut System,
     parameters: &[(String, ParameterValue)],
     setup: &Setup,
     data: &Measured,
 ) -> Result<ChannelResiduals, String> {
+    co_simulate_with(system, parameters, data, &setup.master, setup.step)
+}
+
+/// A co-simulation that did not complete is tried again, in this order:
+/// the system's master at a quarter of its step, the step-size-controlled
+/// strong coupling (`adaptive`), Newton at a quarter step, Gauss–Seidel at
+/// a quarter step (the first that completes is used; each is a different
+/// way through a hard stretch: a shorter step, a step that adapts, another
+/// coupling). Returns the residuals and, when a fallback was needed, what
+/// failed and what ran instead.
+pub fn co_simulate_robust(
+    system: &mut System,
+    parameters: &[(String, ParameterValue)],
+    setup: &Setup,
+    data: &Measured,
+) -> Result<(ChannelResiduals, Option<String>), String> {
+    let h = setup.step;
+    let mut tries: Vec<(String, f64)> = vec![
+        (setup.master.clone(), h),
+        (setup.master.clone(), h / 4.0),
+        ("adaptive".into(), h),
+        ("newton".into(), h / 4.0),
+        ("gauss-seidel".into(), h / 4.0),
+    ];
+    let mut seen = Vec::new();
+    tries.retain(|t| {
+        let new = !seen.contains(t);
+        seen.push(t.clone());
+        new
+    });
+    let mut failures = Vec::new();
+    for (master, step) in &tries {
+        let outcome = co_simulate_with(system, parameters, data, master, *step)
+            .and_then(|r| match &r.incomplete {
+                Some(e) => Err(format!("stopped early: {e}")),
+                None => Ok(r),
+            });
+        match outcome {
+            Ok(r) => {
+                let note = (!failures.is_empty()).then(|| {
+                    format!(
+                        "{}; ran with {master} at {step} s instead",
+                        failures.join("; ")
+                    )
+                });
+                return Ok((r, note));
+            }
+            Err(e) => failures.push(format!("{master} at {step} s: {e}")),
+        }
+    }
+    Err(format!(
+        "no co-simulation completed ({})",
+        failures.join("; ")
+    ))
+}
+
+/// [`co_simulate`] with a given master and macro step.
+pub fn co_simulate_with(
+    system: &mut System,
+    parameters: &[(String, ParameterValue)],
+    data: &Measured,
+    master: &str,
+    step: f64,
+) -> Result<ChannelResiduals, String> {
     let start = data.time[0];
     let stop = *data.time.last().unwrap_or(&start);
     system
         .restart(start, parameters)
         .map_err(|e| format!("setting up the co-simulation: {e}"))?;
-    let mut inputs = ExternalInputs::bind(data.input_table(), system)?.with_slopes(setup.step);
-    let mut master = by_name(&setup.master)?;
-    let run = simulate_with(
-        system,
-        master.as_mut(),
-        start,
-        setup.step,
-        stop,
-        &mut inputs,
-    )
-    .map_err(|e| format!("co-simulation: {e}"))?;
+    let mut inputs = ExternalInputs::bind(data.input_table(), system)?.with_slopes(step);
+    let mut master = by_name(master)?;
+    let run = simulate_with(system, master.as_mut(), start, step, stop, &mut inputs)
+        .map_err(|e| format!("co-simulation: {e}"))?;
     let mut samples = Vec::new();
     for (k, &t) in data.time.iter().enumerate() {
-        let repeated = k > 0 && data.time[k - 1] == t;
+        let repeated = (k > 0 && data.time[k - 1] == t) || data.quality.excluded[k];
         let reached = run
             .time
             .last()
-            .is_some_and(|&last| t <= last + 1e-9 * setup.step);
+            .is_some_and(|&last| t <= last + 1e-9 * step);
         if !repeated && reached {
             samples.push(k);
         }

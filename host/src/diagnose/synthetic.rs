@@ -160,6 +160,7 @@ pub fn generate(
             .collect(),
         f: vec![0.0; n],
         source: String::new(),
+        position_resolution: None,
         normal_force_measured: true,
         trusted: vec![true; n],
     };
@@ -224,6 +225,7 @@ pub fn generate(
             ("rig.v_ref".into(), vr.clone()),
             ("friction.Fn".into(), fn_signal.clone()),
         ],
+        lines: Vec::new(),
     };
     let mut inputs = ExternalInputs::bind(table, &system)?.with_slopes(SAMPLE);
     let mut master = by_name(&master_name)?;

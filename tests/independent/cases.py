@@ -1,0 +1,307 @@
+"""Hidden-effect datasets from an independent simulator, and the nominal
+systems `fricsim diagnose` is given for them.
+
+The data contract (README, "Data a diagnosis can use"): a mass pulled
+through a spring by a measured actuator position, LuGre friction plus one
+hidden effect or none, sampled at 1 kHz through a 1 µm encoder; the nominal
+system is Rig1D (`actuator = 1`, driven by the data's `rig.x_act_in`) with
+a LuGre FMU at the nominal parameters, connected v, x and F, strong coupling
+(`newton`) at 1 ms. The nominal differs from the truth only by the hidden
+effect.
+
+The simulator is `lugre_rig.c` beside this file: plain C with its own
+Runge–Kutta integrator, sharing no code with the FMUs. Every case draws its
+rig (mass, spring, damper), its nominal friction (levels, stiffness,
+damping ratio, with or without viscous and Stribeck terms) and its drive
+(sines, a rounded triangle or ramped steps) from its seed, so that nothing
+is tuned to one rig.
+
+The magnitude ε of an effect is the RMS, along the effect-free trajectory,
+of the change of the friction level it makes, as a fraction of Fc.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import random
+import subprocess
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
+
+#: Kinds of case: what is hidden, and how the nominal stands to the truth.
+KINDS = (
+    "none",
+    "viscous",
+    "stribeck",
+    "direction_dependent",
+    "position_dependent",
+    "presliding_stiff_nominal",
+    "presliding_soft_nominal",
+)
+
+#: The effect a kind should be diagnosed as (None: nothing to find).
+EXPECTED = {
+    "none": None,
+    "viscous": "viscous",
+    "stribeck": "stribeck",
+    "direction_dependent": "direction_dependent",
+    "position_dependent": "position_dependent",
+    "presliding_stiff_nominal": "presliding",
+    "presliding_soft_nominal": "presliding",
+}
+
+SAMPLE = 1e-3
+RESOLUTION = 1e-6
+
+
+def simulator() -> Path:
+    """Build the simulator (once) and return its path."""
+    out = ROOT / "target" / "independent" / "lugre_rig"
+    src = HERE / "lugre_rig.c"
+    if not out.exists() or out.stat().st_mtime < src.stat().st_mtime:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        subprocess.run(
+            [os.environ.get("CC", "cc"), "-O2", "-o", str(out), str(src), "-lm"],
+            check=True,
+        )
+    return out
+
+
+@dataclass
+class Case:
+    kind: str
+    magnitude: float
+    seed: int
+    duration: float = 40.0
+    #: rig and drive
+    rig: dict = field(default_factory=dict)
+    drive: dict = field(default_factory=dict)
+    #: LuGre parameters of the nominal model and of the truth
+    nominal: dict = field(default_factory=dict)
+    truth: dict = field(default_factory=dict)
+    #: position table of the truth (x, scale), when position-dependent
+    table: tuple = ()
+
+    @property
+    def name(self) -> str:
+        return f"{self.kind}-{round(self.magnitude * 100)}pct-s{self.seed}"
+
+
+def draw(kind: str, magnitude: float, seed: int, duration: float = 40.0) -> Case:
+    """A case's rig, drive and nominal friction, drawn from its seed (the
+    hidden effect is sized later, along the effect-free trajectory)."""
+    rng = random.Random(zlib.crc32(f"{kind}/{seed}".encode()))
+    m = rng.uniform(0.5, 4.0)
+    k = rng.uniform(300.0, 3000.0)
+    c = rng.choice([0.0, rng.uniform(0.1, 2.0)])
+    drive = {
+        "drive": rng.choice(["sines", "triangle", "steps"]),
+        "amp": rng.uniform(0.02, 0.08),
+        "period": rng.uniform(2.0, 6.0),
+    }
+    peak_speed = 2 * math.pi * drive["amp"] / drive["period"]
+    fc = rng.uniform(1.0, 5.0)
+    sigma0 = 10 ** rng.uniform(6.0, 7.0)
+    zeta = rng.uniform(0.3, 1.0)
+    nominal = {
+        "Fc": fc,
+        "Fs": fc * rng.choice([1.0, rng.uniform(1.1, 1.4)]),
+        "vs": peak_speed * rng.uniform(0.1, 0.3),
+        "sigma0": sigma0,
+        "sigma1": 2 * zeta * math.sqrt(sigma0 * m),
+        "sigma2": rng.choice([0.0, fc / peak_speed * rng.uniform(0.05, 0.3)]),
+    }
+    if kind == "presliding_soft_nominal":
+        # a nominal presliding distance of 0.3-1 mm against a stiff truth
+        nominal["sigma0"] = fc / rng.uniform(3e-4, 1e-3)
+        nominal["sigma1"] = 2 * zeta * math.sqrt(nominal["sigma0"] * m)
+    if kind == "presliding_stiff_nominal":
+        nominal["sigma0"] = 1e6
+        nominal["sigma1"] = 2 * zeta * math.sqrt(1e6 * m)
+    case = Case(kind, magnitude, seed, duration, {"m": m, "k": k, "c": c}, drive, nominal)
+    case.truth = dict(nominal)
+    case._zeta = zeta  # type: ignore[attr-defined]
+    case._rng = rng  # type: ignore[attr-defined]
+    return case
+
+
+def run_simulator(case: Case, params: dict, out: Path, truth: bool = False, table=()) -> None:
+    args = [str(simulator())]
+    args += [f"{k}={v!r}" for k, v in {**case.rig, **params}.items()]
+    args += [f"{k}={v}" for k, v in case.drive.items()]
+    args += [f"duration={case.duration}", f"sample={SAMPLE}", f"resolution={RESOLUTION}"]
+    args += [f"seed={case.seed}", f"truth={int(truth)}"]
+    if table:
+        xs, scales = table
+        args += ["x_table=" + ",".join(repr(x) for x in xs), "scale=" + ",".join(repr(s) for s in scales)]
+    with open(out, "w") as f:
+        subprocess.run(args, check=True, stdout=f)
+
+
+def read_columns(path: Path) -> dict[str, list[float]]:
+    with open(path) as f:
+        names = f.readline().strip().split(",")
+        cols: list[list[float]] = [[] for _ in names]
+        for line in f:
+            for c, v in zip(cols, line.split(",")):
+                c.append(float(v))
+    return dict(zip(names, cols))
+
+
+def rms(xs) -> float:
+    xs = list(xs)
+    return math.sqrt(sum(x * x for x in xs) / max(len(xs), 1))
+
+
+def size_hidden_effect(case: Case, work: Path) -> None:
+    """Run the effect-free truth, then set the hidden effect's amplitude so
+    that the RMS change of the friction level along that trajectory is
+    ε·Fc (closed forms: every shape is linear in its amplitude)."""
+    rng: random.Random = case._rng  # type: ignore[attr-defined]
+    eps, p = case.magnitude, case.nominal
+    fc = p["Fc"]
+    t = case.truth
+    if case.kind == "presliding_stiff_nominal":
+        # 0.3-1.7 mm of presliding displacement, the damping ratio kept
+        d = rng.uniform(3e-4, 1.7e-3)
+        t["sigma0"] = fc / d
+        t["sigma1"] = 2 * case._zeta * math.sqrt(t["sigma0"] * case.rig["m"])  # type: ignore[attr-defined]
+        return
+    if case.kind == "presliding_soft_nominal":
+        # a stiff truth: 5-50 µm of presliding, 5 to 50 encoder steps (a
+        # contact stiffer than the encoder resolves can be bounded, not sized)
+        t["sigma0"] = fc / rng.uniform(5e-6, 5e-5)
+        t["sigma1"] = 2 * case._zeta * math.sqrt(t["sigma0"] * case.rig["m"])  # type: ignore[attr-defined]
+        return
+    if case.kind == "none":
+        return
+    free = work / f"{case.name}.effect-free.csv"
+    run_simulator(case, p, free, truth=True)
+    d = read_columns(free)
+    x = d["true_x"]
+    v = [(b - a) / SAMPLE for a, b in zip(x, x[1:])]
+    xm = [0.5 * (a + b) for a, b in zip(x, x[1:])]
+    free.unlink()
+
+    def level(vv: float) -> float:
+        return p["Fc"] + (p["Fs"] - p["Fc"]) * math.exp(-((vv / p["vs"]) ** 2))
+
+    if case.kind == "viscous":
+        t["sigma2"] = p["sigma2"] + eps * fc / rms(v)
+    elif case.kind == "stribeck":
+        vs = p["vs"] if p["Fs"] > p["Fc"] else rms(v) * rng.uniform(0.2, 0.5)
+        base = (p["Fs"] - p["Fc"]) * 0 + 0.0
+        shape = rms(math.exp(-((vv / vs) ** 2)) for vv in v)
+        t["vs"] = vs
+        # the excess over the nominal's: Fs − Fc grows by a·Fc
+        if p["Fs"] > p["Fc"]:
+            # same vs: the change is a·Fc·exp(−(v/vs)²)
+            t["Fs"] = p["Fs"] + eps * fc / shape
+        else:
+            t["Fs"] = fc + eps * fc / shape + base
+    elif case.kind == "direction_dependent":
+        neg = rms((level(vv) / fc if vv < 0 else 0.0) for vv in v)
+        a = eps / neg
+        t["Fc_neg"] = p["Fc"] * (1 + a)
+        t["Fs_neg"] = p["Fs"] * (1 + a)
+    elif case.kind == "position_dependent":
+        lo, hi = min(xm), max(xm)
+        knots = 5
+        xs = [lo + (hi - lo) * i / (knots - 1) for i in range(knots)]
+        pattern = [rng.uniform(-1, 1) for _ in range(knots)]
+        mean = sum(pattern) / knots
+        pattern = [q - mean for q in pattern]
+
+        def interp(xx: float) -> float:
+            if xx <= xs[0]:
+                return pattern[0]
+            for i in range(1, knots):
+                if xx <= xs[i]:
+                    u = (xx - xs[i - 1]) / (xs[i] - xs[i - 1])
+                    return pattern[i - 1] + u * (pattern[i] - pattern[i - 1])
+            return pattern[-1]
+
+        a = eps / rms(interp(xx) * level(vv) / fc for xx, vv in zip(xm, v))
+        case.table = (xs, [1 + a * q for q in pattern])
+    else:
+        raise ValueError(case.kind)
+
+
+def make(case: Case, work: Path) -> tuple[Path, Path]:
+    """Write the case's data (and the noise-free truth beside it) and its
+    nominal system; returns (data.csv, nominal.ssd)."""
+    work.mkdir(parents=True, exist_ok=True)
+    size_hidden_effect(case, work)
+    truth_csv = work / f"{case.name}.truth.csv"
+    run_simulator(case, case.truth, truth_csv, truth=True, table=case.table)
+    d = read_columns(truth_csv)
+    data = work / f"{case.name}.csv"
+    with open(data, "w") as f:
+        f.write("time,rig.x_act_in,rig.x\n")
+        for row in zip(d["time"], d["rig.x_act_in"], d["rig.x"]):
+            f.write(f"{row[0]:.6f},{row[1]:.9g},{row[2]:.9g}\n")
+    ssd = work / f"{case.name}.ssd"
+    ssd.write_text(nominal_ssd(case, d["true_x"][0]))
+    return data, ssd
+
+
+def nominal_ssd(case: Case, x0: float, dist: Path | None = None) -> str:
+    dist = dist or ROOT / "dist"
+    r, p = case.rig, case.nominal
+
+    def real(name, value):
+        return f'<ssv:Parameter name="{name}"><ssv:Real value="{value!r}"/></ssv:Parameter>'
+
+    rig = "".join(
+        real(n, v) for n, v in [("m", r["m"]), ("c", r["c"]), ("k", r["k"]), ("x0", x0), ("v_a", 0.0)]
+    ) + '<ssv:Parameter name="actuator"><ssv:Integer value="1"/></ssv:Parameter>'
+    fr = "".join(real(n, p[n]) for n in ["Fc", "Fs", "vs", "sigma0", "sigma1", "sigma2"])
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription version="1.0" name="{case.name}"
+    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
+    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
+    xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues">
+  <ssd:System name="{case.name}">
+    <ssd:Elements>
+      <ssd:Component name="rig" source="{dist / 'Rig1D.fmu'}" type="application/x-fmu-sharedlibrary">
+        <ssd:Connectors>
+          <ssd:Connector name="F" kind="input"><ssc:Real unit="N"/></ssd:Connector>
+          <ssd:Connector name="x_act_in" kind="input"><ssc:Real unit="m"/></ssd:Connector>
+          <ssd:Connector name="v" kind="output"><ssc:Real unit="m/s"/></ssd:Connector>
+          <ssd:Connector name="x" kind="output"><ssc:Real unit="m"/></ssd:Connector>
+        </ssd:Connectors>
+        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
+          <ssv:ParameterSet version="1.0" name="rig"><ssv:Parameters>{rig}</ssv:Parameters></ssv:ParameterSet>
+        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
+      </ssd:Component>
+      <ssd:Component name="friction" source="{dist / 'LuGre.fmu'}" type="application/x-fmu-sharedlibrary">
+        <ssd:Connectors>
+          <ssd:Connector name="v" kind="input"><ssc:Real unit="m/s"/></ssd:Connector>
+          <ssd:Connector name="x" kind="input"><ssc:Real unit="m"/></ssd:Connector>
+          <ssd:Connector name="F" kind="output"><ssc:Real unit="N"/></ssd:Connector>
+        </ssd:Connectors>
+        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
+          <ssv:ParameterSet version="1.0" name="friction"><ssv:Parameters>{fr}</ssv:Parameters></ssv:ParameterSet>
+        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
+      </ssd:Component>
+    </ssd:Elements>
+    <ssd:Connections>
+      <ssd:Connection startElement="rig" startConnector="v" endElement="friction" endConnector="v"/>
+      <ssd:Connection startElement="rig" startConnector="x" endElement="friction" endConnector="x"/>
+      <ssd:Connection startElement="friction" startConnector="F" endElement="rig" endConnector="F"/>
+    </ssd:Connections>
+  </ssd:System>
+  <ssd:DefaultExperiment startTime="0" stopTime="{case.duration}">
+    <ssd:Annotations>
+      <ssc:Annotation type="org.friction-fmu.fricsim">
+        <fricsim:Simulation xmlns:fricsim="urn:friction-fmu:fricsim:1" stepSize="1e-3" master="newton"/>
+      </ssc:Annotation>
+    </ssd:Annotations>
+  </ssd:DefaultExperiment>
+</ssd:SystemStructureDescription>
+"""

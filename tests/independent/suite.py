@@ -1,0 +1,237 @@
+"""The independent hidden-effect suite of `fricsim diagnose`.
+
+Each case (see cases.py) is simulated by the independent simulator,
+diagnosed with the defaults as a user would (`fricsim diagnose SYSTEM.ssd
+DATA.csv --out DIR`), and scored from its report.json:
+
+- named right: the effects found are exactly the hidden one (none for a
+  null case);
+- size: the fitted size of the hidden effect against the truth (relative
+  error; presliding: σ0);
+- never worse: the final held-out RMS against the given model's;
+- a report was written.
+
+Usage: python3 tests/independent/suite.py [--quick] [--out DIR]
+       [--seeds N] [--jobs N]
+Writes DIR/suite.json and DIR/suite.md (the table of BENCHMARKS.md,
+"Independent hidden-effect suite").
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import cases  # noqa: E402
+
+FRICSIM = cases.ROOT / "target" / "release" / "fricsim"
+
+
+def corrupt(data: Path) -> list[tuple[int, str]]:
+    """Spikes and a dropout put into a file in place; returns the (line,
+    kind) of each, lines counted from 1 at the header."""
+    lines = data.read_text().splitlines()
+    n = len(lines) - 1
+    marks = []
+
+    def set_x(row: int, f):
+        t, a, x = lines[row].split(",")
+        lines[row] = f"{t},{a},{f(float(x)):.9g}"
+
+    set_x(n // 5, lambda x: 10 * x if abs(x) > 1e-3 else x + 0.05)
+    marks.append((n // 5 + 1, "spike"))
+    set_x(n // 3, lambda x: 1e6)
+    marks.append((n // 3 + 1, "spike"))
+    # a dropout: five rows repeat the row before while the actuator moves
+    # (placed where it moves fastest)
+    cols = [row.split(",") for row in lines[1:]]
+    speed = [abs(float(cols[k + 1][1]) - float(cols[k][1])) for k in range(n - 1)]
+    k0 = max(range(n // 2, 2 * n // 3), key=lambda k: speed[k])
+    for r in range(k0 + 1, k0 + 6):
+        t = lines[r + 1].split(",")[0]
+        lines[r + 1] = ",".join([t] + lines[k0 + 1].split(",")[1:])
+    marks.append((k0 + 3, "dropout"))
+    data.write_text("\n".join(lines) + "\n")
+    return marks
+
+
+def effect_size(case: cases.Case, report: dict) -> tuple[str, float, float] | None:
+    """(quantity, truth, fitted) of the hidden effect, when it was named."""
+    expected = cases.EXPECTED[case.kind]
+    found = [e for e in report["effects"] if e["name"] == expected]
+    if not found:
+        return None
+    p = found[-1]["parameters"]
+    final = report["final_model"]
+    nom, tru = case.nominal, case.truth
+    if expected == "viscous":
+        return ("added sigma2", tru["sigma2"] - nom["sigma2"], final["sigma2"] - nom["sigma2"])
+    if expected == "stribeck":
+        return ("Fs - Fc", tru["Fs"] - tru["Fc"], final["fs"] - final["fc"])
+    if expected == "direction_dependent":
+        return ("Fc_neg - Fc", tru["Fc_neg"] - tru["Fc"], final["fc_neg"] - final["fc"])
+    if expected == "presliding":
+        return ("sigma0", tru["sigma0"], p["sigma0"])
+    if expected == "position_dependent":
+        xs, scales = case.table
+        fx, fs = final["x_table"], final["scale_pos"]
+
+        def interp(x, xt, yt):
+            if x <= xt[0]:
+                return yt[0]
+            for i in range(1, len(xt)):
+                if x <= xt[i]:
+                    u = (x - xt[i - 1]) / (xt[i] - xt[i - 1])
+                    return yt[i - 1] + u * (yt[i] - yt[i - 1])
+            return yt[-1]
+
+        grid = [fx[0] + (fx[-1] - fx[0]) * i / 100 for i in range(101)]
+        truth = cases.rms((interp(x, xs, scales) - 1) * nom["Fc"] for x in grid)
+        fitted = cases.rms(interp(x, fx, fs) * final["fc"] - nom["Fc"] for x in grid)
+        return ("RMS level change over the travel", truth, fitted)
+    return None
+
+
+def run_case(case: cases.Case, work: Path, bad_data: bool = False) -> dict:
+    started = time.time()
+    data, ssd = cases.make(case, work)
+    marks = corrupt(data) if bad_data else []
+    out = work / f"out-{case.name}{'-bad' if bad_data else ''}"
+    proc = subprocess.run(
+        [str(FRICSIM), "diagnose", str(ssd), str(data), "--out", str(out)],
+        capture_output=True,
+        text=True,
+    )
+    row = {
+        "case": case.name + (" (spikes, dropout)" if bad_data else ""),
+        "kind": case.kind,
+        "magnitude": case.magnitude,
+        "seed": case.seed,
+        "bad_data": bad_data,
+        "rig": case.rig,
+        "drive": case.drive,
+        "nominal": case.nominal,
+        "truth": case.truth,
+        "report": (out / "report.json").exists(),
+        "exit": proc.returncode,
+        "stderr": proc.stderr[-2000:],
+    }
+    if not row["report"]:
+        row["seconds"] = time.time() - started
+        return row
+    report = json.loads((out / "report.json").read_text())
+    found = [e["name"] for e in report["effects"]]
+    expected = cases.EXPECTED[case.kind]
+    row.update(
+        found=found,
+        named_right=found == ([expected] if expected else []),
+        given_rms=report["nominal_rms"],
+        final_rms=report["final_rms"],
+        floor_rms=report["floor_rms"],
+        unexplained=report["unexplained"],
+        refit_kept=report["refit"]["kept"],
+        never_worse=report["final_rms"] <= 1.05 * report["nominal_rms"],
+        diagnose_seconds=report["wall_seconds"],
+    )
+    size = effect_size(case, report)
+    if size:
+        q, truth, fitted = size
+        row["size"] = {"quantity": q, "truth": truth, "fitted": fitted,
+                       "relative_error": abs(fitted - truth) / abs(truth)}
+    if bad_data:
+        q = report["data_quality"]["data"]
+        flagged = {(f["line"], f["kind"]) for f in q["findings"]}
+        row["bad_samples_found"] = all(
+            any(kind == k and abs(line - l) <= 3 for (l, k) in flagged) for line, kind in marks
+        )
+        row["flagged"] = q["excluded_samples"]
+    row["seconds"] = time.time() - started
+    return row
+
+
+def grid(seeds: int, quick: bool) -> list[tuple[cases.Case, bool]]:
+    out = []
+    mags = [0.1] if quick else [0.1, 0.05]
+    for seed in range(1, seeds + 1):
+        for kind in cases.KINDS:
+            for mag in mags if kind not in ("none",) and not kind.startswith("presliding") else [0.1]:
+                out.append((cases.draw(kind, mag, seed), False))
+        out.append((cases.draw("none", 0.1, 100 + seed), True))
+    return out
+
+
+def summarise(rows: list[dict]) -> dict:
+    def share(sel, key):
+        xs = [r for r in rows if sel(r)]
+        ok = sum(1 for r in xs if r.get(key))
+        return ok, len(xs)
+
+    effect = lambda m: lambda r: cases.EXPECTED[r["kind"]] and abs(r["magnitude"] - m) < 1e-9 and not r["bad_data"]  # noqa: E731
+    sized = [r for r in rows if "size" in r]
+    return {
+        "named_right_10pct": share(effect(0.1), "named_right"),
+        "named_right_5pct": share(effect(0.05), "named_right"),
+        "clean_null_no_claim": share(lambda r: r["kind"] == "none" and not r["bad_data"], "named_right"),
+        "bad_data_no_claim": share(lambda r: r["bad_data"], "named_right"),
+        "bad_data_found": share(lambda r: r["bad_data"], "bad_samples_found"),
+        "never_worse": share(lambda r: True, "never_worse"),
+        "reports_written": share(lambda r: True, "report"),
+        "sized_within_10pct": (sum(1 for r in sized if r["size"]["relative_error"] <= 0.1), len(sized)),
+    }
+
+
+def table(rows: list[dict], summary: dict) -> str:
+    lines = [
+        "| case | drive | found | size: truth → fitted (error) | final / given RMS | floor | time (s) |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in rows:
+        if not r["report"]:
+            lines.append(f"| {r['case']} | {r['drive']['drive']} | NO REPORT: {r['stderr'].strip().splitlines()[-1] if r['stderr'].strip() else ''} | | | | |")
+            continue
+        size = r.get("size")
+        s = f"{size['quantity']}: {size['truth']:.4g} → {size['fitted']:.4g} ({100 * size['relative_error']:.1f} %)" if size else ""
+        found = ", ".join(r["found"]) or "none"
+        mark = "" if r["named_right"] else " ✗"
+        lines.append(
+            f"| {r['case']} | {r['drive']['drive']} | {found}{mark} | {s} | {r['final_rms'] / r['given_rms']:.3f} | {r['floor_rms']:.2e} | {r['diagnose_seconds']:.1f} |"
+        )
+    lines.append("")
+    for k, (a, b) in summary.items():
+        lines.append(f"- {k.replace('_', ' ')}: {a}/{b}")
+    return "\n".join(lines) + "\n"
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="10 % only")
+    ap.add_argument("--seeds", type=int, default=2)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--out", type=Path, default=cases.ROOT / "out" / "independent-suite")
+    ap.add_argument("--only", default="", help="comma list of kinds")
+    args = ap.parse_args()
+    todo = grid(args.seeds, args.quick)
+    if args.only:
+        keep = args.only.split(",")
+        todo = [(c, b) for c, b in todo if c.kind in keep]
+    args.out.mkdir(parents=True, exist_ok=True)
+    with ThreadPoolExecutor(args.jobs) as pool:
+        rows = list(pool.map(lambda cb: run_case(cb[0], args.out / "cases", cb[1]), todo))
+    for r in rows:
+        print(r["case"], r.get("found"), r.get("size", {}).get("relative_error"), r.get("final_rms", 0) / max(r.get("given_rms", 1), 1e-300), file=sys.stderr)
+    summary = summarise(rows)
+    (args.out / "suite.json").write_text(json.dumps({"summary": summary, "cases": rows}, indent=1))
+    (args.out / "suite.md").write_text(table(rows, summary))
+    print(table(rows, summary))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
