@@ -116,8 +116,9 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     );
     for e in &d.effects {
         println!(
-            "  {:<20} held-out RMS {:.5} -> {:.5} (p = {:.1e}); where: {} {}",
+            "  {:<20} {:<8} held-out RMS {:.5} -> {:.5} (p = {:.1e}); where: {} {}",
             e.name.name(),
+            e.action,
             e.rms_before,
             e.rms_after,
             e.p_value,
@@ -126,11 +127,14 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         );
     }
     println!(
-        "held-out RMS: nominal {:.5}, refitted nominal {:.5}, final {:.5}; noise floor {:.5}{}",
+        "held-out RMS: given {:.5}, levels refitted {:.5} ({}), final {:.5}; floor {:.5} (noise {:.5}, step error {:.5}){}",
         d.nominal_rms,
-        d.baseline_rms,
+        d.refit.heldout_rms,
+        if d.refit.kept { "kept" } else { "not kept" },
         d.final_rms,
+        d.floor_rms,
         d.noise_floor_rms,
+        d.step_error_rms,
         if d.unexplained {
             format!(
                 "; UNEXPLAINED residual, largest in {}",
@@ -140,6 +144,25 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             String::new()
         }
     );
+    for (label, q) in std::iter::once((&d.data, &d.data_quality.data)).chain(
+        d.data_quality
+            .heldout
+            .as_ref()
+            .map(|q| (&d.heldout, q)),
+    ) {
+        if q.total() > 0 {
+            eprintln!(
+                "warning: {label}: {} spikes, {} dropouts, {} gaps, {} saturated columns; {} samples left out (report.md lists them)",
+                q.spikes, q.dropouts, q.gaps, q.saturated, q.excluded_samples
+            );
+            for f in q.findings.iter().take(5) {
+                eprintln!("  {}", f.describe(label));
+            }
+        }
+    }
+    for f in &d.fallbacks {
+        eprintln!("note: co-simulation fallback: {f}");
+    }
     if d.polish_cosimulations > 0 {
         println!(
             "refinement on the output error: {} co-simulations, {:.2} s",

@@ -79,22 +79,28 @@ pub struct Finding {
 }
 
 impl Finding {
+    /// One line: `FILE: line N: ...` (without the file when `file` is empty).
     pub fn describe(&self, file: &str) -> String {
+        let file = if file.is_empty() {
+            String::new()
+        } else {
+            format!("{file}: ")
+        };
         match self.kind {
             Kind::Gap => format!(
-                "{file}: line {}: gap of {} s in `time` before t = {} s",
+                "{file}line {}: gap of {} s in `time` before t = {} s",
                 self.line, self.value, self.time
             ),
             Kind::Spike => format!(
-                "{file}: line {}: spike in `{}`: {} at t = {} s",
+                "{file}line {}: spike in `{}`: {} at t = {} s",
                 self.line, self.column, self.value, self.time
             ),
             Kind::Dropout => format!(
-                "{file}: line {}: dropout: {} rows repeat the row before (every column held at t = {} s, `{}` = {})",
+                "{file}line {}: dropout: {} rows repeat the row before (every column held at t = {} s, `{}` = {})",
                 self.line, self.samples, self.time, self.column, self.value
             ),
             Kind::Saturation => format!(
-                "{file}: line {}: `{}` saturated at {} ({} samples at that value, from t = {} s)",
+                "{file}line {}: `{}` saturated at {} ({} samples at that value, from t = {} s)",
                 self.line, self.column, self.value, self.samples, self.time
             ),
         }

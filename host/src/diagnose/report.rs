@@ -84,33 +84,83 @@ pub fn markdown(d: &Diagnosis) -> String {
             "No effect of the library improves the model significantly on the held-out data."
         );
     } else {
-        let names: Vec<&str> = d.effects.iter().map(|e| e.name.name()).collect();
+        let names: Vec<String> = d
+            .effects
+            .iter()
+            .map(|e| format!("**{}** ({})", e.name.name(), e.action))
+            .collect();
         let _ = writeln!(
             s,
-            "Missing effect(s), in the order found: **{}**.",
-            names.join("**, **")
+            "Missing or mis-sized effect(s), in the order found: {}.",
+            names.join(", ")
         );
     }
     let _ = writeln!(
         s,
-        "\nHeld-out RMS error (each channel divided by its standard deviation, then averaged in the mean square): nominal as given {:.5}, refitted nominal (baseline) {:.5}, final {:.5} ({} against the baseline). Measurement-noise floor {:.5}.",
+        "\nHeld-out RMS error (each channel divided by its standard deviation, then averaged in the mean square):\n\n| model | held-out RMS | against the given model |\n| --- | --- | --- |\n| nominal as given | {:.5} | |\n| nominal, levels refitted | {} | {} |\n| final | {:.5} | {} |",
         d.nominal_rms,
-        d.baseline_rms,
+        if d.refit.heldout_rms.is_finite() {
+            format!("{:.5}", d.refit.heldout_rms)
+        } else {
+            "failed".into()
+        },
+        match (&d.refit.failure, d.refit.kept) {
+            (Some(e), _) => format!("not kept: its co-simulation failed ({})", e.replace('|', "/")),
+            (None, true) => format!(
+                "{}; kept as the baseline (p = {:.2e} < {:.2e})",
+                pct(d.nominal_rms, d.refit.heldout_rms),
+                d.refit.p_value,
+                d.refit.threshold
+            ),
+            (None, false) => format!(
+                "{}; not kept (p = {:.2e}, threshold {:.2e}): the baseline is the nominal as given",
+                pct(d.nominal_rms, d.refit.heldout_rms),
+                d.refit.p_value,
+                d.refit.threshold
+            ),
+        },
         d.final_rms,
-        pct(d.baseline_rms, d.final_rms),
-        d.noise_floor_rms
+        pct(d.nominal_rms, d.final_rms),
+    );
+    let _ = writeln!(
+        s,
+        "\nFloor: measurement noise and quantisation {:.5}, the co-simulation's step error {:.5}, together {:.5}.",
+        d.noise_floor_rms, d.step_error_rms, d.floor_rms
     );
     if d.unexplained {
         let _ = writeln!(
             s,
-            "\n**Unexplained**: the final error is more than twice the noise floor and no candidate of the library reduces it significantly. The remaining residual is largest in: {}.",
+            "\n**Unexplained**: the final error is more than {} times the floor and no candidate of the library reduces it significantly. The remaining residual is largest in: {}.",
+            super::UNEXPLAINED_FACTOR,
             d.residual_pattern.strongest
         );
     } else {
         let _ = writeln!(
             s,
-            "\nThe final error is within twice the noise floor: nothing unexplained remains."
+            "\nThe final error is within {} times the floor: nothing unexplained remains.",
+            super::UNEXPLAINED_FACTOR
         );
+    }
+    for (what, q) in std::iter::once(("data", &d.data_quality.data))
+        .chain(d.data_quality.heldout.as_ref().map(|q| ("held-out data", q)))
+    {
+        if q.total() == 0 {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            "\n**Bad samples in the {what}**: {} spikes, {} dropouts, {} gaps, {} saturated columns; {} samples left out of the fits and scores (spikes and dropouts repaired by interpolation for the inputs and the inverse dynamics).\n",
+            q.spikes, q.dropouts, q.gaps, q.saturated, q.excluded_samples
+        );
+        for f in &q.findings {
+            let _ = writeln!(s, "- {}", f.describe(""));
+        }
+    }
+    if !d.fallbacks.is_empty() {
+        let _ = writeln!(s, "\n**Co-simulation fallbacks**:\n");
+        for f in &d.fallbacks {
+            let _ = writeln!(s, "- {f}");
+        }
     }
     let _ = writeln!(s, "\n| channel | scale | nominal RMS | baseline RMS | final RMS |\n| --- | --- | --- | --- | --- |");
     for c in &d.channels {
@@ -121,7 +171,14 @@ pub fn markdown(d: &Diagnosis) -> String {
         );
     }
     for (k, e) in d.effects.iter().enumerate() {
-        let _ = writeln!(s, "\n## {}. `{}`: {}\n", k + 1, e.name.name(), e.meaning);
+        let _ = writeln!(
+            s,
+            "\n## {}. `{}` ({}): {}\n",
+            k + 1,
+            e.name.name(),
+            e.action,
+            e.meaning
+        );
         let _ = writeln!(
             s,
             "Held-out RMS {:.5} → {:.5} ({}); p = {:.2e} < {:.2e}.\n",
@@ -147,13 +204,13 @@ pub fn markdown(d: &Diagnosis) -> String {
     let _ = writeln!(s, "\n## Candidates tried\n");
     let _ = writeln!(
         s,
-        "Each candidate is the current model with one effect added (or two that interact), refitted; p is the one-sided p-value of Clark and West's test for nested models on the held-out samples (per sample 2·e₀·(ŷ₁ − ŷ₀), averaged per group, Student's t), against α = {} divided by the candidates of the round; the mean square must also drop by at least 2 %. A round of pairs follows a round in which no single effect was accepted.\n",
+        "Each candidate is the current model with one effect added (or, for viscous, Stribeck and presliding when the model has them, re-sized; or two that interact), refitted; p is the one-sided p-value of Clark and West's test for nested models on the held-out samples (per sample 2·e₀·(ŷ₁ − ŷ₀), averaged per group, Student's t), against α = {} divided by the candidates of the round; the mean square must also drop by at least 2 % and by more than the co-simulation's step error squared. A round of pairs follows a round in which no single effect was accepted.\n",
         d.alpha
     );
     for (r, round) in d.rounds.iter().enumerate() {
         let _ = writeln!(
             s,
-            "Round {} ({} candidates; p must be below {:.2e}):\n\n| candidate | held-out RMS | drop of the mean square | p | force RMS (N, training) | fit runs |\n| --- | --- | --- | --- | --- | --- |",
+            "Round {} ({} candidates; p must be below {:.2e}):\n\n| candidate | held-out RMS | drop of the mean square | p | beyond the step error | force RMS (N, training) | fit runs |\n| --- | --- | --- | --- | --- | --- | --- |",
             r + 1,
             round.len(),
             d.alpha / round.len().max(1) as f64
@@ -162,7 +219,7 @@ pub fn markdown(d: &Diagnosis) -> String {
             if let Some(why) = &c.failure {
                 let _ = writeln!(
                     s,
-                    "| `{}` | rejected: its co-simulation failed ({}) | | | {:.4} | {} |",
+                    "| `{}` | rejected: its co-simulation failed ({}) | | | | {:.4} | {} |",
                     c.name,
                     why.replace('|', "/"),
                     c.force_rms,
@@ -172,11 +229,12 @@ pub fn markdown(d: &Diagnosis) -> String {
             }
             let _ = writeln!(
                 s,
-                "| `{}` | {:.5} | {:.1} % | {:.2e} | {:.4} | {} |",
+                "| `{}` | {:.5} | {:.1} % | {:.2e} | {} | {:.4} | {} |",
                 c.name,
                 c.heldout_rms,
                 100.0 * c.gain,
                 c.p_value,
+                if c.beyond_step_error { "yes" } else { "no" },
                 c.force_rms,
                 c.fit_evaluations
             );
