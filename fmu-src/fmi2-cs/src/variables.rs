@@ -247,7 +247,8 @@ pub struct ModelInfo {
     pub model_identifier: &'static str,
     pub guid: &'static str,
     pub description: &'static str,
-    /// Which seed paper or reference the equations come from.
+    /// Which papers the equations come from (author and year), appended to
+    /// the model description after "Source:".
     pub source: &'static str,
     pub variables: &'static [Variable],
     pub default_experiment: DefaultExperiment,

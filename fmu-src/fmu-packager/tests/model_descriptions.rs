@@ -32,12 +32,11 @@ fn every_model_has_a_distinct_guid_and_identifier() {
 }
 
 #[test]
-fn readme_variable_tables_match_the_code() {
-    let readme =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md"))
-            .unwrap();
+fn docs_variable_tables_match_the_code() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/variables.md");
+    let page = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     assert!(
-        readme.contains(&fmu_packager::variables_markdown()),
-        "README.md's variable tables differ from the code: paste `cargo run -p fmu-packager -- variables-md`"
+        page.contains(&fmu_packager::variables_markdown()),
+        "docs/variables.md's variable tables differ from the code: paste `cargo run -p fmu-packager -- variables-md`"
     );
 }

@@ -1,5 +1,6 @@
-//! `Bristle.fmu`: the pre-sliding bristle model of seed 000 (Appels &
-//! Herder; MODELS.md "Bristle"), driven by the relative displacement `x`.
+//! `Bristle.fmu`: the pre-sliding bristle model of Appels & Herder
+//! (docs/models.md "Pre-sliding bristle model"), driven by the relative
+//! displacement `x`.
 //! A static, position-dependent law: the force follows `x` at once (direct
 //! feedthrough), so the output is evaluated at the current input without
 //! committing the move; `fmi2DoStep` commits it.
@@ -25,23 +26,23 @@ pub mod vr {
     pub const SEED: u32 = 13;
 }
 
-/// Seed 000: lightest mass 0.352 kg, g = 9.81 m/s².
-const SEED000_NORMAL_FORCE: f64 = 0.352 * 9.81;
+/// Appels & Herder: lightest mass 0.352 kg, g = 9.81 m/s².
+const APPELS_HERDER_NORMAL_FORCE: f64 = 0.352 * 9.81;
 
 static VARIABLES: [Variable; 14] = [
     Variable::input(vr::X, "x", 0.0, "m", 1e-8, "Relative displacement of the body"),
     Variable::output(vr::F, "F", "N", "Friction force sigma_b*(sum of connected deflections + disconnected +-delta_max)", &[vr::X]),
     Variable::integer_output(vr::N_CONNECTED, "n_connected", "Number of connected bristles", &[vr::X]),
     Variable::boolean_output(vr::SLIDING, "sliding", "True when every bristle is disconnected (gross sliding)", &[vr::X]),
-    Variable::parameter(vr::SIGMA_INI, "sigma_ini", 2.2173e7, "N/m", "Initial stiffness (all bristles), used when stiffness_from_load is false (seed 000 Table 3)").with_min(0.0),
-    Variable::parameter(vr::DELTA_MAX, "delta_max", 1.5584e-8, "m", "Bristle deflection at which it disconnects (seed 000 Table 3)").with_min(0.0),
-    Variable::parameter(vr::X_REL, "x_rel", 4.4206e-9, "m", "Mean relaxation of a reconnecting bristle (seed 000 Table 3)").with_min(0.0),
-    Variable::boolean_parameter(vr::STIFFNESS_FROM_LOAD, "stiffness_from_load", true, "sigma_ini = mu_c*Fn/delta_max, so the sliding level is mu_c*Fn (seed 000 code)"),
-    Variable::boolean_parameter(vr::COUNT_FROM_LOAD, "count_from_load", true, "Bristle count N = round(c*mu_c*Fn) (seed 000) instead of n_bristles"),
+    Variable::parameter(vr::SIGMA_INI, "sigma_ini", 2.2173e7, "N/m", "Initial stiffness (all bristles), used when stiffness_from_load is false (Appels and Herder, Table 3)").with_min(0.0),
+    Variable::parameter(vr::DELTA_MAX, "delta_max", 1.5584e-8, "m", "Bristle deflection at which it disconnects (Appels and Herder, Table 3)").with_min(0.0),
+    Variable::parameter(vr::X_REL, "x_rel", 4.4206e-9, "m", "Mean relaxation of a reconnecting bristle (Appels and Herder, Table 3)").with_min(0.0),
+    Variable::boolean_parameter(vr::STIFFNESS_FROM_LOAD, "stiffness_from_load", true, "sigma_ini = mu_c*Fn/delta_max, so the sliding level is mu_c*Fn (Appels and Herder's code)"),
+    Variable::boolean_parameter(vr::COUNT_FROM_LOAD, "count_from_load", true, "Bristle count N = round(c*mu_c*Fn) (Appels and Herder) instead of n_bristles"),
     Variable::integer_parameter(vr::N_BRISTLES, "n_bristles", 100, "Bristle count when count_from_load is false (>= 1)"),
-    Variable::parameter(vr::C, "c", 500.0, "1/N", "Scale factor of the bristle count (seed 000: 500 gives about 100 bristles at 0.352 kg)").with_min(0.0),
-    Variable::parameter(vr::MU_C, "mu_c", 0.0633, "", "Coulomb friction coefficient (seed 000 Table 3)").with_min(0.0),
-    Variable::parameter(vr::FN, "Fn", SEED000_NORMAL_FORCE, "N", "Normal force m*g (seed 000: 0.352 kg)").with_min(0.0),
+    Variable::parameter(vr::C, "c", 500.0, "1/N", "Scale factor of the bristle count (Appels and Herder: 500 gives about 100 bristles at 0.352 kg)").with_min(0.0),
+    Variable::parameter(vr::MU_C, "mu_c", 0.0633, "", "Coulomb friction coefficient (Appels and Herder, Table 3)").with_min(0.0),
+    Variable::parameter(vr::FN, "Fn", APPELS_HERDER_NORMAL_FORCE, "N", "Normal force m*g (Appels and Herder: 0.352 kg)").with_min(0.0),
     Variable::integer_parameter(vr::SEED, "seed", 1, "Random seed of the bristle realisation: same seed, bit-identical output"),
 ];
 
@@ -50,7 +51,7 @@ pub static INFO: ModelInfo = ModelInfo {
     model_identifier: "Bristle",
     guid: "{676098e4-701d-41e0-b1ca-6d4cfe1c7bd8}",
     description: "Pre-sliding bristle friction: N bristles of stiffness sigma_ini/N with random pre-tension; each disconnects at |delta| >= delta_max; sliding level sigma_ini*delta_max; bristles reconnect with a random relaxation when the motion reverses.",
-    source: "seed 000 (Appels and Herder, TU Delft), Appendix C; reconnection on reversal derived in MODELS.md.",
+    source: "Appels and Herder (TU Delft), Appendix C code; reconnection on reversal derived here, see docs/models.md.",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,

@@ -1,6 +1,6 @@
-//! `Bristle2D.fmu`: the two-dimensional reset-integrator bristle of seed 004
-//! (Wijata et al. 2016), with the equations derived in MODELS.md "Two-
-//! dimensional bristle"; exact for piecewise-constant slip velocity.
+//! `Bristle2D.fmu`: the two-dimensional reset-integrator bristle of Wijata
+//! et al. 2016, with the equations derived in docs/models.md
+//! "Two-dimensional bristle"; exact for piecewise-constant slip velocity.
 
 use crate::{input_ramp, param_err};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
@@ -56,7 +56,7 @@ static VARIABLES: [Variable; 15] = [
         "sigma01",
         1e4,
         "N/m",
-        "Bristle stiffness along axis 1 (seed 004)",
+        "Bristle stiffness along axis 1 (Wijata et al. 2016: 1e4 N/m)",
     )
     .with_min(0.0),
     Variable::parameter(
@@ -64,7 +64,7 @@ static VARIABLES: [Variable; 15] = [
         "sigma02",
         1e4,
         "N/m",
-        "Bristle stiffness along axis 2 (seed 004)",
+        "Bristle stiffness along axis 2 (Wijata et al. 2016: 1e4 N/m)",
     )
     .with_min(0.0),
     Variable::parameter(
@@ -72,7 +72,7 @@ static VARIABLES: [Variable; 15] = [
         "sigma11",
         74.15,
         "N.s/m",
-        "Bristle damping along axis 1 (seed 004)",
+        "Bristle damping along axis 1 (Wijata et al. 2016: 74.15 N.s/m)",
     )
     .with_min(0.0),
     Variable::parameter(
@@ -80,7 +80,7 @@ static VARIABLES: [Variable; 15] = [
         "sigma12",
         74.15,
         "N.s/m",
-        "Bristle damping along axis 2 (seed 004)",
+        "Bristle damping along axis 2 (Wijata et al. 2016: 74.15 N.s/m)",
     )
     .with_min(0.0),
     Variable::parameter(vr::A1, "a1", 0.1, "", "Stiction gradient along axis 1").with_min(0.0),
@@ -108,7 +108,7 @@ pub static INFO: ModelInfo = ModelInfo {
     model_identifier: "Bristle2D",
     guid: "{4ac05ffa-4571-4523-9d95-9effa10f3869}",
     description: "Two-dimensional bristle (reset integrator): dz/dt = v - [|z| >= z0 and z.v > 0]*(z.v)*z/|z|^2; Fi = (1 + ai(|z|))*sigma0i*zi + sigma1i(|v|)*dzi/dt.",
-    source: "seed 004 (Wijata, Awrejcewicz, Matej, Makowski 2016); equations derived in MODELS.md.",
+    source: "Wijata, Awrejcewicz, Matej, Makowski 2016; equations derived in docs/models.md.",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,

@@ -1,5 +1,6 @@
-//! `Dahl.fmu`: the Dahl law (seed 001 eq. 2–3, 16–17; MODELS.md "Dahl"),
-//! integrated exactly in the displacement domain for every α.
+//! `Dahl.fmu`: the Dahl law (Dahl 1968; Sun et al. 2016 eq. 2–3, 16–17;
+//! docs/models.md "Dahl"), integrated exactly in the displacement domain
+//! for every α.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
@@ -36,7 +37,7 @@ static VARIABLES: [Variable; 7] = [
         "sigma",
         87750.0,
         "N/m",
-        "Rest stiffness dF/dx at F = 0 (seed 001 Table 7)",
+        "Rest stiffness dF/dx at F = 0 (Sun et al. 2016, Table 7)",
     )
     .with_min(0.0),
     Variable::parameter(
@@ -44,7 +45,7 @@ static VARIABLES: [Variable; 7] = [
         "Fc",
         2.0,
         "N",
-        "Coulomb friction level (seed 001 Table 7)",
+        "Coulomb friction level (Sun et al. 2016, Table 7)",
     )
     .with_min(0.0),
     Variable::parameter(
@@ -62,7 +63,7 @@ pub static INFO: ModelInfo = ModelInfo {
     model_identifier: "Dahl",
     guid: "{a54e3c99-50b7-48eb-af8d-f492d8bea339}",
     description: "Dahl friction: dF/dx = sigma*|1 - F/Fc*sgn v|^alpha*sgn(1 - F/Fc*sgn v), dF/dt = dF/dx*v; exact update in x for every alpha.",
-    source: "seed 001 (Sun et al. 2016) eq. 2-3, 16-17; seed 003 eq. 2.4-2.5.",
+    source: "Dahl 1968; Sun et al. 2016 eq. 2-3, 16-17; Thimmalapura 2004 eq. 2.4-2.5. See docs/models.md.",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
@@ -120,7 +121,7 @@ impl Model for DahlFmu {
         false
     }
 
-    /// dF/dt = (dF/dx)·v (seed 001 eq. 3); dz/dt = (dF/dt)/σ.
+    /// dF/dt = (dF/dx)·v (Sun et al. 2016 eq. 3); dz/dt = (dF/dt)/σ.
     fn output_derivative(&self, values: &Values, _slopes: &[f64], output: u32) -> Option<f64> {
         let p = self.law.params();
         let v = values.real(vr::V);

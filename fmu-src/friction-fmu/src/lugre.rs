@@ -1,6 +1,7 @@
-//! `LuGre.fmu`: the LuGre law (seed 001 eq. 9–12; MODELS.md "LuGre") with
-//! the extensions the slider of seed 003 and the tribometer of seed 002
-//! need: velocity-dependent micro-damping, direction-dependent levels,
+//! `LuGre.fmu`: the LuGre law (Canudas de Wit et al. 1995; Sun et al. 2016
+//! eq. 9–12; docs/models.md "LuGre") with the extensions the slider of
+//! Thimmalapura 2004 and the tribometer of Dion et al. 2013 need:
+//! velocity-dependent micro-damping, direction-dependent levels,
 //! position-dependent levels (a table of scale factors over `x`), and the
 //! normal-force form.
 
@@ -156,7 +157,7 @@ fn variables() -> Vec<Variable> {
             vr::NORMAL_FORCE_FORM,
             "normal_force_form",
             false,
-            "Seed 002 form: stiffness, damping and levels are per unit normal force Fn",
+            "Normal-force form (Dion et al. 2013): stiffness, damping and levels are per unit normal force Fn",
         ),
         Variable::boolean_parameter(
             vr::POSITION_DEPENDENT,
@@ -218,7 +219,7 @@ pub static INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
     model_identifier: "LuGre",
     guid: "{cc09ec7b-20f5-4798-9c84-4aa863242977}",
     description: "LuGre friction: dz/dt = v - sigma0*|v|*z/g(v), g(v) = Fc + (Fs - Fc)*exp(-|v/vs|^delta), F = sigma0*z + sigma1(v)*dz/dt + sigma2*v; exact exponential update for piecewise-constant inputs. Defaults: Canudas de Wit et al. 1995.",
-    source: "seed 001 (Sun et al. 2016) eq. 9-12; seed 002 eq. 1-3 (normal-force form); seed 003 eq. 2.8-2.9 (position and direction dependence).",
+    source: "Canudas de Wit et al. 1995; Sun et al. 2016 eq. 9-12; Dion et al. 2013 eq. 1 (normal-force form); Thimmalapura 2004 eq. 2.8-2.9 and Table I (position and direction dependence). See docs/models.md.",
     variables: Box::leak(variables().into_boxed_slice()),
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,

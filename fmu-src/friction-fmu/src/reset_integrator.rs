@@ -1,5 +1,5 @@
 //! `ResetIntegrator.fmu`: the 1-D reset integrator (Haessig & Friedland
-//! 1991; MODELS.md "Reset integrator"), integrated exactly.
+//! 1991; docs/models.md "Reset integrator"), integrated exactly.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
@@ -57,7 +57,7 @@ pub static INFO: ModelInfo = ModelInfo {
     model_identifier: "ResetIntegrator",
     guid: "{39de5f74-c513-4262-b587-f0e6ca39667a}",
     description: "Reset-integrator friction: dz/dt = v unless |z| >= z0 and moving outward; F = (1 + a(z))*sigma0*z + sigma1*dz/dt.",
-    source: "Haessig and Friedland 1991; the 1-D base of seed 004 (Wijata et al. 2016).",
+    source: "Haessig and Friedland 1991; the 1-D base of Wijata et al. 2016. See docs/models.md.",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,

@@ -1,10 +1,10 @@
-//! Pre-sliding bristle model (seed 000, Appels & Herder, TU Delft; its
-//! Matlab code `Initial_bristle_placement.m`, `New_model.m`,
-//! `New_model_hysteresis.m` in Appendix C; MODELS.md "Bristle, pre-sliding").
+//! Pre-sliding bristle model (Appels & Herder, TU Delft; their Matlab code
+//! `Initial_bristle_placement.m`, `New_model.m`, `New_model_hysteresis.m` in
+//! Appendix C; docs/models.md "Pre-sliding bristle model").
 //!
 //! A static, position-driven model: `N` bristles of stiffness
 //! `σb = σ_ini/N` with random pre-deflections `δi`.
-//! - Initialisation (seed code): `δi ~ Normal(0, (2/3)·δmax)`, settle by
+//! - Initialisation (the paper's code): `δi ~ Normal(0, (2/3)·δmax)`, settle by
 //!   subtracting the mean; a bristle with `|δi| > δmax` is redrawn, the set
 //!   settled again and the check restarted, until all are connected.
 //! - Realisation: moving by `dx` adds `dx` to every connected bristle; one
@@ -12,13 +12,14 @@
 //!   `±σb·δmax` (sign of its direction).
 //!   `F = σb·(Σ_connected δi + (n₊ − n₋)·δmax)`; all disconnected:
 //!   `F = σ_ini·δmax = μc·Fn` (the Coulomb level).
-//! - Reversal (derived formulation, see below): when the motion reverses,
+//! - Reversal (derived here, see below): when the motion reverses,
 //!   before the reverse increment is applied every disconnected bristle
 //!   reconnects at `δ = s·(δmax − |r|)`, `s` its disconnection sign,
-//!   `r ~ Normal(x_rel, x_rel/3)` (seed eq. 13 and `New_model_hysteresis.m`,
-//!   "reconnected in the direction that leads to a decrease in strain").
+//!   `r ~ Normal(x_rel, x_rel/3)` (the paper's eq. 13 and
+//!   `New_model_hysteresis.m`, "reconnected in the direction that leads to
+//!   a decrease in strain").
 //!
-//! The seed triggers reconnection when the actuation force is removed and
+//! The paper triggers reconnection when the actuation force is removed and
 //! then lets the body settle; driven by an imposed displacement the body
 //! cannot settle, so here the reconnection happens at a reversal of the
 //! imposed motion and no settling shift is applied (the imposed position
@@ -58,7 +59,7 @@ pub struct BristleParams {
 }
 
 impl BristleParams {
-    /// Parameters from the load, as the seed code does:
+    /// Parameters from the load, as the paper's code does:
     /// `N = round(c·μc·Fn)`, `σ_ini = μc·Fn/δmax` (so the sliding level is
     /// `σ_ini·δmax = μc·Fn`).
     pub fn from_load(
@@ -113,9 +114,9 @@ impl BristleParams {
 }
 
 impl Default for BristleParams {
-    /// Seed 000 (Table 3, Simulation 1): m = 0.352 kg, g = 9.81 m/s²,
+    /// Appels & Herder (Table 3, Simulation 1): m = 0.352 kg, g = 9.81 m/s²,
     /// c = 500, μc = 0.0633, δmax = 1.5584e-8 m, x_rel = 4.4206e-9 m,
-    /// seed 1, through [`BristleParams::from_load`] (N = 109,
+    /// random seed 1, through [`BristleParams::from_load`] (N = 109,
     /// σ_ini ≈ 1.4026e7 N/m).
     fn default() -> Self {
         BristleParams::from_load(500.0, 0.0633, 0.352 * 9.81, 1.5584e-8, 4.4206e-9, 1)
@@ -248,7 +249,7 @@ fn prefix_sums_into(d: &[f64], p: &mut Vec<f64>) {
 }
 
 impl Bristle {
-    /// Places the bristles as the seed's `Initial_bristle_placement.m`.
+    /// Places the bristles as the paper's `Initial_bristle_placement.m`.
     pub fn new(p: BristleParams) -> Result<Self, ParamError> {
         p.validate()?;
         let n = p.n_bristles;
@@ -573,7 +574,7 @@ impl Bristle {
 
 /// `|r|`, `r ~ Normal(x_rel, x_rel/3)`, redrawn while `|r| ≥ δmax` (which
 /// would reconnect a bristle already beyond its range; probability < 1e-13
-/// for the seed's numbers).
+/// for the paper's numbers).
 fn draw_relax(rng: &mut Rng, x_rel: f64, delta_max: f64) -> f64 {
     for _ in 0..100 {
         let r = rng.normal(x_rel, x_rel / 3.0).abs();
@@ -584,7 +585,7 @@ fn draw_relax(rng: &mut Rng, x_rel: f64, delta_max: f64) -> f64 {
     x_rel
 }
 
-/// The seed's `Initial_bristle_placement.m`: `δi ~ Normal(0, (2/3)δmax)`,
+/// The paper's `Initial_bristle_placement.m`: `δi ~ Normal(0, (2/3)δmax)`,
 /// subtract the mean; scan the bristles in order and at the first with
 /// `|δq| > δmax` redraw it, subtract the new mean from all and restart the
 /// scan, until all are within `δmax`.
@@ -592,7 +593,7 @@ fn draw_relax(rng: &mut Rng, x_rel: f64, delta_max: f64) -> f64 {
 /// Implemented in `O(N)` expected time with a lazy common shift
 /// (`δi = raw_i − shift`) and running extremes of the already-checked
 /// prefix, so a restart only rescans when an earlier bristle has really left
-/// the range; the sequence of draws and checks is the seed's. The number of
+/// the range; the sequence of draws and checks is the paper's. The number of
 /// redraws is bounded (`100·N + 1000`, about 0.15·N are needed); should it
 /// ever be exhausted the remaining deflections are clamped into the range.
 fn initial_placement(rng: &mut Rng, n: usize, delta_max: f64) -> Vec<f64> {
@@ -671,7 +672,7 @@ mod tests {
     }
 
     #[test]
-    fn default_is_seed_000_and_validation() {
+    fn default_is_appels_herder_and_validation() {
         let p = BristleParams::default();
         assert_eq!(p.n_bristles, 109);
         assert!(rel(p.sigma_ini * p.delta_max, 0.0633 * 0.352 * 9.81) < 1e-15);
@@ -866,7 +867,7 @@ mod tests {
         }
     }
 
-    /// The seed's algorithm on a plain array (per-bristle deflection and
+    /// The paper's algorithm on a plain array (per-bristle deflection and
     /// disconnection sign), for comparison with the sorted representation.
     /// With `x_rel = 0` the reconnection point `s·δmax` needs no draws.
     struct Naive {

@@ -1,6 +1,7 @@
-//! Two-dimensional bristle (reset-integrator) friction after seed 004
-//! (Wijata, Awrejcewicz, Matej, Makowski 2016); the equations are derived in
-//! MODELS.md "Two-dimensional bristle" because the seed lost them.
+//! Two-dimensional bristle (reset-integrator) friction after Wijata,
+//! Awrejcewicz, Matej, Makowski 2016; the equations are derived in
+//! docs/models.md "Two-dimensional bristle" because our copy of the paper
+//! lost them.
 //!
 //! State: bristle deflection `z = (z1, z2)`, stiction range the disc
 //! `|z| < z0`.
@@ -39,8 +40,8 @@ pub struct Bristle2DParams {
 }
 
 impl Default for Bristle2DParams {
-    /// Seed 004 numerical set: σ01 = σ02 = 1e4 N/m, σ11 = σ12 = 74.15 N·s/m,
-    /// a1 = a2 = 0.1, z0 = 1e-4 m, av = 1e-2 m/s.
+    /// Wijata et al. 2016, numerical set: σ01 = σ02 = 1e4 N/m,
+    /// σ11 = σ12 = 74.15 N·s/m, a1 = a2 = 0.1, z0 = 1e-4 m, av = 1e-2 m/s.
     fn default() -> Self {
         Bristle2DParams {
             sigma01: 1e4,
@@ -56,7 +57,7 @@ impl Default for Bristle2DParams {
 }
 
 impl Bristle2DParams {
-    /// Seed 004 experimental fit: σ01 = 7293.7, σ02 = 5572.08 N/m,
+    /// Wijata et al. 2016, experimental fit: σ01 = 7293.7, σ02 = 5572.08 N/m,
     /// σ11 = 209.2, σ12 = 182.8 N·s/m, a1 = a2 = 0.2, z0 = 1e-4 m,
     /// av = 1e-2 m/s.
     pub fn experimental() -> Self {
@@ -137,16 +138,17 @@ impl Bristle2D {
         dot(self.z, self.z) >= z0 * z0 * (1.0 - BOUNDARY_TOL)
     }
 
-    /// `ż = v − [|z| ≥ z0 and z·v > 0]·(z·v)·z/|z|²` (MODELS.md, derived).
+    /// `ż = v − [|z| ≥ z0 and z·v > 0]·(z·v)·z/|z|²` (docs/models.md, derived).
     pub fn z_dot(&self, v: [f64; 2]) -> [f64; 2] {
         self.z_rate(self.z, v, self.on_boundary())
     }
 
     /// The right-hand side for any deflection `z`, with the contact state
-    /// given: `ż = v − [on_boundary and z·v > 0]·(z·v)·z/|z|²` (MODELS.md,
-    /// derived from seed 004). A pure function, for integrating the law
-    /// with other equations (the monolithic reference solutions), which
-    /// track `on_boundary` as a mode rather than from `|z|`.
+    /// given: `ż = v − [on_boundary and z·v > 0]·(z·v)·z/|z|²`
+    /// (docs/models.md, derived from Wijata et al. 2016). A pure function,
+    /// for integrating the law with other equations (the monolithic
+    /// reference solutions), which track `on_boundary` as a mode rather than
+    /// from `|z|`.
     pub fn z_rate(&self, z: [f64; 2], v: [f64; 2], on_boundary: bool) -> [f64; 2] {
         let zv = dot(z, v);
         if on_boundary && zv > 0.0 {

@@ -1,5 +1,5 @@
-//! Dahl friction (seed 001 eq. 2–3 and 16–17; seed 003 eq. 2.4–2.5;
-//! MODELS.md "Dahl").
+//! Dahl friction (Dahl 1968; Sun et al. 2016 eq. 2–3 and 16–17;
+//! Thimmalapura 2004 eq. 2.4–2.5; docs/models.md "Dahl").
 //!
 //! `dF/dx = σ·|1 − (F/Fc)·sgn v|^α · sgn(1 − (F/Fc)·sgn v)`, `dF/dt = (dF/dx)·v`.
 //!
@@ -24,7 +24,7 @@ pub struct DahlParams {
 }
 
 impl Default for DahlParams {
-    /// Seed 001, Table 7 (nominal): σ = 87 750 N/m, Fc = 2.0 N, α = 1.
+    /// Sun et al. 2016, Table 7 (nominal): σ = 87 750 N/m, Fc = 2.0 N, α = 1.
     fn default() -> Self {
         DahlParams {
             sigma: 87_750.0,
@@ -73,10 +73,11 @@ impl Dahl {
     }
 
     /// The right-hand side of the law in time for any force `f`:
-    /// `dF/dt = σ·|1 − (F/Fc)·sgn v|^α·sgn(1 − (F/Fc)·sgn v)·v` (seed 001
-    /// eq. 2–3; MODELS.md "Dahl"). A pure function, for integrating the law
-    /// together with other equations (the monolithic reference solutions);
-    /// [`Dahl::step`] integrates it exactly in displacement instead.
+    /// `dF/dt = σ·|1 − (F/Fc)·sgn v|^α·sgn(1 − (F/Fc)·sgn v)·v` (Sun et al.
+    /// 2016 eq. 2–3; docs/models.md "Dahl"). A pure function, for
+    /// integrating the law together with other equations (the monolithic
+    /// reference solutions); [`Dahl::step`] integrates it exactly in
+    /// displacement instead.
     pub fn force_rate(&self, f: f64, v: f64) -> f64 {
         if v == 0.0 {
             return 0.0;
@@ -167,7 +168,7 @@ mod tests {
     }
 
     #[test]
-    fn defaults_are_seed_001_table_7_and_validation_names_the_parameter() {
+    fn defaults_are_sun_2016_table_7_and_validation_names_the_parameter() {
         let p = DahlParams::default();
         assert_eq!((p.sigma, p.fc, p.alpha), (87_750.0, 2.0, 1.0));
         let e = Dahl::new(DahlParams { fc: -1.0, ..p }).unwrap_err();

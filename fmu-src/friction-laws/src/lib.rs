@@ -3,9 +3,10 @@
 //! Every law here is a state machine advanced over a time interval with
 //! inputs that vary linearly inside it (`u(τ) = u0 + du·τ`, the first-order
 //! input interpolation of FMI 2.0 co-simulation). The equations and their
-//! sources are in `../shared/MODELS.md`; each module cites the seed paper.
+//! sources are in `docs/models.md`; each module cites its papers by author
+//! and year.
 //!
-//! Sign convention (MODELS.md): `v` is the sliding velocity of the body
+//! Sign convention (docs/models.md): `v` is the sliding velocity of the body
 //! relative to the surface, `F` the friction force resisting positive motion,
 //! so in steady sliding `F` has the sign of `v` and the rig applies `−F`.
 #![forbid(unsafe_code)]

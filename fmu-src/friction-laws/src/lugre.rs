@@ -1,19 +1,19 @@
-//! LuGre friction (seed 001 eq. 9–12; seed 002 eq. 1–3; seed 003 eq.
-//! 2.8–2.9; MODELS.md "LuGre" and "Position- and direction-dependent
-//! levels").
+//! LuGre friction (Canudas de Wit et al. 1995; Sun et al. 2016 eq. 9–12;
+//! Dion et al. 2013 eq. 1; Thimmalapura 2004 eq. 2.8–2.9; docs/models.md
+//! "LuGre").
 //!
 //! `ż = v − σ0·|v|·z / g(v)`, `g(v) = Fc + (Fs − Fc)·exp(−|v/vs|^δ)`,
 //! `F = σ0·z + σ1(v)·ż + σ2·v`, `σ1(v) = σ1·exp(−(v/vd)²)` (vd = 0: constant).
 //!
 //! Options:
 //! - direction-dependent levels: `Fc_neg`, `Fs_neg` (and `scale_neg`) for
-//!   `v < 0` (seed 003);
+//!   `v < 0` (Thimmalapura 2004);
 //! - position-dependent levels: `Fc` and `Fs` multiplied by a scale factor
 //!   piecewise-linear in the position input `x`, constant beyond the table
-//!   ends (seed 003);
-//! - normal-force form (seed 002): `σ0, σ1, σ2, Fc, Fs` are per unit normal
-//!   force and the force is multiplied by the input `Fn`; the ratio `σ0/g`
-//!   and hence the `z` dynamics do not depend on `Fn`.
+//!   ends (Thimmalapura 2004);
+//! - normal-force form (Dion et al. 2013): `σ0, σ1, σ2, Fc, Fs` are per
+//!   unit normal force and the force is multiplied by the input `Fn`; the
+//!   ratio `σ0/g` and hence the `z` dynamics do not depend on `Fn`.
 //!
 //! At constant inputs `ż` is linear in `z` with rate `λ = σ0·|v|/g`, so
 //! `z ← zss + (z − zss)·e^(−λh)`, `zss = g·sgn(v)/σ0`, is exact for any `h`.
@@ -57,7 +57,7 @@ pub struct LuGreParams {
     pub direction_dependent: bool,
     pub fc_neg: f64,
     pub fs_neg: f64,
-    /// Multiply the force by the normal-force input (seed 002 form).
+    /// Multiply the force by the normal-force input (Dion et al. 2013 form).
     pub normal_force_form: bool,
     /// Scale Fc and Fs by the position table.
     pub position_dependent: bool,
@@ -105,11 +105,11 @@ impl Default for LuGreParams {
 }
 
 impl LuGreParams {
-    /// Seed 001 (brass on steel, m ≈ 1 kg): Table 6 static part (Fc = 1.284 N,
-    /// Fs = 2.35 N, vs = 1.13975e-3 m/s, σ2 = 173 N·s/m), σ0 = 66 967.231 N/m
-    /// (Table 9), σ1 = 2√σ0 − σ2 ≈ 344.56 N·s/m (eq. 24, critical damping
-    /// with m = 1).
-    pub fn seed001() -> Self {
+    /// Sun et al. 2016 (brass on steel, m ≈ 1 kg): Table 6 static part
+    /// (Fc = 1.284 N, Fs = 2.35 N, vs = 1.13975e-3 m/s, σ2 = 173 N·s/m),
+    /// σ0 = 66 967.231 N/m (Table 9), σ1 = 2√σ0 − σ2 ≈ 344.56 N·s/m (eq. 24,
+    /// critical damping with m = 1).
+    pub fn sun_2016() -> Self {
         let sigma0 = 66_967.231;
         let sigma2 = 173.0;
         LuGreParams {
@@ -434,15 +434,15 @@ impl LuGre {
     }
 
     /// Stribeck level `g(v)` (N) with the direction, position and
-    /// normal-force scaling (MODELS.md "LuGre"; seed 003 for the levels;
-    /// seed 002 for the `Fn` factor). At `v = 0` the positive-direction
-    /// levels are used.
+    /// normal-force scaling (docs/models.md "LuGre"; Thimmalapura 2004 for
+    /// the levels; Dion et al. 2013 for the `Fn` factor). At `v = 0` the
+    /// positive-direction levels are used.
     pub fn g(&self, v: f64, x: f64, fn_: f64) -> f64 {
         self.g_unit(v.abs(), v, x) * self.fn_factor(fn_)
     }
 
     /// Steady-state (Stribeck) force `Fss = g(v)·sgn v + σ2·v` (σ2 per unit
-    /// `Fn` in the normal-force form); seed 001 eq. 12.
+    /// `Fn` in the normal-force form); Sun et al. 2016 eq. 12.
     pub fn steady_force(&self, v: f64, x: f64, fn_: f64) -> f64 {
         if v == 0.0 {
             return 0.0;
@@ -457,9 +457,9 @@ impl LuGre {
     }
 
     /// The right-hand side of the state equation for any deflection `z`:
-    /// `ż = v − σ0·|v|·z/g(v)` (seed 001 eq. 9–10; MODELS.md "LuGre"), with
-    /// the direction and position scaling of `g`; independent of `Fn`. A
-    /// pure function, for integrating the law together with other
+    /// `ż = v − σ0·|v|·z/g(v)` (Sun et al. 2016 eq. 10–11; docs/models.md
+    /// "LuGre"), with the direction and position scaling of `g`; independent
+    /// of `Fn`. A pure function, for integrating the law together with other
     /// equations (the monolithic reference solutions).
     pub fn z_rate(&self, z: f64, v: f64, x: f64, fn_: f64) -> f64 {
         let _ = fn_;
@@ -486,15 +486,16 @@ impl LuGre {
     }
 
     /// `F = (σ0·z + σ1(v)·ż + σ2·v)·[Fn]` at the current state and the given
-    /// instantaneous inputs (direct feedthrough of `v`; seed 001 eq. 11,
-    /// seed 002 eq. 1).
+    /// instantaneous inputs (direct feedthrough of `v`; Sun et al. 2016
+    /// eq. 9, Dion et al. 2013 eq. 1).
     pub fn force(&self, v: f64, x: f64, fn_: f64) -> f64 {
         self.force_of(self.z, v, x, fn_)
     }
 
     /// The output equation for any deflection `z`:
     /// `F = (σ0·z + σ1(v)·ż + σ2·v)·[Fn]` with `ż` from [`LuGre::z_rate`]
-    /// (seed 001 eq. 11, seed 002 eq. 1). Pure, like [`LuGre::z_rate`].
+    /// (Sun et al. 2016 eq. 9, Dion et al. 2013 eq. 1). Pure, like
+    /// [`LuGre::z_rate`].
     pub fn force_of(&self, z: f64, v: f64, x: f64, fn_: f64) -> f64 {
         let zd = self.z_rate(z, v, x, fn_);
         self.force_at_rate(z, v, zd, fn_)
@@ -603,15 +604,15 @@ impl LuGre {
     /// that interval; `u = Fn` in the normal-force form: `Fn ≤ spread`, the
     /// kink of `max(Fn, 0)`).
     ///
-    /// The held update (seed 001 eq. 9–10 at constant inputs, integrated
-    /// exactly): with `w = |v|`, `s = sgn v`, `g = g(w, s, x)` the level per
-    /// unit `Fn` (direction and position scale included),
+    /// The held update (Sun et al. 2016 eq. 10–11 at constant inputs,
+    /// integrated exactly): with `w = |v|`, `s = sgn v`, `g = g(w, s, x)`
+    /// the level per unit `Fn` (direction and position scale included),
     ///
     /// ```text
     /// zss = s·g/σ0,   λ = σ0·w/g,   E = e^(−λh),   z⁺ = zss + (z − zss)·E,
     /// ```
     ///
-    /// and the output (seed 001 eq. 11, seed 002 eq. 1)
+    /// and the output (Sun et al. 2016 eq. 9, Dion et al. 2013 eq. 1)
     /// `F⁺ = (σ0·z⁺ + σ1(v)·ż⁺ + σ2·v)·φ(Fn)`, `ż⁺ = v − λ·z⁺`,
     /// `σ1(v) = σ1·e^(−(v/vd)²)`, `φ(Fn) = max(Fn, 0)` (1 outside the
     /// normal-force form). Differentiating, with `z⁺ − zss = (z − zss)·E`
@@ -822,7 +823,7 @@ mod tests {
     /// levels, micro-damping and the normal-force form.
     #[test]
     fn force_and_sliding_is_force_and_sliding() {
-        let plain = LuGreParams::seed001();
+        let plain = LuGreParams::sun_2016();
         let varied = LuGreParams {
             direction_dependent: true,
             fc_neg: 0.8 * plain.fc,
@@ -849,7 +850,7 @@ mod tests {
 
     #[test]
     fn parameter_sets_and_validation() {
-        let p = LuGreParams::seed001();
+        let p = LuGreParams::sun_2016();
         assert!((p.sigma1 - 344.56).abs() < 0.01, "{}", p.sigma1);
         assert!(LuGre::new(p).is_ok());
         assert!(LuGre::new(LuGreParams::default()).is_ok());
@@ -906,7 +907,7 @@ mod tests {
 
     #[test]
     fn steady_force_follows_the_stribeck_curve() {
-        let p = LuGreParams::seed001();
+        let p = LuGreParams::sun_2016();
         let mut worst: f64 = 0.0;
         for i in 0..20 {
             // ±1e-5 … ±1e-1 m/s, ten log-spaced speeds per sign.
@@ -926,7 +927,7 @@ mod tests {
 
     #[test]
     fn small_displacement_is_elastic() {
-        let p = LuGreParams::seed001();
+        let p = LuGreParams::sun_2016();
         let mut l = LuGre::new(p).unwrap();
         // 1e-8 m in 1 ms, then at rest: F = σ0·z ≈ σ0·x.
         let x = 1e-8;
@@ -1002,7 +1003,7 @@ mod tests {
         let fast = |t: f64| 0.2 * (3.0 * t).sin() + 0.05;
         check_against_rk4(p, 0.1, 20, fast);
         // With position- and direction-dependent levels.
-        let mut q = LuGreParams::seed001();
+        let mut q = LuGreParams::sun_2016();
         q.direction_dependent = true;
         q.fc_neg = 1.0;
         q.fs_neg = 2.0;
@@ -1164,7 +1165,7 @@ mod tests {
 
     #[test]
     fn state_round_trip_and_finite_for_all_step_sizes() {
-        let p = LuGreParams::seed001();
+        let p = LuGreParams::sun_2016();
         let mut a = LuGre::new(p).unwrap();
         a.step(&inputs(Ramp::new(1e-3, -0.1)), 0.3);
         let mut b = LuGre::new(p).unwrap();

@@ -1,5 +1,5 @@
 //! Reset-integrator friction, 1-D (Haessig & Friedland 1991; the base of the
-//! 2-D model of seed 004; MODELS.md "Reset integrator, 1-D").
+//! 2-D model of Wijata et al. 2016; docs/models.md "Reset integrator").
 //!
 //! `ż = 0` if (`v > 0` and `z ≥ z0`) or (`v < 0` and `z ≤ −z0`), else `ż = v`;
 //! `F = (1 + a(z))·σ0·z + σ1·ż`, `a(z) = a` for `|z| < z0`, else 0.
@@ -21,8 +21,8 @@ pub struct ResetParams {
 }
 
 impl Default for ResetParams {
-    /// Seed 004 numerical set in 1-D: σ0 = 1e4 N/m, σ1 = 74.15 N·s/m,
-    /// a = 0.1, z0 = 1e-4 m.
+    /// Wijata et al. 2016, numerical set in 1-D: σ0 = 1e4 N/m,
+    /// σ1 = 74.15 N·s/m, a = 0.1, z0 = 1e-4 m.
     fn default() -> Self {
         ResetParams {
             sigma0: 1e4,

@@ -1,11 +1,12 @@
 //! Rig dynamics as plain Rust (no FFI, no unsafe): the mechanical side of a
-//! friction co-simulation. Sign convention of MODELS.md: the friction block
-//! outputs F resisting positive slip, and the rig applies −F.
+//! friction co-simulation. Sign convention of docs/models.md: the friction
+//! block outputs F resisting positive slip, and the rig applies −F.
 //!
 //! - [`rig1d`]: one axis — mass, damper, spring to an actuator point
 //!   (ramp, sinusoid or input), built-in drive force, PD/PI controller with
 //!   saturation, moving and dithered surface, quasi-static mode m = 0.
-//! - [`rig2d`]: the planar oscillator of seed 004 with surface dither.
+//! - [`rig2d`]: the planar oscillator of Wijata et al. 2016 with surface
+//!   dither.
 #![forbid(unsafe_code)]
 
 #[cfg(test)]

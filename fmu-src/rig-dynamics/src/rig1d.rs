@@ -1,4 +1,4 @@
-//! One-degree-of-freedom rig (MODELS.md, "Rigs in the seeds"): a mass `m`
+//! One-degree-of-freedom rig (docs/models.md, "Rig1D"): a mass `m`
 //! with viscous damping `c` to ground, a spring `k` to an actuator point
 //! `x_a(t)`, an external force, a built-in drive force, an optional built-in
 //! controller, and the friction force applied as −F:
@@ -7,28 +7,32 @@
 //!
 //! with the slip velocity v = ẋ − v_s(t) and relative displacement
 //! x − x_s(t) over a moving surface x_s(t) = v_surface·t + A_s·sin(2π f_s t)
-//! (belt speed plus dither; seed 004's dither d = A·sin(ωt)).
+//! (belt speed plus dither; the dither d = A·sin(ωt) of Wijata et al. 2016).
 //!
 //! - **Actuator point** ([`Actuator`]): `Prescribed`: x_a(t) = x_a0 + v_a·t +
-//!   A_a·sin(2π f_a t) (the pulled spring of the 1995 benchmark, the piezo
-//!   ramp of seed 000, seed 002's imposed sinusoidal displacement); `Input`:
-//!   x_a = the input `x_act_in`, linear over a step with its slope (seed
-//!   000's piezo staircase of 0.825e-9 m every 10 ms).
+//!   A_a·sin(2π f_a t) (the pulled spring of the 1995 benchmark of Canudas
+//!   de Wit et al., the piezo ramp of Appels & Herder, the imposed
+//!   sinusoidal displacement of Dion et al. 2013); `Input`: x_a = the input
+//!   `x_act_in`, linear over a step with its slope (Appels & Herder's piezo
+//!   staircase of 0.825e-9 m every 10 ms).
 //! - **Drive force** ([`DriveForce`]): F_d(t) = F_step·[t ≥ t_step] +
-//!   A_d·sin(2π f_d t) (seed 001's step forces 0.5–1.5 N; seed 003's 1 Hz
-//!   sine drive), added to the input F_ext. A step inside a communication
-//!   step splits the integration there, so it is taken exactly.
+//!   A_d·sin(2π f_d t) (the step forces 0.5–1.5 N of Sun et al. 2016; the
+//!   1 Hz sine drive of Thimmalapura 2004), added to the input F_ext. A step
+//!   inside a communication step splits the integration there, so it is
+//!   taken exactly.
 //! - **Controller** ([`Controller`], needs m > 0):
 //!   u = Kp·(x_ref − x) + Kd·(β·v_ref − ẋ) + Ki·ξ,  ξ̇ = v_ref − ẋ, ξ(0) = 0,
 //!   F_ctrl = G·sat(u, ±u_max) (u_max = 0: no saturation). The reference is
 //!   built in, v_ref = v_r0 + V·sin(2π f_r t) and x_ref = x_r0 + v_r0·t +
-//!   (V/ω_r)(1 − cos ω_r t) (seed 001's velocity trials ±1e-3·sin(t/k) m/s:
-//!   V = 1e-3, f_r = 1/(2πk)), or taken from the inputs `x_ref`, `v_ref`.
+//!   (V/ω_r)(1 − cos ω_r t) (the velocity trials ±1e-3·sin(t/k) m/s of Sun
+//!   et al. 2016: V = 1e-3, f_r = 1/(2πk)), or taken from the inputs
+//!   `x_ref`, `v_ref`.
 //!   Position PD: Ki = 0, β = 1. Velocity PI: Kp = 0, β = 1 (Kd is the
 //!   proportional and Ki the integral gain on the velocity error). The EMPS
-//!   loop of `shared/data/README.md`, force = gtau·sat(kv·(kp·(qg − qm) − q̇m),
-//!   ±10 V), is Kp = kv·kp, Kd = kv, Ki = 0, β = 0, G = gtau, u_max = 10,
-//!   reference from the input x_ref = qg.
+//!   loop (Janot et al. 2019; docs/models.md "Rig1D"), force =
+//!   gtau·sat(kv·(kp·(qg − qm) − q̇m), ±10 V), is Kp = kv·kp, Kd = kv,
+//!   Ki = 0, β = 0, G = gtau, u_max = 10, reference from the input
+//!   x_ref = qg.
 //!   ξ is integrated exactly: over any interval ξ changes by ∫v_ref − Δx.
 //!   There is no anti-windup: ξ integrates the error also while saturated.
 //!
@@ -56,7 +60,7 @@
 //! sub-step; two crossings inside one sub-step, which ω·h_sub ≤ 0.02 makes
 //! negligible, are not resolved).
 //!
-//! m = 0 selects the quasi-static force balance of seed 000:
+//! m = 0 selects the quasi-static force balance of Appels & Herder:
 //! 0 = k·(x_a − x) − c·ẋ + F_ext − F + F_d. With c = 0 the position follows
 //! the forces directly, x = x_a + (F_ext − F + F_d)/k (direct feedthrough
 //! from F); with c > 0 it is first order, c·ẋ = k·(x_a − x) + F_ext − F + F_d.
@@ -935,7 +939,8 @@ impl Rig1D {
             let fr = u.friction + du.friction * tau;
             let drive = p.drive.value(t);
             if first_order {
-                // c·ẋ = k(x_a − x) + F_ext − F + F_d (quasi-static, seed 000)
+                // c·ẋ = k(x_a − x) + F_ext − F + F_d (quasi-static, as
+                // Appels & Herder's piezo push)
                 return ((p.k * (xa - x) + ext - fr + drive) / p.c, 0.0);
             }
             // F_ctrl with sat(·) replaced by its piece

@@ -1,21 +1,21 @@
-//! Planar oscillator of seed 004 (Wijata et al. 2016; MODELS.md, "Two-
-//! dimensional bristle", behaviours 1–4, and "Rigs in the seeds"): a mass m
+//! Planar oscillator of Wijata et al. 2016 (docs/models.md, "Rig2D", and
+//! "Two-dimensional bristle", the behaviours it reports): a mass m
 //! on a surface, springs k1, k2 along the axes to a fixed anchor at the
 //! origin, dampers c1, c2, the friction components applied as −F1, −F2:
 //!
 //! m·ẍ_i = −k_i·x_i − c_i·ẋ_i + F_ext,i − F_i,  i = 1, 2,
 //!
 //! over a surface moving at (vs1, vs2) with dither along either axis,
-//! x_s,i(t) = vs_i·t + A_i·sin(2π f_i t) (seed 004: d = A·sin(ωt) along x2 in
-//! its simulations, along x1 on its rig). Slip velocity v_i = ẋ_i − ẋ_s,i(t),
-//! relative displacement x_i − x_s,i(t).
+//! x_s,i(t) = vs_i·t + A_i·sin(2π f_i t) (Wijata et al.: d = A·sin(ωt),
+//! along x2 in their simulations, along x1 on their rig). Slip velocity
+//! v_i = ẋ_i − ẋ_s,i(t), relative displacement x_i − x_s,i(t).
 //!
 //! The axes are coupled only through the friction block (its F1, F2 depend
 //! on both slip components), so each axis is a [`Rig1D`] with a fixed
 //! actuator point at 0 and the same mass: the same A-stable Gauss–Legendre
 //! integration, sub-stepped to ω_i·h ≤ 0.02.
 //!
-//! Defaults: seed 004's oscillator, m = 1 kg, k1 = k2 = 100 N/m,
+//! Defaults: the oscillator of Wijata et al., m = 1 kg, k1 = k2 = 100 N/m,
 //! x1(0) = x2(0) = 0.08 m, v1(0) = −0.8 m/s, v2(0) = 0.8 m/s.
 
 use crate::rig1d::{Rig1D, Rig1DInputs, Rig1DParams};
@@ -37,7 +37,7 @@ pub struct Rig2DParams {
 }
 
 impl Default for Rig2DParams {
-    /// Seed 004's planar oscillator.
+    /// The planar oscillator of Wijata et al. 2016.
     fn default() -> Self {
         Rig2DParams {
             m: 1.0,
@@ -189,7 +189,7 @@ mod tests {
 
     /// Without friction each axis is a free damped oscillator:
     /// x_i(t) = e^(−σt)(C1 cos ωd t + C2 sin ωd t), checked to 1e-8 of the
-    /// peak over 3 s in both axes — seed 004's undamped oscillator and an
+    /// peak over 3 s in both axes — Wijata et al.'s undamped oscillator and an
     /// anisotropic damped one.
     #[test]
     fn free_oscillation_matches_the_closed_form_in_both_axes() {

@@ -1,7 +1,8 @@
 //! Prescribed signals of the rigs: sinusoids a·sin(2π f t) for the actuator
-//! (seed 002's imposed displacement, a piezo), the drive force (seed 003's
-//! 1 Hz sine drive), the surface dither (seed 004: d = A·sin(ωt)) and the
-//! controller's velocity reference (seed 001: v = ±1e-3·sin(t/k) m/s).
+//! (the imposed displacement of Dion et al. 2013, a piezo), the drive force
+//! (the 1 Hz sine drive of Thimmalapura 2004), the surface dither (Wijata et
+//! al. 2016: d = A·sin(ωt)) and the controller's velocity reference (Sun et
+//! al. 2016: v = ±1e-3·sin(t/k) m/s).
 
 use std::f64::consts::PI;
 

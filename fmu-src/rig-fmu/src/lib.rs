@@ -1,8 +1,9 @@
-//! The rig FMUs: the mechanical side of the seed scenarios, on the same FMI
+//! The rig FMUs: the mechanical side of the papers' scenarios, on the same FMI
 //! layer as the friction FMUs. `Rig1D.fmu`: mass, damper, spring to a
 //! prescribed or input actuator point, drive force, PD/PI controller,
 //! moving and dithered surface, external force, friction input.
-//! `Rig2D.fmu`: the planar oscillator of seed 004 with surface dither.
+//! `Rig2D.fmu`: the planar oscillator of Wijata et al. 2016 with surface
+//! dither.
 #![forbid(unsafe_code)]
 
 pub mod rig1d;

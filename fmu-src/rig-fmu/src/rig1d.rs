@@ -127,7 +127,7 @@ static VARIABLES: [Variable; 43] = [
         "m",
         1.0,
         "kg",
-        "Mass; 0 selects the quasi-static force balance (seed 000)",
+        "Mass; 0 selects the quasi-static force balance (Appels and Herder's piezo push)",
     )
     .with_min(0.0),
     Variable::parameter(vr::C, "c", 0.0, "N.s/m", "Viscous damping to ground").with_min(0.0),
@@ -151,7 +151,7 @@ static VARIABLES: [Variable; 43] = [
         "v_a",
         0.1,
         "m/s",
-        "Actuator speed (1995 benchmark: 0.1 m/s; seed 000 piezo: 8.25e-8 m/s)",
+        "Actuator speed (Canudas de Wit et al. 1995: 0.1 m/s; Appels and Herder's piezo: 8.25e-8 m/s)",
     ),
     Variable::parameter(
         vr::V_SURFACE,
@@ -255,7 +255,7 @@ static VARIABLES: [Variable; 43] = [
         "dither_amp",
         0.0,
         "m",
-        "Amplitude of the surface dither displacement (seed 004: d = A*sin(omega*t))",
+        "Amplitude of the surface dither displacement (Wijata et al. 2016: d = A*sin(omega*t))",
     ),
     Variable::parameter(
         vr::DITHER_FREQ,
@@ -270,7 +270,7 @@ static VARIABLES: [Variable; 43] = [
         "F_step",
         0.0,
         "N",
-        "Drive force step, applied from t_step on (seed 001: 0.5 to 1.5 N)",
+        "Drive force step, applied from t_step on (Sun et al. 2016: 0.5 to 1.5 N)",
     ),
     Variable::parameter(vr::T_STEP, "t_step", 0.0, "s", "Time of the drive force step"),
     Variable::parameter(
@@ -285,7 +285,7 @@ static VARIABLES: [Variable; 43] = [
         "drive_freq",
         0.0,
         "Hz",
-        "Frequency of the sinusoidal drive force (seed 003: 1 Hz)",
+        "Frequency of the sinusoidal drive force (Thimmalapura 2004: 1 Hz)",
     )
     .with_min(0.0),
     Variable::integer_parameter(
@@ -308,21 +308,21 @@ static VARIABLES: [Variable; 43] = [
         "ref_v0",
         0.0,
         "m/s",
-        "Built-in reference velocity, constant part (seed 001: 2 to 5.5 mm/s)",
+        "Built-in reference velocity, constant part (Sun et al. 2016: 2 to 5.5 mm/s)",
     ),
     Variable::parameter(
         vr::REF_V_AMP,
         "ref_v_amp",
         0.0,
         "m/s",
-        "Built-in reference velocity amplitude: v_ref = ref_v0 + ref_v_amp*sin(2*pi*ref_freq*t) (seed 001: 1e-3)",
+        "Built-in reference velocity amplitude: v_ref = ref_v0 + ref_v_amp*sin(2*pi*ref_freq*t) (Sun et al. 2016: 1e-3)",
     ),
     Variable::parameter(
         vr::REF_FREQ,
         "ref_freq",
         0.0,
         "Hz",
-        "Built-in reference frequency (seed 001's sin(t/k): 1/(2*pi*k))",
+        "Built-in reference frequency (Sun et al. 2016, sin(t/k): 1/(2*pi*k))",
     )
     .with_min(0.0),
     Variable::parameter(
@@ -381,7 +381,7 @@ pub static INFO: ModelInfo = ModelInfo {
     model_identifier: "Rig1D",
     guid: "{f9254f7d-c408-47bd-a8a6-d02748805905}",
     description: "One-degree-of-freedom rig: m*x'' = k*(x_a(t) - x) - c*x' + F_ext - F + F_drive(t) + F_ctrl, slip velocity v = x' - v_s(t). Actuator point prescribed (ramp + sinusoid) or from an input; drive force step + sinusoid; PD/PI controller with saturation on a built-in or input reference; moving surface with dither; quasi-static mode m = 0. 2-stage Gauss-Legendre, sub-stepped, saturation switches located. Defaults: the 1995 stick-slip benchmark (m = 1, k = 2, pulled at 0.1 m/s).",
-    source: "MODELS.md, Rigs in the seeds (1995 benchmark; seed 000 piezo push, quasi-static; seed 001 step forces and velocity trials; seed 003 sine drive; EMPS control loop, shared/data/README.md).",
+    source: "docs/models.md, Rig1D (Canudas de Wit et al. 1995 stick-slip benchmark; Appels and Herder piezo push, quasi-static; Sun et al. 2016 step forces and velocity trials; Thimmalapura 2004 sine drive; EMPS control loop, Janot et al. 2019).",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 20.0, step_size: 1e-4 },
     capabilities: Capabilities::FULL,

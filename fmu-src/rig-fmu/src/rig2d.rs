@@ -1,4 +1,4 @@
-//! `Rig2D.fmu`: the planar oscillator of seed 004,
+//! `Rig2D.fmu`: the planar oscillator of Wijata et al. 2016,
 //! m·ẍ_i = −k_i·x_i − c_i·ẋ_i + F_ext,i − F_i (i = 1, 2), over a surface
 //! moving at (vs1, vs2) with dither along either axis (see
 //! `rig_dynamics::rig2d`). Connect `v1, v2 → Bristle2D.v1, v2` and
@@ -133,13 +133,13 @@ static VARIABLES: [Variable; 27] = [
         "Body acceleration along axis 2",
         &[vr::F2, vr::F_EXT2],
     ),
-    Variable::parameter(vr::M, "m", 1.0, "kg", "Mass, > 0 (seed 004: 1 kg)").with_min(0.0),
+    Variable::parameter(vr::M, "m", 1.0, "kg", "Mass, > 0 (Wijata et al. 2016: 1 kg)").with_min(0.0),
     Variable::parameter(
         vr::K1,
         "k1",
         100.0,
         "N/m",
-        "Spring stiffness along axis 1 (seed 004: 100 N/m)",
+        "Spring stiffness along axis 1 (Wijata et al. 2016: 100 N/m)",
     )
     .with_min(0.0),
     Variable::parameter(
@@ -147,7 +147,7 @@ static VARIABLES: [Variable; 27] = [
         "k2",
         100.0,
         "N/m",
-        "Spring stiffness along axis 2 (seed 004: 100 N/m)",
+        "Spring stiffness along axis 2 (Wijata et al. 2016: 100 N/m)",
     )
     .with_min(0.0),
     Variable::parameter(vr::C1, "c1", 0.0, "N.s/m", "Viscous damping along axis 1").with_min(0.0),
@@ -157,28 +157,28 @@ static VARIABLES: [Variable; 27] = [
         "x1_0",
         0.08,
         "m",
-        "Initial position along axis 1 (seed 004: 0.08 m)",
+        "Initial position along axis 1 (Wijata et al. 2016: 0.08 m)",
     ),
     Variable::parameter(
         vr::X2_0,
         "x2_0",
         0.08,
         "m",
-        "Initial position along axis 2 (seed 004: 0.08 m)",
+        "Initial position along axis 2 (Wijata et al. 2016: 0.08 m)",
     ),
     Variable::parameter(
         vr::V1_0,
         "v1_0",
         -0.8,
         "m/s",
-        "Initial body velocity along axis 1 (seed 004: -0.8 m/s)",
+        "Initial body velocity along axis 1 (Wijata et al. 2016: -0.8 m/s)",
     ),
     Variable::parameter(
         vr::V2_0,
         "v2_0",
         0.8,
         "m/s",
-        "Initial body velocity along axis 2 (seed 004: 0.8 m/s)",
+        "Initial body velocity along axis 2 (Wijata et al. 2016: 0.8 m/s)",
     ),
     Variable::parameter(vr::VS1, "vs1", 0.0, "m/s", "Surface velocity along axis 1"),
     Variable::parameter(vr::VS2, "vs2", 0.0, "m/s", "Surface velocity along axis 2"),
@@ -218,8 +218,8 @@ pub static INFO: ModelInfo = ModelInfo {
     model_name: "Rig2D",
     model_identifier: "Rig2D",
     guid: "{1631f706-d309-41c5-8dca-8f8df1794ec4}",
-    description: "Planar oscillator: m*xi'' = -ki*xi - ci*xi' + F_exti - Fi (i = 1, 2), springs to a fixed anchor, surface moving at (vs1, vs2) with sinusoidal dither along either axis; slip velocities vi = xi' - vsi(t). 2-stage Gauss-Legendre, sub-stepped. Defaults: seed 004's oscillator (m = 1, k1 = k2 = 100, x(0) = (0.08, 0.08) m, v(0) = (-0.8, 0.8) m/s).",
-    source: "seed 004 (Wijata et al. 2016), planar oscillator with surface dither; MODELS.md, Two-dimensional bristle.",
+    description: "Planar oscillator: m*xi'' = -ki*xi - ci*xi' + F_exti - Fi (i = 1, 2), springs to a fixed anchor, surface moving at (vs1, vs2) with sinusoidal dither along either axis; slip velocities vi = xi' - vsi(t). 2-stage Gauss-Legendre, sub-stepped. Defaults: the oscillator of Wijata et al. 2016 (m = 1, k1 = k2 = 100, x(0) = (0.08, 0.08) m, v(0) = (-0.8, 0.8) m/s).",
+    source: "Wijata et al. 2016, planar oscillator with surface dither; docs/models.md, Rig2D.",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 10.0, step_size: 1e-4 },
     capabilities: Capabilities::FULL,

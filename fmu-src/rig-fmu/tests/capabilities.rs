@@ -228,8 +228,9 @@ fn rig1d_directional_derivatives_fall_back_to_the_differences() {
     assert_ne!(j.to_bits(), fd.to_bits());
 }
 
-/// Quasi-static mode (seed 000): x = x_act + (F_ext − F)/k, so ∂x/∂F = −1/k
-/// at every instant — before any step (feedthrough only) and after one.
+/// Quasi-static mode (Appels & Herder): x = x_act + (F_ext − F)/k, so
+/// ∂x/∂F = −1/k at every instant — before any step (feedthrough only) and
+/// after one.
 #[test]
 fn quasi_static_position_feeds_through_minus_one_over_k() {
     let k = 116.04e3;
@@ -395,7 +396,7 @@ fn emps_command_is_the_benchmark_control_law() {
     assert!(saturated > 0, "the case should reach the saturation");
 }
 
-/// Seed 004's oscillator without friction through the FMU: x_i(t) =
+/// Wijata et al.'s oscillator without friction through the FMU: x_i(t) =
 /// x_i(0)·cos ωt + v_i(0)/ω·sin ωt, ω = 10 rad/s, in both axes.
 #[test]
 fn rig2d_free_oscillation_through_the_fmu() {

@@ -134,9 +134,9 @@ fn velocity_sensitivity_matches_differences_of_the_step() {
     // the benchmark's parameters (δ = 2, constant σ1, one level)
     let plain = LuGreParams::default();
     cases += check(&plain, HeldInput::V, 0.0, 1.0, &SPEEDS, &STEPS);
-    // seed 001's brass on steel
+    // Sun et al. 2016's brass on steel
     cases += check(
-        &LuGreParams::seed001(),
+        &LuGreParams::sun_2016(),
         HeldInput::V,
         0.0,
         1.0,

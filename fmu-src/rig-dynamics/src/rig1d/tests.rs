@@ -372,8 +372,8 @@ fn drive_step_and_sine_match_the_closed_form() {
 /// x_r0, on the plant m·ẍ + c·ẋ + k·x: the closed loop is linear,
 /// m·ẍ + (c + G·Kd)·ẋ + (k + G·(Kp + Ki))·x = G·[(Kp + Ki)·x_ref + Kd·β·v_ref
 /// − Ki·(x_r0 − x0)] (ξ = x_ref − x_r0 − (x − x0)), solved in closed form.
-/// Position PD, velocity PI (seed 001's ±1e-3·sin(t/k) trial, k = 2) and
-/// both together.
+/// Position PD, velocity PI (the ±1e-3·sin(t/k) trial of Sun et al. 2016,
+/// k = 2) and both together.
 #[test]
 fn controller_with_builtin_reference_matches_the_closed_form() {
     let base = Rig1DParams {
@@ -459,9 +459,10 @@ fn controller_with_builtin_reference_matches_the_closed_form() {
     }
 }
 
-/// The EMPS loop (shared/data/README.md): force = gtau·sat(kv·(kp·(qg − qm)
-/// − q̇m), ±10 V) on M·q̈ + Fv·q̇ = force (the benchmark's rigid-body model
-/// without Coulomb friction and offset), Kp = kv·kp, Kd = kv, β = 0.
+/// The EMPS loop (Janot et al. 2019; docs/models.md): force =
+/// gtau·sat(kv·(kp·(qg − qm) − q̇m), ±10 V) on M·q̈ + Fv·q̇ = force (the
+/// benchmark's rigid-body model without Coulomb friction and offset),
+/// Kp = kv·kp, Kd = kv, β = 0.
 fn emps(u_max: f64) -> Rig1DParams {
     let (kp, kv) = (160.18, 243.45);
     Rig1DParams {
@@ -678,7 +679,7 @@ fn quasi_static_force_balance_and_feedthrough() {
     assert_eq!(rig.position(&f(0.1)), 8.25e-8 - 0.1 / 116.04e3);
     assert_eq!(rig.velocity(), 8.25e-8);
 
-    // seed 000's piezo staircase from the input, a drive step, F_ext:
+    // Appels & Herder's piezo staircase from the input, a drive step, F_ext:
     // x = x_act_in + (F_ext − F + F_d)/k; ẋ from the slopes of the last step
     let p = Rig1DParams {
         m: 0.0,
