@@ -44,6 +44,16 @@ KINDS = (
     "presliding_soft_nominal",
 )
 
+#: Cases on a plant that is not Rig1D (a two-mass drive, the friction on
+#: the load, driven by a measured motor force): diagnose has no inverse
+#: dynamics for it and fits by output error alone.
+TWO_MASS_KINDS = ("two_mass_none", "two_mass_viscous")
+
+#: Cases whose nominal friction is a Dahl FMU (the truth: LuGre with
+#: Dahl's levels, Fs = Fc, σ1 = 0, plus the hidden effect): diagnose moves
+#: the nominal to LuGre to add what Dahl cannot express.
+DAHL_KINDS = ("dahl_none", "dahl_viscous")
+
 #: The effect a kind should be diagnosed as (None: nothing to find).
 EXPECTED = {
     "none": None,
@@ -53,6 +63,10 @@ EXPECTED = {
     "position_dependent": "position_dependent",
     "presliding_stiff_nominal": "presliding",
     "presliding_soft_nominal": "presliding",
+    "two_mass_none": None,
+    "two_mass_viscous": "viscous",
+    "dahl_none": None,
+    "dahl_viscous": "viscous",
 }
 
 SAMPLE = 1e-3
@@ -123,7 +137,22 @@ def draw(kind: str, magnitude: float, seed: int, duration: float = 40.0) -> Case
     if kind == "presliding_stiff_nominal":
         nominal["sigma0"] = 1e6
         nominal["sigma1"] = 2 * zeta * math.sqrt(1e6 * m)
-    case = Case(kind, magnitude, seed, duration, {"m": m, "k": k, "c": c}, drive, nominal)
+    if kind in DAHL_KINDS:
+        nominal.update(Fs=fc, sigma1=0.0, sigma2=0.0)
+    if kind in TWO_MASS_KINDS:
+        # motor 0.2-1 kg, load 1-4 kg, belt 1e4-5e4 N/m; the motor force
+        # 3-6 times the friction level
+        m_m = rng.uniform(0.2, 1.0)
+        kb = rng.uniform(1e4, 5e4)
+        drive = {"plant": "two_mass", "amp": fc * rng.uniform(3.0, 6.0), "period": rng.uniform(2.0, 5.0)}
+        case = Case(kind, magnitude, seed, min(duration, 20.0),
+                    {"m": m, "k": kb, "c": rng.uniform(5.0, 30.0), "m_m": m_m, "c_m": rng.uniform(0.5, 2.0)},
+                    drive, nominal)
+        peak_speed = drive["amp"] / ((m + m_m) * 2 * math.pi / drive["period"])
+        nominal["vs"] = peak_speed * rng.uniform(0.1, 0.3)
+        nominal["sigma2"] = 0.0
+    else:
+        case = Case(kind, magnitude, seed, duration, {"m": m, "k": k, "c": c}, drive, nominal)
     case.truth = dict(nominal)
     case._zeta = zeta  # type: ignore[attr-defined]
     case._rng = rng  # type: ignore[attr-defined]
@@ -178,7 +207,7 @@ def size_hidden_effect(case: Case, work: Path) -> None:
         t["sigma0"] = fc / rng.uniform(5e-6, 5e-5)
         t["sigma1"] = 2 * case._zeta * math.sqrt(t["sigma0"] * case.rig["m"])  # type: ignore[attr-defined]
         return
-    if case.kind == "none":
+    if case.kind in ("none", "two_mass_none", "dahl_none"):
         return
     free = work / f"{case.name}.effect-free.csv"
     run_simulator(case, p, free, truth=True)
@@ -191,7 +220,7 @@ def size_hidden_effect(case: Case, work: Path) -> None:
     def level(vv: float) -> float:
         return p["Fc"] + (p["Fs"] - p["Fc"]) * math.exp(-((vv / p["vs"]) ** 2))
 
-    if case.kind == "viscous":
+    if case.kind in ("viscous", "two_mass_viscous", "dahl_viscous"):
         t["sigma2"] = p["sigma2"] + eps * fc / rms(v)
     elif case.kind == "stribeck":
         vs = p["vs"] if p["Fs"] > p["Fc"] else rms(v) * rng.uniform(0.2, 0.5)
@@ -241,13 +270,80 @@ def make(case: Case, work: Path) -> tuple[Path, Path]:
     run_simulator(case, case.truth, truth_csv, truth=True, table=case.table)
     d = read_columns(truth_csv)
     data = work / f"{case.name}.csv"
+    columns = [c for c in d if c not in ("true_x", "true_F")]
     with open(data, "w") as f:
-        f.write("time,rig.x_act_in,rig.x\n")
-        for row in zip(d["time"], d["rig.x_act_in"], d["rig.x"]):
-            f.write(f"{row[0]:.6f},{row[1]:.9g},{row[2]:.9g}\n")
+        f.write(",".join(columns) + "\n")
+        for row in zip(*(d[c] for c in columns)):
+            f.write(f"{row[0]:.6f}," + ",".join(f"{x:.9g}" for x in row[1:]) + "\n")
     ssd = work / f"{case.name}.ssd"
-    ssd.write_text(nominal_ssd(case, d["true_x"][0]))
+    if case.kind in TWO_MASS_KINDS:
+        import two_mass_fmu
+
+        ssd.write_text(two_mass_ssd(case, two_mass_fmu.build(ROOT / "target" / "independent")))
+    else:
+        ssd.write_text(nominal_ssd(case, d["true_x"][0]))
     return data, ssd
+
+
+def two_mass_ssd(case: Case, plant_fmu: Path, dist: Path | None = None) -> str:
+    """The nominal system of a two-mass case: TwoMassDrive (motor force u
+    from the data) with LuGre on the load."""
+    dist = dist or ROOT / "dist"
+    r, p = case.rig, case.nominal
+
+    def real(name, value):
+        return f'<ssv:Parameter name="{name}"><ssv:Real value="{value!r}"/></ssv:Parameter>'
+
+    plant = "".join(
+        real(n, v)
+        for n, v in [("m_m", r["m_m"]), ("m_l", r["m"]), ("k_b", r["k"]), ("c_b", r["c"]), ("c_m", r["c_m"]), ("x0", 0.0), ("h_max", 1e-4)]
+    )
+    fr = "".join(real(n, p[n]) for n in ["Fc", "Fs", "vs", "sigma0", "sigma1", "sigma2"])
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription version="1.0" name="{case.name}"
+    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
+    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
+    xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues">
+  <ssd:System name="{case.name}">
+    <ssd:Elements>
+      <ssd:Component name="drive" source="{plant_fmu}" type="application/x-fmu-sharedlibrary">
+        <ssd:Connectors>
+          <ssd:Connector name="u" kind="input"><ssc:Real unit="N"/></ssd:Connector>
+          <ssd:Connector name="F" kind="input"><ssc:Real unit="N"/></ssd:Connector>
+          <ssd:Connector name="x_m" kind="output"><ssc:Real unit="m"/></ssd:Connector>
+          <ssd:Connector name="x_l" kind="output"><ssc:Real unit="m"/></ssd:Connector>
+          <ssd:Connector name="v" kind="output"><ssc:Real unit="m/s"/></ssd:Connector>
+        </ssd:Connectors>
+        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
+          <ssv:ParameterSet version="1.0" name="drive"><ssv:Parameters>{plant}</ssv:Parameters></ssv:ParameterSet>
+        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
+      </ssd:Component>
+      <ssd:Component name="friction" source="{dist / 'LuGre.fmu'}" type="application/x-fmu-sharedlibrary">
+        <ssd:Connectors>
+          <ssd:Connector name="v" kind="input"><ssc:Real unit="m/s"/></ssd:Connector>
+          <ssd:Connector name="x" kind="input"><ssc:Real unit="m"/></ssd:Connector>
+          <ssd:Connector name="F" kind="output"><ssc:Real unit="N"/></ssd:Connector>
+        </ssd:Connectors>
+        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
+          <ssv:ParameterSet version="1.0" name="friction"><ssv:Parameters>{fr}</ssv:Parameters></ssv:ParameterSet>
+        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
+      </ssd:Component>
+    </ssd:Elements>
+    <ssd:Connections>
+      <ssd:Connection startElement="drive" startConnector="v" endElement="friction" endConnector="v"/>
+      <ssd:Connection startElement="drive" startConnector="x_l" endElement="friction" endConnector="x"/>
+      <ssd:Connection startElement="friction" startConnector="F" endElement="drive" endConnector="F"/>
+    </ssd:Connections>
+  </ssd:System>
+  <ssd:DefaultExperiment startTime="0" stopTime="{case.duration}">
+    <ssd:Annotations>
+      <ssc:Annotation type="org.friction-fmu.fricsim">
+        <fricsim:Simulation xmlns:fricsim="urn:friction-fmu:fricsim:1" stepSize="1e-3" master="newton"/>
+      </ssc:Annotation>
+    </ssd:Annotations>
+  </ssd:DefaultExperiment>
+</ssd:SystemStructureDescription>
+"""
 
 
 def nominal_ssd(case: Case, x0: float, dist: Path | None = None) -> str:
@@ -261,6 +357,14 @@ def nominal_ssd(case: Case, x0: float, dist: Path | None = None) -> str:
         real(n, v) for n, v in [("m", r["m"]), ("c", r["c"]), ("k", r["k"]), ("x0", x0), ("v_a", 0.0)]
     ) + '<ssv:Parameter name="actuator"><ssv:Integer value="1"/></ssv:Parameter>'
     fr = "".join(real(n, p[n]) for n in ["Fc", "Fs", "vs", "sigma0", "sigma1", "sigma2"])
+    friction_fmu, x_connector, x_connection = (
+        dist / "LuGre.fmu",
+        '<ssd:Connector name="x" kind="input"><ssc:Real unit="m"/></ssd:Connector>',
+        '<ssd:Connection startElement="rig" startConnector="x" endElement="friction" endConnector="x"/>',
+    )
+    if case.kind in DAHL_KINDS:
+        fr = real("sigma", p["sigma0"]) + real("Fc", p["Fc"]) + real("alpha", 1.0)
+        friction_fmu, x_connector, x_connection = dist / "Dahl.fmu", "", ""
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <ssd:SystemStructureDescription version="1.0" name="{case.name}"
     xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
@@ -279,10 +383,10 @@ def nominal_ssd(case: Case, x0: float, dist: Path | None = None) -> str:
           <ssv:ParameterSet version="1.0" name="rig"><ssv:Parameters>{rig}</ssv:Parameters></ssv:ParameterSet>
         </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
       </ssd:Component>
-      <ssd:Component name="friction" source="{dist / 'LuGre.fmu'}" type="application/x-fmu-sharedlibrary">
+      <ssd:Component name="friction" source="{friction_fmu}" type="application/x-fmu-sharedlibrary">
         <ssd:Connectors>
           <ssd:Connector name="v" kind="input"><ssc:Real unit="m/s"/></ssd:Connector>
-          <ssd:Connector name="x" kind="input"><ssc:Real unit="m"/></ssd:Connector>
+          {x_connector}
           <ssd:Connector name="F" kind="output"><ssc:Real unit="N"/></ssd:Connector>
         </ssd:Connectors>
         <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
@@ -292,7 +396,7 @@ def nominal_ssd(case: Case, x0: float, dist: Path | None = None) -> str:
     </ssd:Elements>
     <ssd:Connections>
       <ssd:Connection startElement="rig" startConnector="v" endElement="friction" endConnector="v"/>
-      <ssd:Connection startElement="rig" startConnector="x" endElement="friction" endConnector="x"/>
+      {x_connection}
       <ssd:Connection startElement="friction" startConnector="F" endElement="rig" endConnector="F"/>
     </ssd:Connections>
   </ssd:System>

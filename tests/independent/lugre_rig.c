@@ -22,6 +22,16 @@
  * actuator are read through an encoder (Gaussian noise of `noise` m, then
  * rounded to `resolution` m).
  *
+ * plant=two_mass: instead, a motor driving a load through a belt spring,
+ * the friction on the load (a plant that is not Rig1D):
+ *
+ *   m_m·x_m'' = u(t) − k·(x_m − x) − c·(x_m' − x') − c_m·x_m'
+ *   m·x''     = k·(x_m − x) + c·(x_m' − x') − F
+ *
+ * driven by a measured motor force u(t) = amp·[(1 − a2)·cos(ω1·t) +
+ * a2·cos(ω2·t)] (the load's mean speed stays zero), both positions read
+ * through the encoder. Output: time,drive.u,drive.x_m,drive.x_l[,...].
+ *
  * Usage: lugre_rig key=value ... > data.csv
  *   keys: m c k Fc Fs Fc_neg Fs_neg vs sigma0 sigma1 sigma2 duration
  *         sample resolution noise seed drive (sines|triangle|steps)
@@ -46,6 +56,8 @@ static char drive[32] = "sines";
 static int n_table = 0;
 static double x_table[MAX_TABLE], scale_tab[MAX_TABLE];
 static int write_truth = 0;
+static int two_mass = 0;
+static double m_m = 0.5, c_m = 1.0;
 static double step_fraction = 0.5; /* of the stiffest time scale */
 
 /* splitmix64 */
@@ -116,14 +128,27 @@ static double level(double v, double x) {
     return position_scale(x) * (fc + (fs - fc) * exp(-r * r));
 }
 
-/* state y = (x, v, z); returns the friction force */
+/* the motor force of the two-mass plant */
+static double motor_force(double t) {
+    return amp * ((1 - a2) * cos(2 * M_PI * f1 * t) + a2 * cos(2 * M_PI * f2 * t));
+}
+
+/* state y = (x, v, z[, x_m, v_m]); returns the friction force */
 static double rhs(double t, const double *y, double *dy) {
     double x = y[0], v = y[1], z = y[2];
     double zd = v - sigma0 * fabs(v) * z / level(v, x);
     double F = sigma0 * z + sigma1 * zd + sigma2 * v;
     dy[0] = v;
-    dy[1] = (k * (actuator(t) - x) - c * v - F) / m;
     dy[2] = zd;
+    if (two_mass) {
+        double belt = k * (y[3] - x) + c * (y[4] - v);
+        dy[1] = (belt - F) / m;
+        dy[3] = y[4];
+        dy[4] = (motor_force(t) - belt - c_m * y[4]) / m_m;
+    } else {
+        dy[1] = (k * (actuator(t) - x) - c * v - F) / m;
+        dy[3] = dy[4] = 0;
+    }
     return F;
 }
 
@@ -161,6 +186,8 @@ int main(int argc, char **argv) {
         KEY("duration", duration) KEY("sample", sample)
         KEY("resolution", resolution) KEY("noise", noise) KEY("amp", amp)
         KEY("period", period) KEY("step_fraction", step_fraction)
+        KEY("m_m", m_m) KEY("c_m", c_m)
+        else if (strcmp(key, "plant") == 0) two_mass = strcmp(val, "two_mass") == 0;
         else if (strcmp(key, "seed") == 0) seed = strtoull(val, NULL, 10);
         else if (strcmp(key, "truth") == 0) write_truth = atoi(val);
         else if (strcmp(key, "drive") == 0) snprintf(drive, sizeof drive, "%s", val);
@@ -187,13 +214,21 @@ int main(int argc, char **argv) {
     if (sigma1 > 0) h_cap = fmin(h_cap, step_fraction * m / sigma1);
 
     /* start at rest, the spring relaxed, no bristle deflection */
-    double y[3] = {actuator(0.0), 0, 0}, k1[3], k2[3], k3[3], k4[3], yt[3];
+    double y[5] = {two_mass ? 0.0 : actuator(0.0), 0, 0, 0, 0}, k1[5], k2[5], k3[5], k4[5], yt[5];
+    if (two_mass) h_cap = fmin(h_cap, step_fraction * sqrt(fmin(m, m_m) / (k + 1e-300)));
     long n = (long)llround(duration / sample);
-    printf("time,rig.x_act_in,rig.x%s\n", write_truth ? ",true_x,true_F" : "");
+    if (two_mass)
+        printf("time,drive.u,drive.x_m,drive.x_l%s\n", write_truth ? ",true_x,true_F" : "");
+    else
+        printf("time,rig.x_act_in,rig.x%s\n", write_truth ? ",true_x,true_F" : "");
     for (long s = 0; s <= n; s++) {
         double t = s * sample;
         double F = rhs(t, y, k1);
-        if (write_truth)
+        if (two_mass) {
+            printf("%.6f,%.9g,%.9g,%.9g", t, motor_force(t), quantise(y[3]), quantise(y[0]));
+            if (write_truth) printf(",%.12g,%.9g", y[0], F);
+            printf("\n");
+        } else if (write_truth)
             printf("%.6f,%.9g,%.9g,%.12g,%.9g\n", t, quantise(actuator(t)), quantise(y[0]), y[0], F);
         else
             printf("%.6f,%.9g,%.9g\n", t, quantise(actuator(t)), quantise(y[0]));
@@ -205,16 +240,16 @@ int main(int argc, char **argv) {
             if (relax < h) h = relax;
             if (t_next - tj - h < 1e-3 * h) h = t_next - tj;
             rhs(tj, y, k1);
-            for (int i = 0; i < 3; i++) yt[i] = y[i] + 0.5 * h * k1[i];
+            for (int i = 0; i < 5; i++) yt[i] = y[i] + 0.5 * h * k1[i];
             rhs(tj + 0.5 * h, yt, k2);
-            for (int i = 0; i < 3; i++) yt[i] = y[i] + 0.5 * h * k2[i];
+            for (int i = 0; i < 5; i++) yt[i] = y[i] + 0.5 * h * k2[i];
             rhs(tj + 0.5 * h, yt, k3);
-            for (int i = 0; i < 3; i++) yt[i] = y[i] + h * k3[i];
+            for (int i = 0; i < 5; i++) yt[i] = y[i] + h * k3[i];
             rhs(tj + h, yt, k4);
-            for (int i = 0; i < 3; i++) y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+            for (int i = 0; i < 5; i++) y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
             tj += h;
         }
-        if (!isfinite(y[0]) || !isfinite(y[1]) || !isfinite(y[2])) {
+        if (!isfinite(y[0]) || !isfinite(y[1]) || !isfinite(y[2]) || !isfinite(y[3]) || !isfinite(y[4])) {
             fprintf(stderr, "lugre_rig: the state is not finite at t = %g s\n", t);
             return 1;
         }

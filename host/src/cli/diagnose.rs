@@ -59,6 +59,15 @@ pub struct DiagnoseArgs {
     /// fitted parameters are those of the force fit).
     #[arg(long)]
     pub no_polish: bool,
+    /// Master of the diagnosis's co-simulations [default: the system's,
+    /// with its inputs interpolated: newton -> newton-interpolated,
+    /// gauss-seidel -> gauss-seidel-interpolated]
+    #[arg(long)]
+    pub master: Option<String>,
+    /// LuGre.fmu to move a Dahl nominal to [default: the LuGre.fmu beside
+    /// the Dahl FMU]
+    #[arg(long)]
+    pub lugre: Option<PathBuf>,
 }
 
 pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
@@ -68,6 +77,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         smooth: a.smooth,
         blocks: a.blocks,
         polish: !a.no_polish,
+        master: a.master.clone(),
         cross_validate: match a.cross_validate {
             CrossValidateArg::Auto => CrossValidate::Auto,
             CrossValidateArg::Always => CrossValidate::Always,
@@ -75,6 +85,9 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         },
         ..Options::default()
     };
+    if let Some(m) = &a.master {
+        fricsim::master::by_name(m).map_err(|e| format!("--master: {e}"))?;
+    }
     if !(a.alpha > 0.0 && a.alpha < 1.0) {
         return Err(format!("--alpha {}: must be between 0 and 1", a.alpha));
     }
@@ -97,8 +110,13 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             .map(|c| Effect::from_name(c))
             .collect::<Result<_, _>>()?;
     }
-    let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let d = diagnose(&file, &a.data, a.heldout.as_deref(), &options)?;
+    let mut file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
+    let moved = fricsim::diagnose::dahl::move_to_lugre(&mut file, a.lugre.as_deref())?;
+    let mut d = diagnose(&file, &a.data, a.heldout.as_deref(), &options)?;
+    if let Some(note) = moved {
+        println!("note: {note}");
+        d.notes.push(note);
+    }
     let out = a
         .out
         .clone()

@@ -369,6 +369,127 @@ impl Setup {
         })
     }
 
+    /// The port (`component.variable`) that drives the friction FMU's input
+    /// `var` through a connection, if one does.
+    pub fn input_source(&self, system: &System, var: &str) -> Option<String> {
+        let vr = self.friction_fmu.variable(var).ok()?.value_reference;
+        system
+            .connections
+            .iter()
+            .find(|c| c.to == (self.friction, vr))
+            .map(|c| {
+                let from = &system.components[c.from.0];
+                let name = from
+                    .fmu
+                    .description()
+                    .variables
+                    .iter()
+                    .find(|v| v.value_reference == c.from.1 && v.causality == Causality::Output)
+                    .map_or("?".to_string(), |v| v.name.clone());
+                format!("{}.{}", from.name, name)
+            })
+    }
+
+    /// The friction law's inputs and force along a co-simulation of the
+    /// nominal system with the data's inputs: for a plant whose inverse
+    /// dynamics diagnose does not know (not a Rig1D) and no measured
+    /// friction force. The force is then not estimated from the data: every
+    /// fit goes by output error through co-simulation, and these series
+    /// only set the candidates' starting ranges (speeds, travel) and the
+    /// states the report bins the change of the force by. `why` says why
+    /// the force could not be estimated.
+    pub fn friction_data_simulated(
+        &self,
+        file: &SystemFile,
+        system: &mut System,
+        data: &Measured,
+        why: &str,
+    ) -> Result<FrictionData, String> {
+        let params = super::sim::system_parameters(file, self, &self.nominal);
+        let run = super::sim::run_on(system, &params, data, &self.master, self.step)?;
+        if let Some(e) = &run.error {
+            return Err(format!("the nominal system stopped early: {e}"));
+        }
+        let f = &self.friction_name;
+        let series = |port: &str| -> Option<Vec<f64>> {
+            let col = run.columns.iter().position(|c| c == port)?;
+            Some(run.rows.iter().map(|r| r[col]).collect())
+        };
+        let law_input = |var: &str| -> Vec<f64> {
+            let port = format!("{f}.{var}");
+            if let Some(col) = data.column(&port) {
+                return col.to_vec();
+            }
+            let simulated = self.input_source(system, var).and_then(|src| series(&src));
+            match simulated {
+                Some(s) => data
+                    .time
+                    .iter()
+                    .map(|&t| crate::inputs::interpolate(t, &run.time, &s, false))
+                    .collect(),
+                None => vec![0.0; data.time.len()],
+            }
+        };
+        let (v, x, fn_) = (law_input("v"), law_input("x"), law_input("Fn"));
+        let force = series(&format!("{f}.F"))
+            .ok_or_else(|| format!("the co-simulation does not record `{f}.F`"))?;
+        let n = data.time.len();
+        let mut d = FrictionData {
+            t: Vec::new(),
+            h: Vec::new(),
+            end: Vec::new(),
+            v: Vec::new(),
+            x: Vec::new(),
+            fn_: Vec::new(),
+            f: Vec::new(),
+            source: format!(
+                "not estimated ({why}): every fit is by output error through co-simulation of the whole system"
+            ),
+            position_resolution: self
+                .input_source(system, "x")
+                .and_then(|src| data.column(&src))
+                .map(quality::resolution),
+            normal_force_measured: data.column(&format!("{f}.Fn")).is_some()
+                && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+                    > fn_.iter().cloned().fold(f64::INFINITY, f64::min),
+            trusted: Vec::new(),
+        };
+        for k in 0..n - 1 {
+            if data.time[k + 1] > data.time[k] {
+                d.t.push(data.time[k]);
+                d.h.push(data.time[k + 1] - data.time[k]);
+                d.end.push(k + 1);
+                d.v.push(v[k]);
+                d.x.push(x[k]);
+                d.fn_.push(fn_[k]);
+                d.f.push(crate::inputs::interpolate(
+                    data.time[k + 1],
+                    &run.time,
+                    &force,
+                    false,
+                ));
+                d.trusted
+                    .push(!data.quality.excluded[k + 1] && !data.quality.after_gap[k + 1]);
+            }
+        }
+        Ok(d)
+    }
+
+    /// Whether the force the data imply can be estimated: measured as
+    /// `friction.F`, or by the inverse dynamics of a Rig1D the friction
+    /// acts on. Otherwise diagnose fits by output error alone
+    /// ([`Setup::friction_data_simulated`]); the reason when not.
+    pub fn force_estimable(&self, data: &Measured) -> Result<(), String> {
+        let f = &self.friction_name;
+        if data.column(&format!("{f}.F")).is_some() || self.rig.is_some() {
+            Ok(())
+        } else {
+            Err(format!(
+                "`{f}.F` is not measured and its force does not act on a Rig1D whose inverse dynamics diagnose knows"
+            ))
+        }
+    }
+
     /// The friction force and law inputs the data imply, on every interval.
     pub fn friction_data(
         &self,

@@ -14,7 +14,10 @@
 //!   change: a logger that repeated its last row and caught up;
 //! - **gap**: a time step more than [`GAP_FACTOR`] times the median;
 //! - **saturation**: a column sitting at its extreme value (largest or
-//!   smallest) in runs of at least [`SATURATION_RUN`] samples, for at least
+//!   smallest) in runs of at least [`SATURATION_RUN`] samples that it
+//!   reaches or leaves at speed (a step of at least [`SATURATION_KINK`]
+//!   times its resolution on the sample before or after: a kink, not the
+//!   smooth arrival of a signal that parks there), for at least
 //!   [`SATURATION_SHARE`] of the file: a clipped sensor or converter.
 //!
 //! Spikes and dropouts are repaired by linear interpolation between the
@@ -36,6 +39,9 @@ pub const LOCAL_WINDOW: usize = 41;
 pub const GAP_FACTOR: f64 = 1.5;
 /// Shortest run at an extreme value that counts toward saturation.
 pub const SATURATION_RUN: usize = 10;
+/// A saturated run is reached or left by a step of at least this many
+/// resolutions of the column (its quantisation step, twice its noise).
+pub const SATURATION_KINK: f64 = 5.0;
 /// Share of the samples at the extreme for a column to be saturated.
 pub const SATURATION_SHARE: f64 = 0.005;
 /// At most this share of a file's samples may be flagged.
@@ -332,6 +338,7 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
         if lo >= hi {
             continue; // a constant column is a setting, not a clipped one
         }
+        let kink = SATURATION_KINK * resolution(y).max(f64::MIN_POSITIVE);
         for extreme in [hi, lo] {
             let mut runs = Vec::new();
             let mut k = 0;
@@ -341,7 +348,9 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                     while k < n && y[k] == extreme {
                         k += 1;
                     }
-                    if k - s >= SATURATION_RUN {
+                    let arrives = s >= 1 && (y[s] - y[s - 1]).abs() >= kink;
+                    let leaves = k < n && (y[k] - y[k - 1]).abs() >= kink;
+                    if k - s >= SATURATION_RUN && (arrives || leaves) {
                         runs.push((s, k));
                     }
                 } else {
@@ -456,6 +465,24 @@ mod tests {
         assert_eq!(s.len(), 1, "{:?}", q.findings);
         assert_eq!((s[0].column.as_str(), s[0].value), ("rig.x", cap));
         assert!(q.excluded_samples >= s[0].samples);
+    }
+
+    /// A drive that ramps smoothly to its largest value and parks there is
+    /// not a clipped one.
+    #[test]
+    fn a_signal_parked_at_its_extreme_is_not_saturated() {
+        let n = 5000;
+        let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let y: Vec<f64> = time
+            .iter()
+            .map(|&t| {
+                let u = (t / 2.0).min(1.0);
+                ((0.02 * (0.5 - 0.5 * (std::f64::consts::PI * u).cos())) / 1e-6).round() * 1e-6
+            })
+            .collect();
+        let mut cols = vec![("rig.x_act_in".to_string(), y)];
+        let q = inspect(&time, &mut cols, &[]);
+        assert_eq!(q.saturated, 0, "{:?}", q.findings);
     }
 
     #[test]

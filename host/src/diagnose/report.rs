@@ -78,6 +78,9 @@ pub fn markdown(d: &Diagnosis) -> String {
         d.master, d.step, d.wall_seconds
     );
     let _ = writeln!(s, "## Result\n");
+    for note in &d.notes {
+        let _ = writeln!(s, "Note: {note}.\n");
+    }
     if d.effects.is_empty() {
         let _ = writeln!(
             s,
@@ -234,7 +237,11 @@ pub fn markdown(d: &Diagnosis) -> String {
                 c.heldout_rms,
                 100.0 * c.gain,
                 c.p_value,
-                if c.beyond_step_error { "yes" } else { "no" },
+                match &c.unresolved {
+                    Some(why) => format!("no: {why}"),
+                    None if c.beyond_step_error => "yes".into(),
+                    None => "no".into(),
+                },
                 c.force_rms,
                 c.fit_evaluations
             );
@@ -501,7 +508,16 @@ fn absolute_source(file: &SystemFile, e: &BytesStart) -> Result<BytesStart<'stat
             .map_err(|err| err.to_string())?
             .into_owned();
         if key == "source" {
-            let path = file.resolve(&value)?;
+            // a component's source as the file holds it now (a Dahl
+            // friction moved to LuGre), else as written
+            let component = (local(e.name().as_ref()) == "Component")
+                .then(|| attr(e, "name"))
+                .flatten()
+                .and_then(|n| file.components.iter().find(|c| c.name == n));
+            let path = match component {
+                Some(c) if c.source_text != value => c.source.clone(),
+                _ => file.resolve(&value)?,
+            };
             let path = std::fs::canonicalize(&path).unwrap_or(path);
             copy.push_attribute((key.as_str(), path.to_string_lossy().as_ref()));
         } else {

@@ -222,6 +222,26 @@ pub fn co_simulate_robust(
     ))
 }
 
+/// Run `system` (restarted with `parameters`) over the file's time span
+/// with its inputs, with `master` at macro step `step`.
+pub fn run_on(
+    system: &mut System,
+    parameters: &[(String, ParameterValue)],
+    data: &Measured,
+    master: &str,
+    step: f64,
+) -> Result<crate::master::Run, String> {
+    let start = data.time[0];
+    let stop = *data.time.last().unwrap_or(&start);
+    system
+        .restart(start, parameters)
+        .map_err(|e| format!("setting up the co-simulation: {e}"))?;
+    let mut inputs = ExternalInputs::bind(data.input_table(), system)?.with_slopes(step);
+    let mut master = by_name(master)?;
+    simulate_with(system, master.as_mut(), start, step, stop, &mut inputs)
+        .map_err(|e| format!("co-simulation: {e}"))
+}
+
 /// [`co_simulate`] with a given master and macro step.
 pub fn co_simulate_with(
     system: &mut System,
@@ -230,15 +250,7 @@ pub fn co_simulate_with(
     master: &str,
     step: f64,
 ) -> Result<ChannelResiduals, String> {
-    let start = data.time[0];
-    let stop = *data.time.last().unwrap_or(&start);
-    system
-        .restart(start, parameters)
-        .map_err(|e| format!("setting up the co-simulation: {e}"))?;
-    let mut inputs = ExternalInputs::bind(data.input_table(), system)?.with_slopes(step);
-    let mut master = by_name(master)?;
-    let run = simulate_with(system, master.as_mut(), start, step, stop, &mut inputs)
-        .map_err(|e| format!("co-simulation: {e}"))?;
+    let run = run_on(system, parameters, data, master, step)?;
     let mut samples = Vec::new();
     for (k, &t) in data.time.iter().enumerate() {
         let repeated = (k > 0 && data.time[k - 1] == t) || data.quality.excluded[k];
