@@ -7,14 +7,19 @@
 //!   scale of the second differences (their median absolute value over
 //!   [`LOCAL_WINDOW`] samples around, leaving out the three it affects,
 //!   over 0.6745; at least the column's quantisation step), so a fast but
-//!   smooth transient, whose neighbours curve as much, is not one;
+//!   smooth transient, whose neighbours curve as much, is not one; and its
+//!   neighbours' second differences are of the opposite sign (a spike of
+//!   height S makes S, −2S, S), so a kink, which makes one alone, is not
+//!   one either;
 //! - **dropout**: two or more rows identical in every column to the row
 //!   before while time advances, after a column that changed on every one
 //!   of the rows before, which then jumps by at least twice its usual
 //!   change: a logger that repeated its last row and caught up;
 //! - **gap**: a time step more than [`GAP_FACTOR`] times the median;
 //! - **saturation**: a column sitting at its extreme value (largest or
-//!   smallest) in runs of at least [`SATURATION_RUN`] samples that it
+//!   smallest) in runs of at least [`SATURATION_RUN`] samples, and
+//!   [`SATURATION_RUN_FACTOR`] times its median run of equal values (a
+//!   column held in steps, a table, sits at every value a while), that it
 //!   reaches or leaves at speed (a step of at least [`SATURATION_KINK`]
 //!   times its resolution on the sample before or after: a kink, not the
 //!   smooth arrival of a signal that parks there), for at least
@@ -33,12 +38,18 @@ use serde::Serialize;
 
 /// A spike's second difference is at least this many local scales.
 pub const SPIKE_FACTOR: f64 = 20.0;
+/// A spike's neighbours' second differences are of the opposite sign and
+/// at least this fraction of its own (half, for a clean spike).
+pub const SPIKE_FLANK: f64 = 0.25;
 /// Samples around a spike whose second differences set the local scale.
 pub const LOCAL_WINDOW: usize = 41;
 /// A time step this many times the median is a gap.
 pub const GAP_FACTOR: f64 = 1.5;
 /// Shortest run at an extreme value that counts toward saturation.
 pub const SATURATION_RUN: usize = 10;
+/// A saturated run is at least this many times the column's median run of
+/// equal values.
+pub const SATURATION_RUN_FACTOR: f64 = 5.0;
 /// A saturated run is reached or left by a step of at least this many
 /// resolutions of the column (its quantisation step, twice its noise).
 pub const SATURATION_KINK: f64 = 5.0;
@@ -294,6 +305,10 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
             let half = LOCAL_WINDOW / 2;
             let mut found = Vec::new();
             for k in 1..n.saturating_sub(1) {
+                // not across an event (a repeated time: a table's step)
+                if time[k] <= time[k - 1] || time[k + 1] <= time[k] {
+                    continue;
+                }
                 let lo = k.saturating_sub(half).max(1);
                 let hi = (k + half).min(n - 2);
                 let local: Vec<f64> = (lo..=hi)
@@ -301,10 +316,17 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                     .map(|j| d2[j].abs())
                     .collect();
                 let scale = (median(local) / 0.6745).max(step).max(f64::MIN_POSITIVE);
-                // the largest |d2| of the three a spike at k affects is at k
+                // a spike of height S at k makes the second differences
+                // (S, −2S, S) at k−1, k, k+1; a kink (a clipped or
+                // triangular signal) makes one alone, and is not a spike
+                let flanked = |j: usize| {
+                    d2[j] * d2[k] < 0.0 && d2[j].abs() >= SPIKE_FLANK * d2[k].abs()
+                };
                 if d2[k].abs() > SPIKE_FACTOR * scale
                     && d2[k].abs() >= d2[k - 1].abs()
                     && d2[k].abs() >= d2[k + 1].abs()
+                    && (k < 2 || flanked(k - 1))
+                    && (k + 2 >= n || flanked(k + 1))
                 {
                     found.push(k);
                 }
@@ -339,6 +361,18 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
             continue; // a constant column is a setting, not a clipped one
         }
         let kink = SATURATION_KINK * resolution(y).max(f64::MIN_POSITIVE);
+        // a column held in steps (a table, a setting) sits at every value
+        // for a while: a clipped signal sits at its extreme far longer
+        // than at its other values
+        let mut run_lengths = Vec::new();
+        let mut start = 0;
+        for k in 1..=n {
+            if k == n || y[k] != y[start] {
+                run_lengths.push((k - start) as f64);
+                start = k;
+            }
+        }
+        let usual_run = median(run_lengths);
         for extreme in [hi, lo] {
             let mut runs = Vec::new();
             let mut k = 0;
@@ -350,7 +384,8 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                     }
                     let arrives = s >= 1 && (y[s] - y[s - 1]).abs() >= kink;
                     let leaves = k < n && (y[k] - y[k - 1]).abs() >= kink;
-                    if k - s >= SATURATION_RUN && (arrives || leaves) {
+                    let long = (k - s) as f64 >= SATURATION_RUN_FACTOR * usual_run;
+                    if k - s >= SATURATION_RUN && long && (arrives || leaves) {
                         runs.push((s, k));
                     }
                 } else {
@@ -424,11 +459,9 @@ mod tests {
         for t in time.iter_mut().skip(4000) {
             *t += 0.05; // a gap before row 4000
         }
-        for y in cols[0].1[4500..4600].iter_mut() {
-            *y = 0.03; // clipped
+        for y in cols[0].1.iter_mut() {
+            *y = y.min(0.03); // clipped: its kinks are not spikes
         }
-        let hi = cols[0].1.iter().cloned().fold(f64::MIN, f64::max);
-        assert_eq!(hi, 0.04f64.min(hi));
         let lines: Vec<u64> = (0..5000).map(|k| k as u64 + 2).collect();
         let q = inspect(&time, &mut cols, &lines);
         let spikes: Vec<u64> = q
@@ -445,6 +478,13 @@ mod tests {
         assert_eq!(gap.line, 4002);
         assert!((gap.value - 0.051).abs() < 1e-9);
         assert_eq!(q.gaps, 1);
+        assert!(
+            q.findings
+                .iter()
+                .any(|f| f.kind == Kind::Saturation && f.column == "rig.x_act_in"),
+            "{:?}",
+            q.findings
+        );
         assert!(q.excluded[1234] && q.excluded[3000] && q.excluded[2002]);
         assert!(!q.excluded[1000]);
     }

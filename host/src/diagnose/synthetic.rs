@@ -132,8 +132,10 @@ pub fn generate(
     noise_free: Option<&Path>,
 ) -> Result<Case, String> {
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
-    // the data come from the system file's own master algorithm
-    let master_name = file.settings.master_or_default();
+    // the data come from the system file's master with its inputs
+    // interpolated (second order, [`super::diagnosis_master`]): as close
+    // to the continuous system as the co-simulation gets at this step
+    let master_name = super::diagnosis_master(&file.settings.master_or_default(), None);
     let setup = Setup::new(file, &mut system, SAMPLE, &master_name)?;
     let n = (duration / SAMPLE).round() as usize;
     let time: Vec<f64> = (0..=n).map(|k| k as f64 * SAMPLE).collect();

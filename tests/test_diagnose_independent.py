@@ -1,0 +1,86 @@
+"""`fricsim diagnose` on data it has never seen: datasets made by an
+independent simulator (tests/independent/lugre_rig.c: plain C, its own
+integrator, no code shared with the FMUs), run as a user would (the
+defaults, the CLI), one case of each kind that once failed: nominal =
+truth, a stiff nominal against millimetre presliding, a soft nominal
+against a stiff truth, an effect at 5 %, spikes and a dropout in the data,
+a plant that is not Rig1D, a Dahl nominal. The full grid (more seeds, every
+effect at 10 % and 5 %) is `python3 tests/independent/suite.py`, whose
+table is in BENCHMARKS.md."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "independent"))
+import cases  # noqa: E402
+import suite  # noqa: E402
+
+def check(row: dict) -> None:
+    """The figures every case must meet."""
+    assert suite.FRICSIM.exists(), "needs target/release/fricsim and dist/: run ./build-fmu.sh"
+    assert row["report"], f"{row['case']}: no report: {row['stderr']}"
+    assert row["named_right"], f"{row['case']}: found {row['found']}"
+    assert row["never_worse"], (
+        f"{row['case']}: final held-out RMS {row['final_rms']} > 1.05 x the given model's {row['given_rms']}"
+    )
+    if "size" in row:
+        assert row["size"]["relative_error"] <= 0.10, f"{row['case']}: {row['size']}"
+    if not row["found"]:
+        assert not row["unexplained"], f"{row['case']}: nothing named, yet 'unexplained'"
+
+
+@pytest.mark.parametrize(
+    "kind,magnitude,seed",
+    [
+        ("none", 0.1, 7),
+        ("presliding_stiff_nominal", 0.1, 7),
+        ("presliding_soft_nominal", 0.1, 8),
+        ("direction_dependent", 0.05, 7),
+        ("viscous", 0.05, 9),
+        ("dahl_viscous", 0.1, 7),
+    ],
+)
+def test_case_from_the_independent_simulator(kind, magnitude, seed, tmp_path):
+    check(suite.run_case(cases.draw(kind, magnitude, seed), tmp_path))
+
+
+def test_spikes_and_a_dropout_are_found_and_change_nothing(tmp_path):
+    row = suite.run_case(cases.draw("none", 0.1, 107), tmp_path, bad_data=True)
+    check(row)
+    assert row["bad_samples_found"], "a spike or the dropout was not reported at its line"
+    assert row["flagged"] >= 7  # two spikes and five repeated rows
+
+
+def test_a_plant_that_is_not_rig1d_is_diagnosed_by_output_error(tmp_path):
+    row = suite.run_case(cases.draw("two_mass_viscous", 0.1, 7), tmp_path)
+    check(row)
+    assert "size" in row
+
+
+def test_the_simulator_converges():
+    """Halving the simulator's step moves the noise-free position by far less
+    than the 1 µm encoder step."""
+    sim = cases.simulator()
+    args = ["m=1.07", "k=1650", "Fc=1.513", "Fs=1.857", "vs=0.0309", "sigma0=5e6",
+            "sigma1=4218", "sigma2=1.74", "amp=0.077", "period=4.64", "duration=5", "truth=1"]
+
+    def run(fraction):
+        out = subprocess.run([str(sim), *args, f"step_fraction={fraction}"], capture_output=True,
+                             text=True, check=True).stdout.splitlines()
+        return [float(line.split(",")[3]) for line in out[1:]]
+
+    a, b = run(0.5), run(0.25)
+    assert max(abs(x - y) for x, y in zip(a, b)) < 1e-9
+
+
+def test_the_simulator_refuses_bad_arguments():
+    sim = cases.simulator()
+    r = subprocess.run([str(sim), "m=-1"], capture_output=True, text=True)
+    assert r.returncode == 2 and "must be positive" in r.stderr
+    r = subprocess.run([str(sim), "mass=1"], capture_output=True, text=True)
+    assert r.returncode == 2 and "unknown key `mass`" in r.stderr
