@@ -31,7 +31,7 @@ pub struct CosimArgs {
     /// Result CSV.
     #[arg(long, default_value = "out/result.csv")]
     pub out: PathBuf,
-    /// Plot (SVG) of the chosen signals.
+    /// Plot of the chosen signals (.png or .svg) [default: no plot].
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// Signals to plot, as component.variable (default: all).
