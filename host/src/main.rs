@@ -25,12 +25,12 @@ enum Command {
         /// The .fmu file.
         fmu: PathBuf,
     },
-    /// Connect FMUs and co-simulate them with a fixed macro step (Jacobi by
-    /// default), writing a CSV (time first, component.variable columns) and,
+    /// Connect FMUs and co-simulate them with a fixed communication step
+    /// (Jacobi by default), writing a CSV (time first, component.variable columns) and,
     /// with --plot, a plot.
     Cosim(cli::cosim::CosimArgs),
     /// Co-simulate a system file (SSP 1.0: an .ssp archive or a .ssd) with
-    /// a fixed macro step, writing a CSV, a summary and, with --plot, a
+    /// a fixed communication step, writing a CSV, a summary and, with --plot, a
     /// plot.
     Run(cli::run::RunArgs),
     /// Pack a .ssd and the files its sources point at (FMUs, .ssv) into a

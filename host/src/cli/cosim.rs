@@ -22,7 +22,9 @@ pub struct CosimArgs {
     /// steps), fixed-point (strong coupling, for comparison).
     #[arg(long, default_value = "jacobi")]
     pub master: String,
-    /// Macro step in seconds.
+    /// Communication step in seconds: the master steps the FMUs by it,
+    /// except that `adaptive` chooses its macro steps inside it and the
+    /// strong-coupling masters halve a step that does not converge.
     #[arg(long, default_value_t = 1e-4)]
     pub step: f64,
     /// Stop time in seconds.
