@@ -25,11 +25,13 @@ enum Command {
         /// The .fmu file.
         fmu: PathBuf,
     },
-    /// Connect FMUs and co-simulate them with a fixed macro step (Jacobi),
-    /// writing a CSV (time first, component.variable columns) and a plot.
+    /// Connect FMUs and co-simulate them with a fixed communication step
+    /// (Jacobi by default), writing a CSV (time first, component.variable columns) and,
+    /// with --plot, a plot.
     Cosim(cli::cosim::CosimArgs),
     /// Co-simulate a system file (SSP 1.0: an .ssp archive or a .ssd) with
-    /// a fixed macro step, writing a CSV, a plot and a summary.
+    /// a fixed communication step, writing a CSV, a summary and, with --plot, a
+    /// plot.
     Run(cli::run::RunArgs),
     /// Pack a .ssd and the files its sources point at (FMUs, .ssv) into a
     /// self-contained .ssp archive (sources become resources/<file name>).

@@ -2,7 +2,7 @@
 //! with the ordinary tests: a seeded generator, a fixed number of
 //! iterations, a few seconds per target. Any failure prints the seed and
 //! iteration, so it can be replayed. The long runs (libFuzzer, coverage
-//! guided) are `scripts/fuzz.sh`; see README "Robustness checks".
+//! guided) are `scripts/fuzz.sh`; see docs/development.md, "Robustness checks".
 //!
 //! - random FMI call sequences against every shipped FMU
 //!   (`fmi/sequence.rs` says what must hold);

@@ -80,14 +80,14 @@ pub fn package(info: &ModelInfo, library: &Path, out_dir: &Path) -> Result<PathB
     Ok(path)
 }
 
-/// Markdown tables of every model's variables, for `docs/variables.md`
+/// Markdown tables of every model's variables, for `docs/fmu-reference.md`
 /// (arrays such as `x_table[1]`…`x_table[32]` collapse into one row
 /// `x_table[i]`).
 pub fn variables_markdown() -> String {
     use fmi2_cs::{Causality, VarType};
     let mut md = String::new();
     for info in all_models() {
-        md.push_str(&format!("## {} — {}\n\n", info.model_name, info.source));
+        md.push_str(&format!("### {} — {}\n\n", info.model_name, info.source));
         md.push_str("| variable | causality | type | start | unit | description |\n|---|---|---|---|---|---|\n");
         let mut seen_arrays: Vec<&str> = Vec::new();
         for v in info.variables {

@@ -25,7 +25,7 @@ enum Command {
         #[arg(default_value = "modelDescription")]
         dir: PathBuf,
     },
-    /// Print the variable tables of docs/variables.md (Markdown).
+    /// Print the variable tables of docs/fmu-reference.md (Markdown).
     VariablesMd,
     /// Package every model: <out>/<Name>.fmu from the shared library.
     Build {

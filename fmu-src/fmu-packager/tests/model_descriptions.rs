@@ -33,10 +33,10 @@ fn every_model_has_a_distinct_guid_and_identifier() {
 
 #[test]
 fn docs_variable_tables_match_the_code() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/variables.md");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/fmu-reference.md");
     let page = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     assert!(
         page.contains(&fmu_packager::variables_markdown()),
-        "docs/variables.md's variable tables differ from the code: paste `cargo run -p fmu-packager -- variables-md`"
+        "docs/fmu-reference.md's variable tables differ from the code: paste `cargo run -p fmu-packager -- variables-md`"
     );
 }

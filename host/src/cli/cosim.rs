@@ -22,7 +22,9 @@ pub struct CosimArgs {
     /// steps), fixed-point (strong coupling, for comparison).
     #[arg(long, default_value = "jacobi")]
     pub master: String,
-    /// Macro step in seconds.
+    /// Communication step in seconds: the master steps the FMUs by it,
+    /// except that `adaptive` chooses its macro steps inside it and the
+    /// strong-coupling masters halve a step that does not converge.
     #[arg(long, default_value_t = 1e-4)]
     pub step: f64,
     /// Stop time in seconds.
@@ -31,7 +33,7 @@ pub struct CosimArgs {
     /// Result CSV.
     #[arg(long, default_value = "out/result.csv")]
     pub out: PathBuf,
-    /// Plot (SVG) of the chosen signals.
+    /// Plot of the chosen signals (.png or .svg) [default: no plot].
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// Signals to plot, as component.variable (default: all).

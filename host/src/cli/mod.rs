@@ -11,8 +11,9 @@ pub mod sweep;
 use fricsim::ssp::SystemFile;
 use std::path::{Path, PathBuf};
 
-/// `--start`, `--stop`, `--step` of the commands that run a system file
-/// (`run`, `sweep`, `reference`), resolved by [`time_grid`].
+/// `--start`, `--stop`, `--step` of the commands that co-simulate a
+/// system file (`run`, `sweep`), resolved by [`time_grid`]. (`reference`
+/// has its own, since there `--step` is only the output interval.)
 #[derive(clap::Args)]
 pub struct GridArgs {
     /// Start time in seconds [default: DefaultExperiment startTime, else 0].
@@ -21,8 +22,10 @@ pub struct GridArgs {
     /// Stop time in seconds [default: DefaultExperiment stopTime].
     #[arg(long)]
     pub stop: Option<f64>,
-    /// Macro step in seconds; for `reference` the output interval, which
-    /// the integrator's steps never cross [default: the file's stepSize
+    /// Communication step in seconds: the results are sampled once per
+    /// step, and the master steps the FMUs by it, except that `adaptive`
+    /// chooses its macro steps inside it and the strong-coupling masters
+    /// halve a step that does not converge [default: the file's stepSize
     /// annotation].
     #[arg(long)]
     pub step: Option<f64>,
@@ -71,7 +74,7 @@ pub fn time_grid(
     }
     let step = step.or(file.settings.step_size).ok_or_else(|| {
         format!(
-            "{}: no step size: give --step or the stepSize of the fricsim annotation (see README, \"Writing a system file\")",
+            "{}: no step size: give --step or the stepSize of the fricsim annotation (see docs/user-guide.md, \"Our annotation\")",
             file.ssd
         )
     })?;

@@ -21,8 +21,18 @@ use std::path::PathBuf;
 pub struct ReferenceArgs {
     /// The system: an .ssp archive or a SystemStructure .ssd file.
     pub system: PathBuf,
-    #[command(flatten)]
-    pub grid: super::GridArgs,
+    /// Start time in seconds [default: DefaultExperiment startTime, else 0].
+    #[arg(long)]
+    pub start: Option<f64>,
+    /// Stop time in seconds [default: DefaultExperiment stopTime].
+    #[arg(long)]
+    pub stop: Option<f64>,
+    /// Output interval in seconds: one row every step, at the times of
+    /// `fricsim run` with the same --step; the solver chooses its own steps
+    /// and never steps across an output time [default: the file's stepSize
+    /// annotation].
+    #[arg(long)]
+    pub step: Option<f64>,
     /// Result CSV [default: out/<file name>_reference.csv].
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -41,7 +51,7 @@ pub struct ReferenceArgs {
 
 pub fn run(a: &ReferenceArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let (start, stop, step) = a.grid.resolve(&file)?;
+    let (start, stop, step) = super::time_grid(&file, a.start, a.stop, a.step)?;
     if !(a.rtol.is_finite() && a.rtol > 0.0 && a.rtol < 1.0) {
         return Err(format!("--rtol must be in (0, 1), got {}", a.rtol));
     }

@@ -27,7 +27,8 @@ pub struct RunArgs {
     /// Result CSV [default: out/<file name>.csv].
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Plot of the chosen signals (.png or .svg).
+    /// Plot of the chosen signals (.png or .svg) [default: no plot; the
+    /// file's Plot annotation only chooses the signals].
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// A signal to plot, component.variable (repeat) [default: the file's
