@@ -1,7 +1,7 @@
 """Hidden-effect datasets from an independent simulator, and the nominal
 systems `fricsim diagnose` is given for them.
 
-The data contract (README, "Data a diagnosis can use"): a mass pulled
+The data contract (docs/diagnose.md, "The data a diagnosis can use"): a mass pulled
 through a spring by a measured actuator position, LuGre friction plus one
 hidden effect or none, sampled at 1 kHz through a 1 µm encoder; the nominal
 system is Rig1D (`actuator = 1`, driven by the data's `rig.x_act_in`) with
@@ -285,127 +285,103 @@ def make(case: Case, work: Path) -> tuple[Path, Path]:
     return data, ssd
 
 
+def _real(name: str, value: float) -> str:
+    return f'<ssv:Parameter name="{name}"><ssv:Real value="{value!r}"/></ssv:Parameter>'
+
+
+def _component(name: str, source: Path, connectors: list[tuple[str, str, str]], parameters: str) -> str:
+    """An SSD component: connectors (name, kind, unit), parameter XML."""
+    conns = "".join(
+        f'<ssd:Connector name="{n}" kind="{k}"><ssc:Real unit="{u}"/></ssd:Connector>' for n, k, u in connectors
+    )
+    return f"""      <ssd:Component name="{name}" source="{source}" type="application/x-fmu-sharedlibrary">
+        <ssd:Connectors>{conns}</ssd:Connectors>
+        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
+          <ssv:ParameterSet version="1.0" name="{name}"><ssv:Parameters>{parameters}</ssv:Parameters></ssv:ParameterSet>
+        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
+      </ssd:Component>
+"""
+
+
+def _ssd(case: Case, components: str, connections: list[tuple[str, str, str, str]]) -> str:
+    """The system file: components, connections (from, port, to, port), the
+    contract's co-simulation settings (newton at 1 ms)."""
+    conns = "".join(
+        f'<ssd:Connection startElement="{a}" startConnector="{b}" endElement="{c}" endConnector="{d}"/>'
+        for a, b, c, d in connections
+    )
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription version="1.0" name="{case.name}"
+    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
+    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
+    xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues">
+  <ssd:System name="{case.name}">
+    <ssd:Elements>
+{components}    </ssd:Elements>
+    <ssd:Connections>{conns}</ssd:Connections>
+  </ssd:System>
+  <ssd:DefaultExperiment startTime="0" stopTime="{case.duration}">
+    <ssd:Annotations>
+      <ssc:Annotation type="org.friction-fmu.fricsim">
+        <fricsim:Simulation xmlns:fricsim="urn:friction-fmu:fricsim:1" stepSize="1e-3" master="newton"/>
+      </ssc:Annotation>
+    </ssd:Annotations>
+  </ssd:DefaultExperiment>
+</ssd:SystemStructureDescription>
+"""
+
+
+def _lugre(case: Case, dist: Path) -> str:
+    p = case.nominal
+    fr = "".join(_real(n, p[n]) for n in ["Fc", "Fs", "vs", "sigma0", "sigma1", "sigma2"])
+    return _component("friction", dist / "LuGre.fmu", [("v", "input", "m/s"), ("x", "input", "m"), ("F", "output", "N")], fr)
+
+
 def two_mass_ssd(case: Case, plant_fmu: Path, dist: Path | None = None) -> str:
     """The nominal system of a two-mass case: TwoMassDrive (motor force u
     from the data) with LuGre on the load."""
     dist = dist or ROOT / "dist"
-    r, p = case.rig, case.nominal
-
-    def real(name, value):
-        return f'<ssv:Parameter name="{name}"><ssv:Real value="{value!r}"/></ssv:Parameter>'
-
+    r = case.rig
     plant = "".join(
-        real(n, v)
+        _real(n, v)
         for n, v in [("m_m", r["m_m"]), ("m_l", r["m"]), ("k_b", r["k"]), ("c_b", r["c"]), ("c_m", r["c_m"]), ("x0", 0.0), ("h_max", 1e-4)]
     )
-    fr = "".join(real(n, p[n]) for n in ["Fc", "Fs", "vs", "sigma0", "sigma1", "sigma2"])
-    return f"""<?xml version="1.0" encoding="UTF-8"?>
-<ssd:SystemStructureDescription version="1.0" name="{case.name}"
-    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
-    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
-    xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues">
-  <ssd:System name="{case.name}">
-    <ssd:Elements>
-      <ssd:Component name="drive" source="{plant_fmu}" type="application/x-fmu-sharedlibrary">
-        <ssd:Connectors>
-          <ssd:Connector name="u" kind="input"><ssc:Real unit="N"/></ssd:Connector>
-          <ssd:Connector name="F" kind="input"><ssc:Real unit="N"/></ssd:Connector>
-          <ssd:Connector name="x_m" kind="output"><ssc:Real unit="m"/></ssd:Connector>
-          <ssd:Connector name="x_l" kind="output"><ssc:Real unit="m"/></ssd:Connector>
-          <ssd:Connector name="v" kind="output"><ssc:Real unit="m/s"/></ssd:Connector>
-        </ssd:Connectors>
-        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
-          <ssv:ParameterSet version="1.0" name="drive"><ssv:Parameters>{plant}</ssv:Parameters></ssv:ParameterSet>
-        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
-      </ssd:Component>
-      <ssd:Component name="friction" source="{dist / 'LuGre.fmu'}" type="application/x-fmu-sharedlibrary">
-        <ssd:Connectors>
-          <ssd:Connector name="v" kind="input"><ssc:Real unit="m/s"/></ssd:Connector>
-          <ssd:Connector name="x" kind="input"><ssc:Real unit="m"/></ssd:Connector>
-          <ssd:Connector name="F" kind="output"><ssc:Real unit="N"/></ssd:Connector>
-        </ssd:Connectors>
-        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
-          <ssv:ParameterSet version="1.0" name="friction"><ssv:Parameters>{fr}</ssv:Parameters></ssv:ParameterSet>
-        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
-      </ssd:Component>
-    </ssd:Elements>
-    <ssd:Connections>
-      <ssd:Connection startElement="drive" startConnector="v" endElement="friction" endConnector="v"/>
-      <ssd:Connection startElement="drive" startConnector="x_l" endElement="friction" endConnector="x"/>
-      <ssd:Connection startElement="friction" startConnector="F" endElement="drive" endConnector="F"/>
-    </ssd:Connections>
-  </ssd:System>
-  <ssd:DefaultExperiment startTime="0" stopTime="{case.duration}">
-    <ssd:Annotations>
-      <ssc:Annotation type="org.friction-fmu.fricsim">
-        <fricsim:Simulation xmlns:fricsim="urn:friction-fmu:fricsim:1" stepSize="1e-3" master="newton"/>
-      </ssc:Annotation>
-    </ssd:Annotations>
-  </ssd:DefaultExperiment>
-</ssd:SystemStructureDescription>
-"""
+    drive = _component(
+        "drive",
+        plant_fmu,
+        [("u", "input", "N"), ("F", "input", "N"), ("x_m", "output", "m"), ("x_l", "output", "m"), ("v", "output", "m/s")],
+        plant,
+    )
+    return _ssd(
+        case,
+        drive + _lugre(case, dist),
+        [("drive", "v", "friction", "v"), ("drive", "x_l", "friction", "x"), ("friction", "F", "drive", "F")],
+    )
 
 
 def nominal_ssd(case: Case, x0: float, dist: Path | None = None) -> str:
+    """The nominal system of a Rig1D case: Rig1D (actuator = 1, driven by
+    the data's x_act_in) with LuGre (or Dahl for a Dahl case)."""
     dist = dist or ROOT / "dist"
     r, p = case.rig, case.nominal
-
-    def real(name, value):
-        return f'<ssv:Parameter name="{name}"><ssv:Real value="{value!r}"/></ssv:Parameter>'
-
-    rig = "".join(
-        real(n, v) for n, v in [("m", r["m"]), ("c", r["c"]), ("k", r["k"]), ("x0", x0), ("v_a", 0.0)]
+    rig_parameters = "".join(
+        _real(n, v) for n, v in [("m", r["m"]), ("c", r["c"]), ("k", r["k"]), ("x0", x0), ("v_a", 0.0)]
     ) + '<ssv:Parameter name="actuator"><ssv:Integer value="1"/></ssv:Parameter>'
-    fr = "".join(real(n, p[n]) for n in ["Fc", "Fs", "vs", "sigma0", "sigma1", "sigma2"])
-    friction_fmu, x_connector, x_connection = (
-        dist / "LuGre.fmu",
-        '<ssd:Connector name="x" kind="input"><ssc:Real unit="m"/></ssd:Connector>',
-        '<ssd:Connection startElement="rig" startConnector="x" endElement="friction" endConnector="x"/>',
+    rig = _component(
+        "rig",
+        dist / "Rig1D.fmu",
+        [("F", "input", "N"), ("x_act_in", "input", "m"), ("v", "output", "m/s"), ("x", "output", "m")],
+        rig_parameters,
     )
+    connections = [("rig", "v", "friction", "v"), ("friction", "F", "rig", "F")]
     if case.kind in DAHL_KINDS:
-        fr = real("sigma", p["sigma0"]) + real("Fc", p["Fc"]) + real("alpha", 1.0)
-        friction_fmu, x_connector, x_connection = dist / "Dahl.fmu", "", ""
-    return f"""<?xml version="1.0" encoding="UTF-8"?>
-<ssd:SystemStructureDescription version="1.0" name="{case.name}"
-    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
-    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
-    xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues">
-  <ssd:System name="{case.name}">
-    <ssd:Elements>
-      <ssd:Component name="rig" source="{dist / 'Rig1D.fmu'}" type="application/x-fmu-sharedlibrary">
-        <ssd:Connectors>
-          <ssd:Connector name="F" kind="input"><ssc:Real unit="N"/></ssd:Connector>
-          <ssd:Connector name="x_act_in" kind="input"><ssc:Real unit="m"/></ssd:Connector>
-          <ssd:Connector name="v" kind="output"><ssc:Real unit="m/s"/></ssd:Connector>
-          <ssd:Connector name="x" kind="output"><ssc:Real unit="m"/></ssd:Connector>
-        </ssd:Connectors>
-        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
-          <ssv:ParameterSet version="1.0" name="rig"><ssv:Parameters>{rig}</ssv:Parameters></ssv:ParameterSet>
-        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
-      </ssd:Component>
-      <ssd:Component name="friction" source="{friction_fmu}" type="application/x-fmu-sharedlibrary">
-        <ssd:Connectors>
-          <ssd:Connector name="v" kind="input"><ssc:Real unit="m/s"/></ssd:Connector>
-          {x_connector}
-          <ssd:Connector name="F" kind="output"><ssc:Real unit="N"/></ssd:Connector>
-        </ssd:Connectors>
-        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
-          <ssv:ParameterSet version="1.0" name="friction"><ssv:Parameters>{fr}</ssv:Parameters></ssv:ParameterSet>
-        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>
-      </ssd:Component>
-    </ssd:Elements>
-    <ssd:Connections>
-      <ssd:Connection startElement="rig" startConnector="v" endElement="friction" endConnector="v"/>
-      {x_connection}
-      <ssd:Connection startElement="friction" startConnector="F" endElement="rig" endConnector="F"/>
-    </ssd:Connections>
-  </ssd:System>
-  <ssd:DefaultExperiment startTime="0" stopTime="{case.duration}">
-    <ssd:Annotations>
-      <ssc:Annotation type="org.friction-fmu.fricsim">
-        <fricsim:Simulation xmlns:fricsim="urn:friction-fmu:fricsim:1" stepSize="1e-3" master="newton"/>
-      </ssc:Annotation>
-    </ssd:Annotations>
-  </ssd:DefaultExperiment>
-</ssd:SystemStructureDescription>
-"""
+        friction = _component(
+            "friction",
+            dist / "Dahl.fmu",
+            [("v", "input", "m/s"), ("F", "output", "N")],
+            _real("sigma", p["sigma0"]) + _real("Fc", p["Fc"]) + _real("alpha", 1.0),
+        )
+    else:
+        friction = _lugre(case, dist)
+        connections.append(("rig", "x", "friction", "x"))
+    return _ssd(case, rig + friction, connections)

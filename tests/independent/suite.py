@@ -12,9 +12,9 @@ DATA.csv --out DIR`), and scored from its report.json:
 - a report was written.
 
 Usage: python3 tests/independent/suite.py [--quick] [--out DIR]
-       [--seeds N] [--jobs N]
-Writes DIR/suite.json and DIR/suite.md (the table of BENCHMARKS.md,
-"Independent hidden-effect suite").
+       [--seeds N] [--jobs N] [--update BENCHMARKS.md]
+Writes DIR/suite.json and DIR/suite.md; with --update, the table between
+the "independent-suite" markers of BENCHMARKS.md.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import subprocess
 import sys
 import time
@@ -232,6 +233,7 @@ def main() -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=cases.ROOT / "out" / "independent-suite")
     ap.add_argument("--only", default="", help="comma list of kinds")
+    ap.add_argument("--update", type=Path, help="rewrite the table between the markers of this file")
     ap.add_argument("--diagnose-arg", action="append", default=[], help="passed on to fricsim diagnose (repeat)")
     args = ap.parse_args()
     todo = grid(args.seeds, args.quick)
@@ -247,8 +249,31 @@ def main() -> int:
         print(r["case"], r.get("found"), r.get("size", {}).get("relative_error"), r.get("final_rms", 0) / max(r.get("given_rms", 1), 1e-300), file=sys.stderr)
     summary = summarise(rows)
     (args.out / "suite.json").write_text(json.dumps({"summary": summary, "cases": rows}, indent=1))
-    (args.out / "suite.md").write_text(table(rows, summary))
-    print(table(rows, summary))
+    text = table(rows, summary)
+    (args.out / "suite.md").write_text(text)
+    print(text)
+    if args.update:
+        import platform
+
+        cpu = "unknown CPU"
+        try:
+            for line in open("/proc/cpuinfo"):
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+        except OSError:
+            pass
+        seconds = sum(r.get("diagnose_seconds", 0) for r in rows)
+        head = (
+            f"Generated {time.strftime('%Y-%m-%d')} by `python3 tests/independent/suite.py --seeds {args.seeds}"
+            f"{' --quick' if args.quick else ''}` on {cpu}, {os.cpu_count()} cores, {platform.system().lower()} "
+            f"{platform.machine()}, {args.jobs} cases at a time; diagnose took {seconds:.0f} s for {len(rows)} cases.\n\n"
+        )
+        begin, end = "<!-- independent-suite: begin", "<!-- independent-suite: end -->"
+        doc = args.update.read_text()
+        i, j = doc.index(begin), doc.index(end)
+        i = doc.index("\n", i) + 1
+        args.update.write_text(doc[:i] + head + text + doc[j:])
     return 0
 
 

@@ -162,12 +162,9 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             String::new()
         }
     );
-    for (label, q) in std::iter::once((&d.data, &d.data_quality.data)).chain(
-        d.data_quality
-            .heldout
-            .as_ref()
-            .map(|q| (&d.heldout, q)),
-    ) {
+    for (label, q) in std::iter::once((&d.data, &d.data_quality.data))
+        .chain(d.data_quality.heldout.as_ref().map(|q| (&d.heldout, q)))
+    {
         if q.total() > 0 {
             eprintln!(
                 "warning: {label}: {} spikes, {} dropouts, {} gaps, {} saturated columns; {} samples left out (report.md lists them)",

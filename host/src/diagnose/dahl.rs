@@ -15,7 +15,10 @@ use std::path::{Path, PathBuf};
 /// there): rewrite `file` in place to use `LuGre.fmu` instead (`lugre`, or
 /// the `LuGre.fmu` beside the Dahl FMU), and return what was done, for the
 /// report. `None` when there is nothing to move.
-pub fn move_to_lugre(file: &mut SystemFile, lugre: Option<&Path>) -> Result<Option<String>, String> {
+pub fn move_to_lugre(
+    file: &mut SystemFile,
+    lugre: Option<&Path>,
+) -> Result<Option<String>, String> {
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
     let model = |i: usize| system.components[i].fmu.description().model_name.clone();
     let n = system.components.len();
@@ -36,9 +39,8 @@ pub fn move_to_lugre(file: &mut SystemFile, lugre: Option<&Path>) -> Result<Opti
     };
     let name = system.components[i].name.clone();
     let fmu = system.components[i].fmu.clone();
-    let mut value = |v: &str| {
-        super::problem::read_value(&mut system.components[i].instance, &fmu, v)
-    };
+    let mut value =
+        |v: &str| super::problem::read_value(&mut system.components[i].instance, &fmu, v);
     let (sigma, fc, alpha) = (value("sigma")?, value("Fc")?, value("alpha")?);
     let def = file
         .components
@@ -58,8 +60,9 @@ pub fn move_to_lugre(file: &mut SystemFile, lugre: Option<&Path>) -> Result<Opti
     }
     def.source_text = path.display().to_string();
     def.source = path.clone();
-    file.parameters
-        .retain(|p| !(p.component == name && ["sigma", "alpha", "Fc"].contains(&p.variable.as_str())));
+    file.parameters.retain(|p| {
+        !(p.component == name && ["sigma", "alpha", "Fc"].contains(&p.variable.as_str()))
+    });
     for (variable, x) in [
         ("Fc", fc),
         ("Fs", fc),
@@ -78,7 +81,9 @@ pub fn move_to_lugre(file: &mut SystemFile, lugre: Option<&Path>) -> Result<Opti
     let shape = if alpha == 1.0 {
         "which is Dahl's law exactly (alpha = 1)".to_string()
     } else {
-        format!("whose presliding curve is Dahl's with alpha = 1, not the nominal's alpha = {alpha}")
+        format!(
+            "whose presliding curve is Dahl's with alpha = 1, not the nominal's alpha = {alpha}"
+        )
     };
     Ok(Some(format!(
         "the nominal friction `{name}` is a Dahl FMU (sigma = {sigma} N/m, Fc = {fc} N); the effects it cannot express are added by moving it to LuGre ({}) with Dahl's levels as the start: Fc = {fc} N, Fs = Fc, sigma0 = sigma, sigma1 = sigma2 = 0, {shape}",

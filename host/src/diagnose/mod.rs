@@ -2,7 +2,7 @@
 //! physical effect is missing, the model with it added and refitted, and
 //! the error on data the fit did not see.
 //!
-//! The workflow (README "Diagnosing a model against measurements"):
+//! The workflow (docs/diagnose.md):
 //! 1. co-simulate the nominal system with the measured inputs and compare
 //!    it with the measured channels ([`sim::co_simulate`]); estimate the
 //!    friction force the data imply ([`problem`]);
@@ -43,7 +43,10 @@ use model::{Effect, FrictionModel};
 use problem::{FrictionData, Measured, Setup};
 use rayon::prelude::*;
 use serde::Serialize;
-use sim::{co_simulate, co_simulate_robust, co_simulate_with, system_parameters, ChannelResiduals, FrictionSim};
+use sim::{
+    co_simulate, co_simulate_robust, co_simulate_with, system_parameters, ChannelResiduals,
+    FrictionSim,
+};
 use std::path::Path;
 use std::time::Instant;
 
@@ -462,7 +465,10 @@ pub fn truth_rms(
         file,
         &mut system,
         step_of(file, &measured),
-        &diagnosis_master(&file.settings.master_or_default(), options.master.as_deref()),
+        &diagnosis_master(
+            &file.settings.master_or_default(),
+            options.master.as_deref(),
+        ),
     )?;
     let params = system_parameters(file, &setup, model);
     let r = co_simulate(&mut system, &params, &setup, &truth)?;
@@ -505,13 +511,17 @@ pub fn diagnose(
         None => None,
     };
     let step = step_of(file, &train);
-    let master = diagnosis_master(&file.settings.master_or_default(), options.master.as_deref());
+    let master = diagnosis_master(
+        &file.settings.master_or_default(),
+        options.master.as_deref(),
+    );
     let setup = Setup::new(file, &mut system, step, &master)?;
     // the force the data imply, or (any other plant, no measured force)
     // the law's states along the nominal co-simulation, and every fit by
     // output error
     let output_error_only = setup.force_estimable(&train).err();
-    let friction_data = |system: &mut crate::system::System, data: &Measured| match &output_error_only {
+    let friction_data = |system: &mut crate::system::System, data: &Measured| {
+        match &output_error_only {
         None => setup.friction_data(system, data, options.smooth),
         Some(why) => setup.friction_data_simulated(file, system, data, why).map_err(|e| {
             format!(
@@ -519,6 +529,7 @@ pub fn diagnose(
                 data.label
             )
         }),
+    }
     };
     let d_train = friction_data(&mut system, &train)?;
     let d_held = match &heldout_file {
@@ -600,62 +611,35 @@ pub fn diagnose(
     let scales = channel_scales(&train);
 
     let context = setup.context(&d_train, options.position_knots);
-    // one model per fold, each co-simulated on the held-out data and
-    // scored on its fold's samples: merged, every scored sample comes from
-    // a model that was not fitted on it
-    let score = |system: &mut crate::system::System,
-                 models: &[FrictionModel]|
+    // `models` (one per fold) co-simulated on the held-out data and scored
+    // on its fold's samples: merged, every scored sample comes from a model
+    // that was not fitted on it. `step`: None for the system's step with
+    // the fallbacks of [`co_simulate_robust`], or a finer step without
+    // them (for the co-simulation's own step error and for the check that
+    // an improvement survives a finer step)
+    let score_with = |system: &mut crate::system::System,
+                      models: &[FrictionModel],
+                      step: Option<f64>|
      -> Result<Scored, String> {
         let mut merged: Option<ChannelResiduals> = None;
         let mut picked = Vec::new();
         let mut notes = Vec::new();
         for (fold, model) in folds.iter().zip(models) {
             let params = system_parameters(file, &setup, model);
-            let (r, note) = co_simulate_robust(system, &params, &setup, held.data)?;
-            notes.extend(note);
-            let mine = (fold.held)(&r);
-            match &mut merged {
-                None => merged = Some(r),
-                Some(m) => {
-                    if m.samples != r.samples {
-                        return Err("the folds' co-simulations compared different samples".into());
-                    }
-                    for &k in &mine {
-                        for c in 0..m.residuals.len() {
-                            m.simulated[c][k] = r.simulated[c][k];
-                            m.residuals[c][k] = r.residuals[c][k];
-                        }
-                    }
+            let r = match step {
+                None => {
+                    let (r, note) = co_simulate_robust(system, &params, &setup, held.data)?;
+                    notes.extend(note);
+                    r
                 }
-            }
-            picked.extend(mine);
-        }
-        let residuals = merged.ok_or("no fold to score")?;
-        picked.sort_unstable();
-        let q_all = residuals.squared(&scales);
-        let q: Vec<f64> = picked.iter().map(|&k| q_all[k]).collect();
-        Ok(Scored {
-            residuals,
-            picked,
-            q,
-            fallback: (!notes.is_empty()).then(|| notes.join("; ")),
-        })
-    };
-    // `models` co-simulated at a finer step than the system's (no
-    // fallback) and scored like [`score`]: for the co-simulation's own step
-    // error and for the check that an improvement survives a finer step
-    let scored_at_step = |system: &mut crate::system::System,
-                          models: &[FrictionModel],
-                          step: f64|
-     -> Result<Scored, String> {
-        let mut merged: Option<ChannelResiduals> = None;
-        let mut picked = Vec::new();
-        for (fold, model) in folds.iter().zip(models) {
-            let params = system_parameters(file, &setup, model);
-            let r = co_simulate_with(system, &params, held.data, &setup.master, step)?;
-            if let Some(e) = &r.incomplete {
-                return Err(e.clone());
-            }
+                Some(h) => {
+                    let r = co_simulate_with(system, &params, held.data, &setup.master, h)?;
+                    if let Some(e) = &r.incomplete {
+                        return Err(e.clone());
+                    }
+                    r
+                }
+            };
             let mine = (fold.held)(&r);
             let m = merged.get_or_insert_with(|| r.clone());
             if m.samples != r.samples {
@@ -677,41 +661,49 @@ pub fn diagnose(
             residuals,
             picked,
             q,
-            fallback: None,
+            fallback: (!notes.is_empty()).then(|| notes.join("; ")),
         })
     };
+    let score = |system: &mut crate::system::System, models: &[FrictionModel]| {
+        score_with(system, models, None)
+    };
+    let scored_at_step =
+        |system: &mut crate::system::System, models: &[FrictionModel], step: f64| {
+            score_with(system, models, Some(step))
+        };
     let fine_step = setup.step / FINE_STEP_DIVISOR;
     // the co-simulation's step error of `models` scored as `scored`
-    let step_error_of = |system: &mut crate::system::System,
-                         models: &[FrictionModel],
-                         scored: &Scored|
-     -> f64 {
-        scored_at_step(system, models, fine_step)
-            .map_or(0.0, |fine| step_error_floor(scored, &fine, &scales))
-    };
+    let step_error_of =
+        |system: &mut crate::system::System, models: &[FrictionModel], scored: &Scored| -> f64 {
+            scored_at_step(system, models, fine_step)
+                .map_or(0.0, |fine| step_error_floor(scored, &fine, &scales))
+        };
 
     // refine a model on the output error of the training samples `pick`
     // ([`fit::polish`])
     // the normalised output residuals of `m` on the training samples `pick`
     let train_residuals = |m: &FrictionModel, pick: &Picker| -> Option<nalgebra::DVector<f64>> {
-            // a system of its own (an FMU instance stays on its thread)
-            let mut system = file.build(0.0).ok()?;
-            let params = system_parameters(file, &setup, m);
-            let (r, _) = co_simulate_robust(&mut system, &params, &setup, &train).ok()?;
-            let picked = pick(&r);
-            let channels = scales.len();
-            let norm = ((picked.len() * channels) as f64).sqrt();
-            Some(nalgebra::DVector::from_iterator(
-                picked.len() * channels,
-                picked.iter().flat_map(|&s| {
-                    let (r, scales) = (&r, &scales);
-                    (0..channels).map(move |c| r.residuals[c][s] / scales[c] / norm)
-                }),
-            ))
+        // a system of its own (an FMU instance stays on its thread)
+        let mut system = file.build(0.0).ok()?;
+        let params = system_parameters(file, &setup, m);
+        let (r, _) = co_simulate_robust(&mut system, &params, &setup, &train).ok()?;
+        let picked = pick(&r);
+        let channels = scales.len();
+        let norm = ((picked.len() * channels) as f64).sqrt();
+        Some(nalgebra::DVector::from_iterator(
+            picked.len() * channels,
+            picked.iter().flat_map(|&s| {
+                let (r, scales) = (&r, &scales);
+                (0..channels).map(move |c| r.residuals[c][s] / scales[c] / norm)
+            }),
+        ))
     };
     let polish = |model: &FrictionModel, pick: &Picker| -> fit::Fitted {
         let mut residual = |models: &[FrictionModel]| -> Vec<Option<nalgebra::DVector<f64>>> {
-            models.par_iter().map(|m| train_residuals(m, pick)).collect()
+            models
+                .par_iter()
+                .map(|m| train_residuals(m, pick))
+                .collect()
         };
         let budget = POLISH_ITERATIONS * (model.free().len() + 1) + 1;
         fit::polish(model, &mut residual, budget)
@@ -748,7 +740,8 @@ pub fn diagnose(
     // output error alone ([`fit_output_error`])
     // (`also`: one more start per fold, the force fit's result when there
     // is one)
-    let fit_folds_output_error = |starts: &(dyn Fn(&FrictionModel) -> Vec<FrictionModel> + Sync),
+    let fit_folds_output_error = |starts: &(dyn Fn(&FrictionModel) -> Vec<FrictionModel>
+                                        + Sync),
                                   base: &[FrictionModel],
                                   also: &[FrictionModel]|
      -> (Vec<FrictionModel>, f64, usize) {
@@ -764,7 +757,11 @@ pub fn diagnose(
             .collect();
         let rms = fitted.iter().map(|f| f.rms).sum::<f64>() / fitted.len() as f64;
         let evaluations = fitted.iter().map(|f| f.evaluations).sum();
-        (fitted.into_iter().map(|f| f.model).collect(), rms, evaluations)
+        (
+            fitted.into_iter().map(|f| f.model).collect(),
+            rms,
+            evaluations,
+        )
     };
     // fit `starts` (per fold: built from that fold's model) on each fold
     let fit_folds = |starts: &(dyn Fn(&FrictionModel) -> Vec<FrictionModel> + Sync),
@@ -795,9 +792,8 @@ pub fn diagnose(
 
     // by output error when the force cannot show the addition (presliding)
     // or is not estimated at all (another plant), else on the force
-    let by_output_error = |added: &[Effect]| {
-        output_error_only.is_some() || added.contains(&Effect::Presliding)
-    };
+    let by_output_error =
+        |added: &[Effect]| output_error_only.is_some() || added.contains(&Effect::Presliding);
     let fit_folds_any = |starts: &(dyn Fn(&FrictionModel) -> Vec<FrictionModel> + Sync),
                          base: &[FrictionModel],
                          added: &[Effect]|
@@ -830,7 +826,10 @@ pub fn diagnose(
     let mut sim = FrictionSim::new(&setup.friction_fmu)?;
     let nominal_folds = vec![setup.nominal.clone(); folds.len()];
     let nominal_scored = score(&mut system, &nominal_folds).map_err(|e| {
-        format!("the nominal system as given cannot be co-simulated on {}: {e}", held.data.label)
+        format!(
+            "the nominal system as given cannot be co-simulated on {}: {e}",
+            held.data.label
+        )
     })?;
     // the groups of the acceptance test: the held-out blocks when there
     // are at least `groups` of them (each block an independent trial,
@@ -853,8 +852,9 @@ pub fn diagnose(
     // the levels refitted (the effects' own parameters stay as given: an
     // effect that is off is a candidate of its own), from the nominal and
     // from levels 20 % lower and 25 % higher
-    let level_starts =
-        |m: &FrictionModel| -> Vec<FrictionModel> { [1.0, 0.8, 1.25].map(|f| m.scaled_levels(f)).to_vec() };
+    let level_starts = |m: &FrictionModel| -> Vec<FrictionModel> {
+        [1.0, 0.8, 1.25].map(|f| m.scaled_levels(f)).to_vec()
+    };
     let (refit_folds, refit_force_rms, _) = fit_folds_any(&level_starts, &nominal_folds, &[])?;
     let refit_model = fit_whole_any(&level_starts(&setup.nominal), &refit_folds, &[])?;
     let refit_scored = score(&mut system, &refit_folds);
@@ -888,7 +888,11 @@ pub fn diagnose(
     };
     let (baseline_model, baseline_folds, baseline_scored) = match refit_scored {
         Ok(scored) if refit.kept => (refit_model.clone(), refit_folds, scored),
-        _ => (setup.nominal.clone(), nominal_folds.clone(), nominal_scored.clone()),
+        _ => (
+            setup.nominal.clone(),
+            nominal_folds.clone(),
+            nominal_scored.clone(),
+        ),
     };
 
     let mut current = baseline_model.clone();
@@ -1141,7 +1145,10 @@ pub fn diagnose(
     let floor = (noise * noise + numerical * numerical).sqrt();
     let final_rms = mean(&current_scored.q).sqrt();
     let mut fallbacks: Vec<String> = Vec::new();
-    for (what, scored) in [("the nominal as given", &nominal_scored), ("the final model", &current_scored)] {
+    for (what, scored) in [
+        ("the nominal as given", &nominal_scored),
+        ("the final model", &current_scored),
+    ] {
         if let Some(note) = &scored.fallback {
             fallbacks.push(format!("{what}: {note}"));
         }
@@ -1366,7 +1373,10 @@ pub fn nested_test(before: &Scored, after: &Scored, scales: &[f64], group: &[usi
             before.q[i] - after.q[i] + change
         })
         .collect();
-    (gain, grouped_signed_rank_test(&f, &group[..n.min(group.len())]))
+    (
+        gain,
+        grouped_signed_rank_test(&f, &group[..n.min(group.len())]),
+    )
 }
 
 /// The means of `d` over its groups (`group[i]` labels `d[i]`; a group is
@@ -1435,8 +1445,8 @@ pub fn grouped_signed_rank_test(d: &[f64], group: &[usize]) -> f64 {
     }
     let nf = n as f64;
     let mean_w = nf * (nf + 1.0) / 4.0;
-    let var_w =
-        nf * (nf + 1.0) * (2.0 * nf + 1.0) / 24.0 - ties.iter().map(|t| t * t * t - t).sum::<f64>() / 48.0;
+    let var_w = nf * (nf + 1.0) * (2.0 * nf + 1.0) / 24.0
+        - ties.iter().map(|t| t * t * t - t).sum::<f64>() / 48.0;
     if var_w <= 0.0 {
         return 1.0;
     }
@@ -1709,7 +1719,11 @@ mod tests {
     fn signed_ranks_see_an_improvement_concentrated_in_a_few_groups() {
         let mut d = vec![0.0; 30];
         for (i, x) in d.iter_mut().enumerate() {
-            *x = if i % 3 == 0 { 100.0 * (1.0 + i as f64) } else { 1e-3 * (1.0 + (i % 5) as f64) };
+            *x = if i % 3 == 0 {
+                100.0 * (1.0 + i as f64)
+            } else {
+                1e-3 * (1.0 + (i % 5) as f64)
+            };
         }
         d[7] = -1e-3;
         let group: Vec<usize> = (0..30).collect();

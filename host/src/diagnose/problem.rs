@@ -498,24 +498,7 @@ impl Setup {
         smooth: f64,
     ) -> Result<FrictionData, String> {
         let f = &self.friction_name;
-        let port_source = |var: &str| -> Option<String> {
-            let vr = self.friction_fmu.variable(var).ok()?.value_reference;
-            system
-                .connections
-                .iter()
-                .find(|c| c.to == (self.friction, vr))
-                .map(|c| {
-                    let from = &system.components[c.from.0];
-                    let name = from
-                        .fmu
-                        .description()
-                        .variables
-                        .iter()
-                        .find(|v| v.value_reference == c.from.1 && v.causality == Causality::Output)
-                        .map_or("?".to_string(), |v| v.name.clone());
-                    format!("{}.{}", from.name, name)
-                })
-        };
+        let port_source = |var: &str| self.input_source(system, var);
         let time = &data.time;
         let n = time.len();
         // intervals of positive length

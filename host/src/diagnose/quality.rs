@@ -243,9 +243,8 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
     }
 
     // dropouts: every column repeated, after steady change, then a jump
-    let same = |a: usize, b: usize, cols: &[(String, Vec<f64>)]| {
-        cols.iter().all(|(_, y)| y[a] == y[b])
-    };
+    let same =
+        |a: usize, b: usize, cols: &[(String, Vec<f64>)]| cols.iter().all(|(_, y)| y[a] == y[b]);
     let mut k = 1;
     while k < n {
         if !(time[k] > time[k - 1] && same(k, k - 1, columns)) {
@@ -319,9 +318,8 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                 // a spike of height S at k makes the second differences
                 // (S, −2S, S) at k−1, k, k+1; a kink (a clipped or
                 // triangular signal) makes one alone, and is not a spike
-                let flanked = |j: usize| {
-                    d2[j] * d2[k] < 0.0 && d2[j].abs() >= SPIKE_FLANK * d2[k].abs()
-                };
+                let flanked =
+                    |j: usize| d2[j] * d2[k] < 0.0 && d2[j].abs() >= SPIKE_FLANK * d2[k].abs();
                 if d2[k].abs() > SPIKE_FACTOR * scale
                     && d2[k].abs() >= d2[k - 1].abs()
                     && d2[k].abs() >= d2[k + 1].abs()
@@ -343,7 +341,8 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                     value: y[k],
                     samples: 1,
                 });
-                let u = (time[k] - time[k - 1]) / (time[k + 1] - time[k - 1]).max(f64::MIN_POSITIVE);
+                let u =
+                    (time[k] - time[k - 1]) / (time[k + 1] - time[k - 1]).max(f64::MIN_POSITIVE);
                 y[k] = y[k - 1] + u * (y[k + 1] - y[k - 1]);
                 q.excluded[k] = true;
             }

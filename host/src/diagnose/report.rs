@@ -144,9 +144,12 @@ pub fn markdown(d: &Diagnosis) -> String {
             super::UNEXPLAINED_FACTOR
         );
     }
-    for (what, q) in std::iter::once(("data", &d.data_quality.data))
-        .chain(d.data_quality.heldout.as_ref().map(|q| ("held-out data", q)))
-    {
+    for (what, q) in std::iter::once(("data", &d.data_quality.data)).chain(
+        d.data_quality
+            .heldout
+            .as_ref()
+            .map(|q| ("held-out data", q)),
+    ) {
         if q.total() == 0 {
             continue;
         }

@@ -198,11 +198,12 @@ pub fn co_simulate_robust(
     });
     let mut failures = Vec::new();
     for (master, step) in &tries {
-        let outcome = co_simulate_with(system, parameters, data, master, *step)
-            .and_then(|r| match &r.incomplete {
+        let outcome = co_simulate_with(system, parameters, data, master, *step).and_then(|r| {
+            match &r.incomplete {
                 Some(e) => Err(format!("stopped early: {e}")),
                 None => Ok(r),
-            });
+            }
+        });
         match outcome {
             Ok(r) => {
                 let note = (!failures.is_empty()).then(|| {
@@ -254,10 +255,7 @@ pub fn co_simulate_with(
     let mut samples = Vec::new();
     for (k, &t) in data.time.iter().enumerate() {
         let repeated = (k > 0 && data.time[k - 1] == t) || data.quality.excluded[k];
-        let reached = run
-            .time
-            .last()
-            .is_some_and(|&last| t <= last + 1e-9 * step);
+        let reached = run.time.last().is_some_and(|&last| t <= last + 1e-9 * step);
         if !repeated && reached {
             samples.push(k);
         }
