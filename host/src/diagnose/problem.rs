@@ -406,10 +406,28 @@ impl Setup {
         why: &str,
     ) -> Result<FrictionData, String> {
         let params = super::sim::system_parameters(file, self, &self.nominal);
-        let run = super::sim::run_on(system, &params, data, &self.master, self.step)?;
-        if let Some(e) = &run.error {
-            return Err(format!("the nominal system stopped early: {e}"));
+        // tried as every co-simulation of the diagnosis is
+        let mut failures = Vec::new();
+        let mut completed = None;
+        for (master, step) in super::sim::fallback_tries(self) {
+            match super::sim::run_on(system, &params, data, &master, step) {
+                Ok(run) if run.error.is_none() => {
+                    completed = Some(run);
+                    break;
+                }
+                Ok(run) => failures.push(format!(
+                    "{master} at {step} s: stopped early: {}",
+                    run.error.unwrap_or_default()
+                )),
+                Err(e) => failures.push(format!("{master} at {step} s: {e}")),
+            }
         }
+        let run = completed.ok_or_else(|| {
+            format!(
+                "the nominal system as given cannot be co-simulated: no co-simulation completed ({})",
+                failures.join("; ")
+            )
+        })?;
         let f = &self.friction_name;
         let series = |port: &str| -> Option<Vec<f64>> {
             let col = run.columns.iter().position(|c| c == port)?;

@@ -182,22 +182,8 @@ pub fn co_simulate_robust(
     setup: &Setup,
     data: &Measured,
 ) -> Result<(ChannelResiduals, Option<String>), String> {
-    let h = setup.step;
-    let mut tries: Vec<(String, f64)> = vec![
-        (setup.master.clone(), h),
-        (setup.master.clone(), h / 4.0),
-        ("adaptive".into(), h),
-        ("newton".into(), h / 4.0),
-        ("gauss-seidel".into(), h / 4.0),
-    ];
-    let mut seen = Vec::new();
-    tries.retain(|t| {
-        let new = !seen.contains(t);
-        seen.push(t.clone());
-        new
-    });
     let mut failures = Vec::new();
-    for (master, step) in &tries {
+    for (master, step) in &fallback_tries(setup) {
         let outcome = co_simulate_with(system, parameters, data, master, *step).and_then(|r| {
             match &r.incomplete {
                 Some(e) => Err(format!("stopped early: {e}")),
@@ -241,6 +227,26 @@ pub fn run_on(
     let mut master = by_name(master)?;
     simulate_with(system, master.as_mut(), start, step, stop, &mut inputs)
         .map_err(|e| format!("co-simulation: {e}"))
+}
+
+/// The (master, step) pairs a co-simulation is tried with, in order
+/// ([`co_simulate_robust`]).
+pub fn fallback_tries(setup: &Setup) -> Vec<(String, f64)> {
+    let h = setup.step;
+    let mut tries: Vec<(String, f64)> = vec![
+        (setup.master.clone(), h),
+        (setup.master.clone(), h / 4.0),
+        ("adaptive".into(), h),
+        ("newton".into(), h / 4.0),
+        ("gauss-seidel".into(), h / 4.0),
+    ];
+    let mut seen = Vec::new();
+    tries.retain(|t| {
+        let new = !seen.contains(t);
+        seen.push(t.clone());
+        new
+    });
+    tries
 }
 
 /// [`co_simulate`] with a given master and macro step.
