@@ -25,7 +25,13 @@ const SIGMA2: f64 = 2.0;
 
 /// BeltOscillator + LuGre (σ2 given; the rig failing with `fault` at step
 /// `fault_step` when that is not 0), Gauss–Seidel at [`H`].
-fn system_file(dir: &Path, name: &str, belt: &Path, sigma2: f64, fault: (i32, usize)) -> SystemFile {
+fn system_file(
+    dir: &Path,
+    name: &str,
+    belt: &Path,
+    sigma2: f64,
+    fault: (i32, usize),
+) -> SystemFile {
     let lugre = common::lugre_fmu();
     let text = format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
@@ -128,8 +134,17 @@ fn a_viscous_term_is_found_by_output_error_on_a_plant_that_is_not_rig1d() {
         (fitted - SIGMA2).abs() <= 0.1 * SIGMA2,
         "sigma2 {fitted} against {SIGMA2}"
     );
-    assert!(d.final_rms < d.nominal_rms, "{} {}", d.final_rms, d.nominal_rms);
-    assert!(!d.unexplained, "final {} floor {}", d.final_rms, d.floor_rms);
+    assert!(
+        d.final_rms < d.nominal_rms,
+        "{} {}",
+        d.final_rms,
+        d.nominal_rms
+    );
+    assert!(
+        !d.unexplained,
+        "final {} floor {}",
+        d.final_rms, d.floor_rms
+    );
 }
 
 #[test]

@@ -195,7 +195,7 @@ def summarise(rows: list[dict]) -> dict:
     return {
         "named_right_10pct": share(effect(0.1), "named_right"),
         "named_right_5pct": share(effect(0.05), "named_right"),
-        "clean_null_no_claim": share(lambda r: r["kind"] == "none" and not r["bad_data"], "named_right"),
+        "clean_null_no_claim": share(lambda r: cases.EXPECTED[r["kind"]] is None and not r["bad_data"], "named_right"),
         "bad_data_no_claim": share(lambda r: r["bad_data"], "named_right"),
         "bad_data_found": share(lambda r: r["bad_data"], "bad_samples_found"),
         "never_worse": share(lambda r: True, "never_worse"),
@@ -211,14 +211,14 @@ def table(rows: list[dict], summary: dict) -> str:
     ]
     for r in rows:
         if not r["report"]:
-            lines.append(f"| {r['case']} | {r['drive']['drive']} | NO REPORT: {r['stderr'].strip().splitlines()[-1] if r['stderr'].strip() else ''} | | | | |")
+            lines.append(f"| {r['case']} | {r['drive'].get('drive', r['drive'].get('plant'))} | NO REPORT: {r['stderr'].strip().splitlines()[-1] if r['stderr'].strip() else ''} | | | | |")
             continue
         size = r.get("size")
         s = f"{size['quantity']}: {size['truth']:.4g} → {size['fitted']:.4g} ({100 * size['relative_error']:.1f} %)" if size else ""
         found = ", ".join(r["found"]) or "none"
         mark = "" if r["named_right"] else " ✗"
         lines.append(
-            f"| {r['case']} | {r['drive']['drive']} | {found}{mark} | {s} | {r['final_rms'] / r['given_rms']:.3f} | {r['floor_rms']:.2e} | {r['diagnose_seconds']:.1f} |"
+            f"| {r['case']} | {r['drive'].get('drive', r['drive'].get('plant'))} | {found}{mark} | {s} | {r['final_rms'] / r['given_rms']:.3f} | {r['floor_rms']:.2e} | {r['diagnose_seconds']:.1f} |"
         )
     lines.append("")
     for k, (a, b) in summary.items():
@@ -234,6 +234,11 @@ def main() -> int:
     ap.add_argument("--out", type=Path, default=cases.ROOT / "out" / "independent-suite")
     ap.add_argument("--only", default="", help="comma list of kinds")
     ap.add_argument("--update", type=Path, help="rewrite the table between the markers of this file")
+    ap.add_argument(
+        "--render-only",
+        action="store_true",
+        help="run nothing: render OUT/suite.json (of an earlier run with the same --seeds) again",
+    )
     ap.add_argument("--diagnose-arg", action="append", default=[], help="passed on to fricsim diagnose (repeat)")
     args = ap.parse_args()
     todo = grid(args.seeds, args.quick)
@@ -241,10 +246,13 @@ def main() -> int:
         keep = args.only.split(",")
         todo = [(c, b) for c, b in todo if c.kind in keep]
     args.out.mkdir(parents=True, exist_ok=True)
-    with ThreadPoolExecutor(args.jobs) as pool:
-        rows = list(
-            pool.map(lambda cb: run_case(cb[0], args.out / "cases", cb[1], tuple(args.diagnose_arg)), todo)
-        )
+    if args.render_only:
+        rows = json.loads((args.out / "suite.json").read_text())["cases"]
+    else:
+        with ThreadPoolExecutor(args.jobs) as pool:
+            rows = list(
+                pool.map(lambda cb: run_case(cb[0], args.out / "cases", cb[1], tuple(args.diagnose_arg)), todo)
+            )
     for r in rows:
         print(r["case"], r.get("found"), r.get("size", {}).get("relative_error"), r.get("final_rms", 0) / max(r.get("given_rms", 1), 1e-300), file=sys.stderr)
     summary = summarise(rows)

@@ -988,7 +988,10 @@ pub fn diagnose(
                     .models
                     .iter()
                     .zip(current_folds.iter())
-                    .find_map(|(m, c)| unresolved_presliding(&t.added, c, m, &context));
+                    .find_map(|(m, c)| {
+                        unresolved_presliding(&t.added, c, m, &context)
+                            .or_else(|| unmoved_resize(&t.added, c, m, &context))
+                    });
                 round.push(CandidateScore {
                     name: label(&t.added),
                     heldout_rms,
@@ -1537,6 +1540,36 @@ fn unresolved_presliding(
         )
     })
 }
+
+/// A re-sized effect (one the current model has already) whose own
+/// parameters all moved by less than [`RESIZE_MIN_CHANGE`] (relative) in
+/// the candidate: its gain came from the levels refitted with it, not from
+/// the effect, which is then not named. Returns the reason.
+fn unmoved_resize(
+    added: &[Effect],
+    current: &FrictionModel,
+    candidate: &FrictionModel,
+    context: &model::Context,
+) -> Option<String> {
+    let [effect] = added else { return None };
+    if !current.shows(*effect, context) || !current.can_try(*effect) {
+        return None;
+    }
+    let before = current.effect_parameters(*effect);
+    let after = candidate.effect_parameters(*effect);
+    let moved = before.iter().zip(&after).any(|((_, a, _), (_, b, _))| {
+        (b - a).abs() > RESIZE_MIN_CHANGE * a.abs().max(f64::MIN_POSITIVE)
+    });
+    (!moved).then(|| {
+        format!(
+            "re-sized by less than {:.0} %: the gain comes from the levels refitted with it",
+            100.0 * RESIZE_MIN_CHANGE
+        )
+    })
+}
+
+/// See [`unmoved_resize`].
+pub const RESIZE_MIN_CHANGE: f64 = 0.05;
 
 /// A presliding distance below this many position resolutions is not
 /// resolved by the data ([`unresolved_presliding`]).
