@@ -903,16 +903,26 @@ pub fn diagnose(
     let (mut polish_seconds, mut polish_runs) = (0.0, 0);
     // the starts of an addition to a model: its first effects added
     // neutrally, the last from a grid
+    // (and the same from the levels as given, when the baseline's refit
+    // moved them: a refit of the levels alone may have bent them to mimic
+    // the missing effect, a raised Fc standing in for a viscous term)
+    let nominal_levels = setup.nominal.clone();
     let addition_starts = |added: &[Effect]| {
         let added = added.to_vec();
         let context = &context;
+        let nominal_levels = &nominal_levels;
         move |m: &FrictionModel| -> Vec<FrictionModel> {
             let (last, first) = added.split_last().expect("an addition has an effect");
             let mut base = m.clone();
             for &e in first {
                 base = base.with(e, context);
             }
-            starts(&base, *last, context)
+            let mut s = starts(&base, *last, context);
+            let given = base.with_levels_of(nominal_levels);
+            if given != base {
+                s.extend(starts(&given, *last, context));
+            }
+            s
         }
     };
     // one round: fit and score each addition (one effect, or two at once)
@@ -1025,6 +1035,20 @@ pub fn diagnose(
                 })
                 .collect();
             passing.sort_by(|&i, &j| round[i].heldout_rms.total_cmp(&round[j].heldout_rms));
+            // candidates whose held-out mean squares differ by less than the
+            // co-simulation's step error squared cannot be told apart by
+            // these data: the one with the fewest free parameters goes first
+            // (a wide Stribeck curve re-sized can mimic a viscous term)
+            if let Some(&first) = passing.first() {
+                let best_ms = round[first].heldout_rms.powi(2);
+                let free = |k: usize| tried[k].models.first().map_or(0, |m| m.free().len());
+                let (mut close, far): (Vec<usize>, Vec<usize>) = passing.iter().partition(|&&k| {
+                    round[k].heldout_rms.powi(2) - best_ms <= current_step_error.powi(2)
+                });
+                close.sort_by_key(|&k| free(k));
+                close.extend(far);
+                passing = close;
+            }
             let mut current_fine: Option<Result<Scored, String>> = None;
             let mut chosen = None;
             for k in passing {

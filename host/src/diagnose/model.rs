@@ -250,6 +250,21 @@ impl FrictionModel {
         m
     }
 
+    /// The model with the levels (Fc, Fs, Fc_neg, Fs_neg, the position
+    /// scales when both have the same table) of `other`.
+    pub fn with_levels_of(&self, other: &FrictionModel) -> FrictionModel {
+        let mut m = self.clone();
+        m.fc = other.fc;
+        m.fs = other.fs;
+        m.fc_neg = other.fc_neg;
+        m.fs_neg = other.fs_neg;
+        if m.x_table == other.x_table {
+            m.scale_pos = other.scale_pos.clone();
+            m.scale_neg = other.scale_neg.clone();
+        }
+        m
+    }
+
     /// σ0 set to `sigma0`, with σ1 scaled by √(σ0 ratio): the damping ratio
     /// of the bristle-mass oscillation held (module doc).
     pub fn with_sigma0(&self, sigma0: f64) -> FrictionModel {
