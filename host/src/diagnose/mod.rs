@@ -1019,10 +1019,6 @@ pub fn diagnose(
                     failure,
                 });
             }
-            let best = (0..round.len())
-                .min_by(|&i, &j| round[i].heldout_rms.total_cmp(&round[j].heldout_rms));
-            rounds.push(round.clone());
-            let _ = best;
             // the passing candidates, best first; the first whose gain
             // survives a finer co-simulation step is accepted (a gain that
             // only offsets the co-simulation's step error does not)
@@ -1054,27 +1050,24 @@ pub fn diagnose(
             for k in passing {
                 let fine_current = current_fine
                     .get_or_insert_with(|| scored_at_step(&mut system, &current_folds, fine_step));
+                // without a finer co-simulation the check cannot be made
                 let survives = match fine_current {
-                    Err(_) => Ok(()), // no finer co-simulation: the check cannot be made
+                    Err(_) => true,
                     Ok(cur) => match scored_at_step(&mut system, &tried[k].models, fine_step) {
-                        Err(_) => Ok(()),
+                        Err(_) => true,
                         Ok(cand) => {
                             let (gain, p) = nested_test(cur, &cand, &scales, &group);
                             round[k].fine_step = Some((gain, p));
-                            if p < threshold && gain >= options.min_gain {
-                                Ok(())
-                            } else {
-                                Err(())
-                            }
+                            p < threshold && gain >= options.min_gain
                         }
                     },
                 };
-                if survives.is_ok() {
+                if survives {
                     chosen = Some(k);
                     break;
                 }
             }
-            rounds.last_mut().expect("pushed above").clone_from(&round);
+            rounds.push(round.clone());
             if let Some(k) = chosen {
                 accepted = Some((tried, k, round[k].p_value, threshold));
                 break;
