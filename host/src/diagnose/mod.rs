@@ -859,11 +859,11 @@ pub fn diagnose(
     let refit_model = fit_whole_any(&level_starts(&setup.nominal), &refit_folds, &[])?;
     let refit_scored = score(&mut system, &refit_folds);
     let refit_threshold = options.alpha;
+    let nominal_step_error = step_error_of(&mut system, &nominal_folds, &nominal_scored);
     let refit = match &refit_scored {
         Ok(scored) => {
             let (gain, p_value) = nested_test(&nominal_scored, scored, &scales, &group);
             let heldout_rms = mean(&scored.q).sqrt();
-            let nominal_step_error = step_error_of(&mut system, &nominal_folds, &nominal_scored);
             RefitDecision {
                 heldout_rms,
                 gain,
@@ -895,6 +895,15 @@ pub fn diagnose(
         ),
     };
 
+    // the current model's step error: what a quarter step changes in its
+    // outputs (a drop of the error smaller than that may compensate the
+    // co-simulation's step error, not physics); recomputed when the
+    // current model changes
+    let mut current_step_error = if refit.kept {
+        step_error_of(&mut system, &baseline_folds, &baseline_scored)
+    } else {
+        nominal_step_error
+    };
     let mut current = baseline_model.clone();
     let mut current_folds = baseline_folds;
     let mut current_scored = baseline_scored.clone();
@@ -975,10 +984,6 @@ pub fn diagnose(
         }
         let mut accepted = None;
         let mut singles_tried = Vec::new();
-        // what halving the step changes in the current model's outputs: a
-        // drop of the error smaller than that may be a compensation of the
-        // co-simulation's step error, not physics
-        let current_step_error = step_error_of(&mut system, &current_folds, &current_scored);
         for additions in [singles, pairs] {
             if additions.is_empty() {
                 continue;
@@ -1155,13 +1160,14 @@ pub fn diagnose(
             current_folds = fold_models;
             current_scored = scored;
         }
+        current_step_error = step_error_of(&mut system, &current_folds, &current_scored);
     }
 
     // the remaining discrepancy against what no model can go below: the
     // measurement noise (and quantisation) and the co-simulation's own
     // step error
     let noise = noise_floor(held.data, &current_scored, &scales);
-    let numerical = step_error_of(&mut system, &current_folds, &current_scored);
+    let numerical = current_step_error;
     let floor = (noise * noise + numerical * numerical).sqrt();
     let final_rms = mean(&current_scored.q).sqrt();
     let mut fallbacks: Vec<String> = Vec::new();
