@@ -27,7 +27,16 @@
  *
  * canGetAndSetFMUstate: an FMUstate is a copy of the instance's State struct
  * (phase, values, state, time), allocated with the importer's allocator; it
- * belongs to the instance that took it. canSerializeFMUstate is false. */
+ * belongs to the instance that took it. canSerializeFMUstate is false.
+ *
+ * providesDirectionalDerivative: right after fmi2DoStep, before an input is
+ * set again, the derivative of the outputs with respect to u and F is the
+ * step's sensitivity to the input held over that step (what a strongly
+ * coupled master's Newton iteration needs); otherwise it is the direct
+ * feedthrough, da/dF = -1/m_l and nothing else. The plant is linear, so the
+ * sensitivity is exact: RK4 is affine in the state and the inputs, and its
+ * derivative along an input is the same RK4 sub-steps run from a zero state
+ * with that input at 1 and the other at 0. */
 
 #include <math.h>
 #include <stdarg.h>
@@ -115,6 +124,9 @@ typedef struct {
     double y[N_STATES];  /* x_m, x_m', x_l, x_l' */
     double time;         /* communication point reached */
     double last_successful_time;
+    double last_h;       /* the last step's size ... */
+    double last_n;       /* ... and RK4 sub-steps */
+    int stepped;         /* no input set since that step */
 } State;
 
 typedef struct {
@@ -414,7 +426,10 @@ EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], si
             return fmi2Error;
         }
     }
-    for (size_t i = 0; i < n; i++) b->s.real[vr[i]] = value[i];
+    for (size_t i = 0; i < n; i++) {
+        b->s.real[vr[i]] = value[i];
+        if (vr[i] == VR_U || vr[i] == VR_F) b->s.stepped = 0;
+    }
     return fmi2OK;
 }
 
@@ -545,16 +560,65 @@ EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[
     (void)s;
     return unsupported(c, "fmi2DeSerializeFMUstate", "canSerializeFMUstate=\"false\"");
 }
-EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
-                                               const fmi2ValueReference z[], size_t nz, const fmi2Real dz[],
-                                               fmi2Real du[]) {
-    (void)u;
-    (void)nu;
-    (void)z;
-    (void)nz;
-    (void)dz;
-    (void)du;
-    return unsupported(c, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative=\"false\"");
+/* d(outputs)/d(input `known`): the last step's sensitivity when `stepped`,
+ * else the direct feedthrough. `d` is indexed by value reference. */
+static void output_sensitivity(const TwoMass *b, fmi2ValueReference known, double d[N_REAL]) {
+    memset(d, 0, sizeof(double) * N_REAL);
+    const double *p = b->s.real;
+    if (!b->s.stepped) {
+        if (known == VR_F) d[VR_A] = -1.0 / p[VR_M_L];
+        return;
+    }
+    double unit[N_REAL], y[N_STATES] = {0}, dy[N_STATES];
+    memcpy(unit, p, sizeof unit);
+    unit[VR_U] = known == VR_U;
+    unit[VR_F] = known == VR_F;
+    integrate(unit, y, b->s.last_h, b->s.last_n);
+    derivatives(unit, y, dy); /* a = x_l'' along the sensitivity */
+    d[VR_X_M] = y[XM];
+    d[VR_X_L] = y[XL];
+    d[VR_V] = y[VL];
+    d[VR_A] = dy[VL];
+}
+
+EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference unknown[],
+                                               size_t n_unknown, const fmi2ValueReference known[],
+                                               size_t n_known, const fmi2Real d_known[],
+                                               fmi2Real d_unknown[]) {
+    TwoMass *b = c;
+    ENTER("fmi2GetDirectionalDerivative", INITIALIZATION | STEP_COMPLETE);
+    if ((n_unknown > 0 && (unknown == NULL || d_unknown == NULL)) ||
+        (n_known > 0 && (known == NULL || d_known == NULL))) {
+        logf_(b, fmi2Error, "logStatusError",
+              "fmi2GetDirectionalDerivative: NULL array for %zu unknowns and %zu knowns", n_unknown, n_known);
+        return fmi2Error;
+    }
+    for (size_t i = 0; i < n_unknown; i++)
+        if (!IS_OUTPUT(unknown[i])) {
+            logf_(b, fmi2Error, "logStatusError",
+                  "fmi2GetDirectionalDerivative: unknown value reference %u is not an output (x_m, x_l, v, a)",
+                  unknown[i]);
+            return fmi2Error;
+        }
+    for (size_t j = 0; j < n_known; j++) {
+        if (known[j] != VR_U && known[j] != VR_F) {
+            logf_(b, fmi2Error, "logStatusError",
+                  "fmi2GetDirectionalDerivative: known value reference %u is not an input (u, F)", known[j]);
+            return fmi2Error;
+        }
+        if (!isfinite(d_known[j])) {
+            logf_(b, fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative: seed %g of %s is not finite",
+                  d_known[j], REAL_NAMES[known[j]]);
+            return fmi2Error;
+        }
+    }
+    for (size_t i = 0; i < n_unknown; i++) d_unknown[i] = 0.0;
+    for (size_t j = 0; j < n_known; j++) {
+        double d[N_REAL];
+        output_sensitivity(b, known[j], d);
+        for (size_t i = 0; i < n_unknown; i++) d_unknown[i] += d[unknown[i]] * d_known[j];
+    }
+    return fmi2OK;
 }
 EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                                               const fmi2Integer order[], const fmi2Real value[]) {
@@ -614,6 +678,9 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
     memcpy(b->s.y, y, sizeof y);
     b->s.time = t + h;
     b->s.last_successful_time = b->s.time;
+    b->s.last_h = h;
+    b->s.last_n = n;
+    b->s.stepped = 1;
     return fmi2OK;
 }
 

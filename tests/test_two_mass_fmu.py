@@ -1,0 +1,145 @@
+"""TwoMassDrive.fmu (host/tests/c/two_mass_drive, a hand-written C FMU that is
+not made by this project's exporter), imported with FMPy: its directional
+derivatives are the step sensitivity right after fmi2DoStep and the direct
+feedthrough otherwise, checked against finite differences taken outside the
+FMU by state rollback; bad arguments are refused with a logged reason; and
+fricsim's Newton master takes its Jacobian from them."""
+
+from __future__ import annotations
+
+import ctypes
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, calloc, free
+from fmpy.logging import addLoggerProxy
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "independent"))
+import cases  # noqa: E402
+import two_mass_fmu  # noqa: E402
+
+OUTPUTS = ["x_m", "x_l", "v", "a"]
+INPUTS = ["u", "F"]
+
+
+@pytest.fixture
+def drive(tmp_path):
+    fmu = two_mass_fmu.build(tmp_path)
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    messages = []
+
+    def logger(env, instance, status, category, message):
+        messages.append((status, message.decode()))
+
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(logger)
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    addLoggerProxy(ctypes.byref(callbacks))
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=str(tmp_path / "unzipped")),
+                      modelIdentifier="TwoMassDrive", instanceName="drive")
+    slave.instantiate(callbacks=callbacks)
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    yield slave, vr, messages, md
+    slave.terminate()
+    slave.freeInstance()
+
+
+def jacobian(slave, vr):
+    return {(o, i): slave.getDirectionalDerivative([vr[o]], [vr[i]], [1.0])[0] for o in OUTPUTS for i in INPUTS}
+
+
+def stepped_outputs(slave, vr, state, t, h, inputs):
+    slave.setFMUstate(state)
+    slave.setReal([vr[n] for n in INPUTS], [inputs[n] for n in INPUTS])
+    slave.doStep(t, h)
+    return dict(zip(OUTPUTS, slave.getReal([vr[o] for o in OUTPUTS])))
+
+
+def test_directional_derivatives_are_the_step_sensitivity_after_a_step(drive):
+    slave, vr, _, md = drive
+    assert md.coSimulation.providesDirectionalDerivative
+    h, t = 1e-3, 0.0
+    inputs = {"u": 3.0, "F": -1.0}
+    # a few steps first, so the state is not at rest
+    for _ in range(20):
+        slave.setReal([vr[n] for n in INPUTS], [inputs[n] for n in INPUTS])
+        slave.doStep(t, h)
+        t += h
+    state = slave.getFMUstate()
+    stepped_outputs(slave, vr, state, t, h, inputs)
+    analytic = jacobian(slave, vr)
+    # central differences outside the FMU, by rolling back the state; the
+    # plant is linear, so they are exact up to rounding
+    delta = 1e-2
+    for i in INPUTS:
+        up = stepped_outputs(slave, vr, state, t, h, {**inputs, i: inputs[i] + delta})
+        down = stepped_outputs(slave, vr, state, t, h, {**inputs, i: inputs[i] - delta})
+        for o in OUTPUTS:
+            fd = (up[o] - down[o]) / (2 * delta)
+            scale = max(abs(fd), 1e-9)
+            assert abs(analytic[(o, i)] - fd) <= 1e-7 * scale, (o, i, analytic[(o, i)], fd)
+    # F acts on the load: over one step it moves the load more than the motor
+    assert analytic[("x_l", "F")] < 0 and abs(analytic[("x_l", "F")]) > abs(analytic[("x_m", "F")])
+    # the plant is linear: the same from another state and other inputs
+    stepped_outputs(slave, vr, state, t, h, {"u": -5.0, "F": 2.0})
+    assert jacobian(slave, vr) == pytest.approx(analytic, rel=1e-12, abs=1e-300)
+    slave.freeFMUstate(state)
+
+
+def test_directional_derivatives_are_the_feedthrough_once_an_input_is_set(drive):
+    slave, vr, _, _ = drive
+    m_l = slave.getReal([vr["m_l"]])[0]
+    before = jacobian(slave, vr)
+    slave.setReal([vr["F"]], [0.5])
+    slave.doStep(0.0, 1e-3)
+    after_step = jacobian(slave, vr)
+    slave.setReal([vr["F"]], [0.7])
+    after_set = jacobian(slave, vr)
+    for j in (before, after_set):
+        assert j[("a", "F")] == pytest.approx(-1.0 / m_l, rel=1e-15)
+        assert all(v == 0.0 for k, v in j.items() if k != ("a", "F"))
+    assert after_step[("x_l", "F")] != 0.0
+    # seeds add linearly: (u, F) with seeds (2, 3)
+    slave.doStep(1e-3, 1e-3)
+    combined = slave.getDirectionalDerivative([vr["x_l"]], [vr["u"], vr["F"]], [2.0, 3.0])[0]
+    single = jacobian(slave, vr)
+    assert combined == pytest.approx(2 * single[("x_l", "u")] + 3 * single[("x_l", "F")], rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "unknown,known,seed,message",
+    [
+        ("m_l", "F", 1.0, "is not an output"),
+        ("x_l", "m_l", 1.0, "is not an input"),
+        ("x_l", "F", float("nan"), "is not finite"),
+    ],
+)
+def test_bad_directional_derivative_calls_are_refused_with_a_reason(drive, unknown, known, seed, message):
+    slave, vr, messages, _ = drive
+    with pytest.raises(Exception):
+        slave.getDirectionalDerivative([vr[unknown]], [vr[known]], [seed])
+    assert any(message in m for s, m in messages if s >= 3), messages
+
+
+def test_fricsims_newton_master_uses_them(tmp_path):
+    case = cases.draw("two_mass_viscous", 0.1, 7)
+    data, ssd = cases.make(case, tmp_path)
+    rows = data.read_text().splitlines()
+    inputs = tmp_path / "u.csv"
+    inputs.write_text("\n".join(",".join(r.split(",")[:2]) for r in rows[:2001]) + "\n")
+    fricsim = cases.ROOT / "target" / "release" / "fricsim"
+    run = subprocess.run(
+        [str(fricsim), "run", str(ssd), "--input", str(inputs), "--master", "newton", "--out", str(tmp_path / "r.csv")],
+        capture_output=True, text=True,
+    )
+    assert run.returncode == 0, run.stderr
+    report = run.stdout + run.stderr
+    assert "Jacobian of drive: directional derivatives (checked against finite differences)" in report, report
