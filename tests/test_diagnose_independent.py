@@ -30,6 +30,8 @@ def check(row: dict) -> None:
     )
     if "size" in row:
         assert row["size"]["relative_error"] <= 0.10, f"{row['case']}: {row['size']}"
+    if "localised_right" in row:
+        assert row["localised_right"], f"{row['case']}: its change put on {row['localised_as']}"
     if not row["found"]:
         assert not row["unexplained"], f"{row['case']}: nothing named, yet 'unexplained'"
 

@@ -37,6 +37,11 @@ fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
         d.final_rms,
         d.baseline_rms
     );
+    // its change is put on the direction of motion, which explains all of it
+    let explained = &d.effects[0].where_.explained_by;
+    assert_eq!(explained[0].state, "direction", "{explained:?}");
+    assert!(explained[0].share > 0.95, "{explained:?}");
+    assert!(explained[1].share < 0.5, "{explained:?}");
     // the outputs: a report that parses, plots and a refitted system
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("emps");

@@ -63,6 +63,17 @@ def corrupt(data: Path) -> list[tuple[int, str]]:
     return marks
 
 
+#: The state whose bins should explain each effect's change (the report's
+#: "Where: the change depends on ...", report.json effects[].where.explained_by).
+EXPLAINING_STATE = {
+    "viscous": "velocity",
+    "stribeck": "velocity",
+    "direction_dependent": "direction",
+    "position_dependent": "position",
+    "presliding": "displacement_since_reversal",
+}
+
+
 def effect_size(case: cases.Case, report: dict, x: list[float], v: list[float]) -> tuple[str, float, float] | None:
     """(quantity, truth, fitted) of the hidden effect, when it was named;
     `x`, `v` the true position and velocity along the experiment (the
@@ -160,6 +171,11 @@ def run_case(case: cases.Case, work: Path, bad_data: bool = False, extra: tuple 
     tx = cases.read_columns(work / f"{case.name}.truth.csv")["true_x"]
     v = [(b - a) / cases.SAMPLE for a, b in zip(tx, tx[1:])]
     size = effect_size(case, report, tx[1:], v)
+    named = [e for e in report["effects"] if e["name"] == expected]
+    if named:
+        explained = named[-1]["where"]["explained_by"]
+        row["localised_as"] = explained[0]["state"] if explained else "none"
+        row["localised_right"] = row["localised_as"] == EXPLAINING_STATE[expected]
     if size:
         q, truth, fitted = size
         row["size"] = {"quantity": q, "truth": truth, "fitted": fitted,
@@ -205,12 +221,13 @@ def summarise(rows: list[dict]) -> dict:
         "never_worse": share(lambda r: True, "never_worse"),
         "reports_written": share(lambda r: True, "report"),
         "sized_within_10pct": (sum(1 for r in sized if r["size"]["relative_error"] <= 0.1), len(sized)),
+        "localised_right": share(lambda r: "localised_right" in r, "localised_right"),
     }
 
 
 def table(rows: list[dict], summary: dict) -> str:
     lines = [
-        "| case | drive | found | size: truth → fitted (error) | final / given RMS | floor | time (s) |",
+        "| case | drive | found (the state its change depends on) | size: truth → fitted (error) | final / given RMS | floor | time (s) |",
         "| --- | --- | --- | --- | --- | --- | --- |",
     ]
     for r in rows:
@@ -220,6 +237,8 @@ def table(rows: list[dict], summary: dict) -> str:
         size = r.get("size")
         s = f"{size['quantity']}: {size['truth']:.4g} → {size['fitted']:.4g} ({100 * size['relative_error']:.1f} %)" if size else ""
         found = ", ".join(r["found"]) or "none"
+        if "localised_as" in r:
+            found += f" (on {r['localised_as'].replace('_', ' ')})"
         mark = "" if r["named_right"] else " ✗"
         lines.append(
             f"| {r['case']} | {r['drive'].get('drive', r['drive'].get('plant'))} | {found}{mark} | {s} | {r['final_rms'] / r['given_rms']:.3f} | {r['floor_rms']:.2e} | {r['diagnose_seconds']:.1f} |"

@@ -3,7 +3,14 @@
 //! states a friction effect depends on: velocity band, direction of
 //! motion, position along the travel, time since the last reversal and
 //! normal load.
+//!
+//! Which state an accepted effect depends on ([`attribute`]): the change
+//! the effect makes to the steady sliding force, averaged within the bins
+//! of one state; the share of the change those bin means keep is that
+//! state's share. A direction dependence keeps all of it when averaged per
+//! direction and about half when averaged per speed band or position.
 
+use super::model::FrictionModel;
 use super::problem::FrictionData;
 use serde::Serialize;
 
@@ -42,6 +49,178 @@ pub struct Where {
     pub share_of_samples: f64,
     /// The same for every bin.
     pub bins: Vec<(String, String, f64, f64)>,
+    /// Which state the effect's change depends on, best first
+    /// ([`attribute`]); `state`/`bin` above are the strongest bin of the
+    /// first of these.
+    pub explained_by: Vec<Attribution>,
+}
+
+/// How much of an effect's improvement each state explains.
+#[derive(Clone, Debug, Serialize)]
+pub struct Attribution {
+    /// `velocity` (its magnitude), `direction`, `position`,
+    /// `displacement_since_reversal`, `normal_load`.
+    pub state: &'static str,
+    /// Share of the variation of the effect's change over the held-out
+    /// data that the bin means of this state explain: 1 when the change
+    /// depends on this state alone.
+    pub share: f64,
+}
+
+/// Bins per continuous state in [`attribute`].
+const ATTRIBUTION_BINS: usize = 20;
+
+/// Metres moved since the velocity last changed sign, per interval (the
+/// pre-sliding displacement the bristles see).
+pub fn displacement_since_reversal(d: &FrictionData) -> Vec<f64> {
+    let mut out = Vec::with_capacity(d.t.len());
+    let mut origin = d.x.first().copied().unwrap_or(0.0);
+    let mut sign = 0.0;
+    for j in 0..d.t.len() {
+        let s = d.v[j].signum();
+        if d.v[j] != 0.0 && s != sign {
+            if sign != 0.0 {
+                origin = d.x[j];
+            }
+            sign = s;
+        }
+        out.push((d.x[j] - origin).abs());
+    }
+    out
+}
+
+/// Bin index of each of `values` among `bins` quantile bins (ties share a bin).
+fn quantile_bins(values: &[f64], bins: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
+    let mut out = vec![0; values.len()];
+    let n = values.len().max(1);
+    for (rank, &i) in order.iter().enumerate() {
+        out[i] = rank * bins / n;
+    }
+    // equal values in one bin: the bin of the first of them
+    for w in 1..order.len() {
+        if values[order[w]] == values[order[w - 1]] {
+            out[order[w]] = out[order[w - 1]];
+        }
+    }
+    out
+}
+
+/// Bin index of each of `values` among `bins` equal bins over their range.
+fn equal_bins(values: &[f64], bins: usize) -> Vec<usize> {
+    let (lo, hi) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    values
+        .iter()
+        .map(|&x| {
+            if hi > lo {
+                (((x - lo) / (hi - lo) * bins as f64) as usize).min(bins - 1)
+            } else {
+                0
+            }
+        })
+        .collect()
+}
+
+/// Which state an effect's change depends on, best first. The change is
+/// the model's steady sliding force (`sliding_level`, [`FrictionModel`]:
+/// levels, Stribeck curve, viscous term) from `before` to `after` at each
+/// held-out interval; each state's bins explain the share
+/// 1 − Σ(change − its bin's mean)² / Σ(change − mean)² of its variation
+/// (1: the change is a function of that state alone; a change that is the
+/// same everywhere depends on none). When an effect leaves the steady
+/// force nearly the same along the data (its spread under a tenth of the
+/// spread of the law's force change along the data, `before_f` to
+/// `after_f`: presliding, which changes only the transition after a
+/// reversal), the law's force change itself, `(after_f − before_f)·sign(v)`,
+/// is binned instead. Only the intervals
+/// where the contact slides count (the held-out `intervals` are those).
+pub fn attribute(
+    d: &FrictionData,
+    intervals: &[usize],
+    (before, before_f): (&FrictionModel, &[f64]),
+    (after, after_f): (&FrictionModel, &[f64]),
+) -> Vec<Attribution> {
+    let sign = |j: usize| if d.v[j] < 0.0 { -1.0 } else { 1.0 };
+    let steady: Vec<f64> = intervals
+        .iter()
+        .map(|&j| {
+            after.sliding_level(d.v[j], d.x[j], d.fn_[j])
+                - before.sliding_level(d.v[j], d.x[j], d.fn_[j])
+        })
+        .collect();
+    let dynamic: Vec<f64> = intervals
+        .iter()
+        .map(|&j| (after_f[j] - before_f[j]) * sign(j))
+        .collect();
+    // the spread about the mean: a change that is the same everywhere
+    // (a level moved alone) depends on no state
+    let spread = |c: &[f64]| {
+        let m = c.iter().sum::<f64>() / c.len().max(1) as f64;
+        c.iter().map(|x| (x - m).powi(2)).sum::<f64>()
+    };
+    let change = if spread(&steady) >= 0.01 * spread(&dynamic) {
+        steady
+    } else {
+        dynamic
+    };
+    let total = spread(&change);
+    let square: f64 = change.iter().map(|x| x * x).sum();
+    // (a spread at the rounding level of the change is none)
+    if total.is_nan() || total <= 1e-12 * square {
+        return Vec::new();
+    }
+    let pick = |f: &dyn Fn(usize) -> f64| -> Vec<f64> { intervals.iter().map(|&j| f(j)).collect() };
+    let since = displacement_since_reversal(d);
+    let mut states: Vec<(&'static str, Vec<usize>)> = vec![
+        (
+            "velocity",
+            quantile_bins(&pick(&|j| d.v[j].abs()), ATTRIBUTION_BINS),
+        ),
+        (
+            "direction",
+            intervals
+                .iter()
+                .map(|&j| usize::from(d.v[j] < 0.0))
+                .collect(),
+        ),
+        ("position", equal_bins(&pick(&|j| d.x[j]), ATTRIBUTION_BINS)),
+        (
+            "displacement_since_reversal",
+            quantile_bins(&pick(&|j| since[j]), ATTRIBUTION_BINS),
+        ),
+    ];
+    if d.normal_force_measured {
+        states.push((
+            "normal_load",
+            quantile_bins(&pick(&|j| d.fn_[j]), ATTRIBUTION_BINS),
+        ));
+    }
+    let mut out: Vec<Attribution> = states
+        .into_iter()
+        .map(|(state, bin)| {
+            let bins = bin.iter().max().map_or(0, |b| b + 1);
+            let (mut sum, mut count) = (vec![0.0; bins], vec![0usize; bins]);
+            for (k, &b) in bin.iter().enumerate() {
+                sum[b] += change[k];
+                count[b] += 1;
+            }
+            let mean: Vec<f64> = (0..bins).map(|b| sum[b] / count[b].max(1) as f64).collect();
+            let left: f64 = (0..change.len())
+                .map(|k| (change[k] - mean[bin[k]]).powi(2))
+                .sum();
+            Attribution {
+                state,
+                share: 1.0 - left / total,
+            }
+        })
+        .collect();
+    out.sort_by(|a, b| b.share.total_cmp(&a.share));
+    out
 }
 
 /// Seconds since the velocity last changed sign, per interval.
@@ -135,6 +314,24 @@ fn bins(d: &FrictionData, intervals: &[usize]) -> Vec<(&'static str, String, Vec
             }
         }
     }
+    // displacement since reversal: quartiles
+    let moved = displacement_since_reversal(d);
+    let mut s: Vec<f64> = intervals.iter().map(|&j| moved[j]).collect();
+    s.sort_by(f64::total_cmp);
+    if let (Some(&first), Some(&last)) = (s.first(), s.last()) {
+        let q = |p: f64| s[((s.len() - 1) as f64 * p) as usize];
+        let edges = [first, q(0.25), q(0.5), q(0.75), last];
+        for k in 0..4 {
+            let (a, b) = (edges[k], edges[k + 1]);
+            if b > a {
+                out.push((
+                    "displacement_since_reversal",
+                    format!("{a:.3e} to {b:.3e} m"),
+                    pick(&|j| moved[j] >= a && (moved[j] < b || (k == 3 && moved[j] <= b))),
+                ));
+            }
+        }
+    }
     if d.normal_force_measured {
         let mut f: Vec<f64> = intervals.iter().map(|&j| d.fn_[j]).collect();
         f.sort_by(f64::total_cmp);
@@ -197,17 +394,21 @@ pub fn localise(d: &FrictionData, intervals: &[usize], model: &[f64]) -> Localis
 }
 
 /// Where the squared friction residual dropped from `before` to `after`:
-/// the bin with the largest ratio of its share of the improvement to its
-/// share of the samples (bins of at least 5 % of the samples).
+/// the state the change depends on ([`attribute`]), and within that
+/// state's bins the one with the largest ratio of its share of the
+/// improvement to its share of the samples (bins of at least 5 % of the
+/// samples; every state's bins when no state explains the change).
 pub fn where_improved(
     d: &FrictionData,
     intervals: &[usize],
-    before: &[f64],
-    after: &[f64],
+    (before_model, before): (&FrictionModel, &[f64]),
+    (after_model, after): (&FrictionModel, &[f64]),
 ) -> Where {
     let gain = |j: usize| (d.f[j] - before[j]).powi(2) - (d.f[j] - after[j]).powi(2);
     let total: f64 = intervals.iter().map(|&j| gain(j)).sum();
     let n = intervals.len().max(1) as f64;
+    let explained_by = attribute(d, intervals, (before_model, before), (after_model, after));
+    let state_of_change = explained_by.first().map(|a| a.state);
     let mut all = Vec::new();
     let mut best: Option<(f64, usize)> = None;
     for (state, label, members) in bins(d, intervals) {
@@ -217,30 +418,168 @@ pub fn where_improved(
         } else {
             0.0
         };
-        if share_samples >= 0.05 {
+        if share_samples >= 0.05 && state_of_change.is_none_or(|s| s == state) {
             let lift = share_gain / share_samples;
             if best.is_none_or(|(b, _)| lift > b) {
                 best = Some((lift, all.len()));
             }
         }
-        all.push((state.to_string(), label, share_gain, share_samples));
+        all.push((state, label, share_gain, share_samples));
     }
     let (state, bin, g, s) = match best {
         Some((_, k)) => all[k].clone(),
-        None => ("none".into(), String::new(), 0.0, 0.0),
+        None => ("none", String::new(), 0.0, 0.0),
     };
     Where {
-        state: match state.as_str() {
-            "velocity" => "velocity",
-            "direction" => "direction",
-            "position" => "position",
-            "time_since_reversal" => "time_since_reversal",
-            "normal_load" => "normal_load",
-            _ => "none",
-        },
+        state,
         bin,
         share_of_improvement: g,
         share_of_samples: s,
-        bins: all,
+        bins: all
+            .into_iter()
+            .map(|(state, label, g, s)| (state.to_string(), label, g, s))
+            .collect(),
+        explained_by,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+
+    /// A minute of a slow sine stroke and a faster one on top, sampled at
+    /// 1 kHz: every speed, both directions and the whole travel.
+    fn data() -> FrictionData {
+        let n = 60_000;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let x: Vec<f64> = t
+            .iter()
+            .map(|&t| 0.05 * (0.6 * t).sin() + 0.01 * (7.3 * t).sin())
+            .collect();
+        let v: Vec<f64> = t
+            .iter()
+            .map(|&t| 0.03 * (0.6 * t).cos() + 0.073 * (7.3 * t).cos())
+            .collect();
+        FrictionData {
+            h: vec![1e-3; n],
+            end: (1..=n).collect(),
+            fn_: vec![1.0; n],
+            f: vec![0.0; n],
+            source: String::new(),
+            position_resolution: None,
+            normal_force_measured: false,
+            trusted: vec![true; n],
+            t,
+            v,
+            x,
+        }
+    }
+
+    fn nominal() -> FrictionModel {
+        FrictionModel::from_values(&BTreeMap::from([
+            ("Fc".to_string(), 2.0),
+            ("Fs".to_string(), 2.0),
+            ("vs".to_string(), 0.01),
+            ("sigma0".to_string(), 1e6),
+            ("sigma1".to_string(), 1e3),
+            ("sigma2".to_string(), 0.0),
+            ("stribeck_exponent".to_string(), 2.0),
+            ("Fc_neg".to_string(), 2.0),
+            ("Fs_neg".to_string(), 2.0),
+            ("direction_dependent".to_string(), 0.0),
+            ("normal_force_form".to_string(), 0.0),
+            ("position_dependent".to_string(), 0.0),
+        ]))
+        .unwrap()
+    }
+
+    /// The law's force along the data: the steady sliding force with the
+    /// sign of v (what a stiff LuGre contact gives while sliding).
+    fn force(d: &FrictionData, m: &FrictionModel) -> Vec<f64> {
+        (0..d.t.len())
+            .map(|j| m.sliding_level(d.v[j], d.x[j], 1.0) * d.v[j].signum())
+            .collect()
+    }
+
+    fn first_state(
+        d: &FrictionData,
+        before: &FrictionModel,
+        after: &FrictionModel,
+    ) -> (&'static str, f64) {
+        let all: Vec<usize> = (0..d.t.len()).collect();
+        let a = attribute(
+            d,
+            &all,
+            (before, &force(d, before)),
+            (after, &force(d, after)),
+        );
+        (a[0].state, a[0].share)
+    }
+
+    #[test]
+    fn each_effect_is_put_on_the_state_it_depends_on() {
+        let d = data();
+        let n = nominal();
+        let mut viscous = n.clone();
+        viscous.sigma2 = 5.0;
+        let mut stribeck = n.clone();
+        stribeck.fs = 2.6;
+        stribeck.fs_neg = 2.6;
+        let mut direction = n.clone();
+        direction.direction_dependent = true;
+        direction.fc_neg = 2.3;
+        direction.fs_neg = 2.3;
+        let mut position = n.clone();
+        position.position_dependent = true;
+        position.x_table = vec![-0.06, -0.02, 0.02, 0.06];
+        position.scale_pos = vec![1.1, 0.9, 1.05, 0.95];
+        position.scale_neg = position.scale_pos.clone();
+        for (after, expected) in [
+            (&viscous, "velocity"),
+            (&stribeck, "velocity"),
+            (&direction, "direction"),
+            (&position, "position"),
+        ] {
+            let (state, share) = first_state(&d, &n, after);
+            assert_eq!(state, expected);
+            assert!(share > 0.9, "{expected}: {share}");
+        }
+    }
+
+    #[test]
+    fn a_change_of_the_transition_alone_goes_to_the_displacement_since_reversal() {
+        let d = data();
+        let n = nominal();
+        let mut stiffer = n.clone();
+        stiffer.sigma0 = 4e6;
+        let all: Vec<usize> = (0..d.t.len()).collect();
+        let since = displacement_since_reversal(&d);
+        let before = force(&d, &n);
+        // the presliding transition: a deficit that decays over 1 mm moved
+        let after: Vec<f64> = (0..d.t.len())
+            .map(|j| before[j] + 0.3 * (-since[j] / 1e-3).exp() * d.v[j].signum())
+            .collect();
+        let a = attribute(&d, &all, (&n, &before), (&stiffer, &after));
+        assert_eq!(a[0].state, "displacement_since_reversal", "{a:?}");
+    }
+
+    #[test]
+    fn a_level_moved_alone_depends_on_no_state() {
+        let d = data();
+        let n = nominal();
+        let mut higher = n.clone();
+        higher.fc = 2.2;
+        higher.fs = 2.2;
+        higher.fc_neg = 2.2;
+        higher.fs_neg = 2.2;
+        let all: Vec<usize> = (0..d.t.len()).collect();
+        let a = attribute(
+            &d,
+            &all,
+            (&n, &force(&d, &n)),
+            (&higher, &force(&d, &higher)),
+        );
+        assert!(a.is_empty(), "{a:?}");
     }
 }

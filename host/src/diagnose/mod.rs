@@ -1147,8 +1147,8 @@ pub fn diagnose(
             let where_ = localise::where_improved(
                 held.friction,
                 &held.intervals,
-                &run_force(&mut sim, &current, held.friction)?,
-                &run_force(&mut sim, &model, held.friction)?,
+                (&current, &run_force(&mut sim, &current, held.friction)?),
+                (&model, &run_force(&mut sim, &model, held.friction)?),
             );
             effects.push(FoundEffect {
                 name: effect,

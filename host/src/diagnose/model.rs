@@ -515,6 +515,25 @@ impl FrictionModel {
         }
     }
 
+    /// The steady sliding force's magnitude at velocity `v`, position `x`
+    /// and normal force `fn_`: LuGre's g(v) + σ2·|v| with its levels for
+    /// that direction and position (docs/models.md, "LuGre"), times `fn_`
+    /// in the normal-force form. What an effect changes in it is the
+    /// effect's signature along the states ([`super::localise::attribute`]).
+    pub fn sliding_level(&self, v: f64, x: f64, fn_: f64) -> f64 {
+        let positive = v >= 0.0;
+        let (fc, fs) = if positive || !self.direction_dependent {
+            (self.fc, self.fs)
+        } else {
+            (self.fc_neg, self.fs_neg)
+        };
+        let ratio = if fc != 0.0 { fs / fc } else { 1.0 };
+        let decay = (-(v.abs() / self.vs.max(1e-300)).powf(self.stribeck_exponent)).exp();
+        let g = self.level(positive, x) * (1.0 + (ratio - 1.0) * decay);
+        let n = if self.normal_force_form { fn_ } else { 1.0 };
+        g * n + self.sigma2 * v.abs()
+    }
+
     /// Coulomb level for direction `positive` at position `x` (per unit Fn
     /// in the normal-force form): Fc or Fc_neg times the table's scale.
     pub fn level(&self, positive: bool, x: f64) -> f64 {

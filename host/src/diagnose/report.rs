@@ -194,14 +194,7 @@ pub fn markdown(d: &Diagnosis) -> String {
             e.p_value,
             e.threshold
         );
-        let _ = writeln!(
-            s,
-            "Where: {} {} holds {:.0} % of the improvement in {:.0} % of the samples.\n",
-            e.where_.state,
-            e.where_.bin,
-            100.0 * e.where_.share_of_improvement,
-            100.0 * e.where_.share_of_samples
-        );
+        let _ = writeln!(s, "{}\n", where_line(&e.where_));
         let _ = writeln!(s, "| parameter | value |\n| --- | --- |");
         for (n, v) in &e.parameters {
             let _ = writeln!(s, "| {n} | {v} |");
@@ -271,6 +264,39 @@ pub fn markdown(d: &Diagnosis) -> String {
         );
     }
     let _ = writeln!(s, "\nPlots: `fit.png` (measured, nominal, final), `residual.png` (friction residual against the states). The refitted system: `refitted.ssp` (`fricsim run refitted.ssp --input <inputs.csv>`).");
+    s
+}
+
+/// The "Where" of an effect in words: the state its change depends on,
+/// how much of the improvement that state explains (and the others), and
+/// its strongest bin.
+pub fn where_line(w: &super::localise::Where) -> String {
+    let words = |state: &str| state.replace('_', " ");
+    let mut s = String::from("Where: ");
+    if let Some((first, rest)) = w.explained_by.split_first() {
+        let _ = write!(
+            s,
+            "the change depends on {}: its bins explain {:.0} % of its variation",
+            words(first.state),
+            100.0 * first.share
+        );
+        if !rest.is_empty() {
+            let others: Vec<String> = rest
+                .iter()
+                .map(|a| format!("{} {:.0} %", words(a.state), 100.0 * a.share))
+                .collect();
+            let _ = write!(s, " ({})", others.join(", "));
+        }
+        s.push_str("; ");
+    }
+    let _ = write!(
+        s,
+        "{} {} holds {:.0} % of the improvement in {:.0} % of the samples.",
+        words(w.state),
+        w.bin,
+        100.0 * w.share_of_improvement,
+        100.0 * w.share_of_samples
+    );
     s
 }
 
