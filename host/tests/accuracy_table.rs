@@ -161,7 +161,7 @@ fn quick_mode_writes_its_table_between_the_markers_and_keeps_the_rest() {
 
     // Run again: the table is replaced, not repeated.
     let output = table(
-        &["--quick", "--masters", "newton", "--cases", "seed000"],
+        &["--quick", "--masters", "newton", "--cases", "piezo-push"],
         &file,
     );
     assert!(output.status.success());
@@ -179,7 +179,7 @@ fn a_file_without_markers_is_refused_and_left_alone() {
     let file = dir.path().join("notes.md");
     std::fs::write(&file, "# Notes\n").unwrap();
     let output = table(
-        &["--quick", "--cases", "seed000", "--masters", "jacobi"],
+        &["--quick", "--cases", "piezo-push", "--masters", "jacobi"],
         &file,
     );
     assert!(!output.status.success());
@@ -309,7 +309,7 @@ fn a_missing_row_table_or_marker_is_named_before_anything_runs() {
     );
     refused(
         &text,
-        &["--steps", "1e-1", "--cases", "seed000"],
+        &["--steps", "1e-1", "--cases", "piezo-push"],
         &["no row for seed 000 piezo push, h = 1e-1 s"],
     );
     refused(

@@ -79,7 +79,7 @@ fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
 #[test]
 fn slider_table_names_position_and_direction_dependence() {
     let r = repo();
-    let file = SystemFile::open(r.join("examples/seed003_breakaway.ssd")).unwrap();
+    let file = SystemFile::open(r.join("examples/slider_breakaway.ssd")).unwrap();
     let d = diagnose(
         &file,
         &r.join("examples/data/slider_breakaway.csv"),

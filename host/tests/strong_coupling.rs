@@ -348,7 +348,7 @@ fn newton_iterates_alike_whatever_the_order_of_the_connections() {
     // the unknowns differently (another pivot order, other roundings),
     // and converge to the same motion within Newton's tolerance.
     let file = fricsim::ssp::SystemFile::open(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed004_dither.ssd"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/planar_dither.ssd"),
     )
     .unwrap();
     let by_component = file.check().unwrap();

@@ -12,7 +12,7 @@ use rig_dynamics::signals::Sinusoid;
 const K: f64 = 116.04e3;
 const V_A: f64 = 8.25e-8;
 
-fn seed000(rig: ComponentSpec) -> SystemSpec {
+fn piezo_push(rig: ComponentSpec) -> SystemSpec {
     SystemSpec {
         components: vec![rig, ComponentSpec::new("bristle", "Bristle")],
         connections: Vec::new(),
@@ -55,7 +55,7 @@ fn level() -> f64 {
 
 #[test]
 fn piezo_push_is_the_root_of_the_force_balance_at_every_output() {
-    let t = run(&seed000(piezo_rig()), 0.05, 30.0);
+    let t = run(&piezo_push(piezo_rig()), 0.05, 30.0);
     assert_eq!(t.columns.last().map(String::as_str), Some("bristle.F"));
     let (x, x_rel, xa) = (col(&t, "rig.x"), col(&t, "rig.x_rel"), col(&t, "rig.x_act"));
     let (v, a, f) = (col(&t, "rig.v"), col(&t, "rig.a"), col(&t, "bristle.F"));
@@ -149,7 +149,7 @@ fn all_bristles_connected_gives_the_closed_form_of_two_springs_in_series() {
 fn a_reversal_holds_the_body_until_the_spring_has_crossed_the_force_drop() {
     // The actuator oscillates: 3e-6 m (beyond sliding, 1.9e-6 m of spring
     // deflection) at 0.02 Hz, so it turns at t = 12.5 s and 37.5 s.
-    let spec = seed000(
+    let spec = piezo_push(
         ComponentSpec::new("rig", "Rig1D")
             .real("m", 0.0)
             .real("c", 0.0)

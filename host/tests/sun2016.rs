@@ -1,6 +1,6 @@
 //! Seed 001 (Sun et al. 2016): the identification trials of the ~1 kg
-//! brass block, run from `examples/seed001_step_force.ssd` (LuGre, force
-//! steps) and `examples/seed001_dahl_velocity.ssd` (Dahl, velocity
+//! brass block, run from `examples/lugre_step_force.ssd` (LuGre, force
+//! steps) and `examples/dahl_velocity.ssd` (Dahl, velocity
 //! control on v = 1e-3·sin(t/k)) through the host.
 //!
 //! MODELS.md "Reference results": a step force below break-away settles at
@@ -11,10 +11,10 @@
 //! x = −(Fs/σ0)·ln(1 − F/Fs) (the tests check these values; the seed's
 //! identification assumed z = x in pre-sliding, eq. 19–21).
 
-mod seed_examples;
-use seed_examples::*;
+mod paper_examples;
+use paper_examples::*;
 
-/// Seed 001's LuGre parameters (examples/lugre_seed001.ssv).
+/// Seed 001's LuGre parameters (examples/lugre_sun2016.ssv).
 const SIGMA0: f64 = 66_967.231;
 const FS: f64 = 2.35;
 const VS: f64 = 1.139_75e-3;
@@ -34,7 +34,7 @@ fn slow_loading_position(f: f64) -> f64 {
 
 #[test]
 fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
-    let example_file = example("seed001_step_force.ssd");
+    let example_file = example("lugre_step_force.ssd");
     assert_eq!(bound(&example_file, "friction.sigma0"), SIGMA0);
     assert_eq!(bound(&example_file, "friction.Fs"), FS);
     assert_eq!(bound(&example_file, "rig.F_step"), 1.0);
@@ -43,7 +43,7 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
     // carries more of the plastic part ∫σ0·|v|·z/g dt than under slow
     // loading; the ratios x/(F/σ0) of the monolithic reference.
     for (force, ratio) in [(0.5, 1.1349), (1.0, 1.4397), (1.5, 2.8333)] {
-        let mut file = example("seed001_step_force.ssd");
+        let mut file = example("lugre_step_force.ssd");
         set_real(&mut file, "rig.F_step", force);
         let run = run_with(&file, &master, h, stop);
         // Settled, not sliding: at rest with the friction equal to the force.
@@ -87,7 +87,7 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
 /// instead: the force rises to `peak` in 4 s (the seed's trials took about
 /// 4 s to reach the set force) and the run ends at the peak.
 fn slowly_loaded(peak: f64) -> fricsim::master::Run {
-    let mut file = example("seed001_step_force.ssd");
+    let mut file = example("lugre_step_force.ssd");
     set_real(&mut file, "rig.F_step", 0.0);
     set_real(&mut file, "rig.drive_amp", peak);
     set_real(&mut file, "rig.drive_freq", 1.0 / 16.0);
@@ -114,7 +114,7 @@ fn slowly_loaded_block_follows_the_pre_sliding_closed_form() {
     // (F/Fs < 2 %), after a step too.
     let x = last(&slowly_loaded(0.02), "rig.x");
     assert!((x * SIGMA0 / 0.02 - 1.0).abs() < 1e-2, "x = {x:e}");
-    let mut file = example("seed001_step_force.ssd");
+    let mut file = example("lugre_step_force.ssd");
     set_real(&mut file, "rig.F_step", 0.02);
     let x = last(&run(&file), "rig.x");
     assert!((x * SIGMA0 / 0.02 - 1.0).abs() < 1e-2, "x = {x:e}");
@@ -139,7 +139,7 @@ fn break_away_at_fs_under_slow_loading_below_it_after_a_step() {
     // away below Fs (above 1.68 N on the reference): 1.5 N holds, 2.0 N
     // slides.
     for (force, slides) in [(1.5, false), (2.0, true)] {
-        let mut file = example("seed001_step_force.ssd");
+        let mut file = example("lugre_step_force.ssd");
         set_real(&mut file, "rig.F_step", force);
         let (h, master, _) = settings(&file);
         let v = last(&run_with(&file, &master, h, 0.5), "rig.v");
@@ -149,7 +149,7 @@ fn break_away_at_fs_under_slow_loading_below_it_after_a_step() {
 
 /// One Dahl trial v_ref = 1e-3·sin(t/k) over one period; returns the run.
 fn dahl_trial(k: f64, h: f64) -> fricsim::master::Run {
-    let mut file = example("seed001_dahl_velocity.ssd");
+    let mut file = example("dahl_velocity.ssd");
     set_real(
         &mut file,
         "rig.ref_freq",
@@ -209,7 +209,7 @@ fn dahl_deviation(run: &fricsim::master::Run, k: f64) -> (f64, (f64, f64), f64) 
 
 #[test]
 fn dahl_velocity_trials_follow_the_closed_form() {
-    let file = example("seed001_dahl_velocity.ssd");
+    let file = example("dahl_velocity.ssd");
     assert_eq!(bound(&file, "friction.sigma"), DAHL_SIGMA);
     assert_eq!(bound(&file, "friction.Fc"), DAHL_FC);
     let h = settings(&file).0;
