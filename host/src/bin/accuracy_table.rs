@@ -93,7 +93,7 @@ const CASES: &[Case] = &[
     },
     Case {
         key: "piezo-push",
-        label: "seed 000 piezo push",
+        label: "piezo push (Appels and Herder)",
         file: "examples/piezo_push.ssd",
     },
 ];
