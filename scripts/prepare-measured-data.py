@@ -40,7 +40,7 @@ import sys
 # EMPS drive gain gtau (N/V), from the EMPS data set's documentation
 # (Janot, Gautier, Brunot 2019; examples/data/README.md).
 GTAU = 35.15065188
-# Seed 003 drive gain (N/V), examples/slider_drift.ssd.
+# Drive gain of Thimmalapura's slider (N/V), examples/slider_drift.ssd.
 DRIVE_GAIN = 3.5
 # Probe speed of the break-away holds (m/s).
 PROBE_SPEED = 1e-4

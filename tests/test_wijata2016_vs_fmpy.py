@@ -1,4 +1,4 @@
-"""`fricsim run` of seed 004's planar oscillator against FMPy.
+"""`fricsim run` of Wijata et al. 2016's planar oscillator against FMPy.
 
 dist/planar_decay.ssp (packed by build-fmu.sh from
 examples/planar_decay.ssd: Rig2D.fmu and Bristle2D.fmu connected

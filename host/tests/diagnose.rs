@@ -72,7 +72,7 @@ fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
     );
 }
 
-/// Seed 003's table of break-away levels (71 rows, one block each): every
+/// Thimmalapura's table of break-away levels (71 rows, one block each): every
 /// row is scored by cross-validation, neither position nor direction alone
 /// improves the held-out error, the two together (one position table per
 /// direction, an interaction) do, significantly, and both are named.

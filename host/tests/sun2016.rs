@@ -1,4 +1,4 @@
-//! Seed 001 (Sun et al. 2016): the identification trials of the ~1 kg
+//! Sun et al. 2016: the identification trials of the ~1 kg
 //! brass block, run from `examples/lugre_step_force.ssd` (LuGre, force
 //! steps) and `examples/dahl_velocity.ssd` (Dahl, velocity
 //! control on v = 1e-3·sin(t/k)) through the host.
@@ -8,17 +8,17 @@
 //! The first holds for LuGre's bristle deflection z, not for the position
 //! x: z lags x by ∫σ0·|v|·z/g(v) dt, so x exceeds F/σ0 by 13–183 % after
 //! a step of 0.5–1.5 N and by 12–59 % under slow loading, where it follows
-//! x = −(Fs/σ0)·ln(1 − F/Fs) (the tests check these values; the seed's
+//! x = −(Fs/σ0)·ln(1 − F/Fs) (the tests check these values; the paper's
 //! identification assumed z = x in pre-sliding, eq. 19–21).
 
 mod paper_examples;
 use paper_examples::*;
 
-/// Seed 001's LuGre parameters (examples/lugre_sun2016.ssv).
+/// Sun et al.'s LuGre parameters (examples/lugre_sun2016.ssv).
 const SIGMA0: f64 = 66_967.231;
 const FS: f64 = 2.35;
 const VS: f64 = 1.139_75e-3;
-/// Seed 001 Table 7 (Dahl).
+/// Sun et al. Table 7 (Dahl).
 const DAHL_FC: f64 = 2.0;
 const DAHL_SIGMA: f64 = 87_750.0;
 
@@ -53,7 +53,7 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
             last(&run, "rig.v")
         );
         assert!((last(&run, "friction.F") / force - 1.0).abs() < 1e-6);
-        // The bristles carry the force: z = F/σ0 (seed eq. 21 for z).
+        // The bristles carry the force: z = F/σ0 (their eq. 21 for z).
         let z = last(&run, "friction.z");
         assert!((z * SIGMA0 / force - 1.0).abs() < 1e-6, "z = {z:e}");
         // The position, against the monolithic reference and at half the
@@ -70,7 +70,7 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
         );
         let x_half = last(&run_with(&file, &master, h / 2.0, stop), "rig.x");
         assert!((x_half / x - 1.0).abs() < 1e-3, "h: {x:e}, h/2: {x_half:e}");
-        // The seed's x = F/σ0 does not hold for x (see the module text).
+        // The paper's x = F/σ0 does not hold for x (see the module text).
         assert!(
             (x_ref * SIGMA0 / force / ratio - 1.0).abs() < 1e-4,
             "reference x/(F/σ0) = {}",
@@ -84,7 +84,7 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
 }
 
 /// The step-force system loaded by a quarter period of a 1/16 Hz sine
-/// instead: the force rises to `peak` in 4 s (the seed's trials took about
+/// instead: the force rises to `peak` in 4 s (the paper's trials took about
 /// 4 s to reach the set force) and the run ends at the peak.
 fn slowly_loaded(peak: f64) -> fricsim::master::Run {
     let mut file = example("lugre_step_force.ssd");
@@ -110,7 +110,7 @@ fn slowly_loaded_block_follows_the_pre_sliding_closed_form() {
             force / SIGMA0
         );
     }
-    // The seed's x = F/σ0 is the small-force limit: within 1 % at 0.02 N
+    // The paper's x = F/σ0 is the small-force limit: within 1 % at 0.02 N
     // (F/Fs < 2 %), after a step too.
     let x = last(&slowly_loaded(0.02), "rig.x");
     assert!((x * SIGMA0 / 0.02 - 1.0).abs() < 1e-2, "x = {x:e}");
@@ -123,7 +123,7 @@ fn slowly_loaded_block_follows_the_pre_sliding_closed_form() {
 #[test]
 fn break_away_at_fs_under_slow_loading_below_it_after_a_step() {
     // Slowly loaded, the block holds at 2.3 N and slides at 2.4 N: the
-    // break-away level is Fs = 2.35 N (the seed measured the block static
+    // break-away level is Fs = 2.35 N (the paper measured the block static
     // within [−2.4, 2.2] N).
     let held = slowly_loaded(2.3);
     assert!(
@@ -216,10 +216,10 @@ fn dahl_velocity_trials_follow_the_closed_form() {
     for k in [1.0, 2.0, 4.0, 6.0] {
         let run = dahl_trial(k, h);
         let (deviation, (xr, fr), tracking) = dahl_deviation(&run, k);
-        // The seed's trials: the block follows the velocity reference (within
+        // The paper's trials: the block follows the velocity reference (within
         // 6 % of its amplitude at k = 1, 4 % at k = 2).
         assert!(tracking < 0.1, "k = {k}: velocity off by {tracking}");
-        // F(x) is the closed form (the seed: within 1 %; here 1e-3 of Fc).
+        // F(x) is the closed form (the paper: within 1 %; here 1e-3 of Fc).
         assert!(
             deviation < 1e-3,
             "k = {k}: |F − closed form| = {deviation}·Fc"

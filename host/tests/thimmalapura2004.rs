@@ -5,7 +5,7 @@
 //! a verbatim copy of the published table), run from `examples/slider_drift.ssd`
 //! through the host.
 //!
-//! The seed's result: under the zero-mean drive the slider drifts toward
+//! The thesis's result: under the zero-mean drive the slider drifts toward
 //! the stable points where the two directional profiles cross (the thesis
 //! names 112 mm and 215 mm, from 10th-order polynomials fitted to its
 //! data). Here the profiles are the measured points themselves,

@@ -1,9 +1,9 @@
-//! Seed 004 (Wijata, Awrejcewicz, Matej, Makowski 2016): the planar
-//! oscillator on two-dimensional bristle friction, as the example system
-//! files `examples/planar_*.ssd` (Rig2D.fmu + Bristle2D.fmu, seed 004's
+//! Wijata, Awrejcewicz, Matej, Makowski 2016: the planar oscillator on
+//! two-dimensional bristle friction, as the example system files
+//! `examples/planar_*.ssd` (Rig2D.fmu + Bristle2D.fmu, the paper's
 //! numerical set from `examples/bristle2d_wijata2016.ssv`) run through the
 //! host, against the behaviours MODELS.md ("Two-dimensional bristle")
-//! says the seed reports, and against closed forms where one exists:
+//! says the paper reports, and against closed forms where one exists:
 //!
 //! 1. planar oscillator: straight-line decay envelopes (R² > 0.99 of a line
 //!    through the successive peaks of |x1| and of |x2|); the start is a
@@ -20,7 +20,7 @@
 //! less than 0.1 % when the macro step is halved (and, for 1, under the
 //! Newton master), and they agree with the monolithic reference
 //! (`fricsim reference`: Rig2D and the 2-D bristle law solved together by
-//! Radau IIA with the stick/slide switches located), on which the seed's
+//! Radau IIA with the stick/slide switches located), on which the paper's
 //! behaviours are checked as well.
 
 mod common;
@@ -31,7 +31,7 @@ use fricsim::ssp::{SystemFile, Value};
 use std::f64::consts::PI;
 use std::process::Command;
 
-/// Seed 004's numbers shared by the examples: m = 1 kg, k = 100 N/m,
+/// Wijata et al.'s numbers shared by the examples: m = 1 kg, k = 100 N/m,
 /// sliding force σ0·z0 = 1 N, peak (stiction) force (1 + a)·σ0·z0 = 1.1 N.
 const M: f64 = 1.0;
 const K: f64 = 100.0;
@@ -214,7 +214,7 @@ fn check_planar(run: &Run) {
             axis + 1,
             t.len()
         );
-        // the seed's claim, and the contrast with the dithered case
+        // the paper's claim, and the contrast with the dithered case
         assert!(linear > 0.99, "x{}: R² of the line {linear}", axis + 1);
         assert!(
             linear > exponential,

@@ -1,4 +1,4 @@
-//! The quasi-static rig (m = 0, c = 0) with the bristle law of seed 000:
+//! The quasi-static rig (m = 0, c = 0) with the bristle law of Appels and Herder:
 //! the reference is the exact root of the force balance at every output
 //! time, the bristle state advanced monotonically from root to root.
 
@@ -8,7 +8,7 @@ use friction_laws::bristle::{Bristle, BristleParams};
 use rig_dynamics::rig1d::{Rig1D, Rig1DInputs, Rig1DParams};
 use rig_dynamics::signals::Sinusoid;
 
-/// Seed 000: k = 116.04e3 N/m, piezo ramp 8.25e-8 m/s, quasi-static.
+/// Appels and Herder: k = 116.04e3 N/m, piezo ramp 8.25e-8 m/s, quasi-static.
 const K: f64 = 116.04e3;
 const V_A: f64 = 8.25e-8;
 
@@ -48,7 +48,7 @@ fn col(t: &Table, name: &str) -> Vec<f64> {
         .unwrap_or_else(|| panic!("no column {name} in {:?}", t.columns))
 }
 
-/// The seed's sliding level μc·m·g (0.352 kg).
+/// The paper's sliding level μc·m·g (0.352 kg).
 fn level() -> f64 {
     0.0633 * 0.352 * 9.81
 }
@@ -79,7 +79,7 @@ fn piezo_push_is_the_root_of_the_force_balance_at_every_output() {
         }
     }
     assert!(worst <= 1e-12 * level(), "worst {worst:e}");
-    // Gross sliding at the end at the seed's level μc·m·g, reached within
+    // Gross sliding at the end at the paper's level μc·m·g, reached within
     // a pre-sliding displacement of 2·δmax.
     let last = t.time.len() - 1;
     assert!((f[last] - level()).abs() < 1e-12 * level(), "{}", f[last]);
