@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # BENCHMARKS.md's accuracy table: relative RMS error of the friction force
 # against the monolithic reference (fricsim reference) for the stick-slip
-# benchmark at sigma0 = 1e5 and 1e7 N/m and seed 000's piezo push, at macro
-# steps 1e-5 ... 1e-2 s, for jacobi, gauss-seidel, newton,
+# benchmark at sigma0 = 1e5 and 1e7 N/m and Appels and Herder's piezo push, at
+# macro steps 1e-5 ... 1e-2 s, for jacobi, gauss-seidel, newton,
 # newton-interpolated and adaptive, with the wall time of every run.
 #
 # Builds the FMUs and the examples' archives (build-fmu.sh) and the

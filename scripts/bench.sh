@@ -2,9 +2,10 @@
 # BENCHMARKS.md's speed tables, every figure measured in one run: one step
 # of each friction FMU through the C ABI, the LuGre stick-slip benchmark on
 # the host against FMPy (scripts/bench_fmpy.py, the same FMUs, step and
-# scheme) and against the monolithic Rust loop, seed 000's Experiments 3
-# curve, the bristle law from 10 to 100 000 bristles, fricsim sweep on one
-# core and on all, and fricsim diagnose on the EMPS data.
+# scheme) and against the monolithic Rust loop, Appels and Herder's
+# Experiments 3 curve, the bristle law from 10 to 100 000 bristles,
+# fricsim sweep on one core and on all, and fricsim diagnose on the EMPS
+# data.
 #
 # Builds the FMUs (build-fmu.sh), the pinned Python venv with FMPy
 # (scripts/setup-venv.sh) and the speed-table program

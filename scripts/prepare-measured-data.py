@@ -21,7 +21,7 @@ Writes, relative to the repository root:
   controller output, hence vir - pulses_N, and the disturbance force is
   F_ext = gtau*pulses_N (examples/data/README.md).
 - examples/data/slider_breakaway.csv from SOURCE_DIR/slider_stiction_by_position.csv
-  (Thimmalapura 2004, Table I), for examples/seed003_breakaway.ssd:
+  (Thimmalapura 2004, Table I), for examples/slider_breakaway.ssd:
   each table row becomes a 1 s hold at the probe speed +-PROBE_SPEED (sign =
   direction) and the row's position, sampled every 0.1 s, with the measured
   friction.F = +-DRIVE_GAIN * breakaway_input_V; positive-direction rows by
@@ -40,7 +40,7 @@ import sys
 # EMPS drive gain gtau (N/V), from the EMPS data set's documentation
 # (Janot, Gautier, Brunot 2019; examples/data/README.md).
 GTAU = 35.15065188
-# Seed 003 drive gain (N/V), examples/seed003_slider_drift.ssd.
+# Drive gain of Thimmalapura's slider (N/V), examples/slider_drift.ssd.
 DRIVE_GAIN = 3.5
 # Probe speed of the break-away holds (m/s).
 PROBE_SPEED = 1e-4
@@ -131,7 +131,7 @@ def prepare_slider(src_dir):
     )
     levels = [DRIVE_GAIN * u for _, _, u in holds]
     print(f"  {len(holds)} holds of 1 s; mean break-away force "
-          f"{sum(levels) / len(levels)!r} N (the Fc = Fs of examples/seed003_breakaway.ssd)")
+          f"{sum(levels) / len(levels)!r} N (the Fc = Fs of examples/slider_breakaway.ssd)")
 
 
 def main():

@@ -22,7 +22,7 @@ def signal(**columns):
 
 w = 2 * np.pi
 CASES = {
-    # seed 001 velocity trial: v = 1e-3*sin(t/k) style, here one cycle a second
+    # Sun et al. 2016's velocity trial: v = 1e-3*sin(t/k) style, here one cycle a second
     "Dahl": (signal(v=5e-3 * np.sin(w * T_SIGNAL)), {"alpha": 1.5}),
     # LuGre with every extension on: direction- and position-dependent levels
     "LuGre": (signal(v=2e-3 * np.sin(w * T_SIGNAL), x=0.3 + 0.2 * np.sin(0.5 * w * T_SIGNAL),

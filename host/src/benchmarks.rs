@@ -158,7 +158,7 @@ pub const FRICTION_FMUS: &[DrivenFmu] = &[
     ("Dahl", &[("v", 1e-3, 0.0)], &["F"]),
     ("LuGre", &[("v", 1e-3, 0.0)], &["F"]),
     ("ResetIntegrator", &[("v", 1e-3, 0.0)], &["F"]),
-    // 3·δmax = 4.7e-8 m of seed 000: loads to sliding, reverses twice a period
+    // 3·δmax = 4.7e-8 m of Appels and Herder: loads to sliding, reverses twice a period
     ("Bristle", &[("x", 4.7e-8, 0.0)], &["F"]),
     (
         "Bristle2D",

@@ -53,7 +53,7 @@ fn benchmarks() -> std::path::PathBuf {
 const CASES: [&str; 3] = [
     "stick-slip, σ0 = 1e5 N/m",
     "stick-slip, σ0 = 1e7 N/m",
-    "seed 000 piezo push",
+    "piezo push (Appels and Herder)",
 ];
 
 /// A percentage entry as a fraction ("0.0433 %" → 4.33e-4).
@@ -131,7 +131,7 @@ fn quick_mode_writes_its_table_between_the_markers_and_keeps_the_rest() {
     // Jacobi and Gauss–Seidel chatter; strong coupling solves it to
     // rounding. The stiff contact (σ0 = 1e7 N/m, period 2 ms) makes the
     // loose masters chatter at 1e-3 s; the strong ones stay within 1 %.
-    let piezo = cells(&text, ERRORS, "seed 000 piezo push");
+    let piezo = cells(&text, ERRORS, "piezo push (Appels and Herder)");
     let stiff = cells(&text, ERRORS, "stick-slip, σ0 = 1e7 N/m");
     for row in [&piezo, &stiff] {
         for loose in &row[3..5] {
@@ -145,7 +145,7 @@ fn quick_mode_writes_its_table_between_the_markers_and_keeps_the_rest() {
         assert!(percent(strong) < 1e-8, "{piezo:?}");
     }
     // The goal lines name each case and each master's verdict.
-    for case in ["stick-slip, σ0 = 1e7 N/m", "seed 000 piezo push"] {
+    for case in ["stick-slip, σ0 = 1e7 N/m", "piezo push (Appels and Herder)"] {
         let goal = text
             .lines()
             .find(|l| l.starts_with(&format!("- {case}: ")))
@@ -161,7 +161,7 @@ fn quick_mode_writes_its_table_between_the_markers_and_keeps_the_rest() {
 
     // Run again: the table is replaced, not repeated.
     let output = table(
-        &["--quick", "--masters", "newton", "--cases", "seed000"],
+        &["--quick", "--masters", "newton", "--cases", "piezo-push"],
         &file,
     );
     assert!(output.status.success());
@@ -179,7 +179,7 @@ fn a_file_without_markers_is_refused_and_left_alone() {
     let file = dir.path().join("notes.md");
     std::fs::write(&file, "# Notes\n").unwrap();
     let output = table(
-        &["--quick", "--cases", "seed000", "--masters", "jacobi"],
+        &["--quick", "--cases", "piezo-push", "--masters", "jacobi"],
         &file,
     );
     assert!(!output.status.success());
@@ -198,11 +198,11 @@ fn unknown_masters_and_cases_are_refused_before_anything_runs() {
         &String::from_utf8_lossy(&output.stderr),
         &["unknown master algorithm `gauss`"],
     );
-    let output = table(&["--quick", "--cases", "seed999"], &file);
+    let output = table(&["--quick", "--cases", "no-such-case"], &file);
     assert!(!output.status.success());
     common::assert_message(
         &String::from_utf8_lossy(&output.stderr),
-        &["unknown case `seed999`", "stick-slip-1e7"],
+        &["unknown case `no-such-case`", "stick-slip-1e7"],
     );
     assert!(
         !file.exists(),
@@ -283,7 +283,7 @@ fn an_altered_published_entry_is_refused_and_named() {
         &stdout,
         &[
             &format!("{case}, h = 1e-2 s: 1 of 6 entries differ"),
-            "seed 000 piezo push, h = 1e-2 s: 6 entries as published",
+            "piezo push (Appels and Herder), h = 1e-2 s: 6 entries as published",
         ],
     );
 }
@@ -301,16 +301,16 @@ fn a_missing_row_table_or_marker_is_named_before_anything_runs() {
         common::assert_message(&stderr, parts);
         assert!(!stderr.contains("reference in"), "something ran: {stderr}");
     };
-    let (line, _) = error_row(&text, "seed 000 piezo push", "1e-2");
+    let (line, _) = error_row(&text, "piezo push (Appels and Herder)", "1e-2");
     refused(
         &text.replacen(&format!("{line}\n"), "", 1),
         &["--steps", "1e-2,1e-3"],
-        &["no row for seed 000 piezo push, h = 1e-2 s"],
+        &["no row for piezo push (Appels and Herder), h = 1e-2 s"],
     );
     refused(
         &text,
-        &["--steps", "1e-1", "--cases", "seed000"],
-        &["no row for seed 000 piezo push, h = 1e-1 s"],
+        &["--steps", "1e-1", "--cases", "piezo-push"],
+        &["no row for piezo push (Appels and Herder), h = 1e-1 s"],
     );
     refused(
         &text.replacen(ERRORS, "**Errors**", 1),

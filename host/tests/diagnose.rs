@@ -77,14 +77,14 @@ fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
     );
 }
 
-/// Seed 003's table of break-away levels (71 rows, one block each): every
+/// Thimmalapura's table of break-away levels (71 rows, one block each): every
 /// row is scored by cross-validation, neither position nor direction alone
 /// improves the held-out error, the two together (one position table per
 /// direction, an interaction) do, significantly, and both are named.
 #[test]
 fn slider_table_names_position_and_direction_dependence() {
     let r = repo();
-    let file = SystemFile::open(r.join("examples/seed003_breakaway.ssd")).unwrap();
+    let file = SystemFile::open(r.join("examples/slider_breakaway.ssd")).unwrap();
     let d = diagnose(
         &file,
         &r.join("examples/data/slider_breakaway.csv"),

@@ -6,15 +6,21 @@
 //!   build writes, `out/`, `dist/`, `target/`, `.venv/`, need not exist in a
 //!   clone; placeholders such as `examples/<name>.ssd` are not checked), and
 //!   a link's `#section` names a heading of the page it points at;
-//! - no page cites a paper by a seed number ("seed 0…"): papers are cited
-//!   by author and year (docs/models.md, References);
+//! - nothing a user reads cites a paper by its old internal number
+//!   ("seed 000" … "seed 004", `seed004_planar.ssd`): neither a page
+//!   (README.md, CHANGELOG.md, BENCHMARKS.md, docs/*.md), nor a file of
+//!   `examples/` or `modelDescription/`, nor the `--help` of `fricsim`, of
+//!   its commands and of the table programs; papers are cited by author and
+//!   year (docs/models.md, References). No file of the repository is named
+//!   by such a number either: a file is named after what it shows;
 //! - docs/fmu-reference.md exists (that it equals what the code generates
 //!   is checked by fmu-src/fmu-packager/tests/model_descriptions.rs);
 //! - the README's command table names only commands and options that
 //!   `fricsim <command> --help` lists, and every command.
 //!
-//! Standard library only, no FMU loaded: it reads text files and runs
-//! `fricsim --help`.
+//! Standard library only, no FMU loaded: it reads text files, lists the
+//! repository's files with `git ls-files` (or walks the tree without git)
+//! and runs the programs' `--help`.
 
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
@@ -346,19 +352,153 @@ fn the_pages_link_to_nothing_outside_the_repository_or_missing() {
     );
 }
 
-#[test]
-fn no_page_cites_a_paper_by_a_seed_number() {
-    let mut problems = Vec::new();
-    for page in pages() {
-        for (i, line) in read(&page).lines().enumerate() {
-            if line.to_lowercase().contains("seed 0") {
-                problems.push(format!("{}:{}: {}", page.display(), i + 1, line.trim()));
+/// Whether `text` names a paper by its old internal number: "seed", at
+/// most one separator (` `, `_`, `-`), then `0` and a digit, in any case
+/// ("Seed 000's piezo push", `seed004_planar.ssd`, `seed-003`). A random
+/// seed ("the `seed` parameter", "--seeds 20", "seed 7") is not one.
+fn has_paper_number(text: &str) -> bool {
+    let lower = text.to_lowercase();
+    let bytes = lower.as_bytes();
+    lower.match_indices("seed").any(|(i, _)| {
+        let mut j = i + "seed".len();
+        if matches!(bytes.get(j), Some(b' ' | b'_' | b'-')) {
+            j += 1;
+        }
+        bytes.get(j) == Some(&b'0') && bytes.get(j + 1).is_some_and(u8::is_ascii_digit)
+    })
+}
+
+/// Every file of the repository, relative to its root: `git ls-files`
+/// where git and the history are at hand, else a walk of the tree without
+/// hidden entries and the directories the build writes.
+fn repository_files() -> Vec<PathBuf> {
+    let root = repo();
+    let listed = Command::new("git")
+        .args(["ls-files", "-z"])
+        .current_dir(&root)
+        .output()
+        .ok()
+        .filter(|out| out.status.success() && !out.stdout.is_empty());
+    if let Some(out) = listed {
+        return String::from_utf8_lossy(&out.stdout)
+            .split('\0')
+            .filter(|p| !p.is_empty())
+            .map(PathBuf::from)
+            .collect();
+    }
+    let mut files = Vec::new();
+    let mut dirs = vec![PathBuf::new()];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(root.join(&dir)).expect("readable directory") {
+            let entry = entry.expect("readable entry");
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let rel = dir.join(&name);
+            if name.starts_with('.') || is_generated(&rel) {
+                continue;
+            }
+            if entry.file_type().expect("file type").is_dir() {
+                dirs.push(rel);
+            } else {
+                files.push(rel);
             }
         }
+    }
+    files.sort();
+    files
+}
+
+/// The lines of `text` that cite a paper by its old number, as
+/// `label:line: text`.
+fn paper_numbers(label: &str, text: &str) -> Vec<String> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, line)| has_paper_number(line))
+        .map(|(i, line)| format!("{label}:{}: {}", i + 1, line.trim()))
+        .collect()
+}
+
+#[test]
+fn no_file_is_named_by_a_paper_number() {
+    let named: Vec<String> = repository_files()
+        .iter()
+        .map(|p| p.display().to_string())
+        .filter(|p| has_paper_number(p))
+        .collect();
+    assert!(
+        named.is_empty(),
+        "name the file after what it shows, not by a paper's old number (seed 000 … 004):\n{}",
+        named.join("\n")
+    );
+}
+
+#[test]
+fn no_page_example_or_model_description_cites_a_paper_by_a_seed_number() {
+    let mut texts = pages();
+    texts.push(PathBuf::from("BENCHMARKS.md"));
+    texts.extend(
+        repository_files()
+            .into_iter()
+            .filter(|p| p.starts_with("examples") || p.starts_with("modelDescription")),
+    );
+    let mut problems = Vec::new();
+    for rel in texts {
+        let path = repo().join(&rel);
+        let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        problems.extend(paper_numbers(
+            &rel.display().to_string(),
+            &String::from_utf8_lossy(&bytes),
+        ));
     }
     assert!(
         problems.is_empty(),
         "cite the paper by author and year (docs/models.md, References), not by a seed number:\n{}",
+        problems.join("\n")
+    );
+}
+
+/// The `--help` of a program of this package, which must succeed.
+fn help(program: &str, args: &[&str]) -> String {
+    let out = Command::new(program)
+        .args(args)
+        .arg("--help")
+        .output()
+        .unwrap_or_else(|e| panic!("{program}: {e}"));
+    assert!(
+        out.status.success(),
+        "{program} {} --help: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8 help")
+}
+
+#[test]
+fn no_help_text_cites_a_paper_by_a_seed_number() {
+    let fricsim = env!("CARGO_BIN_EXE_fricsim");
+    let top = help(fricsim, &[]);
+    let mut problems = paper_numbers("fricsim --help", &top);
+    for command in help_commands(&top) {
+        problems.extend(paper_numbers(
+            &format!("fricsim {command} --help"),
+            &help(fricsim, &[&command]),
+        ));
+    }
+    for (name, program) in [
+        ("accuracy-table", env!("CARGO_BIN_EXE_accuracy-table")),
+        ("speed-table", env!("CARGO_BIN_EXE_speed-table")),
+        (
+            "hidden-effect-suite",
+            env!("CARGO_BIN_EXE_hidden-effect-suite"),
+        ),
+    ] {
+        problems.extend(paper_numbers(
+            &format!("{name} --help"),
+            &help(program, &[]),
+        ));
+    }
+    assert!(
+        problems.is_empty(),
+        "cite the paper by author and year, not by a seed number:\n{}",
         problems.join("\n")
     );
 }
@@ -519,4 +659,25 @@ fn the_checks_themselves_catch_what_they_should() {
     assert!(
         options.contains("--step") && options.contains("--quiet") && options.contains("--help")
     );
+    // a paper's old number, in a name or in prose, but not a random seed
+    for labelled in [
+        "Seed 000's piezo push",
+        "examples/seed004_planar.ssd",
+        "host/tests/seed000.rs",
+        "lugre_seed001.ssv",
+        "the Table of seed-003",
+        "SEED 002",
+    ] {
+        assert!(has_paper_number(labelled), "{labelled}");
+    }
+    for seed in [
+        "the `seed` parameter of Bristle.fmu",
+        "--seeds 20 --seed-param friction.seed",
+        "seed 7",
+        "(seed {SEED:#x})",
+        "random seed 0 or 1",
+        "3 seeds, 0 failures",
+    ] {
+        assert!(!has_paper_number(seed), "{seed}");
+    }
 }

@@ -47,7 +47,7 @@ fn run(l: &Lugre, i: &mut Instance, first: u32, n: u32, velocity: impl Fn(f64) -
     forces
 }
 
-/// LuGre steady state (Canudas de Wit et al. 1995, eq. 9–12 of seed 001):
+/// LuGre steady state (Canudas de Wit et al. 1995, eq. 9–12 of Sun et al. 2016):
 /// Fss(v) = Fc + (Fs − Fc)·exp(−(v/vs)²) + σ2·v; at v = vs = 1e-3 with the
 /// default parameters Fc = 1, Fs = 1.5, σ2 = 0.4.
 #[test]

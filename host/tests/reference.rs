@@ -203,7 +203,7 @@ fn the_reference_of_the_stick_slip_example_has_the_columns_and_times_of_run() {
 #[test]
 fn dahl_and_the_quasi_static_bristle_have_references_too() {
     let dir = tempfile::tempdir().unwrap();
-    // The 1995 rig on Dahl friction (seed 001 parameters): the mass rests
+    // The 1995 rig on Dahl friction (Sun et al. 2016 parameters): the mass rests
     // on the Dahl stiffness σ = 87 750 N/m (ω ≈ 296 rad/s), a loop the
     // Jacobi co-simulation damps poorly. Against the reference its error
     // falls with the macro step (observed relative RMS error of F: 1.4 at
@@ -245,7 +245,7 @@ fn dahl_and_the_quasi_static_bristle_have_references_too() {
         "{errors:?}"
     );
 
-    // Seed 000: the piezo pushes the block through a spring, quasi-statically.
+    // Appels and Herder: the piezo pushes the block through a spring, quasi-statically.
     let piezo = ssd(
         &[
             Part {
@@ -284,7 +284,7 @@ fn dahl_and_the_quasi_static_bristle_have_references_too() {
 
 #[test]
 fn the_planar_oscillator_with_the_2d_bristle_has_a_reference() {
-    // Seed 004's oscillator (Rig2D's defaults) on the 2-D bristle law,
+    // Wijata et al.'s oscillator (Rig2D's defaults) on the 2-D bristle law,
     // coupled per axis. The co-simulation error against the reference
     // falls about tenfold per tenfold smaller step (observed relative RMS
     // error of F1: 1.8e-2 at 1e-3 s, 1.6e-3 at 1e-4 s).

@@ -68,7 +68,7 @@ fn quick_mode_writes_every_table_between_its_markers() {
     }
     for law in ["bristle", "Dahl", "LuGre"] {
         assert_eq!(
-            common::table_row(&text, "**Seed 000's Experiments 3 curve**", law).len(),
+            common::table_row(&text, "**Appels and Herder's Experiments 3 curve**", law).len(),
             4
         );
     }

@@ -1,7 +1,7 @@
 //! Strong coupling (Newton on the interface with state rollback) against
 //! the two failure modes of loose coupling: a stiff contact at a large macro
 //! step (the 1995 LuGre stick-slip benchmark), and a direct-feedthrough loop
-//! (seed 000's quasi-static rig, m = 0, against the bristle law), where
+//! (Appels and Herder's quasi-static rig, m = 0, against the bristle law), where
 //! fixed-point iteration diverges because the loop gain σ/k ≈ 120.
 
 use fricsim::master::strong::{JacobianSource, StepControl, StrongCoupling, Update};
@@ -46,7 +46,7 @@ fn stick_slip() -> System {
     )
 }
 
-/// Seed 000's piezo push: quasi-static rig (m = c = 0), k = 116.04e3 N/m,
+/// Appels and Herder's piezo push: quasi-static rig (m = c = 0), k = 116.04e3 N/m,
 /// actuator at 8.25e-8 m/s, bristles of the 0.352 kg block.
 const K_PIEZO: f64 = 116.04e3;
 const V_PIEZO: f64 = 8.25e-8;
@@ -177,7 +177,7 @@ fn newton_solves_the_quasi_static_feedthrough_loop() {
             run.time[i]
         );
     }
-    // Sliding at μc·m·g = 0.0633·3.45312 N (seed 000, within 1 %).
+    // Sliding at μc·m·g = 0.0633·3.45312 N (Appels and Herder, within 1 %).
     let level = 0.0633 * 3.45312;
     let f_end = *f.last().unwrap();
     assert!((f_end / level - 1.0).abs() < 1e-2, "final force {f_end}");
@@ -348,7 +348,7 @@ fn newton_iterates_alike_whatever_the_order_of_the_connections() {
     // the unknowns differently (another pivot order, other roundings),
     // and converge to the same motion within Newton's tolerance.
     let file = fricsim::ssp::SystemFile::open(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/seed004_dither.ssd"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/planar_dither.ssd"),
     )
     .unwrap();
     let by_component = file.check().unwrap();

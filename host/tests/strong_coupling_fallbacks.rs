@@ -409,7 +409,7 @@ fn fixed_point_divergence_through_the_command_line_reports_the_residual() {
     let dir = TempDir::new().unwrap();
     let out = dir.path().join("result.csv");
     let stderr = failing_run(
-        &common::repository().join("examples/seed000_piezo_push.ssd"),
+        &common::repository().join("examples/piezo_push.ssd"),
         &["--master", "fixed-point", "--stop", "1"],
         &out,
     );

@@ -154,7 +154,7 @@ fn seeds_run_each_bristle_realisation() {
     let out = dir.path().join("seeds.csv");
     let output = fricsim(&[
         "sweep",
-        "examples/seed000_piezo_push.ssd",
+        "examples/piezo_push.ssd",
         "--seeds",
         "3",
         "--stop",

@@ -1,16 +1,16 @@
-//! The planar oscillator of seed 004 (Rig2D) with the 2-D bristle law
+//! The planar oscillator of Wijata et al. 2016 (Rig2D) with the 2-D bristle law
 //! (Bristle2D) as a hybrid ODE system, solved by [`crate::radau`].
 //!
 //! State `y = (x1, ẋ1, x2, ẋ2, z1, z2)`. Right-hand side, from the physics
 //! crates:
 //!
-//! - rig (MODELS.md "Rigs in the seeds", `rig-dynamics/src/rig2d.rs`):
+//! - rig (docs/models.md "Rigs", `rig-dynamics/src/rig2d.rs`):
 //!   `m·ẍ_i = −k_i·x_i − c_i·ẋ_i + F_ext,i − F_i`, each axis a [`Rig1D`]
 //!   ([`Rig2D::axis`]) set to `(t, x_i, ẋ_i)`, whose
 //!   [`Rig1D::acceleration`] and [`Rig1D::slip_velocity`]
 //!   (`v_i = ẋ_i − v_s,i(t)`, surface speed and dither) are used;
-//! - 2-D bristle (MODELS.md "Two-dimensional bristle", derived from seed
-//!   004): `ż = v − [on the boundary and z·v > 0]·(z·v)·z/|z|²`
+//! - 2-D bristle (MODELS.md "Two-dimensional bristle", derived from Wijata
+//!   et al. 2016): `ż = v − [on the boundary and z·v > 0]·(z·v)·z/|z|²`
 //!   ([`Bristle2D::z_rate`]), `F_i = (1 + a_i)·σ0i·z_i + σ1i(|v|)·ż_i`
 //!   inside the disc `|z| < z0`, without the `a_i` on its boundary
 //!   ([`Bristle2D::force_of`]).

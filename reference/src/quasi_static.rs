@@ -1,12 +1,12 @@
 //! The quasi-static rig (m = 0, c = 0) pushing the pre-sliding bristle
-//! model (seed 000: a piezo pushes the block through a spring), solved
-//! exactly.
+//! model (Appels and Herder: a piezo pushes the block through a spring),
+//! solved exactly.
 //!
 //! With no mass and no damper the rig is the force balance
-//! `0 = k·(x_a(t) − x) + F_ext − F + F_d(t)` (MODELS.md "Rigs in the
-//! seeds"; `rig-dynamics/src/rig1d.rs`), and the bristle force `F(ξ)` of
-//! seed 000 is a function of the displacement ξ it is driven with (`rig.x`,
-//! or `rig.x_rel = x − x_s(t)`). In the bristle's coordinate the balance is
+//! `0 = k·(x_a(t) − x) + F_ext − F + F_d(t)` (docs/models.md "Rigs";
+//! `rig-dynamics/src/rig1d.rs`), and the bristle force `F(ξ)` of Appels
+//! and Herder is a function of the displacement ξ it is driven with
+//! (`rig.x`, or `rig.x_rel = x − x_s(t)`). In the bristle's coordinate the balance is
 //!
 //! `ξ + F(ξ)/k = R(t)`,  `R(t) = x_a(t) + (F_ext + F_d(t))/k − x_s(t)`
 //!
@@ -28,7 +28,7 @@
 //! a drive-force step too.
 //!
 //! At a reversal the disconnected bristles reconnect with a force drop (the
-//! seed's relaxation), so `F` jumps at the turning point and the balance
+//! paper's relaxation), so `F` jumps at the turning point and the balance
 //! may have no root beyond it: the body then stays where it is until `R`
 //! has travelled through the jump, the friction force being set-valued
 //! there; it is reported as the balance value `k·(R − ξ)`, inside the jump.

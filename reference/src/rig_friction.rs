@@ -9,11 +9,11 @@
 //! - friction inputs: `v` = the rig's slip velocity `ẋ − v_s(t)`
 //!   ([`Rig1D::slip_velocity`]) or its body velocity, `x` = its position or
 //!   its displacement relative to the surface ([`Rig1D::relative_displacement`]);
-//! - LuGre (seed 001 eq. 9–11): `ż = v − σ0·|v|·z/g(v)` ([`LuGre::z_rate`]),
+//! - LuGre (Sun et al. 2016 eq. 9–11): `ż = v − σ0·|v|·z/g(v)` ([`LuGre::z_rate`]),
 //!   `F = σ0·z + σ1(v)·ż + σ2·v` ([`LuGre::force_of`]);
-//!   Dahl (seed 001 eq. 2–3): `dF/dt = σ·|1 − F/Fc·sgn v|^α·sgn(1 − F/Fc·sgn v)·v`
+//!   Dahl (Sun et al. 2016 eq. 2–3): `dF/dt = σ·|1 − F/Fc·sgn v|^α·sgn(1 − F/Fc·sgn v)·v`
 //!   ([`Dahl::force_rate`]);
-//! - rig (MODELS.md "Rigs in the seeds", `rig-dynamics/src/rig1d.rs`):
+//! - rig (docs/models.md "Rigs", `rig-dynamics/src/rig1d.rs`):
 //!   `m·ẍ = k·(x_a(t) − x) − c·ẋ + F_ext − F + F_d(t) + F_ctrl`, evaluated by
 //!   [`Rig1D::acceleration`] on a copy of the rig set to `(t, x, ẋ, ξ)`, so
 //!   actuator law, drive force, controller and surface motion are the

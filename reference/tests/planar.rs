@@ -1,6 +1,6 @@
-//! Rig2D with the 2-D bristle law (seed 004): the behaviours the seed
-//! reports, the reference against the law's exact update along its own
-//! path, and convergence in the tolerance.
+//! Rig2D with the 2-D bristle law (Wijata et al. 2016): the behaviours the
+//! paper reports, the reference against the law's exact update along its
+//! own path, and convergence in the tolerance.
 
 use fricsim_reference::radau::RadauStats;
 use fricsim_reference::{ComponentSpec, ReferenceModel, SystemSpec, Table, RTOL};
@@ -19,7 +19,7 @@ fn planar(rig: ComponentSpec) -> SystemSpec {
     .connect("friction.F2", "rig.F2")
 }
 
-/// Seed 004's oscillator (Rig2D's defaults): m = 1 kg, k1 = k2 = 100 N/m,
+/// Wijata et al.'s oscillator (Rig2D's defaults): m = 1 kg, k1 = k2 = 100 N/m,
 /// x(0) = (0.08, 0.08) m, v(0) = (−0.8, 0.8) m/s: the velocity is
 /// perpendicular to the displacement and balances the springs, so the
 /// frictionless orbit is a circle (behaviour 4).

@@ -1,4 +1,4 @@
-//! The quasi-static rig (m = 0, c = 0) with the bristle law of seed 000:
+//! The quasi-static rig (m = 0, c = 0) with the bristle law of Appels and Herder:
 //! the reference is the exact root of the force balance at every output
 //! time, the bristle state advanced monotonically from root to root.
 
@@ -8,11 +8,11 @@ use friction_laws::bristle::{Bristle, BristleParams};
 use rig_dynamics::rig1d::{Rig1D, Rig1DInputs, Rig1DParams};
 use rig_dynamics::signals::Sinusoid;
 
-/// Seed 000: k = 116.04e3 N/m, piezo ramp 8.25e-8 m/s, quasi-static.
+/// Appels and Herder: k = 116.04e3 N/m, piezo ramp 8.25e-8 m/s, quasi-static.
 const K: f64 = 116.04e3;
 const V_A: f64 = 8.25e-8;
 
-fn seed000(rig: ComponentSpec) -> SystemSpec {
+fn piezo_push(rig: ComponentSpec) -> SystemSpec {
     SystemSpec {
         components: vec![rig, ComponentSpec::new("bristle", "Bristle")],
         connections: Vec::new(),
@@ -48,14 +48,14 @@ fn col(t: &Table, name: &str) -> Vec<f64> {
         .unwrap_or_else(|| panic!("no column {name} in {:?}", t.columns))
 }
 
-/// The seed's sliding level μc·m·g (0.352 kg).
+/// The paper's sliding level μc·m·g (0.352 kg).
 fn level() -> f64 {
     0.0633 * 0.352 * 9.81
 }
 
 #[test]
 fn piezo_push_is_the_root_of_the_force_balance_at_every_output() {
-    let t = run(&seed000(piezo_rig()), 0.05, 30.0);
+    let t = run(&piezo_push(piezo_rig()), 0.05, 30.0);
     assert_eq!(t.columns.last().map(String::as_str), Some("bristle.F"));
     let (x, x_rel, xa) = (col(&t, "rig.x"), col(&t, "rig.x_rel"), col(&t, "rig.x_act"));
     let (v, a, f) = (col(&t, "rig.v"), col(&t, "rig.a"), col(&t, "bristle.F"));
@@ -79,7 +79,7 @@ fn piezo_push_is_the_root_of_the_force_balance_at_every_output() {
         }
     }
     assert!(worst <= 1e-12 * level(), "worst {worst:e}");
-    // Gross sliding at the end at the seed's level μc·m·g, reached within
+    // Gross sliding at the end at the paper's level μc·m·g, reached within
     // a pre-sliding displacement of 2·δmax.
     let last = t.time.len() - 1;
     assert!((f[last] - level()).abs() < 1e-12 * level(), "{}", f[last]);
@@ -149,7 +149,7 @@ fn all_bristles_connected_gives_the_closed_form_of_two_springs_in_series() {
 fn a_reversal_holds_the_body_until_the_spring_has_crossed_the_force_drop() {
     // The actuator oscillates: 3e-6 m (beyond sliding, 1.9e-6 m of spring
     // deflection) at 0.02 Hz, so it turns at t = 12.5 s and 37.5 s.
-    let spec = seed000(
+    let spec = piezo_push(
         ComponentSpec::new("rig", "Rig1D")
             .real("m", 0.0)
             .real("c", 0.0)

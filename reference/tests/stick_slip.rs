@@ -213,7 +213,7 @@ fn recorded_inputs_and_parameters_follow_the_outputs_they_are_connected_to() {
 
 #[test]
 fn lugre_pre_sliding_settles_with_the_bristles_at_f_over_sigma0() {
-    // MODELS.md: with seed 001's parameters a step force below break-away
+    // MODELS.md: with Sun et al. 2016's parameters a step force below break-away
     // settles at x = F/σ0 (14.9 µm at 1 N). At rest the LuGre force is
     // σ0·z, so the bristle deflection z settles at F/σ0 exactly; the
     // body's x equals it only while F ≪ Fs: on the way, ż = v − σ0·|v|·z/g

@@ -92,9 +92,9 @@ const CASES: &[Case] = &[
         file: "examples/stick_slip_sigma1e7.ssd",
     },
     Case {
-        key: "seed000",
-        label: "seed 000 piezo push",
-        file: "examples/seed000_piezo_push.ssd",
+        key: "piezo-push",
+        label: "piezo push (Appels and Herder)",
+        file: "examples/piezo_push.ssd",
     },
 ];
 
@@ -127,7 +127,7 @@ struct Args {
     /// [default: jacobi,gauss-seidel,newton,newton-interpolated,adaptive].
     #[arg(long, value_delimiter = ',')]
     masters: Vec<String>,
-    /// Cases, comma-separated: stick-slip, stick-slip-1e7, seed000 [default: all].
+    /// Cases, comma-separated: stick-slip, stick-slip-1e7, piezo-push [default: all].
     #[arg(long, value_delimiter = ',')]
     cases: Vec<String>,
     /// Write nothing: recompute the rows of --steps and --cases at each

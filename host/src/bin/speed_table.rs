@@ -18,12 +18,12 @@
 //!      ([`StickSlipModel::monolithic_jacobi`],
 //!      [`StickSlipModel::monolithic_newton`]). Only the FMI boundary and
 //!      the master's bookkeeping differ between the two.
-//! 3. **Seed 000's Experiments 3 curve**: the force–displacement curve of
-//!    the bristle model with seed 000's parameters (0.352 kg, N = 109
-//!    bristles), 1000 displacement increments from rest to sliding
-//!    (0 → 3·δmax), bristle placement included; Dahl and LuGre over the
-//!    same increments for comparison (the seed: 0.33 s, 29.1 s, 19.55 s in
-//!    Matlab).
+//! 3. **Appels and Herder's Experiments 3 curve**: the force–displacement
+//!    curve of the bristle model with Appels and Herder's parameters
+//!    (0.352 kg, N = 109 bristles), 1000 displacement increments from rest
+//!    to sliding (0 → 3·δmax), bristle placement included; Dahl and LuGre
+//!    over the same increments for comparison (theirs: 0.33 s, 29.1 s,
+//!    19.55 s in Matlab).
 //! 4. **Bristle count** 10 … 100 000: a 1000-increment curve with one
 //!    reversal (0 → 3·δmax → −3·δmax), per-increment cost.
 //! 5. **`fricsim sweep`** ([`fricsim::sweep::run_all`]) on one thread and
@@ -66,8 +66,8 @@ pub const END: &str = "<!-- speed: end -->";
 const SMALL_STEP: f64 = 1e-5;
 const LARGE_STEP: f64 = 1e-2;
 const BRISTLE_COUNTS: &[usize] = &[10, 100, 1_000, 10_000, 100_000];
-/// The seed's Matlab times for the Experiments 3 curve (Table 6), s.
-const SEED_TIMES: [(&str, f64); 3] = [("bristle", 0.33), ("Dahl", 29.1), ("LuGre", 19.55)];
+/// Appels and Herder's Matlab times for the Experiments 3 curve (Table 6), s.
+const PAPER_TIMES: [(&str, f64); 3] = [("bristle", 0.33), ("Dahl", 29.1), ("LuGre", 19.55)];
 
 #[derive(Parser)]
 #[command(
@@ -167,7 +167,7 @@ fn run(args: &Args) -> Result<(), String> {
     let started = Instant::now();
     let laws = law_table(&root, &sizes)?;
     let host = host_table(&root, &python, &sizes)?;
-    let curve = seed000_curve(sizes.repeats)?;
+    let curve = appels_herder_curve(sizes.repeats)?;
     let scaling = bristle_scaling(sizes.repeats)?;
     let sweep = sweep_speedup(&root, &sizes)?;
     let diagnose = if sizes.diagnose {
@@ -827,13 +827,13 @@ impl StickSlipModel {
     }
 }
 
-// ---- 3. seed 000's Experiments 3 curve -----------------------------------
+// ---- 3. Appels and Herder's Experiments 3 curve -------------------------
 
 struct CurveRow {
     law: &'static str,
     /// Wall time of one curve, s.
     time: f64,
-    seed_time: f64,
+    paper_time: f64,
 }
 
 /// Times one call of `curve` precisely: enough calls for ≥ 20 ms, the
@@ -859,10 +859,10 @@ fn loading(k: usize, delta_max: f64) -> f64 {
     3.0 * delta_max * k as f64 / INCREMENTS as f64
 }
 
-fn seed000_curve(repeats: usize) -> Result<Vec<CurveRow>, String> {
+fn appels_herder_curve(repeats: usize) -> Result<Vec<CurveRow>, String> {
     let p = BristleParams::default();
     let bristle = per_call(repeats, || {
-        let mut b = Bristle::new(p).expect("seed 000 parameters");
+        let mut b = Bristle::new(p).expect("Appels and Herder's parameters");
         let mut sum = 0.0;
         for k in 1..=INCREMENTS {
             b.move_to(loading(k, p.delta_max));
@@ -871,8 +871,8 @@ fn seed000_curve(repeats: usize) -> Result<Vec<CurveRow>, String> {
         sum
     })?;
     // Dahl and LuGre with the same stiffness and sliding level, driven
-    // through the same displacements, one increment per 10 ms (seed 000's
-    // piezo: an increment every 10 ms).
+    // through the same displacements, one increment per 10 ms (Appels and
+    // Herder's piezo: an increment every 10 ms).
     let level = p.sigma_ini * p.delta_max;
     let dt = 0.01;
     let dahl_params = DahlParams {
@@ -918,22 +918,22 @@ fn seed000_curve(repeats: usize) -> Result<Vec<CurveRow>, String> {
         }
         sum
     })?;
-    eprintln!("seed 000 curve: bristle {bristle:e} s, Dahl {dahl:e} s, LuGre {lugre:e} s");
+    eprintln!("Appels and Herder curve: bristle {bristle:e} s, Dahl {dahl:e} s, LuGre {lugre:e} s");
     Ok(vec![
         CurveRow {
             law: "bristle",
             time: bristle,
-            seed_time: SEED_TIMES[0].1,
+            paper_time: PAPER_TIMES[0].1,
         },
         CurveRow {
             law: "Dahl",
             time: dahl,
-            seed_time: SEED_TIMES[1].1,
+            paper_time: PAPER_TIMES[1].1,
         },
         CurveRow {
             law: "LuGre",
             time: lugre,
-            seed_time: SEED_TIMES[2].1,
+            paper_time: PAPER_TIMES[2].1,
         },
     ])
 }
@@ -1195,12 +1195,12 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
 
     let _ = writeln!(
         s,
-        "\n**Seed 000's Experiments 3 curve**: the force–displacement curve at 0.352 kg (N = {} bristles, seed 000's Table 3), {INCREMENTS} increments from rest to 3·δmax (sliding), bristle placement included; Dahl and LuGre with the same stiffness and sliding level over the same increments (one per 10 ms). The seed's times are Matlab on a 3.16 GHz workstation:\n",
+        "\n**Appels and Herder's Experiments 3 curve**: the force–displacement curve at 0.352 kg (N = {} bristles, their Table 3), {INCREMENTS} increments from rest to 3·δmax (sliding), bristle placement included; Dahl and LuGre with the same stiffness and sliding level over the same increments (one per 10 ms). Their times are Matlab on a 3.16 GHz workstation:\n",
         BristleParams::default().n_bristles
     );
     let _ = writeln!(
         s,
-        "| law | here | seed 000 (Matlab) | seed / here |\n|---|---|---|---|"
+        "| law | here | Appels and Herder (Matlab) | theirs / here |\n|---|---|---|---|"
     );
     for c in &r.curve {
         let _ = writeln!(
@@ -1208,14 +1208,14 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
             "| {} | {} | {} s | {:.0}× |",
             c.law,
             duration(c.time),
-            c.seed_time,
-            c.seed_time / c.time
+            c.paper_time,
+            c.paper_time / c.time
         );
     }
 
     let _ = writeln!(
         s,
-        "\n**Bristle count**: the bristle law (`friction-laws`) over a {INCREMENTS}-increment curve with one reversal (0 → 3·δmax in 500 increments, back to −3·δmax in 500), seed 000's σ_ini and δmax; the placement (`Bristle::new`, once per realisation) apart:\n"
+        "\n**Bristle count**: the bristle law (`friction-laws`) over a {INCREMENTS}-increment curve with one reversal (0 → 3·δmax in 500 increments, back to −3·δmax in 500), Appels and Herder's σ_ini and δmax; the placement (`Bristle::new`, once per realisation) apart:\n"
     );
     let _ = writeln!(
         s,
@@ -1319,7 +1319,7 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
     if let Some(c) = r.curve.first() {
         let _ = writeln!(
             s,
-            "- seed 000's Experiments 3 curve (≈100 bristles) under 1 ms: {}: {}",
+            "- Appels and Herder's Experiments 3 curve (≈100 bristles) under 1 ms: {}: {}",
             duration(c.time),
             met(c.time < 1e-3)
         );

@@ -1,10 +1,10 @@
-//! Seed 000 (Appels & Herder, TU Delft): the piezo push of the 0.352 kg
+//! Appels and Herder (TU Delft): the piezo push of the 0.352 kg
 //! block through k = 116.04e3 N/m, quasi-static rig (Rig1D, m = 0) against
-//! the pre-sliding bristle law (Bristle.fmu, seed-000 defaults), run from
-//! `examples/seed000_piezo_push.ssd` and `examples/seed000_relaxation.ssd`
+//! the pre-sliding bristle law (Bristle.fmu, defaults: the paper's), run from
+//! `examples/piezo_push.ssd` and `examples/piezo_relaxation.ssd`
 //! through the host.
 //!
-//! The seed's results (MODELS.md "Reference results", "Bristle"): sliding
+//! The paper's results (MODELS.md "Reference results", "Bristle"): sliding
 //! at σ_ini·δmax = μc·m·g; the transition to sliding completed within
 //! 2·δmax of body displacement; after the load is removed the block is
 //! pulled back (relaxation), by at most one bristle's largest deflection,
@@ -12,13 +12,13 @@
 //! The rig–bristle loop is algebraic (both sides direct feedthrough, loop
 //! gain σ_ini/k ≈ 120): the newton master solves it, jacobi cannot.
 
-mod seed_examples;
+mod paper_examples;
 use fricsim::master::{by_name, simulate};
-use seed_examples::*;
+use paper_examples::*;
 
 const K: f64 = 116.04e3;
 const V_A: f64 = 8.25e-8;
-/// Bristle.fmu's seed-000 defaults.
+/// Bristle.fmu's defaults (Appels and Herder's parameters).
 const MU_C: f64 = 0.0633;
 const FN: f64 = 0.352 * 9.81;
 const DELTA_MAX: f64 = 1.5584e-8;
@@ -47,7 +47,7 @@ fn zero_load_position(x: &[f64], f: &[f64], i: usize) -> (f64, f64) {
 
 #[test]
 fn the_push_slides_at_mu_c_m_g_after_a_transition_within_two_delta_max() {
-    let file = example("seed000_piezo_push.ssd");
+    let file = example("piezo_push.ssd");
     assert_eq!(settings(&file).1, "newton");
     assert_eq!(bound(&file, "rig.k"), K);
     assert_eq!(bound(&file, "rig.v_a"), V_A);
@@ -66,7 +66,7 @@ fn the_push_slides_at_mu_c_m_g_after_a_transition_within_two_delta_max() {
             run.time[i]
         );
     }
-    // Sliding at μc·m·g = 0.21858 N (the seed: within 1 %; here exact).
+    // Sliding at μc·m·g = 0.21858 N (the paper: within 1 %; here exact).
     let end = *f.last().unwrap();
     assert!((end / level() - 1.0).abs() < 1e-9, "sliding force {end}");
     // All bristles connected at first: F = σ_ini·x.
@@ -100,7 +100,7 @@ fn the_push_slides_at_mu_c_m_g_after_a_transition_within_two_delta_max() {
         2.0 * DELTA_MAX
     );
     println!(
-        "seed 000 push: sliding at {:.6} N (μc·m·g = {:.6} N), reached between x = {:.4e} and {:.4e} m (2·δmax = {:.4e} m), t = {} s",
+        "piezo push: sliding at {:.6} N (μc·m·g = {:.6} N), reached between x = {:.4e} and {:.4e} m (2·δmax = {:.4e} m), t = {} s",
         end,
         level(),
         x[onset - 1],
@@ -114,7 +114,7 @@ fn the_push_slides_at_mu_c_m_g_after_a_transition_within_two_delta_max() {
 fn the_push_equals_the_monolithic_reference() {
     // The checked quantities are converged: the exact roots of the force
     // balance at the same times (fricsim reference) agree to rounding.
-    let file = example("seed000_piezo_push.ssd");
+    let file = example("piezo_push.ssd");
     let (h, _, stop) = settings(&file);
     let run = run(&file);
     let table = reference(&file, h, stop);
@@ -138,7 +138,7 @@ fn jacobi_breaks_the_force_balance_of_the_piezo_loop() {
     // Jacobi gives the rig the friction force of the previous step: with a
     // loop gain of about 120 the block is thrown back and forth and the
     // friction force takes both signs under a push in one direction.
-    let file = example("seed000_piezo_push.ssd");
+    let file = example("piezo_push.ssd");
     let run = run_with(&file, "jacobi", 1e-2, 1.0);
     let (x, f, xa) = (
         column(&run, "rig.x"),
@@ -161,7 +161,7 @@ fn jacobi_breaks_the_force_balance_of_the_piezo_loop() {
 
 #[test]
 fn removing_the_load_in_sliding_pulls_the_block_back_by_delta_max_minus_x_rel() {
-    let file = example("seed000_relaxation.ssd");
+    let file = example("piezo_relaxation.ssd");
     let (h, master, stop) = settings(&file);
     assert_eq!(master, "newton");
     let t_release = bound(&file, "rig.t_step");
@@ -187,7 +187,7 @@ fn removing_the_load_in_sliding_pulls_the_block_back_by_delta_max_minus_x_rel() 
         x[i - 1] - x0
     };
     let relaxation = relaxation_at(h);
-    // The seed's settling (eqs. 11–13, no bristle connected): the block
+    // The paper's settling (eqs. 11–13, no bristle connected): the block
     // comes back by the mean deflection of the reconnected bristles,
     // δmax − mean|r|, r ~ Normal(x_rel, x_rel/3): δmax − x_rel on average;
     // the mean of N = 109 draws scatters by (x_rel/3)/√109 = 1.3 % of that.
@@ -212,7 +212,7 @@ fn removing_the_load_in_sliding_pulls_the_block_back_by_delta_max_minus_x_rel() 
     );
     let i = index(t_release, h);
     let (x0, _) = zero_load_position(&x, &f, i);
-    let turning = reference(&example("seed000_piezo_push.ssd"), h, t_release)
+    let turning = reference(&example("piezo_push.ssd"), h, t_release)
         .column("rig.x")
         .unwrap()[i];
     let reference_relaxation = turning - x0;
@@ -221,19 +221,19 @@ fn removing_the_load_in_sliding_pulls_the_block_back_by_delta_max_minus_x_rel() 
         "reference {reference_relaxation:e}, co-simulation {relaxation:e}"
     );
     println!(
-        "seed 000 relaxation after sliding: {relaxation:.5e} m (h/2: {finer:.5e}, reference {reference_relaxation:.5e}; δmax − x_rel = {expected:.5e}, δmax = {DELTA_MAX:e})"
+        "piezo relaxation after sliding: {relaxation:.5e} m (h/2: {finer:.5e}, reference {reference_relaxation:.5e}; δmax − x_rel = {expected:.5e}, δmax = {DELTA_MAX:e})"
     );
 }
 
 #[test]
 fn relaxation_grows_with_the_pre_sliding_displacement() {
-    // The seed's Experiments 3: push into pre-sliding, remove the load,
+    // The paper's Experiments 3: push into pre-sliding, remove the load,
     // measure how far the block comes back. Releases every second of the
     // push up to the onset of sliding (about 23 s), each with the load of
     // that instant removed by a drive-force step, solved by the monolithic
     // reference: a property of the law. (Co-simulated with newton, the
     // releases at 20, 21 and 22 s fail: see the ignored test below.)
-    let push = example("seed000_piezo_push.ssd");
+    let push = example("piezo_push.ssd");
     let h = settings(&push).0;
     let pushed = run(&push);
     let (x_push, f_push) = (column(&pushed, "rig.x"), column(&pushed, "friction.F"));
@@ -242,7 +242,7 @@ fn relaxation_grows_with_the_pre_sliding_displacement() {
         let t = f64::from(second);
         let i = index(t, h);
         assert!(f_push[i] < level() * (1.0 - 1e-9), "sliding at {t} s");
-        let mut file = example("seed000_relaxation.ssd");
+        let mut file = example("piezo_relaxation.ssd");
         set_real(&mut file, "rig.t_step", t);
         set_real(&mut file, "rig.F_step", -f_push[i]);
         let table = reference(&file, h, t + 2.0 * h);
@@ -290,7 +290,7 @@ fn relaxation_grows_with_the_pre_sliding_displacement() {
         println!("pre-sliding displacement {d:.4e} m: relaxation {r:.4e} m");
     }
     println!(
-        "least-squares slope: {all:.3} over all releases, {late_slope:.3} for displacements ≥ δmax/2 (seed, measured: ≈ 0.30)"
+        "least-squares slope: {all:.3} over all releases, {late_slope:.3} for displacements ≥ δmax/2 (the paper, measured: ≈ 0.30)"
     );
 }
 
@@ -308,7 +308,7 @@ fn relaxation_grows_with_the_pre_sliding_displacement() {
 /// since the jump of the load does not shrink with the step.
 #[test]
 fn newton_solves_or_reports_every_pre_sliding_release() {
-    let push = example("seed000_piezo_push.ssd");
+    let push = example("piezo_push.ssd");
     let h = settings(&push).0;
     let pushed = run(&push);
     let f_push = column(&pushed, "friction.F");
@@ -316,7 +316,7 @@ fn newton_solves_or_reports_every_pre_sliding_release() {
     for second in 1..=22 {
         let t = f64::from(second);
         let i = index(t, h);
-        let mut file = example("seed000_relaxation.ssd");
+        let mut file = example("piezo_relaxation.ssd");
         set_real(&mut file, "rig.t_step", t);
         set_real(&mut file, "rig.F_step", -f_push[i]);
         let mut system = file.build(0.0).unwrap_or_else(|e| panic!("{e}"));

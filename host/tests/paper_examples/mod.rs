@@ -1,5 +1,5 @@
-//! Helpers of the seed-scenario tests (`seed000.rs`, `seed001.rs`,
-//! `seed003.rs`): open a system file of `examples/` (its sources are
+//! Helpers of the papers' scenario tests (`appels_herder.rs`,
+//! `sun2016.rs`, `thimmalapura2004.rs`): open a system file of `examples/` (its sources are
 //! `../dist/*.fmu`), change parameters, run it through the host with a
 //! master by name as `fricsim run` does, and solve the same file with the
 //! monolithic reference of `fricsim reference`.

@@ -1,9 +1,9 @@
-"""`fricsim run` of seed 004's planar oscillator against FMPy.
+"""`fricsim run` of Wijata et al. 2016's planar oscillator against FMPy.
 
-dist/seed004_planar.ssp (packed by build-fmu.sh from
-examples/seed004_planar.ssd: Rig2D.fmu and Bristle2D.fmu connected
+dist/planar_decay.ssp (packed by build-fmu.sh from
+examples/planar_decay.ssd: Rig2D.fmu and Bristle2D.fmu connected
 v1, v2 -> friction, F1, F2 -> rig, the bristle parameters from
-seed004_bristle2d.ssv) is read by FMPy's own SSP reader
+bristle2d_wijata2016.ssv) is read by FMPy's own SSP reader
 (`fmpy.ssp.ssd.read_ssd`, schema-validated, the .ssv binding resolved inside
 the archive) and its FMUs are driven by FMU2Slave instances in a Python loop
 with the same fixed step (1e-4 s) and Jacobi scheme as fricsim (the loop of
@@ -22,7 +22,7 @@ STOP = 3.0
 
 
 def test_fricsim_run_of_the_planar_oscillator_equals_fmpy(tmp_path):
-    ssp = DIST / "seed004_planar.ssp"
+    ssp = DIST / "planar_decay.ssp"
     assert ssp.exists(), f"{ssp} is missing: run ./build-fmu.sh"
     out = tmp_path / "run.csv"
     # step, master and stop time from the example's annotation

@@ -1,9 +1,9 @@
-//! Seed 004 (Wijata, Awrejcewicz, Matej, Makowski 2016): the planar
-//! oscillator on two-dimensional bristle friction, as the example system
-//! files `examples/seed004_*.ssd` (Rig2D.fmu + Bristle2D.fmu, seed 004's
-//! numerical set from `examples/seed004_bristle2d.ssv`) run through the
+//! Wijata, Awrejcewicz, Matej, Makowski 2016: the planar oscillator on
+//! two-dimensional bristle friction, as the example system files
+//! `examples/planar_*.ssd` (Rig2D.fmu + Bristle2D.fmu, the paper's
+//! numerical set from `examples/bristle2d_wijata2016.ssv`) run through the
 //! host, against the behaviours MODELS.md ("Two-dimensional bristle")
-//! says the seed reports, and against closed forms where one exists:
+//! says the paper reports, and against closed forms where one exists:
 //!
 //! 1. planar oscillator: straight-line decay envelopes (R² > 0.99 of a line
 //!    through the successive peaks of |x1| and of |x2|); the start is a
@@ -20,7 +20,7 @@
 //! less than 0.1 % when the macro step is halved (and, for 1, under the
 //! Newton master), and they agree with the monolithic reference
 //! (`fricsim reference`: Rig2D and the 2-D bristle law solved together by
-//! Radau IIA with the stick/slide switches located), on which the seed's
+//! Radau IIA with the stick/slide switches located), on which the paper's
 //! behaviours are checked as well.
 
 mod common;
@@ -31,7 +31,7 @@ use fricsim::ssp::{SystemFile, Value};
 use std::f64::consts::PI;
 use std::process::Command;
 
-/// Seed 004's numbers shared by the examples: m = 1 kg, k = 100 N/m,
+/// Wijata et al.'s numbers shared by the examples: m = 1 kg, k = 100 N/m,
 /// sliding force σ0·z0 = 1 N, peak (stiction) force (1 + a)·σ0·z0 = 1.1 N.
 const M: f64 = 1.0;
 const K: f64 = 100.0;
@@ -203,7 +203,7 @@ fn planar_peaks(run: &Run) -> [(Vec<f64>, Vec<f64>); 2] {
     ["rig.x1", "rig.x2"].map(|x| half_cycle_peaks(&run.time, &column(run, x), 0.1, F_STICK / K))
 }
 
-/// Behaviour (1) on a result of `seed004_planar`.
+/// Behaviour (1) on a result of `planar_decay`.
 fn check_planar(run: &Run) {
     for (axis, (t, a)) in planar_peaks(run).iter().enumerate() {
         assert!(t.len() >= 6, "x{}: only {} peaks", axis + 1, t.len());
@@ -214,7 +214,7 @@ fn check_planar(run: &Run) {
             axis + 1,
             t.len()
         );
-        // the seed's claim, and the contrast with the dithered case
+        // the paper's claim, and the contrast with the dithered case
         assert!(linear > 0.99, "x{}: R² of the line {linear}", axis + 1);
         assert!(
             linear > exponential,
@@ -249,22 +249,22 @@ fn check_planar(run: &Run) {
 
 #[test]
 fn planar_oscillator_decays_with_straight_line_envelopes() {
-    let (run, _) = run_example("seed004_planar", Options::default());
+    let (run, _) = run_example("planar_decay", Options::default());
     check_planar(&run);
 }
 
 #[test]
 fn planar_oscillator_peaks_are_converged_in_step_and_master() {
-    let (base, h) = run_example("seed004_planar", Options::default());
+    let (base, h) = run_example("planar_decay", Options::default());
     let (halved, _) = run_example(
-        "seed004_planar",
+        "planar_decay",
         Options {
             step: Some(h / 2.0),
             ..Default::default()
         },
     );
     let (newton, _) = run_example(
-        "seed004_planar",
+        "planar_decay",
         Options {
             master: Some("newton"),
             ..Default::default()
@@ -302,7 +302,7 @@ fn planar_oscillator_peaks_are_converged_in_step_and_master() {
     }
 }
 
-/// Surface velocity of `seed004_stick_slip`.
+/// Surface velocity of `planar_stick_slip`.
 const VS: [f64; 2] = [0.006, 0.008];
 
 /// Times at which the axis switches between sticking (|v_i| ≤ 0.1·|vs_i|)
@@ -334,7 +334,7 @@ fn slip_onsets(run: &Run) -> Vec<f64> {
         .collect()
 }
 
-/// Behaviour (2) on a result of `seed004_stick_slip` sampled every `h`.
+/// Behaviour (2) on a result of `planar_stick_slip` sampled every `h`.
 fn check_stick_slip(run: &Run, h: f64) {
     let t = &run.time;
     // Sticking and slipping switch at the same instants in both axes.
@@ -403,15 +403,15 @@ fn check_stick_slip(run: &Run, h: f64) {
 
 #[test]
 fn surface_drag_gives_stick_slip_in_step_in_both_axes() {
-    let (run, h) = run_example("seed004_stick_slip", Options::default());
+    let (run, h) = run_example("planar_stick_slip", Options::default());
     check_stick_slip(&run, h);
 }
 
 #[test]
 fn stick_slip_instants_are_converged() {
-    let (base, h) = run_example("seed004_stick_slip", Options::default());
+    let (base, h) = run_example("planar_stick_slip", Options::default());
     let (halved, _) = run_example(
-        "seed004_stick_slip",
+        "planar_stick_slip",
         Options {
             step: Some(h / 2.0),
             ..Default::default()
@@ -433,7 +433,7 @@ fn stick_slip_instants_are_converged() {
     assert!(relative(pb, pa) < 1e-3, "period {pa} vs {pb}");
 }
 
-/// Dither of `seed004_dither` along x2: amplitude (m) and frequency (Hz).
+/// Dither of `planar_dither` along x2: amplitude (m) and frequency (Hz).
 const DITHER: (f64, f64) = (0.005, 100.0);
 
 /// Envelope fits of the dithered oscillator, per axis: peaks down to a
@@ -443,7 +443,7 @@ fn dither_envelopes(run: &Run) -> [(Vec<f64>, Vec<f64>); 2] {
     ["rig.x1", "rig.x2"].map(|x| half_cycle_peaks(&run.time, &column(run, x), 0.1, floor))
 }
 
-/// Behaviour (3) on a result of `seed004_dither`.
+/// Behaviour (3) on a result of `planar_dither`.
 fn check_dither(run: &Run) {
     let [(t1, a1), (t2, a2)] = dither_envelopes(run);
     assert!(
@@ -502,15 +502,15 @@ fn check_dither(run: &Run) {
 
 #[test]
 fn dither_along_x2_makes_the_envelopes_exponential() {
-    let (run, _) = run_example("seed004_dither", Options::default());
+    let (run, _) = run_example("planar_dither", Options::default());
     check_dither(&run);
 }
 
 #[test]
 fn dither_envelopes_are_converged() {
-    let (base, h) = run_example("seed004_dither", Options::default());
+    let (base, h) = run_example("planar_dither", Options::default());
     let (halved, _) = run_example(
-        "seed004_dither",
+        "planar_dither",
         Options {
             step: Some(h / 2.0),
             ..Default::default()
@@ -561,7 +561,7 @@ fn polar(run: &Run) -> (Vec<f64>, Vec<f64>) {
 fn friction_turns_the_circular_orbit_into_a_spiral() {
     // Without friction (z0 = 1e-12 m: F ≤ 1e-8 N) the orbit is a circle.
     let (free, _) = run_example(
-        "seed004_spiral",
+        "planar_spiral",
         Options {
             parameters: &[("friction.z0", 1e-12)],
             ..Default::default()
@@ -575,11 +575,11 @@ fn friction_turns_the_circular_orbit_into_a_spiral() {
     let t_end = free.time[free.time.len() - 1];
     assert!(relative(phi[phi.len() - 1], omega() * t_end) < 1e-4);
 
-    let (run, _) = run_example("seed004_spiral", Options::default());
+    let (run, _) = run_example("planar_spiral", Options::default());
     check_spiral(&run);
 }
 
-/// Behaviour (4) on a result of `seed004_spiral`: the angle keeps turning
+/// Behaviour (4) on a result of `planar_spiral`: the angle keeps turning
 /// at ω while the radius shrinks by the same amount every turn,
 /// 2π·F/(2mω²), to a rest inside the stiction radius. Returns the radius
 /// at whole turns.
@@ -614,9 +614,9 @@ fn check_spiral(run: &Run) -> Vec<f64> {
 
 #[test]
 fn planar_oscillator_agrees_with_the_reference() {
-    let reference = reference("seed004_planar", None);
+    let reference = reference("planar_decay", None);
     check_planar(&reference);
-    let (run, _) = run_example("seed004_planar", Options::default());
+    let (run, _) = run_example("planar_decay", Options::default());
     for (axis, (a, b)) in planar_peaks(&run)
         .iter()
         .zip(planar_peaks(&reference).iter())
@@ -633,8 +633,8 @@ fn planar_oscillator_agrees_with_the_reference() {
 
 #[test]
 fn stick_slip_agrees_with_the_reference() {
-    let reference = reference("seed004_stick_slip", None);
-    let (run, h) = run_example("seed004_stick_slip", Options::default());
+    let reference = reference("planar_stick_slip", None);
+    let (run, h) = run_example("planar_stick_slip", Options::default());
     check_stick_slip(&reference, h);
     let (a, b) = (slip_onsets(&run), slip_onsets(&reference));
     assert_eq!(a.len(), b.len(), "{a:?} vs {b:?}");
@@ -651,9 +651,9 @@ fn stick_slip_agrees_with_the_reference() {
 fn dither_envelopes_agree_with_the_reference() {
     // sampled every 1e-4 s (the run's step is 2.5e-5 s): a quarter of the
     // rows, the same integration (its steps stop at every dither reversal)
-    let reference = reference("seed004_dither", Some(1e-4));
+    let reference = reference("planar_dither", Some(1e-4));
     check_dither(&reference);
-    let (run, _) = run_example("seed004_dither", Options::default());
+    let (run, _) = run_example("planar_dither", Options::default());
     let (a, b) = (dither_envelopes(&run), dither_envelopes(&reference));
     for axis in 0..2 {
         let ((ta, pa), (tb, pb)) = (&a[axis], &b[axis]);
@@ -680,8 +680,8 @@ fn dither_envelopes_agree_with_the_reference() {
 
 #[test]
 fn spiral_agrees_with_the_reference() {
-    let reference = check_spiral(&reference("seed004_spiral", None));
-    let (run, _) = run_example("seed004_spiral", Options::default());
+    let reference = check_spiral(&reference("planar_spiral", None));
+    let (run, _) = run_example("planar_spiral", Options::default());
     let radii = check_spiral(&run);
     let worst = worst_relative(&radii, &reference);
     eprintln!("radii at whole turns differ from the reference by {worst:.1e}");

@@ -1,6 +1,6 @@
-//! Seed 001 (Sun et al. 2016): the identification trials of the ~1 kg
-//! brass block, run from `examples/seed001_step_force.ssd` (LuGre, force
-//! steps) and `examples/seed001_dahl_velocity.ssd` (Dahl, velocity
+//! Sun et al. 2016: the identification trials of the ~1 kg
+//! brass block, run from `examples/lugre_step_force.ssd` (LuGre, force
+//! steps) and `examples/dahl_velocity.ssd` (Dahl, velocity
 //! control on v = 1e-3·sin(t/k)) through the host.
 //!
 //! MODELS.md "Reference results": a step force below break-away settles at
@@ -8,17 +8,17 @@
 //! The first holds for LuGre's bristle deflection z, not for the position
 //! x: z lags x by ∫σ0·|v|·z/g(v) dt, so x exceeds F/σ0 by 13–183 % after
 //! a step of 0.5–1.5 N and by 12–59 % under slow loading, where it follows
-//! x = −(Fs/σ0)·ln(1 − F/Fs) (the tests check these values; the seed's
+//! x = −(Fs/σ0)·ln(1 − F/Fs) (the tests check these values; the paper's
 //! identification assumed z = x in pre-sliding, eq. 19–21).
 
-mod seed_examples;
-use seed_examples::*;
+mod paper_examples;
+use paper_examples::*;
 
-/// Seed 001's LuGre parameters (examples/lugre_seed001.ssv).
+/// Sun et al.'s LuGre parameters (examples/lugre_sun2016.ssv).
 const SIGMA0: f64 = 66_967.231;
 const FS: f64 = 2.35;
 const VS: f64 = 1.139_75e-3;
-/// Seed 001 Table 7 (Dahl).
+/// Sun et al. Table 7 (Dahl).
 const DAHL_FC: f64 = 2.0;
 const DAHL_SIGMA: f64 = 87_750.0;
 
@@ -34,7 +34,7 @@ fn slow_loading_position(f: f64) -> f64 {
 
 #[test]
 fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
-    let example_file = example("seed001_step_force.ssd");
+    let example_file = example("lugre_step_force.ssd");
     assert_eq!(bound(&example_file, "friction.sigma0"), SIGMA0);
     assert_eq!(bound(&example_file, "friction.Fs"), FS);
     assert_eq!(bound(&example_file, "rig.F_step"), 1.0);
@@ -43,7 +43,7 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
     // carries more of the plastic part ∫σ0·|v|·z/g dt than under slow
     // loading; the ratios x/(F/σ0) of the monolithic reference.
     for (force, ratio) in [(0.5, 1.1349), (1.0, 1.4397), (1.5, 2.8333)] {
-        let mut file = example("seed001_step_force.ssd");
+        let mut file = example("lugre_step_force.ssd");
         set_real(&mut file, "rig.F_step", force);
         let run = run_with(&file, &master, h, stop);
         // Settled, not sliding: at rest with the friction equal to the force.
@@ -53,7 +53,7 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
             last(&run, "rig.v")
         );
         assert!((last(&run, "friction.F") / force - 1.0).abs() < 1e-6);
-        // The bristles carry the force: z = F/σ0 (seed eq. 21 for z).
+        // The bristles carry the force: z = F/σ0 (their eq. 21 for z).
         let z = last(&run, "friction.z");
         assert!((z * SIGMA0 / force - 1.0).abs() < 1e-6, "z = {z:e}");
         // The position, against the monolithic reference and at half the
@@ -70,7 +70,7 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
         );
         let x_half = last(&run_with(&file, &master, h / 2.0, stop), "rig.x");
         assert!((x_half / x - 1.0).abs() < 1e-3, "h: {x:e}, h/2: {x_half:e}");
-        // The seed's x = F/σ0 does not hold for x (see the module text).
+        // The paper's x = F/σ0 does not hold for x (see the module text).
         assert!(
             (x_ref * SIGMA0 / force / ratio - 1.0).abs() < 1e-4,
             "reference x/(F/σ0) = {}",
@@ -84,10 +84,10 @@ fn step_forces_settle_in_pre_sliding_with_the_bristles_at_f_over_sigma0() {
 }
 
 /// The step-force system loaded by a quarter period of a 1/16 Hz sine
-/// instead: the force rises to `peak` in 4 s (the seed's trials took about
+/// instead: the force rises to `peak` in 4 s (the paper's trials took about
 /// 4 s to reach the set force) and the run ends at the peak.
 fn slowly_loaded(peak: f64) -> fricsim::master::Run {
-    let mut file = example("seed001_step_force.ssd");
+    let mut file = example("lugre_step_force.ssd");
     set_real(&mut file, "rig.F_step", 0.0);
     set_real(&mut file, "rig.drive_amp", peak);
     set_real(&mut file, "rig.drive_freq", 1.0 / 16.0);
@@ -110,11 +110,11 @@ fn slowly_loaded_block_follows_the_pre_sliding_closed_form() {
             force / SIGMA0
         );
     }
-    // The seed's x = F/σ0 is the small-force limit: within 1 % at 0.02 N
+    // The paper's x = F/σ0 is the small-force limit: within 1 % at 0.02 N
     // (F/Fs < 2 %), after a step too.
     let x = last(&slowly_loaded(0.02), "rig.x");
     assert!((x * SIGMA0 / 0.02 - 1.0).abs() < 1e-2, "x = {x:e}");
-    let mut file = example("seed001_step_force.ssd");
+    let mut file = example("lugre_step_force.ssd");
     set_real(&mut file, "rig.F_step", 0.02);
     let x = last(&run(&file), "rig.x");
     assert!((x * SIGMA0 / 0.02 - 1.0).abs() < 1e-2, "x = {x:e}");
@@ -123,7 +123,7 @@ fn slowly_loaded_block_follows_the_pre_sliding_closed_form() {
 #[test]
 fn break_away_at_fs_under_slow_loading_below_it_after_a_step() {
     // Slowly loaded, the block holds at 2.3 N and slides at 2.4 N: the
-    // break-away level is Fs = 2.35 N (the seed measured the block static
+    // break-away level is Fs = 2.35 N (the paper measured the block static
     // within [−2.4, 2.2] N).
     let held = slowly_loaded(2.3);
     assert!(
@@ -139,7 +139,7 @@ fn break_away_at_fs_under_slow_loading_below_it_after_a_step() {
     // away below Fs (above 1.68 N on the reference): 1.5 N holds, 2.0 N
     // slides.
     for (force, slides) in [(1.5, false), (2.0, true)] {
-        let mut file = example("seed001_step_force.ssd");
+        let mut file = example("lugre_step_force.ssd");
         set_real(&mut file, "rig.F_step", force);
         let (h, master, _) = settings(&file);
         let v = last(&run_with(&file, &master, h, 0.5), "rig.v");
@@ -149,7 +149,7 @@ fn break_away_at_fs_under_slow_loading_below_it_after_a_step() {
 
 /// One Dahl trial v_ref = 1e-3·sin(t/k) over one period; returns the run.
 fn dahl_trial(k: f64, h: f64) -> fricsim::master::Run {
-    let mut file = example("seed001_dahl_velocity.ssd");
+    let mut file = example("dahl_velocity.ssd");
     set_real(
         &mut file,
         "rig.ref_freq",
@@ -209,17 +209,17 @@ fn dahl_deviation(run: &fricsim::master::Run, k: f64) -> (f64, (f64, f64), f64) 
 
 #[test]
 fn dahl_velocity_trials_follow_the_closed_form() {
-    let file = example("seed001_dahl_velocity.ssd");
+    let file = example("dahl_velocity.ssd");
     assert_eq!(bound(&file, "friction.sigma"), DAHL_SIGMA);
     assert_eq!(bound(&file, "friction.Fc"), DAHL_FC);
     let h = settings(&file).0;
     for k in [1.0, 2.0, 4.0, 6.0] {
         let run = dahl_trial(k, h);
         let (deviation, (xr, fr), tracking) = dahl_deviation(&run, k);
-        // The seed's trials: the block follows the velocity reference (within
+        // The paper's trials: the block follows the velocity reference (within
         // 6 % of its amplitude at k = 1, 4 % at k = 2).
         assert!(tracking < 0.1, "k = {k}: velocity off by {tracking}");
-        // F(x) is the closed form (the seed: within 1 %; here 1e-3 of Fc).
+        // F(x) is the closed form (the paper: within 1 %; here 1e-3 of Fc).
         assert!(
             deviation < 1e-3,
             "k = {k}: |F − closed form| = {deviation}·Fc"
