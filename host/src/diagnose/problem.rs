@@ -10,7 +10,7 @@
 //! `[t_k, t_k+1]`:
 //! - measured directly when `friction.F` is a column;
 //! - otherwise by inverse dynamics of the Rig1D the friction acts on
-//!   (seed 001 eq. 15; the EMPS benchmark's inverse dynamic model), from
+//!   (Sun et al. 2016, eq. 15; the EMPS benchmark's inverse dynamic model), from
 //!   its equation `m·ẍ = k·(x_a − x) − c·ẋ + F_ext − F + F_d(t) + F_ctrl`:
 //!   `F = k·(x_a − x) − c·ẋ + F_ext + F_d(t) + G·u_ctrl − m·ẍ`, with x
 //!   from the measured `rig.x` smoothed by a Savitzky–Golay filter (local
