@@ -6,7 +6,7 @@
 # newton-interpolated and adaptive, with the wall time of every run.
 #
 # Builds the FMUs and the examples' archives (build-fmu.sh) and the
-# accuracy-table program (host/src/bin/accuracy_table.rs), then runs it;
+# accuracy-table program (bench/src/bin/accuracy_table.rs), then runs it;
 # the tables are written between the markers of BENCHMARKS.md. Arguments
 # go to the program: --quick (1e-3 s only, 2 s per case), --steps,
 # --stop, --masters, --cases, --update OTHER.md; --help lists them.
@@ -18,7 +18,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./build-fmu.sh >/dev/null
-cargo build --release -p fricsim --bin accuracy-table
+cargo build --release -p fricsim-bench --bin accuracy-table
 args=("$@")
 case " $* " in
     *" --update "*|*" --update="*|*" --check "*|*" --check="*) ;;

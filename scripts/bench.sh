@@ -9,7 +9,7 @@
 #
 # Builds the FMUs (build-fmu.sh), the pinned Python venv with FMPy
 # (scripts/setup-venv.sh) and the speed-table program
-# (host/src/bin/speed_table.rs), then runs it; the tables are written
+# (bench/src/bin/speed_table.rs), then runs it; the tables are written
 # between the markers `<!-- speed: begin … -->` and `<!-- speed: end -->`
 # of BENCHMARKS.md. Arguments go to the program: --quick (short runs, no
 # fricsim diagnose: the tables appear, the numbers mean little),
@@ -21,7 +21,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./build-fmu.sh >/dev/null
 scripts/setup-venv.sh
-cargo build --release -p fricsim --bin speed-table --bin fricsim
+cargo build --release -p fricsim-bench -p fricsim --bin speed-table --bin fricsim
 args=("$@")
 case " $* " in
     *" --update "*|*" --update="*) ;;

@@ -3,7 +3,7 @@
 `fricsim run`, driven from Python by FMPy's low-level FMU2Slave API.
 
 The system comes as JSON on stdin (written by the `speed-table` program,
-host/src/bin/speed_table.rs, from the same system file it runs itself):
+bench/src/bin/speed_table.rs, from the same system file it runs itself):
 
     {"components": [{"name": "rig", "fmu": "dist/Rig1D.fmu",
                      "parameters": {"m": 1.0, ...}}, ...],

@@ -32,7 +32,7 @@ rm -rf "$out"
 mkdir -p "$out"
 
 ./build-fmu.sh > /dev/null
-cargo build --release --quiet -p fricsim --bin hidden-effect-suite
+cargo build --release --quiet -p fricsim-bench --bin hidden-effect-suite
 suite=target/release/hidden-effect-suite
 grid=(--all "${magnitudes[@]}" --seeds "$seeds" --null-seeds "$null_seeds")
 

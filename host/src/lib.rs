@@ -23,7 +23,6 @@
 //! # Ok::<(), fricsim::FmuError>(())
 //! ```
 
-pub mod benchmarks;
 pub mod compare;
 pub mod error;
 pub mod fmu;

@@ -1,6 +1,6 @@
 //! A system file as the monolithic reference sees it ([`fricsim_reference`]):
 //! used by `fricsim reference` and by the accuracy table
-//! (`src/bin/accuracy_table.rs`), so that both solve the same system.
+//! (`bench/src/bin/accuracy_table.rs`), so that both solve the same system.
 
 use crate::ssp::{SystemFile, Value as SspValue};
 use fricsim_reference::{ComponentSpec, SystemSpec, Value};

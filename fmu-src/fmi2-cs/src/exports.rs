@@ -293,11 +293,11 @@ unsafe fn c_str(s: fmi2String, what: &str) -> Result<String, String> {
 }
 
 pub fn types_platform() -> *const c_char {
-    TYPES_PLATFORM.as_ptr() as *const c_char
+    fmi2TypesPlatform.as_ptr()
 }
 
 pub fn version() -> *const c_char {
-    VERSION.as_ptr() as *const c_char
+    fmi2Version.as_ptr()
 }
 
 /// `fmi2Instantiate`: the GUID picks the model from `registry`.

@@ -18,7 +18,7 @@
 //!   measurement-noise floor) and against the noise-free truth (the model
 //!   error alone).
 //!
-//! `hidden-effect-suite` (host/src/bin) runs a grid of cases and writes
+//! `hidden-effect-suite` (bench/src/bin) runs a grid of cases and writes
 //! the table of BENCHMARKS.md; `host/tests/diagnose_hidden_effects.rs`
 //! runs a few.
 

@@ -10,13 +10,13 @@
 //! value-access and step functions do not allocate unless they fail.
 
 use super::archive::{unpack, UnpackOptions};
-use super::ffi::*;
 use super::library::{c_text, Functions, Library};
 use super::logger::{fricsim_fmi2_logger, Log, Sink};
 use super::model_description::{ModelDescription, ScalarVariable, ValueReference};
 use super::watchdog::Watched;
 use super::Status;
 use crate::error::FmuError;
+use fmi2_types::*;
 use std::ffi::CString;
 use std::mem::ManuallyDrop;
 use std::os::raw::c_void;

@@ -7,9 +7,9 @@
 //! and output derivatives §4.2.1) are resolved only when the model
 //! description declares the capability, and then they must be there.
 
-use super::ffi::*;
 use super::model_description::ModelDescription;
 use crate::error::FmuError;
+use fmi2_types::*;
 use std::ffi::CStr;
 use std::path::{Path, PathBuf};
 
@@ -159,7 +159,7 @@ impl Library {
 
         // SAFETY: both functions take no arguments and return a static string.
         let version = unsafe { c_text((functions.get_version)()) };
-        if version != "2.0" {
+        if version.as_bytes() != fmi2Version.to_bytes() {
             return Err(FmuError::WrongFmiVersion {
                 path: path.to_path_buf(),
                 found: version,

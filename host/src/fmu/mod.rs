@@ -6,9 +6,12 @@
 //! - [`logger`]: the FMU's log messages (callback in `logger.c`);
 //! - [`instance`]: [`Fmu`] and its [`Instance`]s, the safe API;
 //! - [`watchdog`]: the optional time limit on each call.
+//!
+//! The C types of the standard are those of `fmi2-types`, the crate the
+//! exporter of this repository (`fmi2-cs`) uses too; the host depends on
+//! that crate alone, not on the exporter.
 
 pub mod archive;
-mod ffi;
 pub mod instance;
 pub mod library;
 pub mod logger;

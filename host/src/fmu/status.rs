@@ -1,5 +1,6 @@
 //! `fmi2Status` (FMI 2.0.4 §2.1.3) as a Rust value.
 
+use fmi2_types::{fmi2Discard, fmi2Error, fmi2Fatal, fmi2OK, fmi2Pending, fmi2Warning};
 use std::fmt;
 use std::os::raw::c_int;
 
@@ -19,15 +20,16 @@ pub enum Status {
 }
 
 impl Status {
-    /// The status an FMU returned as a C integer.
+    /// The status an FMU returned as a C integer ([`fmi2_types::fmi2Status`]).
+    #[allow(non_upper_case_globals)] // the standard's names, as patterns
     pub fn from_raw(raw: c_int) -> Status {
         match raw {
-            0 => Status::Ok,
-            1 => Status::Warning,
-            2 => Status::Discard,
-            3 => Status::Error,
-            4 => Status::Fatal,
-            5 => Status::Pending,
+            fmi2OK => Status::Ok,
+            fmi2Warning => Status::Warning,
+            fmi2Discard => Status::Discard,
+            fmi2Error => Status::Error,
+            fmi2Fatal => Status::Fatal,
+            fmi2Pending => Status::Pending,
             other => Status::Invalid(other),
         }
     }

@@ -1,5 +1,7 @@
 //! Helpers shared by the integration tests: the C stub FMU (compiled with
 //! `cc` at test time), zipping a directory, and the repository's LuGre.fmu.
+//! The tests of bench/ (the BENCHMARKS.md programs) include this file by
+//! path too, so paths here are relative to the workspace, not to host/.
 #![allow(dead_code)]
 
 use std::io::Write;
@@ -9,7 +11,7 @@ use std::sync::OnceLock;
 use tempfile::TempDir;
 
 /// The stub FMU's C source.
-pub const STUB_SOURCE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/c/stub_fmu.c");
+pub const STUB_SOURCE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../host/tests/c/stub_fmu.c");
 
 /// Compile C `source` into the shared library `out` with extra `flags`.
 pub fn compile_shared(source: &Path, out: &Path, flags: &[&str]) {

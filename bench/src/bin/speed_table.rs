@@ -42,14 +42,14 @@
 //! builds everything and updates BENCHMARKS.md.
 
 use clap::Parser;
-use fricsim::benchmarks::{
-    bristle_curve, bristle_curve_point, command_line, exit_code, load_average, machine, splice,
-    today, FmuStepper, TableFileArgs, FRICTION_FMUS, INCREMENTS,
-};
 use fricsim::fmu::Fmu;
 use fricsim::master::{by_name, simulate_with, step_count, NoObserver, Rows};
 use fricsim::ssp::{SystemFile, Value};
 use fricsim::sweep::{grid, run_all, Axis, Plan};
+use fricsim_bench::{
+    bristle_curve, bristle_curve_point, command_line, exit_code, load_average, machine, splice,
+    today, FmuStepper, TableFileArgs, FRICTION_FMUS, INCREMENTS,
+};
 use friction_laws::bristle::{Bristle, BristleParams};
 use friction_laws::dahl::{Dahl, DahlParams};
 use friction_laws::lugre::{HeldInput, LuGre, LuGreInputs, LuGreParams};

@@ -1,6 +1,16 @@
-//! What the programs that write BENCHMARKS.md share (`accuracy-table`,
-//! `speed-table`): replacing the generated part of a markdown file between
-//! two markers, and naming the machine and the date of a measurement.
+//! `fricsim-bench`: the programs that measure the host for BENCHMARKS.md,
+//! kept out of the product (`fricsim`, host/), which they use as a library:
+//!
+//! - `speed-table` (scripts/bench.sh): the speed tables, the monolithic
+//!   limit included (the laws and the rig stepped in one loop, no FMI);
+//! - `accuracy-table` (scripts/accuracy-table.sh): the accuracy table;
+//! - `hidden-effect-suite` (scripts/hidden-effect-suite.sh): the
+//!   hidden-effect suite of `fricsim diagnose`;
+//! - `benches/speed.rs`: criterion's statistics for single figures.
+//!
+//! This library is what they share: replacing the generated part of a
+//! markdown file between two markers, naming the machine and the date of a
+//! measurement, and the workloads of the speed figures.
 
 use std::path::Path;
 
@@ -171,10 +181,10 @@ pub const FRICTION_FMUS: &[DrivenFmu] = &[
 /// resolved value references: [`FmuStepper::step`] is one communication
 /// step through the C ABI (`fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal`).
 pub struct FmuStepper {
-    instance: crate::fmu::Instance,
+    instance: fricsim::fmu::Instance,
     inputs: &'static [Sinusoid],
-    input_vrs: Vec<crate::fmu::ValueReference>,
-    output_vrs: Vec<crate::fmu::ValueReference>,
+    input_vrs: Vec<fricsim::fmu::ValueReference>,
+    output_vrs: Vec<fricsim::fmu::ValueReference>,
     u: Vec<f64>,
     /// The outputs after the last step.
     pub y: Vec<f64>,
@@ -183,7 +193,7 @@ pub struct FmuStepper {
 impl FmuStepper {
     /// Instantiate the `index`-th model of [`FRICTION_FMUS`] from `fmu`,
     /// initialised at t = 0 with its default parameters.
-    pub fn new(fmu: &crate::fmu::Fmu, index: usize) -> Result<FmuStepper, String> {
+    pub fn new(fmu: &fricsim::fmu::Fmu, index: usize) -> Result<FmuStepper, String> {
         let (model, inputs, outputs) = FRICTION_FMUS[index];
         let vr = |name: &str| {
             fmu.variable(name)
@@ -212,7 +222,7 @@ impl FmuStepper {
     }
 
     /// Set the inputs at `t`, step to `t + h`, read the outputs.
-    pub fn step(&mut self, t: f64, h: f64) -> Result<(), crate::FmuError> {
+    pub fn step(&mut self, t: f64, h: f64) -> Result<(), fricsim::FmuError> {
         for (x, (_, a, phase)) in self.u.iter_mut().zip(self.inputs) {
             *x = a * (std::f64::consts::TAU * t + phase).sin();
         }

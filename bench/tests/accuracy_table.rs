@@ -10,6 +10,7 @@
 //! stay reproducible), and an entry altered in a copy must be refused and
 //! named. Nothing here depends on how fast the machine is.
 
+#[path = "../../host/tests/common/mod.rs"]
 mod common;
 
 use common::table_row as cells;

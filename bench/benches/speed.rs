@@ -1,5 +1,5 @@
 //! Criterion benchmarks of the Rust parts behind BENCHMARKS.md's speed
-//! tables (`cargo bench -p fricsim --bench speed`), with criterion's
+//! tables (`cargo bench -p fricsim-bench --bench speed`), with criterion's
 //! statistics for a closer look at one figure; the tables themselves come
 //! from `speed-table` (scripts/bench.sh), which measures everything in one
 //! run, FMPy included.
@@ -11,8 +11,8 @@
 //!   curve with one reversal ([`bristle_curve`]), 10 to 100 000 bristles.
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
-use fricsim::benchmarks::{bristle_curve, FmuStepper, FRICTION_FMUS};
 use fricsim::fmu::Fmu;
+use fricsim_bench::{bristle_curve, FmuStepper, FRICTION_FMUS};
 use friction_laws::bristle::{Bristle, BristleParams};
 use std::path::Path;
 

@@ -34,12 +34,12 @@
 //! wall times and the "Generated" line are not compared.
 
 use clap::Parser;
-use fricsim::benchmarks::{
-    command_line, exit_code, generated_part, machine, splice, today, TableFileArgs,
-};
 use fricsim::compare::{compare, ResultFile};
 use fricsim::master::{by_name, simulate_with, NoObserver, Run};
 use fricsim::ssp::SystemFile;
+use fricsim_bench::{
+    command_line, exit_code, generated_part, machine, splice, today, TableFileArgs,
+};
 use fricsim_reference::{ReferenceModel, RTOL};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

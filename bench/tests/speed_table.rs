@@ -3,6 +3,7 @@
 //! its markers, with every row, and keep the rest of the file. No timing
 //! is checked: the numbers depend on the machine.
 
+#[path = "../../host/tests/common/mod.rs"]
 mod common;
 
 use std::process::Command;

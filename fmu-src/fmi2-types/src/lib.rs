@@ -1,14 +1,26 @@
-//! C types of the FMI 2.0 standard (`fmi2TypesPlatform.h`,
-//! `fmi2FunctionTypes.h`; FMI 2.0.4 §2.1.2–§2.1.5 and §4.2), as the importer
-//! sees them.
+//! The C types of the FMI 2.0 standard (`fmi2TypesPlatform.h`,
+//! `fmi2FunctionTypes.h`; FMI 2.0.4 §2.1.2–§2.1.5 and §4.2), written once
+//! for both sides of the C ABI: the exporter (`fmi2-cs`, which the FMUs of
+//! this repository are built on) and the importer (`fricsim`, host/), which
+//! imports FMUs built by anyone and so depends on this crate, not on the
+//! exporter. Types and constants only: no code, no dependencies, `no_std`.
 //!
-//! Every function returns its `fmi2Status` as a plain `c_int` here, not as a
-//! Rust enum: an FMU built by someone else may return any integer, and an
-//! out-of-range value in a `#[repr(C)] enum` would be undefined behaviour.
-//! [`Status::from_raw`](super::Status::from_raw) converts it.
+//! Every status crosses the ABI as a plain `c_int` ([`fmi2Status`]), as
+//! the C `enum` does: an importer must accept whatever integer an FMU
+//! returns, and an out-of-range value in a `#[repr(C)] enum` would be
+//! undefined behaviour. An exporter, which only ever returns values it
+//! made, may use an enum of its own on its side of the ABI (`fmi2-cs`
+//! does, checked against [`fmi2OK`] … [`fmi2Pending`] at compile time).
+#![no_std]
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
 
-use std::os::raw::{c_char, c_int, c_uint, c_void};
+use core::ffi::{c_char, c_int, c_uint, c_void, CStr};
+
+/// `fmi2TypesPlatform` (§2.1.2): what `fmi2GetTypesPlatform` returns for
+/// the types of this crate.
+pub const fmi2TypesPlatform: &CStr = c"default";
+/// `fmi2Version` (§2.1.4): what `fmi2GetVersion` returns.
+pub const fmi2Version: &CStr = c"2.0";
 
 pub type fmi2Component = *mut c_void;
 pub type fmi2ComponentEnvironment = *mut c_void;
@@ -20,21 +32,32 @@ pub type fmi2Boolean = c_int;
 pub type fmi2Char = c_char;
 pub type fmi2String = *const fmi2Char;
 pub type fmi2Byte = c_char;
-/// An `fmi2Status` as returned by the FMU (0 = OK … 5 = Pending).
-pub type fmi2Status = c_int;
 
 pub const fmi2True: fmi2Boolean = 1;
 pub const fmi2False: fmi2Boolean = 0;
 
+/// An `fmi2Status` as it crosses the ABI (§2.1.3), ordered by severity:
+/// [`fmi2OK`] … [`fmi2Pending`]; any other value is a broken FMU.
+pub type fmi2Status = c_int;
+pub const fmi2OK: fmi2Status = 0;
+pub const fmi2Warning: fmi2Status = 1;
+pub const fmi2Discard: fmi2Status = 2;
+pub const fmi2Error: fmi2Status = 3;
+pub const fmi2Fatal: fmi2Status = 4;
+pub const fmi2Pending: fmi2Status = 5;
+
 pub type fmi2Type = c_int;
+pub const fmi2ModelExchange: fmi2Type = 0;
 pub const fmi2CoSimulation: fmi2Type = 1;
 
 pub type fmi2StatusKind = c_int;
+pub const fmi2DoStepStatus: fmi2StatusKind = 0;
+pub const fmi2PendingStatus: fmi2StatusKind = 1;
 pub const fmi2LastSuccessfulTime: fmi2StatusKind = 2;
 pub const fmi2Terminated: fmi2StatusKind = 3;
 
-/// The importer's logger (§2.1.5). Variadic in C: ours is written in C
-/// (`logger.c`).
+/// The importer's logger (§2.1.5). Variadic in C: stable Rust can call it
+/// but cannot define it (fricsim's is written in C, `logger.c`).
 pub type fmi2CallbackLogger = Option<
     unsafe extern "C" fn(
         fmi2ComponentEnvironment,
