@@ -10,6 +10,8 @@ cargo build --release -p friction-fmu-c -p rig-fmu-c -p fmu-packager -p friction
 target/release/fmu-package check modelDescription
 target/release/fmu-package build --lib-dir target/release --out dist
 cargo build --release -p fricsim
+# (packed afresh: an example renamed or removed leaves no stale archive)
+rm -f dist/*.ssp
 for ssd in examples/*.ssd; do
     target/release/fricsim pack "$ssd" "dist/$(basename "$ssd" .ssd).ssp"
 done
