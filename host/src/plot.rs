@@ -122,6 +122,10 @@ pub(crate) fn tick_label(y: f64, lo: f64, hi: f64) -> String {
     if !(magnitude.is_finite() && resolution > 0.0) {
         return format!("{y}");
     }
+    // a tick at zero that rounding moved off it (-3e-21 on a range of 1e-5)
+    if y.abs() < resolution * 1e-6 {
+        return "0".into();
+    }
     let finest = resolution.log10().floor() as i32;
     if (1e-3..1e5).contains(&magnitude) {
         format!("{:.*}", (-finest).max(0) as usize, y)
@@ -152,5 +156,7 @@ mod tests {
         assert_eq!(tick_label(2.5, 0.0, 10.0), "2.5");
         assert_eq!(tick_label(250000.0, 0.0, 1e6), "2.5e5");
         assert_eq!(tick_label(f64::NAN, 0.0, 1.0), "NaN");
+        // zero, rounded off it
+        assert_eq!(tick_label(-3e-21, -2e-5, 3e-5), "0");
     }
 }

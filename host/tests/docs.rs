@@ -483,19 +483,7 @@ fn no_help_text_cites_a_paper_by_a_seed_number() {
             &help(fricsim, &[&command]),
         ));
     }
-    for (name, program) in [
-        ("accuracy-table", env!("CARGO_BIN_EXE_accuracy-table")),
-        ("speed-table", env!("CARGO_BIN_EXE_speed-table")),
-        (
-            "hidden-effect-suite",
-            env!("CARGO_BIN_EXE_hidden-effect-suite"),
-        ),
-    ] {
-        problems.extend(paper_numbers(
-            &format!("{name} --help"),
-            &help(program, &[]),
-        ));
-    }
+    // (the benchmark programs' help: bench/tests/help.rs)
     assert!(
         problems.is_empty(),
         "cite the paper by author and year, not by a seed number:\n{}",

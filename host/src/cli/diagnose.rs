@@ -185,7 +185,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         );
     }
     println!(
-        "{:.2} s; wrote {}/report.json, report.md, fit.png, residual.png, refitted.ssp",
+        "{:.2} s; wrote {}/report.html (open it in a browser), report.md, report.json, gap.png, fit.png, law.png, residual.png, refitted.ssp, inputs.csv",
         d.wall_seconds,
         out.display()
     );

@@ -53,7 +53,46 @@ pub struct Where {
     /// ([`attribute`]); `state`/`bin` above are the strongest bin of the
     /// first of these.
     pub explained_by: Vec<Attribution>,
+    /// The time spans (s) where the effect earns its improvement: of 100
+    /// runs of consecutive held-out intervals, those whose share of the
+    /// improvement is at least twice their share of the samples, joined
+    /// where they touch.
+    pub intervals: Vec<(f64, f64)>,
 }
+
+/// Runs of consecutive `intervals` (at most [`EARNING_RUNS`], of equal
+/// count) whose share of the total of `gain` is at least twice their share
+/// of the intervals, as time spans, joined where they touch.
+fn earning_spans(
+    d: &FrictionData,
+    intervals: &[usize],
+    gain: &dyn Fn(usize) -> f64,
+) -> Vec<(f64, f64)> {
+    let total: f64 = intervals.iter().map(|&j| gain(j)).sum();
+    let n = intervals.len();
+    if n == 0 || total.is_nan() || total <= 0.0 {
+        return Vec::new();
+    }
+    let runs = EARNING_RUNS.min(n);
+    let mut spans: Vec<(f64, f64)> = Vec::new();
+    for r in 0..runs {
+        let run = &intervals[r * n / runs..(r + 1) * n / runs];
+        let share = run.iter().map(|&j| gain(j)).sum::<f64>() / total;
+        if share < 2.0 * run.len() as f64 / n as f64 {
+            continue;
+        }
+        let (first, last) = (run[0], run[run.len() - 1]);
+        let (t0, t1) = (d.t[first], d.t[last] + d.h[last]);
+        match spans.last_mut() {
+            Some(prev) if t0 <= prev.1 + 1.5 * d.h[first] => prev.1 = t1,
+            _ => spans.push((t0, t1)),
+        }
+    }
+    spans
+}
+
+/// Runs the held-out data are cut into by [`earning_spans`].
+const EARNING_RUNS: usize = 100;
 
 /// How much of an effect's improvement each state explains.
 #[derive(Clone, Debug, Serialize)]
@@ -440,6 +479,7 @@ pub fn where_improved(
             .map(|(state, label, g, s)| (state.to_string(), label, g, s))
             .collect(),
         explained_by,
+        intervals: earning_spans(d, intervals, &gain),
     }
 }
 

@@ -29,7 +29,9 @@
 //!    data, and say where it lies ([`localise`]).
 
 pub mod dahl;
+pub mod figures;
 pub mod fit;
+pub mod html;
 pub mod localise;
 pub mod model;
 pub mod problem;
@@ -250,6 +252,52 @@ pub struct CandidateScore {
     pub failure: Option<String>,
 }
 
+/// A LuGre FMU variable before and after a change, by the FMU's own name
+/// and unit (what a user sets in the FMU).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FmuValue {
+    pub name: String,
+    pub unit: String,
+    pub before: f64,
+    pub after: f64,
+}
+
+/// `names` of the friction FMU from `before` to `after`, with the FMU's
+/// units; a name `before` does not set has the FMU's start value there (a
+/// name `after` does not carry is left out).
+fn fmu_values(
+    fmu: &crate::fmu::Fmu,
+    names: &[String],
+    before: &FrictionModel,
+    after: &FrictionModel,
+) -> Vec<FmuValue> {
+    let (b, a): (
+        std::collections::BTreeMap<String, f64>,
+        std::collections::BTreeMap<String, f64>,
+    ) = (
+        before.parameters().into_iter().collect(),
+        after.parameters().into_iter().collect(),
+    );
+    names
+        .iter()
+        .filter_map(|n| {
+            let (unit, start) = match fmu.variable(n).ok().map(|v| &v.kind) {
+                Some(crate::fmu::model_description::VariableKind::Real { unit, start, .. }) => {
+                    (unit.clone().unwrap_or_default(), *start)
+                }
+                _ => (String::new(), None),
+            };
+            Some(FmuValue {
+                name: n.clone(),
+                unit,
+                // a variable the model did not set had the FMU's start value
+                before: b.get(n).copied().or(start).or(a.get(n).copied())?,
+                after: *a.get(n)?,
+            })
+        })
+        .collect()
+}
+
 /// An accepted effect.
 #[derive(Clone, Debug, Serialize)]
 pub struct FoundEffect {
@@ -260,6 +308,8 @@ pub struct FoundEffect {
     pub meaning: &'static str,
     /// Its parameters after the refit: name → value.
     pub parameters: serde_json::Map<String, serde_json::Value>,
+    /// The same as LuGre FMU variables, before and after this effect.
+    pub variables: Vec<FmuValue>,
     pub rms_before: f64,
     pub rms_after: f64,
     pub p_value: f64,
@@ -319,10 +369,15 @@ pub struct Diagnosis {
     pub nominal_model: FrictionModel,
     pub baseline_model: FrictionModel,
     pub final_model: FrictionModel,
+    /// Every LuGre FMU parameter the final model sets differently from the
+    /// nominal as given.
+    pub changes: Vec<FmuValue>,
     pub samples: usize,
     pub heldout_samples: usize,
     /// Family-wise significance level.
     pub alpha: f64,
+    /// Smallest relative drop of the held-out mean square accepted.
+    pub min_gain: f64,
     /// Folds scored: 1 (a held-out file or one third of the blocks) or 3
     /// (cross-validation, [`CrossValidate`]).
     pub folds: usize,
@@ -335,6 +390,10 @@ pub struct Diagnosis {
     pub master: String,
     #[serde(skip)]
     pub plots: PlotData,
+    /// The data file's time and the columns that drive inputs (for the
+    /// `inputs.csv` that reruns the refitted system).
+    #[serde(skip)]
+    pub measured_inputs: (Vec<f64>, Vec<(String, Vec<f64>)>),
 }
 
 /// The nominal's levels refitted (Fc, Fc_neg or the position scales, from
@@ -396,6 +455,10 @@ pub struct PlotData {
     pub x: Vec<f64>,
     pub since_reversal: Vec<f64>,
     pub fn_: Option<Vec<f64>>,
+    /// Metres moved since the last reversal, at the held-out intervals.
+    pub displacement: Vec<f64>,
+    /// The friction force the data imply (N), at the held-out intervals.
+    pub force: Vec<f64>,
     pub residual_before: Vec<f64>,
     pub residual_after: Vec<f64>,
 }
@@ -1159,6 +1222,12 @@ pub fn diagnose(
                 },
                 meaning: effect.meaning(),
                 parameters: effect_parameters(&model, effect),
+                variables: fmu_values(
+                    &setup.friction_fmu,
+                    &model.effect_variables(effect),
+                    &current,
+                    &model,
+                ),
                 rms_before: mean(&current_scored.q).sqrt(),
                 rms_after: mean(&scored.q).sqrt(),
                 p_value,
@@ -1241,12 +1310,20 @@ pub fn diagnose(
         baseline_pattern,
         effects,
         rounds,
+        changes: {
+            let names: Vec<String> = current.parameters().into_iter().map(|(n, _)| n).collect();
+            fmu_values(&setup.friction_fmu, &names, &setup.nominal, &current)
+                .into_iter()
+                .filter(|v| v.before != v.after)
+                .collect()
+        },
         nominal_model: setup.nominal.clone(),
         baseline_model,
         final_model: current,
         samples: train.time.len(),
         heldout_samples: current_scored.q.len(),
         alpha: options.alpha,
+        min_gain: options.min_gain,
         folds: folds.len(),
         wall_seconds: started.elapsed().as_secs_f64(),
         polish_seconds,
@@ -1254,6 +1331,7 @@ pub fn diagnose(
         step,
         master,
         plots,
+        measured_inputs: (train.time.clone(), train.inputs.clone()),
     })
 }
 
@@ -1692,7 +1770,10 @@ fn plot_data(
         .collect();
     let d = held.friction;
     let since = localise::time_since_reversal(d);
+    let moved = localise::displacement_since_reversal(d);
     PlotData {
+        displacement: held.intervals.iter().map(|&j| moved[j]).collect(),
+        force: held.intervals.iter().map(|&j| d.f[j]).collect(),
         time,
         channels,
         v: held.intervals.iter().map(|&j| d.v[j]).collect(),

@@ -468,6 +468,42 @@ impl FrictionModel {
         p
     }
 
+    /// The LuGre FMU variables that carry `effect` in this model (their
+    /// values are in [`FrictionModel::parameters`]): what a user sets in
+    /// the FMU to reproduce it.
+    pub fn effect_variables(&self, effect: Effect) -> Vec<String> {
+        let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let with_neg = |pos: &str, neg: &str| {
+            if self.direction_dependent {
+                names(&[pos, neg])
+            } else {
+                names(&[pos])
+            }
+        };
+        match effect {
+            Effect::Viscous => names(&["sigma2"]),
+            Effect::Stribeck => {
+                let mut v = with_neg("Fs", "Fs_neg");
+                v.extend(names(&["Fc", "vs"]));
+                v
+            }
+            Effect::Presliding => names(&["sigma0", "sigma1"]),
+            Effect::DirectionDependent => names(&["Fc", "Fc_neg", "Fs", "Fs_neg"]),
+            Effect::NormalLoad => with_neg("Fc", "Fc_neg"),
+            Effect::PositionDependent => {
+                let mut v = with_neg("Fc", "Fc_neg");
+                for i in 1..=self.x_table.len() {
+                    v.push(format!("x_table[{i}]"));
+                    v.push(format!("scale_pos[{i}]"));
+                    if self.direction_dependent {
+                        v.push(format!("scale_neg[{i}]"));
+                    }
+                }
+                v
+            }
+        }
+    }
+
     /// The parameters that describe `effect` in this model, for the report
     /// (name, value, unit).
     pub fn effect_parameters(&self, effect: Effect) -> Vec<(String, f64, &'static str)> {

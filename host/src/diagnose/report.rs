@@ -1,16 +1,14 @@
 //! The output directory of `fricsim diagnose`: `report.json`, `report.md`,
-//! `fit.png` (measured vs nominal vs final on each measured channel, on
-//! the held-out data), `residual.png` (friction residual against the
-//! localising states, before and after) and `refitted.ssp` (the system
-//! with the refitted friction parameters, runnable by `fricsim run` and
-//! FMPy). Everything is written into a temporary sibling directory first
+//! `report.html` (self-contained, [`super::html`]) with its figures also as
+//! PNG ([`super::figures`]), `refitted.ssp` (the system with the refitted
+//! friction parameters, runnable by `fricsim run` and FMPy) and
+//! `inputs.csv` (the data's input columns, to rerun it). Everything is written into a temporary sibling directory first
 //! and renamed into place at the end, so a failure leaves nothing half
 //! written.
 
 use super::model::FrictionModel;
-use super::{Diagnosis, PlotData};
+use super::Diagnosis;
 use crate::ssp::SystemFile;
-use plotters::prelude::*;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -42,9 +40,19 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
     let json = serde_json::to_string_pretty(d).map_err(|e| e.to_string())?;
     std::fs::write(dir.join("report.json"), json + "\n").map_err(|e| e.to_string())?;
     std::fs::write(dir.join("report.md"), markdown(d)).map_err(|e| e.to_string())?;
-    plot_fit(&d.plots, &dir.join("fit.png"))?;
-    plot_residuals(&d.plots, &dir.join("residual.png"))?;
+    let figures = super::figures::draw_all(d, dir)?;
+    write_inputs(d, &dir.join("inputs.csv"))?;
     write_ssp(file, friction, &d.final_model, &dir.join("refitted.ssp"))?;
+    let rerun = format!(
+        "fricsim run {} --input {}",
+        out.join("refitted.ssp").display(),
+        out.join("inputs.csv").display()
+    );
+    std::fs::write(
+        dir.join("report.html"),
+        super::html::page(d, &figures, &rerun, d.min_gain),
+    )
+    .map_err(|e| e.to_string())?;
     if out.exists() {
         std::fs::remove_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     }
@@ -263,7 +271,7 @@ pub fn markdown(d: &Diagnosis) -> String {
             a.rms
         );
     }
-    let _ = writeln!(s, "\nPlots: `fit.png` (measured, nominal, final), `residual.png` (friction residual against the states). The refitted system: `refitted.ssp` (`fricsim run refitted.ssp --input <inputs.csv>`).");
+    let _ = writeln!(s, "\nThe same with figures: `report.html`; the figures as PNG: `gap.png` (held-out error per round), `fit.png` (measured, given, final and residuals against time), `law.png` (force against velocity), `levels.png` (position dependence), `residual.png` (friction residual binned against the states). The refitted system: `refitted.ssp` (`fricsim run refitted.ssp --input inputs.csv`).");
     s
 }
 
@@ -302,118 +310,24 @@ pub fn where_line(w: &super::localise::Where) -> String {
 
 type Fail = String;
 
-fn plot_fit(p: &PlotData, path: &Path) -> Result<(), Fail> {
-    crate::plot::register_font()?;
-    let n = p.channels.len().max(1);
-    let root = BitMapBackend::new(path, (1200, 300 * n as u32 + 40)).into_drawing_area();
-    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    root.fill(&WHITE).map_err(|e| fail(&e))?;
-    let root = root
-        .titled(
-            "held-out data: measured (black), nominal (red), final (blue)",
-            ("sans-serif", 20),
-        )
-        .map_err(|e| fail(&e))?;
-    let panels = root.split_evenly((n, 1));
-    let (t0, t1) = range(&p.time);
-    for ((name, meas, nom, fin), panel) in p.channels.iter().zip(panels.iter()) {
-        let (lo, hi) = range(&[meas.as_slice(), nom, fin].concat());
-        let mut chart = ChartBuilder::on(panel)
-            .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(80)
-            .build_cartesian_2d(t0..t1, lo..hi)
-            .map_err(|e| fail(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("time [s]")
-            .y_desc(name.as_str())
-            .y_label_formatter(&|y| crate::plot::tick_label(*y, lo, hi))
-            .draw()
-            .map_err(|e| fail(&e))?;
-        for (series, color) in [(meas, BLACK), (nom, RED), (fin, BLUE)] {
-            chart
-                .draw_series(
-                    thin(&p.time, series)
-                        .into_iter()
-                        .map(|(t, y)| Circle::new((t, y), 1, color.filled())),
-                )
-                .map_err(|e| fail(&e))?;
+/// The data file's input columns (what drives the system), for
+/// `fricsim run refitted.ssp --input inputs.csv`.
+fn write_inputs(d: &Diagnosis, path: &Path) -> Result<(), Fail> {
+    let (time, columns) = &d.measured_inputs;
+    let mut text = String::from("time");
+    for (name, _) in columns {
+        text.push(',');
+        text.push_str(name);
+    }
+    text.push('\n');
+    for (k, t) in time.iter().enumerate() {
+        let _ = write!(text, "{t:?}");
+        for (_, values) in columns {
+            let _ = write!(text, ",{:?}", values[k]);
         }
+        text.push('\n');
     }
-    root.present().map_err(|e| fail(&e))
-}
-
-fn plot_residuals(p: &PlotData, path: &Path) -> Result<(), Fail> {
-    crate::plot::register_font()?;
-    let mut states: Vec<(&str, &Vec<f64>)> = vec![
-        ("velocity v [m/s]", &p.v),
-        ("position x [m]", &p.x),
-        ("time since reversal [s]", &p.since_reversal),
-    ];
-    if let Some(f) = &p.fn_ {
-        states.push(("normal force Fn [N]", f));
-    }
-    let root = BitMapBackend::new(path, (1200, 280 * states.len() as u32 + 40)).into_drawing_area();
-    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    root.fill(&WHITE).map_err(|e| fail(&e))?;
-    let root = root
-        .titled(
-            "friction residual (data - law) on held-out data: baseline (red), final (blue)",
-            ("sans-serif", 20),
-        )
-        .map_err(|e| fail(&e))?;
-    let panels = root.split_evenly((states.len(), 1));
-    let (lo, hi) = range(&[p.residual_before.as_slice(), &p.residual_after].concat());
-    for ((label, xs), panel) in states.iter().zip(panels.iter()) {
-        let (x0, x1) = range(xs);
-        let mut chart = ChartBuilder::on(panel)
-            .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x0..x1, lo..hi)
-            .map_err(|e| fail(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc(*label)
-            .y_desc("residual [N]")
-            .x_label_formatter(&|x| crate::plot::tick_label(*x, x0, x1))
-            .y_label_formatter(&|y| crate::plot::tick_label(*y, lo, hi))
-            .draw()
-            .map_err(|e| fail(&e))?;
-        for (series, color) in [(&p.residual_before, RED), (&p.residual_after, BLUE)] {
-            chart
-                .draw_series(
-                    thin(xs, series)
-                        .into_iter()
-                        .map(|(x, y)| Circle::new((x, y), 1, color.filled())),
-                )
-                .map_err(|e| fail(&e))?;
-        }
-    }
-    root.present().map_err(|e| fail(&e))
-}
-
-/// At most 6000 evenly picked points.
-fn thin(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
-    let n = x.len().min(y.len());
-    let every = n.div_ceil(6000).max(1);
-    (0..n).step_by(every).map(|i| (x[i], y[i])).collect()
-}
-
-fn range(v: &[f64]) -> (f64, f64) {
-    let (lo, hi) = v
-        .iter()
-        .filter(|x| x.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-            (a.min(x), b.max(x))
-        });
-    if lo <= hi {
-        let pad = ((hi - lo) * 0.05).max(1e-12 * lo.abs().max(1.0));
-        (lo - pad, hi + pad)
-    } else {
-        (0.0, 1.0)
-    }
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// The refitted system: the nominal ssd with every `source` made absolute,
