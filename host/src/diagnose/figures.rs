@@ -105,6 +105,19 @@ pub fn draw_all(d: &Diagnosis, dir: &Path) -> Result<Vec<Figure>, String> {
     Ok(out)
 }
 
+/// The legend of `chart`'s labelled series at `position`, on a light box.
+fn legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> DrawResult<DB> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+}
+
 /// The finite range of `v`, padded by 5 %.
 fn range(v: impl IntoIterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = v
@@ -259,12 +272,7 @@ fn draw_fit<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &Diagnosis) ->
                     .label(*label)
                     .legend(move |(x, y)| Circle::new((x + 7, y), 4, colour.filled()));
             }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()?;
+            legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }
     }
     Ok(())
@@ -338,12 +346,7 @@ fn draw_law<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &Diagnosis) ->
             }
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
+    legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     Ok(())
 }
 
@@ -398,12 +401,7 @@ fn draw_levels<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &Diagnosis)
             .iter()
             .map(|&x| Circle::new((x, m.level(true, x)), 5, FINAL.filled())),
     )?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
@@ -481,12 +479,7 @@ fn draw_residual<DB: DrawingBackend>(
             [(x0, 0.0), (x1, 0.0)],
             BLACK.mix(0.4),
         )))?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     }
     Ok(())
 }

@@ -335,59 +335,56 @@ fn bins(d: &FrictionData, intervals: &[usize]) -> Vec<(&'static str, String, Vec
             ));
         }
     }
-    // time since reversal: quartiles
+    // time and displacement since reversal, normal load: quartiles
     let since = time_since_reversal(d);
-    let mut s: Vec<f64> = intervals.iter().map(|&j| since[j]).collect();
-    s.sort_by(f64::total_cmp);
-    if let (Some(&first), Some(&last)) = (s.first(), s.last()) {
-        let q = |p: f64| s[((s.len() - 1) as f64 * p) as usize];
-        let edges = [first, q(0.25), q(0.5), q(0.75), last];
-        for k in 0..4 {
-            let (a, b) = (edges[k], edges[k + 1]);
-            if b > a {
-                out.push((
-                    "time_since_reversal",
-                    format!("{a:.3} to {b:.3} s"),
-                    pick(&|j| since[j] >= a && (since[j] < b || (k == 3 && since[j] <= b))),
-                ));
-            }
-        }
-    }
-    // displacement since reversal: quartiles
+    out.extend(quartiles(
+        "time_since_reversal",
+        intervals,
+        &since,
+        &|a, b| format!("{a:.3} to {b:.3} s"),
+    ));
     let moved = displacement_since_reversal(d);
-    let mut s: Vec<f64> = intervals.iter().map(|&j| moved[j]).collect();
-    s.sort_by(f64::total_cmp);
-    if let (Some(&first), Some(&last)) = (s.first(), s.last()) {
-        let q = |p: f64| s[((s.len() - 1) as f64 * p) as usize];
-        let edges = [first, q(0.25), q(0.5), q(0.75), last];
-        for k in 0..4 {
-            let (a, b) = (edges[k], edges[k + 1]);
-            if b > a {
-                out.push((
-                    "displacement_since_reversal",
-                    format!("{a:.3e} to {b:.3e} m"),
-                    pick(&|j| moved[j] >= a && (moved[j] < b || (k == 3 && moved[j] <= b))),
-                ));
-            }
-        }
-    }
+    out.extend(quartiles(
+        "displacement_since_reversal",
+        intervals,
+        &moved,
+        &|a, b| format!("{a:.3e} to {b:.3e} m"),
+    ));
     if d.normal_force_measured {
-        let mut f: Vec<f64> = intervals.iter().map(|&j| d.fn_[j]).collect();
-        f.sort_by(f64::total_cmp);
-        let q = |p: f64| f[((f.len() - 1) as f64 * p) as usize];
-        let edges = [q(0.0), q(0.25), q(0.5), q(0.75), q(1.0)];
-        for k in 0..4 {
-            let (a, b) = (edges[k], edges[k + 1]);
-            if b > a {
-                out.push((
-                    "normal_load",
-                    format!("{a:.4} to {b:.4} N"),
-                    pick(&|j| d.fn_[j] >= a && (d.fn_[j] < b || (k == 3 && d.fn_[j] <= b))),
-                ));
-            }
-        }
+        out.extend(quartiles("normal_load", intervals, &d.fn_, &|a, b| {
+            format!("{a:.4} to {b:.4} N")
+        }));
     }
     out
+}
+
+/// The quartile bins of `values` (per interval) over `intervals`: each
+/// (state, label from its bounds, members); empty bins left out.
+fn quartiles(
+    state: &'static str,
+    intervals: &[usize],
+    values: &[f64],
+    label: &dyn Fn(f64, f64) -> String,
+) -> Vec<(&'static str, String, Vec<usize>)> {
+    let mut s: Vec<f64> = intervals.iter().map(|&j| values[j]).collect();
+    s.sort_by(f64::total_cmp);
+    if s.is_empty() {
+        return Vec::new();
+    }
+    let q = |p: f64| s[((s.len() - 1) as f64 * p) as usize];
+    let edges = [q(0.0), q(0.25), q(0.5), q(0.75), q(1.0)];
+    (0..4)
+        .filter(|&k| edges[k + 1] > edges[k])
+        .map(|k| {
+            let (a, b) = (edges[k], edges[k + 1]);
+            let members = intervals
+                .iter()
+                .copied()
+                .filter(|&j| values[j] >= a && (values[j] < b || (k == 3 && values[j] <= b)))
+                .collect();
+            (state, label(a, b), members)
+        })
+        .collect()
 }
 
 /// The residual `d.f − model` over `intervals`, by state.
