@@ -203,9 +203,16 @@ pub fn markdown(d: &Diagnosis) -> String {
             e.threshold
         );
         let _ = writeln!(s, "{}\n", where_line(&e.where_));
-        let _ = writeln!(s, "| parameter | value |\n| --- | --- |");
-        for (n, v) in &e.parameters {
-            let _ = writeln!(s, "| {n} | {v} |");
+        let _ = writeln!(
+            s,
+            "| LuGre variable | unit | before | after |\n| --- | --- | --- | --- |"
+        );
+        for v in &e.variables {
+            let _ = writeln!(
+                s,
+                "| `{}` | {} | {} | {} |",
+                v.name, v.unit, v.before, v.after
+            );
         }
     }
     let _ = writeln!(s, "\n## Candidates tried\n");
