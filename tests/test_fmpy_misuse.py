@@ -207,6 +207,23 @@ def test_wrong_communication_points_and_step_sizes(instance, model):
     finish(inst, "StepComplete")
 
 
+@pytest.mark.parametrize("model", SHIPPED)
+def test_no_step_past_a_defined_stop_time(instance, model):
+    """FMI 2.0 section 2.1.6: fmi2DoStep past the stopTime that
+    fmi2SetupExperiment defined returns fmi2Error, and the instance is
+    left where it was: the step up to the stop time still works."""
+    inst = instance(model)
+    inst.fmu.setupExperiment(startTime=0.0, stopTime=0.01)
+    inst.fmu.enterInitializationMode()
+    inst.fmu.exitInitializationMode()
+    inst.fmu.doStep(0.0, 0.005)
+    refused(inst, lambda: inst.fmu.doStep(0.005, 0.01), "fmi2DoStep", "past stopTime = 0.01")
+    inst.fmu.doStep(0.005, 0.005)
+    y = first(inst, "output").valueReference
+    assert math.isfinite(inst.fmu.getReal([y])[0])
+    inst.fmu.terminate()
+
+
 def serialized(instance, model):
     inst = in_state(instance, model, "StepComplete")
     for k in range(3):

@@ -765,6 +765,16 @@ impl Instance {
         if !on_time {
             return Err(self.communication_point_refused(t));
         }
+        // FMI 2.0 §2.1.6: with a stop time defined, a step that would
+        // compute past it is refused (nothing changes)
+        if let Some(stop) = self.stop_time {
+            if t + h > stop + TIME_TOLERANCE * stop.abs().max(1.0) {
+                return Err(format!(
+                    "fmi2DoStep: the step from {t} by {h} ends at {}, past stopTime = {stop} defined by fmi2SetupExperiment (FMI 2.0 section 2.1.6: an FMU must not compute past it)",
+                    t + h
+                ));
+            }
+        }
         let replay = self.needs_step_replay;
         if replay {
             if self.step_state_current {

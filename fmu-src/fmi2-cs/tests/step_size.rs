@@ -85,3 +85,34 @@ fn every_positive_finite_step_size_and_no_other() {
     fmu.do_step(0.0, 0.5).unwrap();
     assert_eq!(fmu.time, 0.5);
 }
+
+/// FMI 2.0 §2.1.6: with a stop time defined by fmi2SetupExperiment, a step
+/// that would compute past it returns an error naming both times and
+/// changes nothing; steps up to it (within rounding) are taken.
+#[test]
+fn no_step_past_a_defined_stop_time() {
+    let info = toy_info(
+        "Still",
+        vec![
+            Variable::input(0, "u", 0.0, "", 1.0, "input"),
+            Variable::output(1, "y", "", "the state", &[]),
+        ],
+    );
+    let logger = fmi2_cs::logger::Logger::new(None, std::ptr::null_mut(), "probe", false);
+    let mut fmu = Instance::new(info, Box::new(Still { info, s: 0.0 }), "probe", logger);
+    fmu.setup_experiment(0.0, Some(1.0)).unwrap();
+    fmu.enter_initialization_mode().unwrap();
+    fmu.exit_initialization_mode().unwrap();
+    // ten steps of 0.1 end at 0.9999999999999999: on the stop time
+    let mut t = 0.0;
+    for _ in 0..10 {
+        fmu.do_step(t, 0.1).unwrap();
+        t += 0.1;
+    }
+    let e = fmu.do_step(fmu.time, 0.1).unwrap_err();
+    assert!(e.contains("past stopTime = 1"), "{e}");
+    assert!((fmu.time - 1.0).abs() < 1e-12, "{}", fmu.time);
+    // refused, not failed: an instance without a stop time steps on
+    let mut open = instance();
+    open.do_step(0.0, 2.0).unwrap();
+}
