@@ -109,21 +109,41 @@ pub struct Attribution {
 /// Bins per continuous state in [`attribute`].
 const ATTRIBUTION_BINS: usize = 20;
 
-/// Metres moved since the velocity last changed sign, per interval (the
-/// pre-sliding displacement the bristles see).
+/// Metres moved since the motion last reversed, per interval (the
+/// pre-sliding displacement the bristles see). A reversal is
+/// where the position turns back from its furthest point by more than a
+/// deadband (3 times the position resolution the data show, at least 1e-4
+/// of the travel), not where the estimated velocity changes sign: while the
+/// contact creeps, that sign flips with the noise and would restart the
+/// count at random.
 pub fn displacement_since_reversal(d: &FrictionData) -> Vec<f64> {
-    let mut out = Vec::with_capacity(d.t.len());
+    let (lo, hi) =
+        d.x.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
+    let travel = if hi > lo { hi - lo } else { 0.0 };
+    let deadband = (3.0 * d.position_resolution.unwrap_or(0.0))
+        .max(1e-4 * travel)
+        .max(f64::MIN_POSITIVE);
+    let mut out = Vec::with_capacity(d.x.len());
     let mut origin = d.x.first().copied().unwrap_or(0.0);
-    let mut sign = 0.0;
-    for j in 0..d.t.len() {
-        let s = d.v[j].signum();
-        if d.v[j] != 0.0 && s != sign {
-            if sign != 0.0 {
-                origin = d.x[j];
+    let (mut furthest, mut direction) = (origin, 0.0);
+    for &x in &d.x {
+        if direction == 0.0 {
+            if (x - origin).abs() > deadband {
+                direction = (x - origin).signum();
+                furthest = x;
             }
-            sign = s;
+        } else if (x - furthest) * direction > 0.0 {
+            furthest = x;
+        } else if (furthest - x) * direction > deadband {
+            // turned back: the furthest point is the reversal
+            origin = furthest;
+            furthest = x;
+            direction = -direction;
         }
-        out.push((d.x[j] - origin).abs());
+        out.push((x - origin).abs());
     }
     out
 }
@@ -144,6 +164,30 @@ fn quantile_bins(values: &[f64], bins: usize) -> Vec<usize> {
         }
     }
     out
+}
+
+/// Bin index of each of `values` (≥ 0) among `bins` bins whose edges grow
+/// geometrically from a ten-thousandth of the largest value to it (smaller
+/// values in the first): what happens at small speeds and just after a
+/// reversal, where the friction transitions live, gets bins of its own
+/// instead of sharing one with a decade of larger values.
+fn log_bins(values: &[f64], bins: usize) -> Vec<usize> {
+    let hi = values.iter().copied().fold(0.0, f64::max);
+    if hi.is_nan() || hi <= 0.0 {
+        return vec![0; values.len()];
+    }
+    let lo = hi * 1e-4;
+    let per_bin = (hi / lo).ln() / bins as f64;
+    values
+        .iter()
+        .map(|&x| {
+            if x > lo {
+                (((x / lo).ln() / per_bin) as usize).min(bins - 1)
+            } else {
+                0
+            }
+        })
+        .collect()
 }
 
 /// Bin index of each of `values` among `bins` equal bins over their range.
@@ -218,7 +262,7 @@ pub fn attribute(
     let mut states: Vec<(&'static str, Vec<usize>)> = vec![
         (
             "velocity",
-            quantile_bins(&pick(&|j| d.v[j].abs()), ATTRIBUTION_BINS),
+            log_bins(&pick(&|j| d.v[j].abs()), ATTRIBUTION_BINS),
         ),
         (
             "direction",
@@ -230,7 +274,7 @@ pub fn attribute(
         ("position", equal_bins(&pick(&|j| d.x[j]), ATTRIBUTION_BINS)),
         (
             "displacement_since_reversal",
-            quantile_bins(&pick(&|j| since[j]), ATTRIBUTION_BINS),
+            log_bins(&pick(&|j| since[j]), ATTRIBUTION_BINS),
         ),
     ];
     if d.normal_force_measured {
@@ -599,6 +643,40 @@ mod tests {
             .collect();
         let a = attribute(&d, &all, (&n, &before), (&stiffer, &after));
         assert_eq!(a[0].state, "displacement_since_reversal", "{a:?}");
+    }
+
+    #[test]
+    fn the_displacement_since_reversal_counts_from_the_turning_point() {
+        // 1 mm forwards, then 2 mm back, the estimated velocity's sign
+        // flipping at every sample while the motion creeps
+        let n = 3000;
+        let x: Vec<f64> = (0..n)
+            .map(|k| {
+                let k = k as f64;
+                if k < 1000.0 {
+                    1e-6 * k
+                } else {
+                    1e-3 - 1e-6 * (k - 1000.0)
+                }
+            })
+            .collect();
+        let mut d = data();
+        d.t = (0..n).map(|k| k as f64 * 1e-3).collect();
+        d.h = vec![1e-3; n];
+        d.v = (0..n)
+            .map(|k| if k % 2 == 0 { 1e-4 } else { -1e-4 })
+            .collect();
+        d.fn_ = vec![1.0; n];
+        d.f = vec![0.0; n];
+        d.trusted = vec![true; n];
+        d.end = (1..=n).collect();
+        d.position_resolution = Some(1e-6);
+        d.x = x;
+        let moved = displacement_since_reversal(&d);
+        assert!((moved[999] - 0.999e-3).abs() < 1e-12, "{}", moved[999]);
+        // turned back at 1 mm (after the 3 µm deadband): counted from there
+        assert!((moved[2999] - 1.999e-3).abs() < 1e-12, "{}", moved[2999]);
+        assert!(moved[1500] > moved[1200], "{} {}", moved[1500], moved[1200]);
     }
 
     #[test]
