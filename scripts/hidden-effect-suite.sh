@@ -45,13 +45,11 @@ if ! { [ -x .venv-baseline/bin/python ] && [ -f "$stamp" ] && [ "$(cat "$stamp")
     echo "$want" > "$stamp"
 fi
 
-started=$(date +%s)
 "$suite" "${grid[@]}" --json "$out/diagnose.json" | tee "$out/diagnose.md"
-diagnose_seconds=$(( $(date +%s) - started ))
 "$suite" "${grid[@]}" --export "$out/export" 2> /dev/null
 .venv-baseline/bin/python scripts/sindy-baseline.py "$out/export" --json "$out/sindy.json" | tee "$out/sindy.md"
 
-args=(--diagnose "$out/diagnose.json" --sindy "$out/sindy.json" --seconds "$diagnose_seconds"
+args=(--diagnose "$out/diagnose.json" --sindy "$out/sindy.json"
       --command "scripts/hidden-effect-suite.sh $*")
 if [ "$update" = 1 ]; then
     python3 scripts/suite-report.py "${args[@]}" --update BENCHMARKS.md

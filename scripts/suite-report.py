@@ -3,7 +3,7 @@
 `hidden-effect-suite` (fricsim diagnose) and of scripts/sindy-baseline.py
 (PySINDy) on the same cases. Standard library only.
 
-    suite-report.py --diagnose D.json --sindy S.json --seconds N --command CMD [--update FILE]
+    suite-report.py --diagnose D.json --sindy S.json --command CMD [--update FILE]
 
 Without --update the section goes to stdout; with it, the part of FILE
 between BEGIN and END (below) is replaced (appended when missing).
@@ -40,7 +40,7 @@ def pct(k, n):
     return f"{k}/{n}" if n else "-"
 
 
-def section(diag, sindy, seconds, command):
+def section(diag, sindy, command):
     rows = {}
     for r in diag:
         k = key(r["case"]["hidden"], r["case"]["magnitude"] if r["case"]["hidden"] else 0)
@@ -51,7 +51,7 @@ def section(diag, sindy, seconds, command):
     out = []
     out.append(
         f"Generated {datetime.date.today().isoformat()} by `{command.strip()}` on {machine()}; "
-        f"diagnose took {seconds} s for {len(diag)} cases."
+        f"the {len(diag)} cases' diagnoses took {sum(r['seconds'] for r in diag):.0f} s in all."
     )
     out.append("")
     out.append(
@@ -69,7 +69,9 @@ def section(diag, sindy, seconds, command):
         within = sum(r["sizes_within"] for r in d)
         drops = sorted(r["heldout_drop"] for r in d)
         drop2 = sum(x >= 2.0 for x in drops)
-        truth_drops = sorted(r["truth_drop"] for r in d)
+        # (None: 0/0, both models exactly the truth, as on null cases where
+        # the given model is kept)
+        truth_drops = sorted(r["truth_drop"] for r in d if r["truth_drop"] is not None)
         truth2 = sum(x >= 2.0 for x in truth_drops)
         s_named = sum(r["named_right"] for r in s)
         s_invented = sum(bool(r["invented"]) for r in s)
@@ -117,7 +119,6 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--diagnose", required=True)
     ap.add_argument("--sindy", required=True)
-    ap.add_argument("--seconds", required=True)
     ap.add_argument("--command", required=True)
     ap.add_argument("--update")
     a = ap.parse_args()
@@ -125,7 +126,7 @@ def main():
         diag = json.load(fh)
     with open(a.sindy) as fh:
         sindy = json.load(fh)
-    text = section(diag, sindy, a.seconds, a.command)
+    text = section(diag, sindy, a.command)
     if not a.update:
         print(text)
         return
