@@ -5,7 +5,7 @@
 //! problems, and what changed in the system.
 
 use super::figures::Figure;
-use super::report::where_line;
+use super::report::{pct as percent, where_line};
 use super::{CandidateScore, Diagnosis, FmuValue, UNEXPLAINED_FACTOR};
 use std::fmt::Write as _;
 
@@ -65,14 +65,6 @@ fn with_unit(x: f64, unit: &str) -> String {
         number(x)
     } else {
         format!("{} {}", number(x), escape(unit))
-    }
-}
-
-fn percent(before: f64, after: f64) -> String {
-    if before > 0.0 && after.is_finite() {
-        format!("{:+.1} %", 100.0 * (after - before) / before)
-    } else {
-        "–".into()
     }
 }
 

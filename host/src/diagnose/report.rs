@@ -61,8 +61,10 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
     Ok(())
 }
 
-fn pct(before: f64, after: f64) -> String {
-    if before > 0.0 {
+/// The relative change from `before` to `after`, signed, in per cent
+/// ("n/a" without a positive `before` or a finite `after`).
+pub(super) fn pct(before: f64, after: f64) -> String {
+    if before > 0.0 && after.is_finite() {
         format!("{:+.1} %", 100.0 * (after - before) / before)
     } else {
         "n/a".into()
