@@ -1,4 +1,5 @@
-"""Bad input through FMPy (issue 2): invalid parameters are refused at
+"""Bad input through FMPy: parameters outside their declared min/max are
+refused when set, other invalid parameters at
 fmi2ExitInitializationMode, NaN/inf inputs, unknown value references and
 calls in the wrong state return fmi2Error, each with a logged message that
 names the function and the value; the instance stays usable."""
@@ -8,18 +9,26 @@ import math
 import pytest
 from fmpy.fmi1 import FMICallException
 
+# Within the declared bounds, but no valid model: refused at initialization.
 INVALID_PARAMETERS = [
     ("Dahl", {"sigma": 0.0}, "sigma"),
-    ("Dahl", {"alpha": -1.0}, "alpha"),
-    ("LuGre", {"sigma0": -1.0}, "sigma0"),
     ("LuGre", {"Fc": 1.0, "Fs": 0.5}, "Fs"),
     ("LuGre", {"vs": 0.0}, "vs"),
     ("ResetIntegrator", {"z0": 0.0}, "z0"),
-    ("ResetIntegrator", {"sigma0": -5.0}, "sigma0"),
     ("Bristle", {"delta_max": 0.0}, "delta_max"),
     ("Bristle", {"count_from_load": False, "n_bristles": 0}, "n_bristles"),
     ("Bristle2D", {"z0": 0.0}, "z0"),
-    ("Bristle2D", {"sigma02": -1.0}, "sigma02"),
+]
+# Outside the min/max of the model description: refused when set, also when
+# the options in force do not read the parameter (LuGre's Fc_neg and
+# scale_neg with direction_dependent off).
+OUT_OF_BOUNDS = [
+    ("Dahl", "alpha", -1.0),
+    ("LuGre", "sigma0", -1.0),
+    ("LuGre", "Fc_neg", -0.5),
+    ("LuGre", "scale_neg[3]", -1.0),
+    ("ResetIntegrator", "sigma0", -5.0),
+    ("Bristle2D", "sigma02", -1.0),
 ]
 
 
@@ -52,6 +61,28 @@ def test_invalid_parameter_refused_at_exit_initialization(instance, model, value
     inst.fmu.reset()
     inst.fmu.setupExperiment(startTime=0.0)
     inst.fmu.enterInitializationMode()
+    inst.fmu.exitInitializationMode()
+    inst.fmu.doStep(0.0, 1e-3)
+
+
+@pytest.mark.parametrize("model,parameter,value", OUT_OF_BOUNDS)
+def test_parameter_outside_its_declared_bounds_refused_when_set(instance, model, parameter, value):
+    inst = instance(model)
+    variable = next(v for v in inst.md.modelVariables if v.name == parameter)
+    low = float(variable.min) if variable.min is not None else -math.inf
+    high = float(variable.max) if variable.max is not None else math.inf
+    assert not low <= value <= high, "the case must lie outside the declared bounds"
+    inst.fmu.setupExperiment(startTime=0.0)
+    inst.fmu.enterInitializationMode()
+    before = inst.fmu.getReal([inst.vr[parameter]])[0]
+    with pytest.raises(FMICallException) as e:
+        inst.fmu.setReal([inst.vr[parameter]], [value])
+    assert e.value.status == 3  # fmi2Error
+    message = inst.last_error()
+    assert message.startswith(f"fmi2SetReal: {parameter} (value reference {inst.vr[parameter]}) = "), message
+    assert "declared min" in message or "declared max" in message, message
+    # nothing changed, and the instance initialises
+    assert inst.fmu.getReal([inst.vr[parameter]])[0] == before
     inst.fmu.exitInitializationMode()
     inst.fmu.doStep(0.0, 1e-3)
 

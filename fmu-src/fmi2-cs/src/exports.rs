@@ -5,17 +5,79 @@
 
 use crate::ffi::*;
 use crate::instance::Instance;
-use crate::logger::Logger;
+use crate::logger::{Logger, Reporter};
 use crate::model::ModelFactory;
 use crate::serialize::Snapshot;
-use crate::state_machine::{allowed_mask, is_allowed, State};
+use crate::state_machine::{allowed_mask, State};
 use crate::variables::VarType;
+use std::cell::UnsafeCell;
 use std::collections::BTreeSet;
 use std::ffi::CStr;
 use std::os::raw::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
+
+/// What an `fmi2Component` points to: the instance, and the flag that
+/// admits one call into it at a time. The FMI standard leaves calls into
+/// one instance from two threads at once undefined (FMI 2.0.4 §2.1.5); a
+/// friction block must not take its importer down for it, so the second
+/// call is refused with `fmi2Error` and a message instead of running on a
+/// state the first is changing. Uncontended, the flag costs one atomic
+/// exchange and one store per call (BENCHMARKS.md, "The instance guard").
+pub struct Slot {
+    /// Set while a call runs on `instance`.
+    busy: AtomicBool,
+    /// The importer's logger for a refused call, which must not touch the
+    /// instance (another thread is changing it).
+    refusals: Reporter,
+    instance: UnsafeCell<Instance>,
+}
+
+// SAFETY: `instance` is reached only by the thread that set `busy`
+// (`Slot::admit`), one at a time; `refusals` is only read.
+unsafe impl Sync for Slot {}
+
+impl Slot {
+    fn new(instance: Instance) -> Slot {
+        Slot {
+            busy: AtomicBool::new(false),
+            refusals: instance.logger.reporter(),
+            instance: UnsafeCell::new(instance),
+        }
+    }
+
+    /// The instance, if no other call is running on it: the caller owns it
+    /// until [`Slot::release`]. `None`: another thread is inside a call.
+    #[inline(always)]
+    fn admit(&self) -> Option<*mut Instance> {
+        if cfg!(feature = "unguarded-instances") {
+            return Some(self.instance.get());
+        }
+        // (`swap`: one locked exchange, no compare loop)
+        (!self.busy.swap(true, Ordering::Acquire)).then(|| self.instance.get())
+    }
+
+    #[inline(always)]
+    fn release(&self) {
+        if !cfg!(feature = "unguarded-instances") {
+            self.busy.store(false, Ordering::Release);
+        }
+    }
+}
+
+/// A call refused because another thread is inside a call on the same
+/// instance: logged through the copy of the logger, `fmi2Error`.
+#[cold]
+#[inline(never)]
+fn concurrent_call(slot: &Slot, function: &str) -> fmi2Status {
+    slot.refusals.error(&format!(
+        "{function}: refused: another thread is inside a call on this instance \
+         (FMI 2.0 leaves concurrent calls into one instance undefined; \
+         call it from one thread at a time)"
+    ));
+    fmi2Status::fmi2Error
+}
 
 /// Addresses of the instances this library created and has not freed.
 static LIVE: Mutex<BTreeSet<usize>> = Mutex::new(BTreeSet::new());
@@ -54,24 +116,44 @@ fn recently_live(c: usize) -> bool {
     c != 0 && RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c)
 }
 
-/// The instance behind `c` for a call's fast path, if `c` is in
-/// [`RECENTLY_LIVE`] (no lock), its state is in `allowed` and calls are
-/// not logged; else `None`, and the call takes [`call_allowed`], which
-/// checks again and reports.
+/// A call admitted into a slot ([`Slot::admit`]): released when dropped.
+struct Admitted<'a>(&'a Slot);
+
+impl Drop for Admitted<'_> {
+    #[inline(always)]
+    fn drop(&mut self) {
+        self.0.release();
+    }
+}
+
+/// The instance behind `c` for a call's fast path, admitted, if `c` is in
+/// [`RECENTLY_LIVE`] (no lock), no other call is running on it, its state
+/// is in `allowed` and calls are not logged; else `None`, and the call
+/// takes [`call_allowed`], which checks again and reports. The instance
+/// is the caller's until the [`Admitted`] is dropped; what the caller
+/// does with it must not panic (there is no `catch_unwind` here).
 ///
 /// # Safety
 /// As [`call_allowed`]: `c` is dereferenced only if recently live.
 #[inline(always)]
-unsafe fn recent_instance<'a>(c: fmi2Component, allowed: u32) -> Option<&'a mut Instance> {
+unsafe fn recent_instance<'a>(
+    c: fmi2Component,
+    allowed: u32,
+) -> Option<(Admitted<'a>, &'a mut Instance)> {
     let c = c as usize;
     if !recently_live(c) {
         return None;
     }
-    // SAFETY: a recently live address is a live instance, created by
-    // `instantiate` and not freed; this is the only reference to it until
-    // the caller returns.
-    let instance = unsafe { &mut *(c as *mut Instance) };
-    (allowed & instance.state as u32 != 0 && !instance.logger.logs_calls()).then_some(instance)
+    // SAFETY: a recently live address is a live slot, created by
+    // `instantiate` and not freed.
+    let slot = unsafe { &*(c as *const Slot) };
+    let instance = slot.admit()?;
+    let admitted = Admitted(slot);
+    // SAFETY: admitted: this thread alone reaches the instance until
+    // `admitted` is dropped.
+    let instance = unsafe { &mut *instance };
+    (allowed & instance.state as u32 != 0 && !instance.logger.logs_calls())
+        .then_some((admitted, instance))
 }
 
 /// [`is_live`] from [`LIVE`], noting a live `c` in [`RECENTLY_LIVE`].
@@ -145,13 +227,17 @@ unsafe fn call_named(
         // No instance, so no logger to report to: the status says it.
         return fmi2Status::fmi2Error;
     }
-    let instance = c as *mut Instance;
+    // SAFETY: live, so a slot created by `instantiate` and not freed.
+    let slot = unsafe { &*(c as *const Slot) };
+    let Some(instance) = slot.admit() else {
+        return concurrent_call(slot, function());
+    };
     // (a `move` closure: `function` and the pointer are captured by value,
     // not through a stack slot written at every call)
     let outcome = catch_unwind(AssertUnwindSafe(move || {
-        // SAFETY: c is a live instance created by Box::into_raw in
-        // `instantiate`; this is the only reference to it until the
-        // closure returns or unwinds.
+        // SAFETY: c is a live slot created by Box::into_raw in
+        // `instantiate`, admitted: this is the only reference to its
+        // instance until the closure returns or unwinds.
         let instance = unsafe { &mut *instance };
         // The step loop's case in two tests: the state allows the call and
         // call logging is off; everything else is out of line.
@@ -166,11 +252,13 @@ unsafe fn call_named(
             Err(message) => log_error(instance, function(), message),
         }
     }));
-    outcome.unwrap_or_else(|payload| {
+    let status = outcome.unwrap_or_else(|payload| {
         // SAFETY: as above; the closure's reference ended with the unwind.
         let instance = unsafe { &mut *instance };
         panicked(instance, function(), payload)
-    })
+    });
+    slot.release();
+    status
 }
 
 /// A call of `function` on `instance` panicked with `payload`: the
@@ -361,19 +449,27 @@ pub unsafe fn instantiate(
             ));
             return std::ptr::null_mut();
         };
-        let instance = Box::new(Instance::new(
+        let slot = Box::new(Slot::new(Instance::new(
             factory.info,
             (factory.create)(),
             &name,
             logger,
-        ));
-        let address = Box::into_raw(instance);
+        )));
+        let address = Box::into_raw(slot);
         live().insert(address as usize);
         address as fmi2Component
     }));
     outcome.unwrap_or(std::ptr::null_mut())
 }
 
+/// `fmi2FreeInstance`. An instance another thread is inside a call on is
+/// not freed (that call would run on freed memory): the refusal is
+/// logged, and the importer may free it again once the call has returned.
+/// (A call that has found the instance live but not yet entered it when
+/// the instance is freed is a window of a few instructions the guard does
+/// not close: freeing an instance while calling it is the importer's
+/// error either way.)
+///
 /// # Safety
 /// `c` is checked against the live set before use.
 pub unsafe fn free_instance(c: fmi2Component) {
@@ -381,25 +477,29 @@ pub unsafe fn free_instance(c: fmi2Component) {
         if c.is_null() {
             return;
         }
-        let removed = {
-            let mut live = live();
-            let removed = live.remove(&(c as usize));
-            for slot in &RECENTLY_LIVE {
-                // only with the lock held, as every store into the slots
-                if slot.load(Ordering::Acquire) == c as usize {
-                    slot.store(0, Ordering::Release);
-                }
-            }
-            removed
-        };
-        if removed {
-            // SAFETY: was live, so it came from Box::into_raw and is freed once.
-            let instance = unsafe { Box::from_raw(c as *mut Instance) };
-            if !is_allowed("fmi2FreeInstance", instance.state) && instance.state != State::Fatal {
-                // Freed anyway: keeping it would leak; nothing else is possible.
-            }
-            drop(instance);
+        let mut live = live();
+        if !live.contains(&(c as usize)) {
+            return;
         }
+        // SAFETY: live, so a slot created by `instantiate` and not freed.
+        let slot = unsafe { &*(c as *const Slot) };
+        if slot.admit().is_none() {
+            drop(live);
+            concurrent_call(slot, "fmi2FreeInstance");
+            return;
+        }
+        live.remove(&(c as usize));
+        for recent in &RECENTLY_LIVE {
+            // only with the lock held, as every store into the slots
+            if recent.load(Ordering::Acquire) == c as usize {
+                recent.store(0, Ordering::Release);
+            }
+        }
+        drop(live);
+        // SAFETY: was live, so it came from Box::into_raw and is freed
+        // once (removed from the live set above, under the lock); admitted,
+        // so no call is running on it.
+        drop(unsafe { Box::from_raw(c as *mut Slot) });
     }));
 }
 
@@ -603,11 +703,13 @@ pub unsafe fn set_real(
     // reports.
     const ALLOWED: u32 = crate::state_machine::allowed_mask("fmi2SetReal");
     if n == 1 && both_usable(vr, value) {
+        // SAFETY: non-null and aligned, one element each (FMI contract)
+        let (vr, value) = unsafe { (*vr, *value) };
         // SAFETY: as `call_allowed`
-        if let Some(inst) = unsafe { recent_instance(c, ALLOWED) } {
-            // SAFETY: non-null and aligned, one element each (FMI contract)
-            let (vr, value) = unsafe { (*vr, *value) };
-            if inst.set_real_plain(vr, value) {
+        if let Some((admitted, inst)) = unsafe { recent_instance(c, ALLOWED) } {
+            let done = inst.set_real_plain(vr, value);
+            drop(admitted);
+            if done {
                 return fmi2Status::fmi2OK;
             }
         }

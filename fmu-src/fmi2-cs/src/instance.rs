@@ -105,9 +105,11 @@ mod flag {
     pub const SETTABLE_BEFORE_INIT: u8 = 1 << 5;
     /// May be set in step mode.
     pub const SETTABLE_IN_STEP: u8 = 1 << 6;
-    /// Bit 7 of an input: the model checks it
-    /// ([`crate::Model::input_checked`]). Tested only once the byte has
-    /// the settable bits, which an output's never has.
+    /// Bit 7 of a settable variable: a value set is checked beyond
+    /// finiteness, against the declared `min`/`max` of the variable, or
+    /// by the model ([`crate::Model::input_checked`]) for an input. Tested
+    /// only once the byte has the settable bits, which an output's never
+    /// has.
     pub const CHECKED: u8 = 1 << 7;
     /// Bit 7 of an output: it has no direct feedthrough (no `depends_on`),
     /// a function of the model state alone, which [`Instance::get`] of it
@@ -200,7 +202,10 @@ impl Instance {
             .variables
             .iter()
             .map(|v| {
-                let checked = v.causality == Causality::Input && model.input_checked(v.vr);
+                let settable = matches!(v.causality, Causality::Input | Causality::Parameter);
+                let bounded = settable && (v.min.is_some() || v.max.is_some());
+                let checked =
+                    bounded || (v.causality == Causality::Input && model.input_checked(v.vr));
                 flags_of(v) | if checked { flag::CHECKED } else { 0 }
             })
             .collect();
@@ -508,7 +513,7 @@ impl Instance {
         if f & want != want || !value.is_finite() {
             self.check_set(t, &[vr], &[value], in_step_mode)?;
         } else if f & flag::CHECKED != 0 {
-            self.check_input(vr, value)?;
+            self.check_value(vr, value)?;
         }
         let stored = self.store_one(f, vr, value);
         // (a value reference that passed the checks has a value: `flags`
@@ -590,7 +595,7 @@ impl Instance {
         } else if any & flag::CHECKED != 0 {
             for (&vr, &value) in vrs.iter().zip(values) {
                 if self.flags[vr as usize] & flag::CHECKED != 0 {
-                    self.check_input(vr, value)?;
+                    self.check_value(vr, value)?;
                 }
             }
         }
@@ -614,7 +619,23 @@ impl Instance {
 
     /// The model's check of input `vr` = `value`, as an FMI message.
     #[inline]
-    fn check_input(&self, vr: u32, value: f64) -> Result<(), String> {
+    /// The checks of a finite value set into variable `vr` beyond its
+    /// type and causality: the declared `min`/`max` of the model
+    /// description, for every parameter and input whether or not the
+    /// model's options use it (a value outside them is refused when set,
+    /// not when an option that reads it is switched on later); then the
+    /// model's own check of an input.
+    fn check_value(&self, vr: u32, value: f64) -> Result<(), String> {
+        let v = &self.info.variables[vr as usize];
+        if let Some(min) = v.min.filter(|min| value < *min) {
+            return Err(self.input_refused(vr, value, format!("below its declared min = {min}")));
+        }
+        if let Some(max) = v.max.filter(|max| value > *max) {
+            return Err(self.input_refused(vr, value, format!("above its declared max = {max}")));
+        }
+        if v.causality != Causality::Input {
+            return Ok(());
+        }
         match self.model.check_input(vr, value) {
             Ok(()) => Ok(()),
             Err(e) => Err(self.input_refused(vr, value, e)),
@@ -668,8 +689,8 @@ impl Instance {
                     v.name
                 ));
             }
-            if v.causality == Causality::Input {
-                self.check_input(*vr, *value)?;
+            if matches!(v.causality, Causality::Input | Causality::Parameter) {
+                self.check_value(*vr, *value)?;
             }
         }
         Ok(())

@@ -5,20 +5,61 @@ use crate::ffi::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
 use crate::variables::LOG_CATEGORIES;
 use std::ffi::CString;
 
-pub struct Logger {
+/// What it takes to send a message to the importer: its callback, its
+/// environment pointer and the instance's name.
+#[derive(Clone)]
+pub struct Reporter {
     callback: fmi2CallbackLogger,
     environment: fmi2ComponentEnvironment,
     instance_name: CString,
+}
+
+// The environment pointer belongs to the importer, which guarantees that it
+// may be used from the thread that calls into the instance (a refused
+// concurrent call reports from its own thread, as any call does).
+unsafe impl Send for Reporter {}
+unsafe impl Sync for Reporter {}
+
+impl Reporter {
+    /// Send `message` with `status` in `category`, whether or not the
+    /// category is enabled (the caller decides).
+    pub fn send(&self, status: fmi2Status, category: usize, message: &str) {
+        if let Some(callback) = self.callback {
+            let category_c = to_cstring(LOG_CATEGORIES[category].0);
+            // The message is the format string, with every '%' doubled: C
+            // importers that run it through vsnprintf print it unchanged, and
+            // importers that print it as is (FMPy's ctypes logger is not
+            // variadic) show it readable. No argument is ever consumed.
+            let message_c = to_cstring(&message.replace('%', "%%"));
+            // SAFETY: the importer supplied this callback for exactly this
+            // use; every string is NUL-terminated and outlives the call, and
+            // the format contains no conversion that would read an argument.
+            unsafe {
+                callback(
+                    self.environment,
+                    self.instance_name.as_ptr(),
+                    status as i32,
+                    category_c.as_ptr(),
+                    message_c.as_ptr(),
+                );
+            }
+        }
+    }
+
+    /// An error, category `logStatusError`.
+    pub fn error(&self, message: &str) {
+        self.send(fmi2Status::fmi2Error, CATEGORY_ERROR, message);
+    }
+}
+
+pub struct Logger {
+    reporter: Reporter,
     /// One flag per entry of [`LOG_CATEGORIES`].
     enabled: [bool; 4],
     /// The last message of status Error or Fatal (for tests and for the
     /// host's reports; the importer receives it through the callback).
     pub last_error: Option<String>,
 }
-
-// The environment pointer belongs to the importer, which guarantees that it
-// may be used from the thread that calls into the instance.
-unsafe impl Send for Logger {}
 
 pub const CATEGORY_ERROR: usize = 0;
 pub const CATEGORY_FATAL: usize = 1;
@@ -33,9 +74,11 @@ impl Logger {
         logging_on: bool,
     ) -> Self {
         let mut logger = Logger {
-            callback,
-            environment,
-            instance_name: to_cstring(instance_name),
+            reporter: Reporter {
+                callback,
+                environment,
+                instance_name: to_cstring(instance_name),
+            },
             enabled: [true, true, false, false],
             last_error: None,
         };
@@ -86,29 +129,15 @@ impl Logger {
         if matches!(status, fmi2Status::fmi2Error | fmi2Status::fmi2Fatal) {
             self.last_error = Some(message.to_string());
         }
-        if !self.enabled[category] {
-            return;
+        if self.enabled[category] {
+            self.reporter.send(status, category, message);
         }
-        if let Some(callback) = self.callback {
-            let category_c = to_cstring(LOG_CATEGORIES[category].0);
-            // The message is the format string, with every '%' doubled: C
-            // importers that run it through vsnprintf print it unchanged, and
-            // importers that print it as is (FMPy's ctypes logger is not
-            // variadic) show it readable. No argument is ever consumed.
-            let message_c = to_cstring(&message.replace('%', "%%"));
-            // SAFETY: the importer supplied this callback for exactly this
-            // use; every string is NUL-terminated and outlives the call, and
-            // the format contains no conversion that would read an argument.
-            unsafe {
-                callback(
-                    self.environment,
-                    self.instance_name.as_ptr(),
-                    status as i32,
-                    category_c.as_ptr(),
-                    message_c.as_ptr(),
-                );
-            }
-        }
+    }
+
+    /// A copy of what sends the messages, for a thread that must not touch
+    /// this logger.
+    pub fn reporter(&self) -> Reporter {
+        self.reporter.clone()
     }
 
     pub fn error(&mut self, message: &str) {

@@ -370,8 +370,27 @@ fn output_derivatives_agree_with_a_short_step() {
 
 #[test]
 fn invalid_parameters_are_refused_with_name_and_value() {
+    // Outside the bounds the model description declares: refused when set.
+    let when_set: &[BadCase] = &[
+        ("Dahl", &[("sigma", -2.0)], "sigma (value reference 4) = -2"),
+        ("ResetIntegrator", &[("z0", -1e-4)], "z0 (value reference"),
+        (
+            "Bristle",
+            &[("delta_max", -1.0)],
+            "delta_max (value reference",
+        ),
+        (
+            "Bristle2D",
+            &[("sigma11", -1.0)],
+            "sigma11 (value reference",
+        ),
+    ];
+    for (model, bad, needle) in when_set {
+        common::refused_when_set(model, bad, needle);
+    }
+    // Within them, but not a valid model (Fc > 0, Fs >= Fc, a table of at
+    // least two increasing points, ...): refused at initialization.
     let cases: &[BadCase] = &[
-        ("Dahl", &[("sigma", -2.0)], "sigma = -2"),
         ("Dahl", &[("Fc", 0.0)], "Fc = 0"),
         ("LuGre", &[("sigma0", 0.0)], "sigma0 = 0"),
         ("LuGre", &[("Fs", 0.9)], "Fs = 0.9"),
@@ -394,8 +413,6 @@ fn invalid_parameters_are_refused_with_name_and_value() {
             ],
             "x_table",
         ),
-        ("ResetIntegrator", &[("z0", -1e-4)], "z0 = -0.0001"),
-        ("Bristle", &[("delta_max", -1.0)], "delta_max = -1"),
         (
             "Bristle",
             &[("count_from_load", 0.0), ("n_bristles", 0.0)],
@@ -406,7 +423,6 @@ fn invalid_parameters_are_refused_with_name_and_value() {
             &[("stiffness_from_load", 0.0), ("sigma_ini", 0.0)],
             "sigma_ini = 0",
         ),
-        ("Bristle2D", &[("sigma11", -1.0)], "sigma11 = -1"),
     ];
     for (model, bad, needle) in cases {
         common::refused_at_initialization(model, bad, needle);

@@ -49,3 +49,44 @@ fn a_negative_normal_force_is_refused_alone_and_in_a_list() {
             .unwrap();
     }
 }
+
+/// A parameter is checked against its declared bounds when it is set,
+/// whether or not the options in force use it: `Fc_neg` and the
+/// `scale_neg` table are read only when `direction_dependent` is on, yet
+/// a negative value is refused at once, naming the parameter, the value
+/// and the bound, and nothing is set. Values within the bounds are taken.
+#[test]
+fn unused_parameters_are_checked_against_their_declared_bounds() {
+    let mut fmu = lugre();
+    let (dd, fc_neg, scale) = (
+        vr(&fmu, "direction_dependent"),
+        vr(&fmu, "Fc_neg"),
+        vr(&fmu, "scale_neg[5]"),
+    );
+    fmu.setup_experiment(0.0, None).unwrap();
+    fmu.enter_initialization_mode().unwrap();
+    assert_eq!(fmu.values().real(dd), 0.0, "direction_dependent is off");
+    let before = fmu.values().real(fc_neg);
+
+    let err = fmu.set(VarType::Real, &[fc_neg], &[-1.0]).unwrap_err();
+    assert_eq!(
+        err,
+        format!("Fc_neg (value reference {fc_neg}) = -1: below its declared min = 0")
+    );
+    let err = fmu
+        .set(VarType::Real, &[scale, fc_neg], &[0.5, -2.0])
+        .unwrap_err();
+    assert!(err.starts_with("Fc_neg"), "{err}");
+    assert_eq!(fmu.values().real(fc_neg), before);
+    assert_eq!(fmu.values().real(scale), 1.0, "all or nothing");
+    let err = fmu.set(VarType::Real, &[scale], &[-0.1]).unwrap_err();
+    assert!(
+        err.contains("scale_neg[5]") && err.contains("min = 0"),
+        "{err}"
+    );
+
+    fmu.set(VarType::Real, &[fc_neg, scale], &[0.0, 2.0])
+        .unwrap();
+    assert_eq!(fmu.values().real(fc_neg), 0.0);
+    fmu.exit_initialization_mode().unwrap();
+}

@@ -154,6 +154,29 @@ impl Fmu {
         x
     }
 
+    /// The value of `name` of any type, as f64.
+    pub fn get_any(&self, name: &str) -> f64 {
+        let v = self.var(name);
+        let status = unsafe {
+            match v.var_type {
+                VarType::Real => {
+                    let mut x = f64::NAN;
+                    (fmi2GetReal(self.c, &v.vr, 1, &mut x), x)
+                }
+                VarType::Integer => {
+                    let mut x = 0;
+                    (fmi2GetInteger(self.c, &v.vr, 1, &mut x), x as f64)
+                }
+                VarType::Boolean => {
+                    let mut x = 0;
+                    (fmi2GetBoolean(self.c, &v.vr, 1, &mut x), x as f64)
+                }
+            }
+        };
+        assert_eq!(status.0, OK, "{}", last_error());
+        status.1
+    }
+
     pub fn set_slope(&self, name: &str, slope: f64) {
         let v = self.var(name);
         assert_eq!(
@@ -359,5 +382,27 @@ pub fn refused_at_initialization(model: &'static str, bad: &[(&str, f64)], needl
         m.contains("fmi2ExitInitializationMode") && m.contains(needle),
         "{model}: {m}"
     );
+    fmu
+}
+
+/// `model` with every value of `bad` but the last set (each accepted), and
+/// the last refused when set, outside the bounds the model description
+/// declares: `fmi2Error`, a message with `needle`, the value unchanged.
+pub fn refused_when_set(model: &'static str, bad: &[(&str, f64)], needle: &str) -> Fmu {
+    let (last, first) = bad.split_last().expect("a value to refuse");
+    let fmu = Fmu::instantiated(model, first);
+    let v = fmu.var(last.0);
+    let before = fmu.get_any(last.0);
+    assert_eq!(
+        fmu.set_any(last.0, last.1),
+        fmi2Status::fmi2Error,
+        "{model} {bad:?}"
+    );
+    let m = last_error();
+    assert!(
+        m.starts_with("fmi2Set") && m.contains(needle) && m.contains("declared"),
+        "{model}: {m}"
+    );
+    assert_eq!(fmu.get_any(last.0), before, "{model}.{}", v.name);
     fmu
 }
