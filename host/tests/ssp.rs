@@ -858,3 +858,30 @@ fn junk_is_refused_without_a_panic() {
         &["none.ssd", "no such file"],
     );
 }
+
+/// A document of 240 000 elements (120 000 inline parameters of the
+/// friction component, `Fs` again and again: the last one counts) is read
+/// in one pass, every element's line counted as the parser goes; a
+/// connection to an unknown component after them is refused naming its
+/// line. (Asking for each element's line from the start of the file made
+/// the pass quadratic: 77 s for 120 000 elements; BENCHMARKS.md times it.)
+#[test]
+fn a_document_of_many_elements_is_read_in_one_pass_and_located() {
+    let one = r#"                  <ssv:Parameter name="Fs"><ssv:Real value="1.6" unit="N"/></ssv:Parameter>
+"#;
+    let system = valid_system().replacen(one, &one.repeat(120_000), 1);
+    let (_dir, file) = open(&system);
+    file.expect("accepted").check().expect("checks");
+
+    let bad = system.replacen(
+        r#"startElement="rig" startConnector="v""#,
+        r#"startElement="rigg" startConnector="v""#,
+        1,
+    );
+    let line = bad.lines().position(|l| l.contains("rigg")).unwrap() + 1;
+    assert!(line > 120_000, "{line}");
+    assert_message(
+        &refused(&bad),
+        &[&format!("system.ssd:{line}"), "no component `rigg`"],
+    );
+}

@@ -10,6 +10,7 @@
 //! names, units declared in `UnitDefinitions`, `ModelStructure` indices).
 
 use crate::error::FmuError;
+use crate::ssp::xml::line_column;
 use quick_xml::events::Event;
 use serde::Deserialize;
 use std::collections::HashMap;
@@ -283,21 +284,6 @@ impl ModelDescription {
                 model: self.model_name.clone(),
             })
     }
-}
-
-/// 1-based line and column (in characters) of byte `offset`.
-fn line_column(text: &[u8], offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line_start = before
-        .iter()
-        .rposition(|&b| b == b'\n')
-        .map_or(0, |i| i + 1);
-    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-    let column = String::from_utf8_lossy(&before[line_start..])
-        .chars()
-        .count()
-        + 1;
-    (line, column)
 }
 
 /// First pass: the root element must be `fmiModelDescription` with

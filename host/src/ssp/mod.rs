@@ -30,7 +30,7 @@
 //! almost always a typing mistake.
 
 pub mod pack;
-mod xml;
+pub(crate) mod xml;
 
 pub use pack::pack;
 
