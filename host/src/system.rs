@@ -95,6 +95,34 @@ pub struct System {
     /// be used for every component, [`System::step_jacobi`] sets the
     /// inputs straight from that row.
     direct: bool,
+    /// What the build noticed and accepted (a connection between a
+    /// variable with a unit and one without, say), for the command to
+    /// show: [`System::warnings`].
+    warnings: Vec<String>,
+}
+
+/// The units of a connection `from -> to`, as the FMUs declare them.
+/// FMI 2.0 and SSP 1.0 leave units optional: a side without one connects
+/// to any unit, with a warning (`Ok(Some(warning))`); two different
+/// declared units are refused, since fricsim does not convert them.
+pub fn connection_units(
+    from: &str,
+    from_unit: Option<&str>,
+    to: &str,
+    to_unit: Option<&str>,
+) -> Result<Option<String>, String> {
+    match (from_unit, to_unit) {
+        (Some(a), Some(b)) if a != b => Err(format!(
+            "unit mismatch: `{from}` has unit `{a}`, `{to}` has unit `{b}` (fricsim does not convert units; connect quantities of the same unit)"
+        )),
+        (None, Some(u)) | (Some(u), None) => {
+            let unitless = if from_unit.is_none() { from } else { to };
+            Ok(Some(format!(
+                "connection {from} -> {to}: `{unitless}` declares no unit, the other side `{u}`: connected as is (units are optional in FMI and SSP; make sure the value is in {u})"
+            )))
+        }
+        _ => Ok(None),
+    }
 }
 
 /// What [`System::sample`] has read: one row of every component's
@@ -291,6 +319,7 @@ impl System {
             sources: Vec::new(),
             values: Vec::new(),
             direct: false,
+            warnings: Vec::new(),
         };
         for (from, to) in connections {
             let (fi, fv) = find(&system.components, from)?;
@@ -324,6 +353,14 @@ impl System {
                     "connection {from} -> {to}: only Real variables can be connected"
                 )));
             }
+            match connection_units(from, out.kind.unit(), to, inp.kind.unit()) {
+                Ok(warning) => system.warnings.extend(warning),
+                Err(e) => {
+                    return Err(SystemError::Invalid(format!(
+                        "connection {from} -> {to}: {e}"
+                    )))
+                }
+            }
             if system
                 .connections
                 .iter()
@@ -346,6 +383,12 @@ impl System {
         }
         system.set_parameters(parameters)?;
         Ok(system)
+    }
+
+    /// What the build noticed and accepted, one sentence each (a command
+    /// prints them as warnings).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// Start over at `start` with the same instances: `fmi2Reset` each,

@@ -93,6 +93,7 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
         System::build(&components, &parameters, &connections).map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
     let mut master = fricsim::master::by_name(&a.master)?;
+    super::print_warnings(system.warnings());
     let started = std::time::Instant::now();
     let run = simulate(&mut system, master.as_mut(), a.step, a.stop).map_err(|e| e.to_string())?;
     let elapsed = started.elapsed();

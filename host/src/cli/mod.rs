@@ -105,3 +105,10 @@ pub fn call_time_limit(seconds: Option<f64>) -> Result<Option<std::time::Duratio
         )),
     }
 }
+
+/// What a built system noticed and accepted, on stderr, one line each.
+pub fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+}

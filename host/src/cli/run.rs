@@ -85,6 +85,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
 
     let mut system = file.build(start).map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
+    super::print_warnings(system.warnings());
     let plot_signals = if !a.plot_signals.is_empty() {
         a.plot_signals.clone()
     } else {

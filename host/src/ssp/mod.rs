@@ -1074,19 +1074,12 @@ impl SystemFile {
                 k.unit.clone().or_else(|| v.kind.unit().map(str::to_string))
             };
             let (fu, tu) = (unit_of(fk, &fv), unit_of(tk, &tv));
-            if fu != tu {
-                let show = |u: &Option<String>| {
-                    u.as_ref()
-                        .map_or("no unit".to_string(), |u| format!("unit `{u}`"))
-                };
-                return Err(error(
-                    &conn.location,
-                    format!(
-                        "unit mismatch: `{from}` has {}, `{to}` has {} (fricsim does not convert units; connect quantities of the same unit)",
-                        show(&fu),
-                        show(&tu)
-                    ),
-                ));
+            // (a side without a unit connects with a warning, which the
+            // built system carries: `System::warnings`)
+            if let Err(e) =
+                crate::system::connection_units(&from, fu.as_deref(), &to, tu.as_deref())
+            {
+                return Err(error(&conn.location, e));
             }
             if let Some(first) = connections.iter().find(|c| c.to == to) {
                 return Err(error(
