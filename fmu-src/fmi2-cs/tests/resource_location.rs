@@ -8,9 +8,8 @@
 use fmi2_cs::ffi::*;
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelFactory, ModelInfo, Values, Variable};
 use std::cell::RefCell;
-use std::ffi::{c_void, CStr, CString};
-use std::os::raw::{c_char, c_int};
-use std::ptr::{null, null_mut};
+use std::ffi::{CStr, CString};
+use std::ptr::null;
 
 static VARIABLES: [Variable; 2] = [
     Variable::input(0, "u", 0.0, "", 1.0, "input"),
@@ -69,16 +68,7 @@ impl Model for Toy {
     fn do_step(&mut self, _: &Values, _: &[f64], _: f64) -> Result<(), String> {
         Ok(())
     }
-    fn save_state(&self, out: &mut Vec<f64>) {
-        out.push(self.s);
-    }
-    fn restore_state(&mut self, s: &[f64]) -> Result<(), String> {
-        self.s = s[0];
-        Ok(())
-    }
-    fn clone_model(&self) -> Box<dyn Model> {
-        Box::new(self.clone())
-    }
+    toy_instance::one_value_toy_state!();
     fn needs_resources(&self) -> bool {
         self.reads_resources
     }
@@ -114,27 +104,13 @@ static REGISTRY: [ModelFactory; 2] = [
 fmi2_cs::export_fmi2!(&REGISTRY[..]);
 use fmi2_exports::*;
 
-thread_local! {
-    static LOG: RefCell<Vec<(i32, String, String)>> = const { RefCell::new(Vec::new()) };
-}
+#[path = "support/toy_instance.rs"]
+#[allow(dead_code)] // its instance helpers: this test goes through the C API
+mod toy_instance;
 
-extern "C" fn record(
-    _env: *mut c_void,
-    _name: *const c_char,
-    status: c_int,
-    category: *const c_char,
-    message: *const c_char,
-) {
-    // SAFETY: the FMU passes NUL-terminated strings.
-    let (c, m) = unsafe { (CStr::from_ptr(category), CStr::from_ptr(message)) };
-    LOG.with(|l| {
-        l.borrow_mut().push((
-            status,
-            c.to_string_lossy().into(),
-            m.to_string_lossy().into(),
-        ))
-    });
-}
+#[path = "support/recording_logger.rs"]
+mod recording_logger;
+use recording_logger::{callbacks, log_clear, log_snapshot};
 
 /// Instantiate `guid` with `location` (None: a NULL pointer) and logging
 /// on or off; the instance (NULL if refused) and the messages logged.
@@ -143,22 +119,8 @@ fn instantiate(
     location: Option<&str>,
     logging_on: bool,
 ) -> (fmi2Component, Vec<(i32, String, String)>) {
-    LOG.with(|l| l.borrow_mut().clear());
-    // SAFETY: five-argument non-variadic function called through the
-    // variadic pointer type with no variadic arguments (as ctypes importers do).
-    let logger = unsafe {
-        std::mem::transmute::<
-            *const (),
-            unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...),
-        >(record as *const ())
-    };
-    let callbacks = fmi2CallbackFunctions {
-        logger: Some(logger),
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: null_mut(),
-    };
+    log_clear();
+    let callbacks = callbacks();
     let location = location.map(|l| CString::new(l).unwrap());
     let c = unsafe {
         fmi2Instantiate(
@@ -171,7 +133,7 @@ fn instantiate(
             if logging_on { fmi2True } else { fmi2False },
         )
     };
-    (c, LOG.with(|l| l.borrow().clone()))
+    (c, log_snapshot())
 }
 
 /// A Windows path in the binary's own convention.
