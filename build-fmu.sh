@@ -1,14 +1,22 @@
 #!/usr/bin/env bash
-# Build the FMU libraries (friction laws, rigs) in release mode and package one .fmu per model into
-# dist/: dist/<Name>.fmu holds modelDescription.xml (rendered from the code's
-# variable table) and binaries/linux64/<modelIdentifier>.so. Then every
-# example system examples/<name>.ssd (sources ../dist/*.fmu) is checked and
-# packed into a self-contained dist/<name>.ssp (FMUs and .ssv under resources/).
+# Build the FMU libraries (friction laws, rigs) in release mode, for Linux
+# and, cross-built with MinGW-w64, for Windows, and package one .fmu per
+# model into dist/: dist/<Name>.fmu holds modelDescription.xml (rendered
+# from the code's variable table), binaries/linux64/<modelIdentifier>.so and
+# binaries/win64/<modelIdentifier>.dll. Then every example system
+# examples/<name>.ssd (sources ../dist/*.fmu) is checked and packed into a
+# self-contained dist/<name>.ssp (FMUs and .ssv under resources/).
 set -euo pipefail
 cd "$(dirname "$0")"
+# the MinGW-w64 linker, Wine for the tests, the Rust target (idempotent)
+scripts/setup-windows.sh
 cargo build --release -p friction-fmu-c -p rig-fmu-c -p fmu-packager -p friction-fmu
+# the linker and flags of this target are in .cargo/config.toml
+cargo build --release --target x86_64-pc-windows-gnu -p friction-fmu-c -p rig-fmu-c
 target/release/fmu-package check modelDescription
-target/release/fmu-package build --lib-dir target/release --out dist
+target/release/fmu-package build --out dist \
+    --platform linux64=target/release \
+    --platform win64=target/x86_64-pc-windows-gnu/release
 cargo build --release -p fricsim
 # (packed afresh: an example renamed or removed leaves no stale archive)
 rm -f dist/*.ssp

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# All tests, on a fresh machine: build the FMUs, run the Rust tests, create
-# the pinned Python venv (FMPy), install Chromium (the report tests render
-# report.html in it) and run the Python tests.
+# All tests, on a fresh machine: build the FMUs (build-fmu.sh installs
+# MinGW-w64 and Wine through scripts/setup-windows.sh: the Windows DLLs are
+# cross-built and tested under Wine), run the Rust tests, create the pinned
+# Python venv (FMPy), install Chromium (the report tests render report.html
+# in it) and run the Python tests.
 set -euo pipefail
 cd "$(dirname "$0")"
 ./build-fmu.sh

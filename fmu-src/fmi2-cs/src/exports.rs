@@ -7,6 +7,7 @@ use crate::ffi::*;
 use crate::instance::Instance;
 use crate::logger::{Logger, Reporter};
 use crate::model::ModelFactory;
+use crate::resource_location;
 use crate::serialize::Snapshot;
 use crate::state_machine::{allowed_mask, State};
 use crate::variables::VarType;
@@ -398,7 +399,7 @@ pub unsafe fn instantiate(
     instance_name: fmi2String,
     fmu_type: fmi2Type,
     guid: fmi2String,
-    _resource_location: fmi2String,
+    resource_location: fmi2String,
     functions: *const fmi2CallbackFunctions,
     _visible: fmi2Boolean,
     logging_on: fmi2Boolean,
@@ -449,9 +450,44 @@ pub unsafe fn instantiate(
             ));
             return std::ptr::null_mut();
         };
+        let mut model = (factory.create)();
+        // SAFETY: NULL or NUL-terminated by the FMI contract.
+        let location = unsafe { c_str(resource_location, "fmuResourceLocation") };
+        let directory = match &location {
+            Ok(uri) => resource_location::to_path(uri, resource_location::PathStyle::NATIVE)
+                .map_err(|e| format!("fmuResourceLocation \"{uri}\" {e}")),
+            Err(e) => Err(e.clone()),
+        };
+        match directory {
+            Ok(dir) => {
+                logger.call(|| {
+                    format!(
+                        "fmi2Instantiate: fmuResourceLocation \"{}\" is the directory \"{dir}\"{}",
+                        location.as_deref().unwrap_or(""),
+                        if model.needs_resources() {
+                            ""
+                        } else {
+                            " (not read: this model uses no resources)"
+                        }
+                    )
+                });
+                if model.needs_resources() {
+                    model.set_resource_dir(&dir);
+                }
+            }
+            Err(e) if model.needs_resources() => {
+                logger.error(&format!(
+                    "fmi2Instantiate: {e}; {} reads its resources from there, so it needs the URI of a directory (file:///C:/dir/resources, file:///home/dir/resources)",
+                    factory.info.model_name
+                ));
+                return std::ptr::null_mut();
+            }
+            Err(e) => logger
+                .call(|| format!("fmi2Instantiate: {e}; accepted: this model uses no resources")),
+        }
         let slot = Box::new(Slot::new(Instance::new(
             factory.info,
-            (factory.create)(),
+            model,
             &name,
             logger,
         )));

@@ -22,6 +22,7 @@ pub mod instance;
 pub mod logger;
 pub mod model;
 pub mod model_description;
+pub mod resource_location;
 pub mod serialize;
 pub mod state_machine;
 pub mod values;

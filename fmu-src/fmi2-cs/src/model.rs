@@ -147,6 +147,22 @@ pub trait Model: Send {
     fn output_derivative(&self, _values: &Values, _slopes: &[f64], _output: u32) -> Option<f64> {
         None
     }
+
+    /// Whether the model reads files from the FMU's `resources/`
+    /// directory. If it does, `fmi2Instantiate` refuses a
+    /// `fmuResourceLocation` that names no directory
+    /// ([`crate::resource_location`]) and passes the directory to
+    /// [`Model::set_resource_dir`]; if not (the default, and every model of
+    /// this project), any location is accepted and only logged. Asked once,
+    /// when the instance is created.
+    fn needs_resources(&self) -> bool {
+        false
+    }
+
+    /// The FMU's `resources/` directory, as a path of the platform the
+    /// binary runs on; called once, right after creation, on a model that
+    /// [`Model::needs_resources`].
+    fn set_resource_dir(&mut self, _dir: &str) {}
 }
 
 /// An entry of the binary's model registry: the GUID picks the model.

@@ -4,9 +4,8 @@
 
 use fmi2_cs::ffi::*;
 use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelFactory, ModelInfo, Values, Variable};
-use std::cell::RefCell;
-use std::ffi::{c_void, CStr, CString};
-use std::os::raw::{c_char, c_int};
+use std::ffi::CString;
+use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
 
 // ---- a toy model: y = k*u + s, ds/dt = u; panics in a step when u = 13 ----
@@ -87,58 +86,9 @@ static REGISTRY: [ModelFactory; 1] = [ModelFactory {
 fmi2_cs::export_fmi2!(&REGISTRY[..]);
 use fmi2_exports::*;
 
-// ---- a logger that records messages ----------------------------------------
-
-// The FMU calls the logger synchronously on the calling thread, and each
-// test runs on its own thread: a thread-local log keeps tests apart.
-thread_local! {
-    static LOG: RefCell<Vec<(i32, String, String)>> = const { RefCell::new(Vec::new()) };
-}
-
-fn log_snapshot() -> Vec<(i32, String, String)> {
-    LOG.with(|l| l.borrow().clone())
-}
-
-fn log_clear() {
-    LOG.with(|l| l.borrow_mut().clear());
-}
-
-extern "C" fn record(
-    _env: *mut c_void,
-    _name: *const c_char,
-    status: c_int,
-    category: *const c_char,
-    message: *const c_char,
-) {
-    // SAFETY: the FMU passes NUL-terminated strings.
-    let (c, m) = unsafe { (CStr::from_ptr(category), CStr::from_ptr(message)) };
-    LOG.with(|l| {
-        l.borrow_mut().push((
-            status,
-            c.to_string_lossy().into(),
-            m.to_string_lossy().into(),
-        ))
-    });
-}
-
-fn callbacks() -> fmi2CallbackFunctions {
-    // SAFETY: on x86-64 and aarch64 a non-variadic function with these five
-    // arguments can be called through the variadic pointer type (the FMU
-    // passes no variadic arguments); this is what ctypes importers do.
-    let logger = unsafe {
-        std::mem::transmute::<
-            *const (),
-            unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...),
-        >(record as *const ())
-    };
-    fmi2CallbackFunctions {
-        logger: Some(logger),
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: null_mut(),
-    }
-}
+#[path = "support/recording_logger.rs"]
+mod recording_logger;
+use recording_logger::{callbacks, log_clear, log_snapshot};
 
 fn last_error_containing(needle: &str) -> String {
     let log = log_snapshot();

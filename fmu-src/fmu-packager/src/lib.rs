@@ -6,7 +6,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The FMU libraries of this project: crate name (the shared library is
-/// `lib<crate>.so`), generation tool, and the models it holds.
+/// `lib<crate>.so`, `<crate>.dll`, …: [`PLATFORMS`]), generation tool, and
+/// the models it holds.
 pub fn libraries() -> Vec<(&'static str, &'static str, Vec<&'static ModelInfo>)> {
     vec![
         (
@@ -49,11 +50,96 @@ pub fn description_path(dir: &Path, info: &ModelInfo) -> PathBuf {
     dir.join(format!("{}.xml", info.model_name))
 }
 
-/// Write `dist/<Name>.fmu`: `modelDescription.xml` and
-/// `binaries/linux64/<modelIdentifier>.so`.
-pub fn package(info: &ModelInfo, library: &Path, out_dir: &Path) -> Result<PathBuf, String> {
-    let binary =
-        std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+/// The platform folders of FMI 2.0 (FMI 2.0.4 §2.4: `binaries/<platform>/`)
+/// with the file name of a Rust `cdylib` built for each: prefix and
+/// extension (`libfriction_fmu_c.so`, `friction_fmu_c.dll`,
+/// `libfriction_fmu_c.dylib`).
+pub const PLATFORMS: &[(&str, &str, &str)] = &[
+    ("linux32", "lib", "so"),
+    ("linux64", "lib", "so"),
+    ("win32", "", "dll"),
+    ("win64", "", "dll"),
+    ("darwin32", "lib", "dylib"),
+    ("darwin64", "lib", "dylib"),
+];
+
+fn platform(name: &str) -> Result<&'static (&'static str, &'static str, &'static str), String> {
+    PLATFORMS
+        .iter()
+        .find(|(p, _, _)| *p == name)
+        .ok_or_else(|| {
+            let known: Vec<&str> = PLATFORMS.iter().map(|(p, _, _)| *p).collect();
+            format!(
+                "unknown platform \"{name}\" (FMI 2.0 platforms: {})",
+                known.join(", ")
+            )
+        })
+}
+
+/// The libraries of one platform: `binaries/<platform>/` of every FMU
+/// comes from `dir`, where cargo wrote the `cdylib`s for that platform
+/// (`target/release`, `target/x86_64-pc-windows-gnu/release`, …).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Platform {
+    pub name: &'static str,
+    pub dir: PathBuf,
+}
+
+impl std::str::FromStr for Platform {
+    type Err = String;
+    /// `PLATFORM=DIR`, e.g. `win64=target/x86_64-pc-windows-gnu/release`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (name, dir) = s
+            .split_once('=')
+            .ok_or_else(|| format!("\"{s}\" is not PLATFORM=DIR (e.g. darwin64=target/release)"))?;
+        if dir.is_empty() {
+            return Err(format!("\"{s}\" names no directory"));
+        }
+        Ok(Platform {
+            name: platform(name)?.0,
+            dir: PathBuf::from(dir),
+        })
+    }
+}
+
+impl Platform {
+    /// The built library of crate `library` (`lib<crate>.so`,
+    /// `<crate>.dll`, `lib<crate>.dylib`) in this platform's directory.
+    pub fn built_library(&self, library: &str) -> PathBuf {
+        let (_, prefix, extension) = platform(self.name).expect("checked when parsed");
+        self.dir.join(format!("{prefix}{library}.{extension}"))
+    }
+}
+
+/// The archive entry of `model_identifier`'s binary for `platform`:
+/// `binaries/win64/LuGre.dll`.
+pub fn binary_entry(platform: &str, model_identifier: &str) -> Result<String, String> {
+    let (name, _, extension) = self::platform(platform)?;
+    Ok(format!("binaries/{name}/{model_identifier}.{extension}"))
+}
+
+/// Write `dist/<Name>.fmu`: `modelDescription.xml` and, for every
+/// platform of `platforms` (in that order, no platform twice), the
+/// library of `info`'s crate built for it, as
+/// `binaries/<platform>/<modelIdentifier>.<so|dll|dylib>`.
+pub fn package(
+    info: &ModelInfo,
+    platforms: &[Platform],
+    out_dir: &Path,
+) -> Result<PathBuf, String> {
+    if platforms.is_empty() {
+        return Err("no platform to package".into());
+    }
+    let mut binaries = Vec::with_capacity(platforms.len());
+    for (i, p) in platforms.iter().enumerate() {
+        if platforms[..i].iter().any(|q| q.name == p.name) {
+            return Err(format!("platform {} given twice", p.name));
+        }
+        let library = p.built_library(library_of(info));
+        let binary = std::fs::read(&library)
+            .map_err(|e| format!("cannot read {} ({}): {e}", library.display(), p.name))?;
+        binaries.push((binary_entry(p.name, info.model_identifier)?, binary));
+    }
     let xml = render(info)?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
@@ -71,10 +157,9 @@ pub fn package(info: &ModelInfo, library: &Path, out_dir: &Path) -> Result<PathB
             .map_err(|e| format!("{}: {e}", path.display()))
     };
     add("modelDescription.xml", xml.as_bytes())?;
-    add(
-        &format!("binaries/linux64/{}.so", info.model_identifier),
-        &binary,
-    )?;
+    for (entry, binary) in &binaries {
+        add(entry, binary)?;
+    }
     zip.finish()
         .map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(path)

@@ -2,7 +2,7 @@
 //! and package FMUs. Used by `build-fmu.sh`.
 
 use clap::{Parser, Subcommand};
-use fmu_packager::{all_models, description_path, package, render};
+use fmu_packager::{all_models, description_path, package, render, Platform};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -27,11 +27,19 @@ enum Command {
     },
     /// Print the variable tables of docs/fmu-reference.md (Markdown).
     VariablesMd,
-    /// Package every model: <out>/<Name>.fmu from the shared library.
+    /// Package every model: <out>/<Name>.fmu from the shared libraries.
     Build {
-        /// Directory with the built cdylibs (lib<crate>.so).
-        #[arg(long, default_value = "target/release")]
-        lib_dir: PathBuf,
+        /// PLATFORM=DIR: binaries/PLATFORM/ of every FMU from the cdylibs
+        /// built for it in DIR (lib<crate>.so for linux32/64, <crate>.dll
+        /// for win32/64, lib<crate>.dylib for darwin32/64). Repeat for
+        /// several platforms, e.g. --platform linux64=target/release
+        /// --platform win64=target/x86_64-pc-windows-gnu/release.
+        #[arg(
+            long = "platform",
+            value_name = "PLATFORM=DIR",
+            default_value = "linux64=target/release"
+        )]
+        platforms: Vec<Platform>,
         #[arg(long, default_value = "dist")]
         out: PathBuf,
     },
@@ -66,10 +74,14 @@ fn run(cli: Cli) -> Result<(), String> {
             println!("model descriptions match the code");
         }
         Command::VariablesMd => print!("{}", fmu_packager::variables_markdown()),
-        Command::Build { lib_dir, out } => {
+        Command::Build { platforms, out } => {
+            let names: Vec<&str> = platforms.iter().map(|p| p.name).collect();
             for info in all_models() {
-                let lib = lib_dir.join(format!("lib{}.so", fmu_packager::library_of(info)));
-                println!("wrote {}", package(info, &lib, &out)?.display());
+                println!(
+                    "wrote {} ({})",
+                    package(info, &platforms, &out)?.display(),
+                    names.join(", ")
+                );
             }
         }
     }

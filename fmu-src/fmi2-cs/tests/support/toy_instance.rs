@@ -1,7 +1,8 @@
 //! The description and an initialized instance of a toy model, for the
 //! tests of the layer on a model of their own
 //! (`fmi2-cs/tests/directional_scale.rs`, `get_lists.rs`,
-//! `step_derivatives.rs`, `step_size.rs`).
+//! `step_derivatives.rs`, `step_size.rs`; its state macro also
+//! `resource_location.rs`).
 //! Included with `#[path]`.
 
 use fmi2_cs::instance::Instance;
