@@ -29,7 +29,7 @@ CARGO_TARGET_DIR=target/unguarded cargo build --release -q -p friction-fmu-c -p 
 unguarded=target/bench-guard/unguarded
 rm -rf "$unguarded" && mkdir -p "$unguarded"
 cp -r examples "$unguarded/"
-target/release/fmu-package build --lib-dir target/unguarded/release --out "$unguarded/dist" > /dev/null
+target/release/fmu-package build --out "$unguarded/dist" --platform linux64=target/unguarded/release > /dev/null
 
 out=target/bench-guard/times.csv
 echo "turn,build,in_process_ms,command_ns,final_force" > "$out"
