@@ -23,7 +23,7 @@ from fmpy.fmi2 import FMU2Slave
 
 from conftest import ROOT, fmu_path
 
-DRIVE = ROOT / "target" / "fmi-crate" / "release" / "fmi-crate-drive"
+DRIVE = ROOT / "target" / "fmi-crate" / "debug" / "fmi-crate-drive"
 H = 1e-3
 N = 3000  # 3 s: two and a half periods of the velocity below
 
