@@ -11,10 +11,11 @@
 //! crate read from the model description), the experiment is set up from
 //! the first to the last time of INPUT.csv (a defined stop time), and at
 //! each row but the last the inputs are set and the FMU steps to the next
-//! row's time. OUT.csv gets `time` and every Real and Boolean (as 0/1)
-//! output the crate finds in the model description, in its order, after
-//! initialization and after each step; reals are printed with Rust's
-//! shortest round-trip formatting, so they are read back bit for bit.
+//! row's time. OUT.csv gets `time` and every Real, Integer and Boolean
+//! (as 0/1) output the crate finds in the model description, in its
+//! order, after initialization and after each step; reals are printed
+//! with Rust's shortest round-trip formatting, so they are read back bit
+//! for bit.
 //!
 //! Afterwards one step past the stop time is attempted; its outcome is
 //! printed on stdout as `step past stop: <result>` (FMI 2.0 §2.1.6: it must
@@ -33,6 +34,13 @@ use fmi::{
 };
 
 type Res<T> = Result<T, Box<dyn Error>>;
+
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Real,
+    Integer,
+    Boolean,
+}
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -95,21 +103,31 @@ fn run(fmu: &str, input: &str, out: &str, assignments: &[String]) -> Res<()> {
         }
         input_vrs.push(var.value_reference);
     }
-    // Every Real and Boolean output, in the model description's order.
-    let outputs: Vec<(String, u32, bool)> = md
+    // Every Real, Integer and Boolean output, in the model description's order.
+    let outputs: Vec<(String, u32, Kind)> = md
         .get_model_variables()
         .filter(|v| v.causality == Causality::Output)
-        .filter_map(|v| match v.elem {
-            ScalarVariableElement::Real(_) => Some((v.name.clone(), v.value_reference, true)),
-            ScalarVariableElement::Boolean(_) => Some((v.name.clone(), v.value_reference, false)),
-            _ => None,
+        .filter_map(|v| {
+            let kind = match v.elem {
+                ScalarVariableElement::Real(_) => Kind::Real,
+                ScalarVariableElement::Integer(_) => Kind::Integer,
+                ScalarVariableElement::Boolean(_) => Kind::Boolean,
+                _ => return None,
+            };
+            Some((v.name.clone(), v.value_reference, kind))
         })
         .collect();
-    if !outputs.iter().any(|(_, _, real)| *real) {
+    if !outputs.iter().any(|o| o.2 == Kind::Real) {
         return Err("the model description declares no Real output".into());
     }
-    let real_vrs: Vec<u32> = outputs.iter().filter(|o| o.2).map(|o| o.1).collect();
-    let bool_vrs: Vec<u32> = outputs.iter().filter(|o| !o.2).map(|o| o.1).collect();
+    let vrs = |kind: Kind| -> Vec<u32> {
+        outputs
+            .iter()
+            .filter(|o| o.2 == kind)
+            .map(|o| o.1)
+            .collect()
+    };
+    let (real_vrs, int_vrs, bool_vrs) = (vrs(Kind::Real), vrs(Kind::Integer), vrs(Kind::Boolean));
 
     let mut inst = import.instantiate_cs("fmi-crate", false, false)?;
     for assignment in assignments {
@@ -147,19 +165,23 @@ fn run(fmu: &str, input: &str, out: &str, assignments: &[String]) -> Res<()> {
     }
     csv.push('\n');
     let mut reals = vec![0.0; real_vrs.len()];
+    let mut ints = vec![0; int_vrs.len()];
     let mut bools = vec![0; bool_vrs.len()];
     let mut record = |inst: &mut InstanceCS, t: f64| -> Res<()> {
         inst.get_real(&real_vrs, &mut reals)?;
+        if !int_vrs.is_empty() {
+            inst.get_integer(&int_vrs, &mut ints)?;
+        }
         if !bool_vrs.is_empty() {
             inst.get_boolean(&bool_vrs, &mut bools)?;
         }
         write!(csv, "{t:?}")?;
-        let (mut r, mut b) = (reals.iter(), bools.iter());
-        for (_, _, real) in &outputs {
-            if *real {
-                write!(csv, ",{:?}", r.next().unwrap())?;
-            } else {
-                write!(csv, ",{}", i32::from(*b.next().unwrap() != 0))?;
+        let (mut r, mut i, mut b) = (reals.iter(), ints.iter(), bools.iter());
+        for (_, _, kind) in &outputs {
+            match kind {
+                Kind::Real => write!(csv, ",{:?}", r.next().unwrap())?,
+                Kind::Integer => write!(csv, ",{}", i.next().unwrap())?,
+                Kind::Boolean => write!(csv, ",{}", i32::from(*b.next().unwrap() != 0))?,
             }
         }
         csv.push('\n');
