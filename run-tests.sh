@@ -2,12 +2,14 @@
 # All tests, on a fresh machine: build the FMUs (build-fmu.sh installs
 # MinGW-w64 and Wine through scripts/setup-windows.sh: the Windows DLLs are
 # cross-built and tested under Wine), run the Rust tests, create the pinned
-# Python venv (FMPy), install Chromium (the report tests render report.html
-# in it) and run the Python tests.
+# Python venv (FMPy, fmutool, libcosimpy), install Chromium (the report
+# tests render report.html in it), build the `fmi` crate's importer
+# (libclang for its bindings) and run the Python tests.
 set -euo pipefail
 cd "$(dirname "$0")"
 ./build-fmu.sh
 cargo test --workspace --profile release-test
 scripts/setup-venv.sh
 scripts/setup-browser.sh
+scripts/setup-fmi-crate.sh
 .venv/bin/python -m pytest tests -q

@@ -462,6 +462,36 @@ fn malformed_xml_is_located() {
 }
 
 #[test]
+fn two_hyphens_inside_a_comment_are_refused_with_their_line() {
+    // XML 1.0 §2.5: other tools' parsers (expat, libxml2) refuse the file,
+    // so fricsim must not accept it either; examples/ once had such comments.
+    // the line and column of the `--`, in a comment of several lines with
+    // single hyphens before it
+    let text = valid_system().replace(
+        "<ssd:Connections>",
+        "<!-- run it, re-plotted,\n     with the option --plot -->\n    <ssd:Connections>",
+    );
+    let line = text.lines().position(|l| l.contains("--plot")).unwrap() + 1;
+    let message = refused(&text);
+    assert_message(
+        &message,
+        &[&format!("system.ssd:{line}:22:"), "`--` inside a comment"],
+    );
+    // and in a parameter file (more.ssv, bound to the friction component)
+    let dir = valid_files();
+    let more = dir.path().join("more.ssv");
+    let good = std::fs::read_to_string(&more).unwrap();
+    let bad = good.replacen("<ssv:Parameters>", "<!-- a -- b --><ssv:Parameters>", 1);
+    assert_ne!(bad, good);
+    std::fs::write(&more, bad).unwrap();
+    let message = match SystemFile::open(dir.path().join("system.ssd")) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("a parameter file with -- in a comment was accepted"),
+    };
+    assert_message(&message, &["more.ssv:3:", "`--` inside a comment"]);
+}
+
+#[test]
 fn a_truncated_file_says_so() {
     let text = valid_system();
     for cut in [text.len() / 3, text.len() / 2, text.len() - 40] {

@@ -97,6 +97,9 @@ impl LineCounter {
 /// lines of the elements. Returns the version.
 pub fn first_pass(xml: &str, root: &str, namespace: &str) -> Result<(String, Lines), SyntaxError> {
     let mut reader = quick_xml::NsReader::from_str(xml);
+    // `--` inside a comment is not well-formed XML (XML 1.0 §2.5): other
+    // SSP tools' parsers refuse such a file, so it is refused here too.
+    reader.config_mut().check_comments = true;
     let at = |offset: u64, message: String| {
         let (line, column) = line_column(xml.as_bytes(), offset as usize);
         SyntaxError {
@@ -116,6 +119,21 @@ pub fn first_pass(xml: &str, root: &str, namespace: &str) -> Result<(String, Lin
         let (ns, event) = match reader.read_resolved_event() {
             Ok((ResolveResult::Bound(n), event)) => (n.into_inner().to_string(), event),
             Ok((_, event)) => (String::new(), event),
+            Err(quick_xml::Error::IllFormed(
+                quick_xml::errors::IllFormedError::DoubleHyphenInComment,
+            )) => {
+                // located here: quick-xml's offset for this error can be
+                // off within a comment that holds a single `-` before
+                let from = position as usize;
+                let opened = xml[from..].find("<!--").map_or(from, |p| from + p + 4);
+                let offset = xml[opened..].find("--").map_or(opened, |p| opened + p);
+                return Err(at(
+                    offset as u64,
+                    "`--` inside a comment, which XML does not allow (XML 1.0 §2.5): \
+                     other SSP tools refuse the file"
+                        .to_string(),
+                ));
+            }
             Err(e) => {
                 let mut message = e.to_string();
                 // A file cut inside a tag, an attribute value or a comment
