@@ -245,6 +245,22 @@ fn counted(start: f64, h: f64, j: usize) -> f64 {
     start + j as i64 as f64 * h
 }
 
+/// Leave initialization mode at `start`: external inputs set, the
+/// connections propagated before and after `fmi2ExitInitializationMode`.
+fn initialize(
+    system: &mut System,
+    start: f64,
+    observer: &mut dyn Observer,
+) -> Result<(), FmuError> {
+    let mut buffer = vec![0.0; system.connections.len()];
+    observer.before_step(system, start, true)?;
+    system.propagate(&mut buffer)?;
+    for c in &mut system.components {
+        c.instance.exit_initialization_mode()?;
+    }
+    system.propagate(&mut buffer)
+}
+
 /// [`simulate`] from `start` (t = start + n·h; the system must have been
 /// set up at `start`), with `observer` consulted at each communication
 /// point: as FMPy does, external inputs are applied at the start time in
@@ -257,13 +273,7 @@ pub fn simulate_with(
     stop: f64,
     observer: &mut dyn Observer,
 ) -> Result<Run, FmuError> {
-    let mut buffer = vec![0.0; system.connections.len()];
-    observer.before_step(system, start, true)?;
-    system.propagate(&mut buffer)?;
-    for c in &mut system.components {
-        c.instance.exit_initialization_mode()?;
-    }
-    system.propagate(&mut buffer)?;
+    initialize(system, start, observer)?;
     let columns = system.columns();
     let n = step_count(start, h, stop);
     system.start_recording(n + 1);
@@ -329,13 +339,7 @@ pub fn simulate_streaming(
     observer: &mut dyn Observer,
     sink: &mut dyn RowSink,
 ) -> Result<Streamed, FmuError> {
-    let mut buffer = vec![0.0; system.connections.len()];
-    observer.before_step(system, start, true)?;
-    system.propagate(&mut buffer)?;
-    for c in &mut system.components {
-        c.instance.exit_initialization_mode()?;
-    }
-    system.propagate(&mut buffer)?;
+    initialize(system, start, observer)?;
     let columns = system.columns();
     let n = step_count(start, h, stop);
     system.start_streamed_recording(CHUNK_STEPS.min(n) + 1);
