@@ -2,27 +2,364 @@
 //! (FMPy's convention), numbers written so that they parse back exactly.
 //! A run that stopped early keeps its rows and ends with a comment line
 //! `# INCOMPLETE: …` (CSV readers such as numpy's skip `#` lines).
+//!
+//! [`ResultWriter`] takes the rows of a run as they are computed
+//! ([`crate::master::simulate_streaming`]) and writes them at once, keeping
+//! only a summary of each column and the columns to be plotted, so that a
+//! run's memory does not grow with its length; [`write_csv`] writes a
+//! [`Run`] held in memory as the same file.
 
-use crate::master::Run;
-use std::io::Write;
-use std::path::Path;
+use crate::master::{RowSink, Run};
+use crate::rows::Rows;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
 
-pub fn write_csv(run: &Run, path: &Path) -> std::io::Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(out, "time,{}", run.columns.join(","))?;
-    for (t, row) in run.time.iter().zip(&run.rows) {
-        write!(out, "{t:?}")?;
-        for x in row {
-            write!(out, ",{x:?}")?;
+/// A CSV result file written row by row: created (with its directory) at
+/// the first rows, so that a run that fails before its first row leaves
+/// no file.
+pub struct CsvFile {
+    path: PathBuf,
+    header: String,
+    out: Option<BufWriter<File>>,
+}
+
+impl CsvFile {
+    /// A file at `path` with the columns `time` and `columns`.
+    pub fn new(path: &Path, columns: &[String]) -> CsvFile {
+        CsvFile {
+            path: path.to_path_buf(),
+            header: format!("time,{}", columns.join(",")),
+            out: None,
         }
-        writeln!(out)?;
     }
-    if let Some(e) = &run.error {
-        let one_line = e.replace(['\n', '\r'], " ");
-        writeln!(out, "# INCOMPLETE: the run stopped early: {one_line}")?;
+
+    fn out(&mut self) -> std::io::Result<&mut BufWriter<File>> {
+        if self.out.is_none() {
+            if let Some(dir) = self.path.parent() {
+                std::fs::create_dir_all(dir)?;
+            }
+            let mut out = BufWriter::with_capacity(1 << 16, File::create(&self.path)?);
+            writeln!(out, "{}", self.header)?;
+            self.out = Some(out);
+        }
+        Ok(self.out.as_mut().expect("opened above"))
     }
-    out.flush()
+
+    /// The first `times.len()` rows of `rows`, at `times`.
+    pub fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
+        let out = self.out()?;
+        let mut digits = zmij::Buffer::new();
+        let mut line = Vec::with_capacity(32 * (rows.width() + 1));
+        for (t, row) in times.iter().zip(rows) {
+            line.clear();
+            push_number(&mut line, &mut digits, *t);
+            for x in row {
+                line.push(b',');
+                push_number(&mut line, &mut digits, *x);
+            }
+            line.push(b'\n');
+            out.write_all(&line)?;
+        }
+        Ok(())
+    }
+
+    /// The end of the file: `# INCOMPLETE: the run stopped early: …` if
+    /// `error` says why the run stopped early.
+    pub fn finish(mut self, error: Option<&str>) -> std::io::Result<()> {
+        let out = self.out()?;
+        if let Some(e) = error {
+            let one_line = e.replace(['\n', '\r'], " ");
+            writeln!(out, "# INCOMPLETE: the run stopped early: {one_line}")?;
+        }
+        out.flush()
+    }
+}
+
+/// Write `run` (rows held in memory) as a CSV result file.
+pub fn write_csv(run: &Run, path: &Path) -> std::io::Result<()> {
+    let mut file = CsvFile::new(path, &run.columns);
+    file.write_rows(&run.time, &run.rows)?;
+    file.finish(run.error.as_deref())
+}
+
+/// What a summary tells of each column: its least, greatest and last
+/// value, over the rows seen so far, and of the rows their number and
+/// first and last times.
+#[derive(Clone, Debug)]
+pub struct ColumnStats {
+    pub rows: usize,
+    pub first_time: Option<f64>,
+    pub last_time: Option<f64>,
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+    /// The last row (NaN before the first).
+    pub last: Vec<f64>,
+}
+
+impl ColumnStats {
+    pub fn new(width: usize) -> ColumnStats {
+        ColumnStats {
+            rows: 0,
+            first_time: None,
+            last_time: None,
+            min: vec![f64::INFINITY; width],
+            max: vec![f64::NEG_INFINITY; width],
+            last: vec![f64::NAN; width],
+        }
+    }
+
+    /// The first `times.len()` rows of `rows`, at `times`.
+    pub fn add(&mut self, times: &[f64], rows: &Rows) {
+        for (t, row) in times.iter().zip(rows) {
+            self.first_time.get_or_insert(*t);
+            self.last_time = Some(*t);
+            self.rows += 1;
+            for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(row) {
+                *lo = lo.min(*x);
+                *hi = hi.max(*x);
+            }
+            self.last.copy_from_slice(row);
+        }
+    }
+}
+
+/// The rows of a run as they come: written to a CSV file, summed up in
+/// [`ColumnStats`], and the columns to be plotted kept.
+pub struct ResultWriter {
+    file: CsvFile,
+    pub stats: ColumnStats,
+    /// The columns kept (their indices), their names, their times and rows.
+    kept: Option<Kept>,
+}
+
+struct Kept {
+    indices: Vec<usize>,
+    names: Vec<String>,
+    time: Vec<f64>,
+    rows: Rows,
+}
+
+impl ResultWriter {
+    /// A writer of the rows of `columns` to the CSV file `path`.
+    pub fn new(path: &Path, columns: &[String]) -> ResultWriter {
+        ResultWriter {
+            file: CsvFile::new(path, columns),
+            stats: ColumnStats::new(columns.len()),
+            kept: None,
+        }
+    }
+
+    /// Keep the columns `names` in memory besides writing them (for a
+    /// plot: [`ResultWriter::kept`]).
+    pub fn keep_columns(&mut self, columns: &[String], names: &[String]) -> Result<(), String> {
+        let indices = names
+            .iter()
+            .map(|s| {
+                columns.iter().position(|c| c == s).ok_or_else(|| {
+                    format!(
+                        "cannot plot `{s}`: no such column (columns: {})",
+                        columns.join(", ")
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        self.kept = Some(Kept {
+            rows: Rows::new(indices.len()),
+            indices,
+            names: names.to_vec(),
+            time: Vec::new(),
+        });
+        Ok(())
+    }
+
+    /// The columns kept ([`ResultWriter::keep_columns`]), as a run of
+    /// those columns alone.
+    pub fn kept(&self) -> Option<Run> {
+        self.kept.as_ref().map(|k| Run {
+            columns: k.names.clone(),
+            time: k.time.clone(),
+            rows: k.rows.clone(),
+            error: None,
+        })
+    }
+
+    /// The end of the file (see [`CsvFile::finish`]).
+    pub fn finish(self, error: Option<&str>) -> std::io::Result<()> {
+        self.file.finish(error)
+    }
+}
+
+impl RowSink for ResultWriter {
+    fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String> {
+        self.file
+            .write_rows(times, rows)
+            .map_err(|e| format!("{}: {e}", self.file.path.display()))?;
+        self.stats.add(times, rows);
+        if let Some(k) = &mut self.kept {
+            k.time.extend_from_slice(times);
+            for row in rows.iter().take(times.len()) {
+                let new = k.rows.push_zeros();
+                for (x, &i) in new.iter_mut().zip(&k.indices) {
+                    *x = row[i];
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Append `x` to `line` as Rust's `{x:?}` writes it (the shortest digits
+/// that parse back to the same `f64`; plain decimal from 1e-4 to below
+/// 1e16, else `1.5e-7`, `2e16`; of two shortest digit strings equally
+/// near `x` the even one, where std may take the other, both exact),
+/// several times faster: the digits come
+/// from the `zmij` crate, whose own layout differs from Rust's only for
+/// values below 1e-4 (`0.00001`) and above (`1e+16`), which are laid out
+/// again here.
+pub fn push_number(line: &mut Vec<u8>, digits: &mut zmij::Buffer, x: f64) {
+    let magnitude = x.abs();
+    if !x.is_finite() {
+        line.extend_from_slice(format!("{x:?}").as_bytes());
+        return;
+    }
+    let text = digits.format_finite(x).as_bytes();
+    if (1e-4..1e16).contains(&magnitude) || magnitude == 0.0 {
+        line.extend_from_slice(text);
+        return;
+    }
+    // d.ddd·10^e from zmij's `d.ddde±x` or `0.000ddd`
+    let (negative, text) = match text {
+        [b'-', rest @ ..] => (true, rest),
+        _ => (false, text),
+    };
+    let mut mantissa = [0u8; 24];
+    let mut n = 0;
+    let exponent = match text.iter().position(|&b| b == b'e') {
+        Some(e) => {
+            for &b in text[..e].iter().filter(|b| b.is_ascii_digit()) {
+                mantissa[n] = b;
+                n += 1;
+            }
+            let exp = std::str::from_utf8(&text[e + 1..]).unwrap_or("0");
+            exp.trim_start_matches('+').parse::<i32>().unwrap_or(0)
+        }
+        None => {
+            // below 1e-4: `0.` then zeros then the digits
+            let fraction = &text[2.min(text.len())..];
+            let zeros = fraction.iter().take_while(|&&b| b == b'0').count();
+            for &b in &fraction[zeros..] {
+                mantissa[n] = b;
+                n += 1;
+            }
+            -(zeros as i32) - 1
+        }
+    };
+    while n > 1 && mantissa[n - 1] == b'0' {
+        n -= 1;
+    }
+    if negative {
+        line.push(b'-');
+    }
+    line.push(mantissa[0]);
+    if n > 1 {
+        line.push(b'.');
+        line.extend_from_slice(&mantissa[1..n]);
+    }
+    line.push(b'e');
+    line.extend_from_slice(exponent.to_string().as_bytes());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::push_number;
+
+    fn written(x: f64) -> String {
+        let mut line = Vec::new();
+        push_number(&mut line, &mut zmij::Buffer::new(), x);
+        String::from_utf8(line).unwrap()
+    }
+
+    /// Every value is written as `{:?}` writes it, and parses back to the
+    /// same bits: edge values, every power of ten and its neighbours, and
+    /// millions of random bit patterns and of random magnitudes.
+    #[test]
+    fn numbers_are_written_as_rust_writes_them_and_parse_back_bit_for_bit() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.1,
+            1e-4,
+            -1e-4,
+            1e16,
+            1e15,
+            9.999999999999998e15,
+            f64::MAX,
+            f64::MIN,
+            f64::MIN_POSITIVE,
+            5e-324,
+            -5e-324,
+            f64::from_bits(0x000f_ffff_ffff_ffff),
+            f64::EPSILON,
+            1.0 / 3.0,
+            123456.789,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for p in -325..=308 {
+            let x: f64 = format!("1e{p}").parse().unwrap();
+            for y in [
+                x,
+                f64::from_bits(x.to_bits() + 1),
+                f64::from_bits(x.to_bits().saturating_sub(1)),
+            ] {
+                values.extend([y, -y, 1.5 * y, 9.87654321 * y]);
+            }
+        }
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for i in 0..2_000_000u64 {
+            let r = next();
+            values.push(if i % 2 == 0 {
+                f64::from_bits(r)
+            } else {
+                (r >> 11) as f64 / (1u64 << 53) as f64 * 10f64.powi((i % 48) as i32 - 24)
+            });
+        }
+        let mut ties = 0;
+        for x in values {
+            let text = written(x);
+            let std = format!("{x:?}");
+            if text != std {
+                // the one difference allowed: of two shortest digit
+                // strings equally near `x`, zmij takes the even one
+                // (1500000000000000.25 as `…0.2`, std `…0.3`); both parse
+                // back to `x`
+                assert_eq!(
+                    text.len(),
+                    std.len(),
+                    "bits {:#x}: {text} {std}",
+                    x.to_bits()
+                );
+                assert_eq!(std.parse::<f64>().unwrap().to_bits(), x.to_bits());
+                ties += 1;
+            }
+            let back: f64 = text.parse().unwrap();
+            if x.is_nan() {
+                assert!(back.is_nan());
+            } else {
+                assert_eq!(back.to_bits(), x.to_bits(), "{text}");
+            }
+        }
+        // ties are rare (about 0.2 % of these values)
+        assert!(ties < 10_000, "{ties} ties");
+    }
 }

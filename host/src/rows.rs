@@ -248,6 +248,24 @@ impl Rows {
         width
     }
 
+    /// Drop every row but the last, which becomes row 0 (the numbers
+    /// after it are zeros made ready again): for a run that hands its
+    /// rows on as it goes and reads the next step's inputs from the last.
+    ///
+    /// # Panics
+    /// For a [`Rows::windowed`] table, whose rows are folded instead.
+    pub fn keep_last(&mut self) {
+        assert!(!self.is_windowed(), "keep_last on a windowed table");
+        if self.len <= 1 {
+            return;
+        }
+        let width = self.width;
+        let end = self.len * width;
+        self.values.copy_within(end - width..end, 0);
+        self.values[width..end].fill(0.0);
+        self.len = 1;
+    }
+
     /// Remove the last row, if any (its numbers become zeros made ready
     /// for the next row).
     pub fn pop(&mut self) {

@@ -635,6 +635,21 @@ impl System {
         forget_sampled(&mut self.components);
     }
 
+    /// [`System::start_recording`] of every row, whatever
+    /// [`System::keep_last_rows`] says: for a run that hands its rows on
+    /// as it goes ([`crate::master::simulate_streaming`]).
+    pub(crate) fn start_streamed_recording(&mut self, rows: usize) {
+        let width = self.recording.rows.width();
+        self.recording.rows = Rows::with_capacity(width, rows);
+        forget_sampled(&mut self.components);
+    }
+
+    /// Drop every row read but the last, which stays the row the inputs
+    /// are read from ([`Rows::keep_last`]).
+    pub(crate) fn keep_last_sample(&mut self) {
+        self.recording.rows.keep_last();
+    }
+
     /// Let the recordings started from now on keep only their last
     /// `window` rows (at least 2), the others summed into
     /// [`Rows::square_sums`] and counted in [`Rows::rows_pushed`]: for runs

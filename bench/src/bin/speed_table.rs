@@ -8,7 +8,8 @@
 //!    (1e-2 s) step, the inputs a 1 Hz sinusoid through stick and slip.
 //! 2. **The LuGre stick-slip benchmark** (`examples/stick_slip.ssd`, 20 s at
 //!    1e-4 s) with Jacobi and strong coupling (`newton`):
-//!    - the host, exactly as `fricsim run` runs it ([`simulate_with`]);
+//!    - the host, exactly as `fricsim run` runs it ([`simulate_streaming`],
+//!      the rows handed on chunk by chunk; only the last is kept);
 //!    - FMPy driving the same two FMUs with the same step and scheme from
 //!      Python (`scripts/bench_fmpy.py`, FMU2Slave), started from here;
 //!    - the monolithic limit: the same laws and rig (`friction-laws`,
@@ -43,7 +44,7 @@
 
 use clap::Parser;
 use fricsim::fmu::Fmu;
-use fricsim::master::{by_name, simulate_with, step_count, NoObserver, Rows};
+use fricsim::master::{by_name, simulate_streaming, step_count, NoObserver, RowSink, Rows};
 use fricsim::ssp::{SystemFile, Value};
 use fricsim::sweep::{grid, run_all, Axis, Plan};
 use fricsim_bench::{
@@ -369,21 +370,38 @@ fn host_run(
     let mut algorithm = by_name(master)?;
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
     let clock = Instant::now();
-    let run = simulate_with(
+    let mut last = LastRow::default();
+    let run = simulate_streaming(
         &mut system,
         algorithm.as_mut(),
         0.0,
         h,
         stop,
         &mut NoObserver,
+        &mut last,
     )
     .map_err(|e| e.to_string())?;
     let wall = clock.elapsed().as_secs_f64();
     if let Some(e) = run.error {
         return Err(format!("{STICK_SLIP} with {master}: {e}"));
     }
-    let force = final_value(&run.columns, &run.rows, "friction.F")?;
+    let force = final_value(&run.columns, &last.0, "friction.F")?;
     Ok((wall, force, algorithm))
+}
+
+/// The rows of a host run as `fricsim run` takes them, chunk by chunk
+/// ([`simulate_streaming`]), keeping the last only: the time of writing
+/// them is not the host's stepping.
+#[derive(Default)]
+struct LastRow(Rows);
+
+impl RowSink for LastRow {
+    fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String> {
+        if let Some(row) = rows.get(times.len().wrapping_sub(1)) {
+            self.0 = Rows::from_rows(row.len(), [row]);
+        }
+        Ok(())
+    }
 }
 
 /// `--only`: one side of the stick-slip benchmark, run `repeats` times

@@ -1,7 +1,8 @@
 //! `fricsim cosim`: connect FMUs given on the command line, co-simulate
 //! with a fixed macro step, write a CSV and a plot, print a summary.
 
-use fricsim::master::simulate;
+use fricsim::master::{simulate_streaming, NoObserver};
+use fricsim::results::ResultWriter;
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
 
@@ -94,18 +95,41 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
     let mut master = fricsim::master::by_name(&a.master)?;
     super::print_warnings(system.warnings());
+    let columns = system.columns();
+    let mut writer = ResultWriter::new(&a.out, &columns);
+    let signals = if a.plot_signals.is_empty() {
+        columns.clone()
+    } else {
+        a.plot_signals.clone()
+    };
+    // a signal that cannot be plotted is reported once the CSV is written
+    let plot_error = match a.plot {
+        Some(_) => writer.keep_columns(&columns, &signals).err(),
+        None => None,
+    };
     let started = std::time::Instant::now();
-    let run = simulate(&mut system, master.as_mut(), a.step, a.stop).map_err(|e| e.to_string())?;
+    let run = simulate_streaming(
+        &mut system,
+        master.as_mut(),
+        0.0,
+        a.step,
+        a.stop,
+        &mut NoObserver,
+        &mut writer,
+    )
+    .map_err(|e| e.to_string())?;
     let elapsed = started.elapsed();
-    fricsim::results::write_csv(&run, &a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
-    if let Some(plot) = &a.plot {
-        let signals = if a.plot_signals.is_empty() {
-            run.columns.clone()
-        } else {
-            a.plot_signals.clone()
-        };
+    let kept = writer.kept();
+    let stats = writer.stats.clone();
+    writer
+        .finish(run.error.as_deref())
+        .map_err(|e| format!("{}: {e}", a.out.display()))?;
+    if let Some(e) = plot_error {
+        return Err(e);
+    }
+    if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
         fricsim::plot::plot_signals(
-            &run,
+            kept,
             &signals,
             plot,
             &format!("fricsim cosim ({})", master.name()),
@@ -113,19 +137,14 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     }
     println!(
         "{} macro steps of {} s with {}, {} columns, {:.3} s wall time",
-        run.rows.len() - 1,
+        run.rows.saturating_sub(1),
         a.step,
         master.name(),
         run.columns.len(),
         elapsed.as_secs_f64()
     );
     for (k, c) in run.columns.iter().enumerate() {
-        let (lo, hi) = run
-            .rows
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), r| {
-                (l.min(r[k]), h.max(r[k]))
-            });
+        let (lo, hi) = (stats.min[k], stats.max[k]);
         println!("  {c:<24} min {lo:>12.5e}  max {hi:>12.5e}");
     }
     if let Some(report) = master.report() {

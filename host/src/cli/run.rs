@@ -5,7 +5,8 @@
 //! (`DefaultExperiment`, our annotation), else from defaults.
 
 use fricsim::inputs::{ExternalInputs, InputTable};
-use fricsim::master::{by_name, simulate_with, step_count, Observer, Run};
+use fricsim::master::{by_name, simulate_streaming, step_count, Observer, Streamed};
+use fricsim::results::{ColumnStats, ResultWriter};
 use fricsim::ssp::SystemFile;
 use fricsim::system::System;
 use fricsim::FmuError;
@@ -113,24 +114,42 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         bar
     };
     let mut watch = Watch { inputs, bar };
-    let started = std::time::Instant::now();
-    let run = simulate_with(&mut system, master.as_mut(), start, step, stop, &mut watch)
-        .map_err(|e| format!("initialization failed: {e}"))?;
-    let elapsed = started.elapsed();
-    watch.bar.finish_and_clear();
-
     let out = a
         .out
         .clone()
         .unwrap_or_else(|| super::default_out(&a.system, ""));
-    fricsim::results::write_csv(&run, &out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let mut plot_error = None;
-    if let Some(plot) = &a.plot {
-        let signals = if plot_signals.is_empty() {
-            run.columns.clone()
-        } else {
-            plot_signals
-        };
+    let columns = system.columns();
+    let mut writer = ResultWriter::new(&out, &columns);
+    let plot_signals = if plot_signals.is_empty() {
+        columns.clone()
+    } else {
+        plot_signals
+    };
+    // a plot that cannot be drawn does not hide the run or its summary
+    let mut plot_error = match a.plot {
+        Some(_) => writer.keep_columns(&columns, &plot_signals).err(),
+        None => None,
+    };
+    let started = std::time::Instant::now();
+    let run = simulate_streaming(
+        &mut system,
+        master.as_mut(),
+        start,
+        step,
+        stop,
+        &mut watch,
+        &mut writer,
+    )
+    .map_err(|e| format!("initialization failed: {e}"))?;
+    let elapsed = started.elapsed();
+    watch.bar.finish_and_clear();
+
+    let kept = writer.kept();
+    let stats = writer.stats.clone();
+    writer
+        .finish(run.error.as_deref())
+        .map_err(|e| format!("{}: {e}", out.display()))?;
+    if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
         let title = format!(
             "{} ({})",
             if file.name.is_empty() {
@@ -140,13 +159,20 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
             },
             master.name()
         );
-        // a plot that cannot be drawn does not hide the summary
-        plot_error = fricsim::plot::plot_signals(&run, &signals, plot, &title).err();
+        plot_error = fricsim::plot::plot_signals(kept, &plot_signals, plot, &title).err();
     }
 
     print!(
         "{}",
-        summary(&file, &run, n, step, master.name(), elapsed.as_secs_f64())
+        summary(
+            &file,
+            &run,
+            &stats,
+            n,
+            step,
+            master.name(),
+            elapsed.as_secs_f64()
+        )
     );
     if let Some(report) = master.report() {
         println!("{report}");
@@ -158,7 +184,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     if let Some(e) = run.error {
         return Err(format!(
             "run INCOMPLETE (the {} rows up to the failure are in {}): {e}",
-            run.rows.len(),
+            run.rows,
             out.display()
         ));
     }
@@ -170,10 +196,18 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
 
 /// The summary: what ran, how long, each column's min/max/final value,
 /// and whether the run completed.
-fn summary(file: &SystemFile, run: &Run, n: usize, step: f64, master: &str, wall: f64) -> String {
+fn summary(
+    file: &SystemFile,
+    run: &Streamed,
+    stats: &ColumnStats,
+    n: usize,
+    step: f64,
+    master: &str,
+    wall: f64,
+) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let done = run.rows.len().saturating_sub(1);
+    let done = run.rows.saturating_sub(1);
     let _ = writeln!(
         s,
         "{}: {} components, {} connections, {} parameter values",
@@ -185,8 +219,8 @@ fn summary(file: &SystemFile, run: &Run, n: usize, step: f64, master: &str, wall
     let _ = writeln!(
         s,
         "{done} of {n} macro steps of {step} s with {master} ({} to {} s), {wall:.3} s wall time: {}",
-        run.time.first().copied().unwrap_or(0.0),
-        run.time.last().copied().unwrap_or(0.0),
+        stats.first_time.unwrap_or(0.0),
+        stats.last_time.unwrap_or(0.0),
         if run.error.is_none() { "completed" } else { "INCOMPLETE" }
     );
     let width = run
@@ -202,13 +236,7 @@ fn summary(file: &SystemFile, run: &Run, n: usize, step: f64, master: &str, wall
         "signal", "min", "max", "final"
     );
     for (k, c) in run.columns.iter().enumerate() {
-        let (lo, hi) = run
-            .rows
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), r| {
-                (l.min(r[k]), h.max(r[k]))
-            });
-        let last = run.rows.last().map_or(f64::NAN, |r| r[k]);
+        let (lo, hi, last) = (stats.min[k], stats.max[k], stats.last[k]);
         let _ = writeln!(s, "  {c:<width$} {lo:>13.5e} {hi:>13.5e} {last:>13.5e}");
     }
     s

@@ -245,6 +245,22 @@ fn counted(start: f64, h: f64, j: usize) -> f64 {
     start + j as i64 as f64 * h
 }
 
+/// Leave initialization mode at `start`: external inputs set, the
+/// connections propagated before and after `fmi2ExitInitializationMode`.
+fn initialize(
+    system: &mut System,
+    start: f64,
+    observer: &mut dyn Observer,
+) -> Result<(), FmuError> {
+    let mut buffer = vec![0.0; system.connections.len()];
+    observer.before_step(system, start, true)?;
+    system.propagate(&mut buffer)?;
+    for c in &mut system.components {
+        c.instance.exit_initialization_mode()?;
+    }
+    system.propagate(&mut buffer)
+}
+
 /// [`simulate`] from `start` (t = start + n·h; the system must have been
 /// set up at `start`), with `observer` consulted at each communication
 /// point: as FMPy does, external inputs are applied at the start time in
@@ -257,23 +273,12 @@ pub fn simulate_with(
     stop: f64,
     observer: &mut dyn Observer,
 ) -> Result<Run, FmuError> {
-    let mut buffer = vec![0.0; system.connections.len()];
-    observer.before_step(system, start, true)?;
-    system.propagate(&mut buffer)?;
-    for c in &mut system.components {
-        c.instance.exit_initialization_mode()?;
-    }
-    system.propagate(&mut buffer)?;
+    initialize(system, start, observer)?;
     let columns = system.columns();
     let n = step_count(start, h, stop);
     system.start_recording(n + 1);
     system.sample()?;
-    let error = match (master.as_jacobi(), observer.between_steps()) {
-        (Some(jacobi), false) => step_all::<_, false>(system, jacobi, observer, start, h, n),
-        (Some(jacobi), true) => step_all::<_, true>(system, jacobi, observer, start, h, n),
-        (None, false) => step_all::<_, false>(system, master, observer, start, h, n),
-        (None, true) => step_all::<_, true>(system, master, observer, start, h, n),
-    };
+    let error = step_range(system, master, observer, start, h, 0..n, n);
     // the times of the rows kept follow from their number: nothing is
     // stored for them as the run steps
     let rows = system.take_recording();
@@ -284,6 +289,120 @@ pub fn simulate_with(
         rows,
         error,
     })
+}
+
+/// Macro steps per chunk of a [`simulate_streaming`] run: the rows of a
+/// chunk are handed on and dropped before the next chunk starts, so a run
+/// holds at most this many rows (about 200 kB for the stick-slip
+/// benchmark's six columns, which stay in the cache while they are
+/// written), whatever its length.
+pub const CHUNK_STEPS: usize = 4096;
+
+/// Where the rows of a [`simulate_streaming`] run go as they are
+/// computed: a result file, a summary, the columns of a plot.
+pub trait RowSink {
+    /// The first `times.len()` rows of `rows`, at `times`: the next
+    /// communication points of the run, in order. An error stops the run
+    /// (its message is the run's [`Streamed::error`]); so does a sink that
+    /// asks for it ([`RowSink::stop_requested`]).
+    fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String>;
+    /// Why the run is to stop before its end, if it is: asked between
+    /// chunks (a run interrupted by a signal stops there).
+    fn stop_requested(&self) -> Option<String> {
+        None
+    }
+}
+
+/// What a [`simulate_streaming`] run leaves once its rows are handed on.
+pub struct Streamed {
+    pub columns: Vec<String>,
+    /// Rows handed to the sink: one per communication point completed.
+    pub rows: usize,
+    /// Why the run stopped early, if it did: an FMU's failure, the sink's
+    /// error or its request to stop.
+    pub error: Option<String>,
+}
+
+/// [`simulate_with`], handing the rows to `sink` as the run goes instead
+/// of keeping them: every [`CHUNK_STEPS`] macro steps, the rows recorded
+/// since the last chunk (but the last one, from which the connected
+/// inputs are read) go to the sink and are dropped, so that the memory a
+/// run takes does not grow with its length. The rows and their times are
+/// those of [`simulate_with`] bit for bit. The steps run in the same loop
+/// as [`simulate_with`]'s, over a chunk at a time.
+pub fn simulate_streaming(
+    system: &mut System,
+    master: &mut dyn MasterAlgorithm,
+    start: f64,
+    h: f64,
+    stop: f64,
+    observer: &mut dyn Observer,
+    sink: &mut dyn RowSink,
+) -> Result<Streamed, FmuError> {
+    initialize(system, start, observer)?;
+    let columns = system.columns();
+    let n = step_count(start, h, stop);
+    system.start_streamed_recording(CHUNK_STEPS.min(n) + 1);
+    system.sample()?;
+    // communication points handed to the sink so far; steps done
+    let mut written = 0;
+    let mut done = 0;
+    let mut error = None;
+    loop {
+        if error.is_none() && done < n {
+            error = sink.stop_requested();
+        }
+        let end = if error.is_none() {
+            (done + CHUNK_STEPS).min(n)
+        } else {
+            done
+        };
+        if end > done {
+            error = step_range(system, master, observer, start, h, done..end, n);
+            done = end;
+        }
+        let last_chunk = error.is_some() || done == n;
+        let held = system.recorded().len();
+        // the last row stays until the run ends: the next step reads the
+        // connected inputs from it
+        let handing = if last_chunk { held } else { held - 1 };
+        let times = communication_times(start, h, written..written + handing);
+        if let Err(e) = sink.write(&times, system.recorded()) {
+            error.get_or_insert(e);
+            break;
+        }
+        written += handing;
+        if last_chunk {
+            break;
+        }
+        system.keep_last_sample();
+    }
+    system.take_recording();
+    Ok(Streamed {
+        columns,
+        rows: written,
+        error,
+    })
+}
+
+/// The steps `steps` of a run of `n` from `start` (the row of the
+/// communication point where they start already read), through
+/// [`step_all`] in the copy that fits the master and the observer.
+fn step_range(
+    system: &mut System,
+    master: &mut dyn MasterAlgorithm,
+    observer: &mut dyn Observer,
+    start: f64,
+    h: f64,
+    steps: std::ops::Range<usize>,
+    n: usize,
+) -> Option<String> {
+    match (master.as_jacobi(), observer.between_steps()) {
+        (Some(jacobi), false) => step_all::<_, false>(system, jacobi, observer, start, h, steps, n),
+        (Some(jacobi), true) => step_all::<_, true>(system, jacobi, observer, start, h, steps, n),
+        (None, false) => step_all::<_, false>(system, master, observer, start, h, steps, n),
+        (None, true) => step_all::<_, true>(system, master, observer, start, h, steps, n),
+    }
 }
 
 /// [`communication_time`] of each point of `points`, computed as
@@ -346,9 +465,9 @@ impl Advance for jacobi::Jacobi {
     }
 }
 
-/// The `n` steps of [`simulate_with`] from `start`, after the row of
-/// point 0: a row per communication point completed; why the run stopped
-/// early, if it did. One copy for the Jacobi master, its step inlined, one
+/// The steps `steps` of the `n` of [`simulate_with`] from `start`, after
+/// the row of the point where they start: a row per communication point
+/// completed; why the run stopped early, if it did. One copy for the Jacobi master, its step inlined, one
 /// for any other, called through the trait object; each in two, with and
 /// without the observer's calls between the steps
 /// ([`Observer::between_steps`], `BETWEEN_STEPS`).
@@ -359,12 +478,13 @@ fn step_all<M: Advance + ?Sized, const BETWEEN_STEPS: bool>(
     observer: &mut dyn Observer,
     start: f64,
     h: f64,
+    steps: std::ops::Range<usize>,
     n: usize,
 ) -> Option<String> {
     // t = start + i·h, each counted from the start; the step's end is the
     // next step's start, so each is computed once
-    let mut t_next = counted(start, h, 0);
-    for i in 0..n {
+    let mut t_next = counted(start, h, steps.start);
+    for i in steps {
         let t = t_next;
         t_next = counted(start, h, i + 1);
         let stepped = if BETWEEN_STEPS {
