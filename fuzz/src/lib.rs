@@ -19,6 +19,7 @@ pub static ALL: LazyLock<Vec<ModelFactory>> = LazyLock::new(|| {
         .map(|f| ModelFactory {
             info: f.info,
             create: f.create,
+            create_model_exchange: f.create_model_exchange,
         })
         .collect()
 });

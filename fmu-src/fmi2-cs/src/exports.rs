@@ -426,12 +426,16 @@ pub unsafe fn instantiate(
                 return std::ptr::null_mut();
             }
         };
-        if fmu_type != fmi2CoSimulation {
-            logger.error(&format!(
-                "fmi2Instantiate: fmuType = {fmu_type} is not supported: this FMU implements Co-Simulation (1) only"
-            ));
-            return std::ptr::null_mut();
-        }
+        let model_exchange = match fmu_type {
+            t if t == fmi2CoSimulation => false,
+            t if t == fmi2ModelExchange => true,
+            other => {
+                logger.error(&format!(
+                    "fmi2Instantiate: fmuType = {other} is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)"
+                ));
+                return std::ptr::null_mut();
+            }
+        };
         let guid = match unsafe { c_str(guid, "fmuGUID") } {
             Ok(g) => g,
             Err(e) => {
@@ -450,7 +454,21 @@ pub unsafe fn instantiate(
             ));
             return std::ptr::null_mut();
         };
-        let mut model = (factory.create)();
+        let create = if model_exchange {
+            match factory.create_model_exchange {
+                Some(create) if factory.info.model_exchange.is_some() => create,
+                _ => {
+                    logger.error(&format!(
+                        "fmi2Instantiate: fmuType = 0 (Model Exchange) is not supported by {}: it implements Co-Simulation (1) only (see its model description: no <ModelExchange> element)",
+                        factory.info.model_name
+                    ));
+                    return std::ptr::null_mut();
+                }
+            }
+        } else {
+            factory.create
+        };
+        let mut model = create();
         // SAFETY: NULL or NUL-terminated by the FMI contract.
         let location = unsafe { c_str(resource_location, "fmuResourceLocation") };
         let directory = match &location {
@@ -485,13 +503,14 @@ pub unsafe fn instantiate(
             Err(e) => logger
                 .call(|| format!("fmi2Instantiate: {e}; accepted: this model uses no resources")),
         }
-        let slot = Box::new(Slot::new(Instance::new(
-            factory.info,
-            model,
-            &name,
-            logger,
-        )));
-        let address = Box::into_raw(slot);
+        let mut instance = Instance::new(factory.info, model, &name, logger);
+        if model_exchange {
+            if let Err(e) = instance.make_model_exchange() {
+                instance.logger.error(&format!("fmi2Instantiate: {e}"));
+                return std::ptr::null_mut();
+            }
+        }
+        let address = Box::into_raw(Box::new(Slot::new(instance)));
         live().insert(address as usize);
         address as fmi2Component
     }));
@@ -1025,6 +1044,113 @@ pub unsafe fn cancel_step(c: fmi2Component) -> fmi2Status {
     unsafe { call!(c, "fmi2CancelStep", |_| Ok(fmi2Status::fmi2OK)) }
 }
 
+// ---- Model Exchange (FMI 2.0.4 §3.2) ---------------------------------------
+
+simple_call!(enter_event_mode, "fmi2EnterEventMode", enter_event_mode);
+simple_call!(
+    enter_continuous_time_mode,
+    "fmi2EnterContinuousTimeMode",
+    enter_continuous_time_mode
+);
+
+/// # Safety
+/// See [`call_allowed`]; `event_info` is NULL or points to an
+/// `fmi2EventInfo`.
+pub unsafe fn new_discrete_states(c: fmi2Component, event_info: *mut fmi2EventInfo) -> fmi2Status {
+    unsafe {
+        call!(c, "fmi2NewDiscreteStates", |inst| {
+            let out = out_slice(event_info, 1, "fmi2eventInfo")?;
+            let changed = inst.new_discrete_states()?;
+            out[0] = fmi2EventInfo {
+                newDiscreteStatesNeeded: fmi2False,
+                terminateSimulation: fmi2False,
+                nominalsOfContinuousStatesChanged: fmi2False,
+                valuesOfContinuousStatesChanged: if changed { fmi2True } else { fmi2False },
+                nextEventTimeDefined: fmi2False,
+                nextEventTime: 0.0,
+            };
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call_allowed`]; the two flags are NULL or point to an
+/// `fmi2Boolean` each.
+pub unsafe fn completed_integrator_step(
+    c: fmi2Component,
+    _no_set_fmu_state_prior: fmi2Boolean,
+    enter_event_mode: *mut fmi2Boolean,
+    terminate_simulation: *mut fmi2Boolean,
+) -> fmi2Status {
+    unsafe {
+        call!(c, "fmi2CompletedIntegratorStep", |_| {
+            let enter = out_slice(enter_event_mode, 1, "enterEventMode")?;
+            let terminate = out_slice(terminate_simulation, 1, "terminateSimulation")?;
+            // no step events: nothing to do after an accepted step
+            enter[0] = fmi2False;
+            terminate[0] = fmi2False;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call_allowed`].
+pub unsafe fn set_time(c: fmi2Component, time: f64) -> fmi2Status {
+    unsafe {
+        call!(c, "fmi2SetTime", |inst| {
+            inst.set_time(time)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// # Safety
+/// See [`call_allowed`] and [`in_slice`]; `nx` is checked against the
+/// model's number of states before `x` is read.
+pub unsafe fn set_continuous_states(c: fmi2Component, x: *const f64, nx: usize) -> fmi2Status {
+    unsafe {
+        call!(c, "fmi2SetContinuousStates", |inst| {
+            inst.check_nx(nx)?;
+            let x = in_slice(x, nx, "x[]")?;
+            inst.set_continuous_states(x)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
+/// The state-sized reads of Model Exchange: `fmi2GetDerivatives`,
+/// `fmi2GetContinuousStates`, `fmi2GetNominalsOfContinuousStates` (`n` =
+/// nx) and `fmi2GetEventIndicators` (`n` = ni, `indicators`), the length
+/// checked before `out` is written.
+///
+/// # Safety
+/// See [`call_allowed`] and [`out_slice`].
+pub unsafe fn get_state_array(
+    c: fmi2Component,
+    function: &'static str,
+    out: *mut f64,
+    n: usize,
+    what: &'static str,
+    indicators: bool,
+    read: fn(&mut Instance, &mut [f64]) -> Result<(), String>,
+) -> fmi2Status {
+    unsafe {
+        // (the mask looked up by name: one function for four calls)
+        call_allowed(c, function, allowed_mask(function), |inst| {
+            if indicators {
+                inst.check_ni(n)?;
+            } else {
+                inst.check_nx(n)?;
+            }
+            let out = out_slice(out, n, what)?;
+            read(inst, out)?;
+            Ok(fmi2Status::fmi2OK)
+        })
+    }
+}
+
 /// `fmi2Get*Status`. Only `fmi2LastSuccessfulTime` (Real) and
 /// `fmi2Terminated` (Boolean) are meaningful for an FMU that never returns
 /// `fmi2Pending` or `fmi2Discard`; other kinds give `fmi2Discard`.
@@ -1058,8 +1184,9 @@ pub unsafe fn get_status<T: Copy>(
     }
 }
 
-/// Emit every FMI 2.0 Co-Simulation function for the models in `registry`
-/// (an expression of type `&'static [ModelFactory]`). Invoke once in a cdylib.
+/// Emit every FMI 2.0 function, Co-Simulation and Model Exchange, for the
+/// models in `registry` (an expression of type `&'static [ModelFactory]`).
+/// Invoke once in a cdylib.
 #[macro_export]
 macro_rules! export_fmi2 {
     ($registry:expr) => {
@@ -1301,6 +1428,121 @@ macro_rules! export_fmi2 {
             #[no_mangle]
             pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
                 unsafe { x::cancel_step(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
+                unsafe { x::enter_event_mode(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2NewDiscreteStates(
+                c: fmi2Component,
+                event_info: *mut fmi2EventInfo,
+            ) -> fmi2Status {
+                unsafe { x::new_discrete_states(c, event_info) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
+                unsafe { x::enter_continuous_time_mode(c) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
+                c: fmi2Component,
+                no_set_prior: fmi2Boolean,
+                enter_event_mode: *mut fmi2Boolean,
+                terminate_simulation: *mut fmi2Boolean,
+            ) -> fmi2Status {
+                unsafe {
+                    x::completed_integrator_step(
+                        c,
+                        no_set_prior,
+                        enter_event_mode,
+                        terminate_simulation,
+                    )
+                }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
+                unsafe { x::set_time(c, time) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetContinuousStates(
+                c: fmi2Component,
+                states: *const fmi2Real,
+                nx: usize,
+            ) -> fmi2Status {
+                unsafe { x::set_continuous_states(c, states, nx) }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetDerivatives(
+                c: fmi2Component,
+                derivatives: *mut fmi2Real,
+                nx: usize,
+            ) -> fmi2Status {
+                unsafe {
+                    x::get_state_array(
+                        c,
+                        "fmi2GetDerivatives",
+                        derivatives,
+                        nx,
+                        "derivatives[]",
+                        false,
+                        |i, out| i.get_derivatives(out),
+                    )
+                }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetEventIndicators(
+                c: fmi2Component,
+                indicators: *mut fmi2Real,
+                ni: usize,
+            ) -> fmi2Status {
+                unsafe {
+                    x::get_state_array(
+                        c,
+                        "fmi2GetEventIndicators",
+                        indicators,
+                        ni,
+                        "eventIndicators[]",
+                        true,
+                        |i, out| i.get_event_indicators(out),
+                    )
+                }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetContinuousStates(
+                c: fmi2Component,
+                states: *mut fmi2Real,
+                nx: usize,
+            ) -> fmi2Status {
+                unsafe {
+                    x::get_state_array(
+                        c,
+                        "fmi2GetContinuousStates",
+                        states,
+                        nx,
+                        "x[]",
+                        false,
+                        |i, out| i.get_continuous_states(out),
+                    )
+                }
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
+                c: fmi2Component,
+                nominals: *mut fmi2Real,
+                nx: usize,
+            ) -> fmi2Status {
+                unsafe {
+                    x::get_state_array(
+                        c,
+                        "fmi2GetNominalsOfContinuousStates",
+                        nominals,
+                        nx,
+                        "x_nominal[]",
+                        false,
+                        |i, out| i.get_nominals(out),
+                    )
+                }
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi2GetStatus(

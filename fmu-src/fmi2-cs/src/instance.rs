@@ -16,6 +16,8 @@ use crate::values::Indices;
 use crate::variables::{Causality, ModelInfo, VarType, Variable};
 use crate::Values;
 
+mod model_exchange;
+
 /// Relative tolerance on communication points (time is taken from the
 /// master at every step, never summed inside the FMU).
 const TIME_TOLERANCE: f64 = 1e-9;
@@ -92,6 +94,10 @@ pub struct Instance {
     /// same list at every step, and comparing it is cheaper than checking
     /// it again (lists of [`Instance::REMEMBERED`] or more values).
     checked_get: (VarType, Vec<u32>, bool),
+    /// Instantiated for Model Exchange (`fmi2ModelExchange`): its states
+    /// are those of the Model Exchange machine, its model answers
+    /// [`Model::ode`].
+    model_exchange: bool,
 }
 
 /// Bits of [`Instance::flags`].
@@ -130,6 +136,12 @@ fn type_flag(t: VarType) -> u8 {
 }
 
 fn flags_of(v: &Variable) -> u8 {
+    if v.causality == Causality::Local {
+        // A state derivative, computed when read: without its type bit, so
+        // that the hot paths send it to the checks, which compute it
+        // ([`Instance::get_computed`]); never settable.
+        return 0;
+    }
     let mut f = type_flag(v.var_type);
     if v.causality == Causality::Output {
         f |= flag::OUTPUT;
@@ -268,6 +280,7 @@ impl Instance {
             flags,
             nominals,
             checked_get: (VarType::Real, Vec::new(), false),
+            model_exchange: false,
         }
     }
 
@@ -314,7 +327,11 @@ impl Instance {
     }
 
     pub fn enter_initialization_mode(&mut self) -> Result<(), String> {
-        self.state = State::InitializationMode;
+        self.state = if self.model_exchange {
+            State::MeInitializationMode
+        } else {
+            State::InitializationMode
+        };
         self.time = self.start_time;
         self.outputs_dirty = true;
         Ok(())
@@ -327,12 +344,22 @@ impl Instance {
         self.outputs_dirty = false;
         self.initialized = true;
         self.replay.valid = false;
-        self.state = State::StepComplete;
+        // (Model Exchange: the initial event iteration follows, FMI 2.0.4
+        // §3.2.3)
+        self.state = if self.model_exchange {
+            State::EventMode
+        } else {
+            State::StepComplete
+        };
         Ok(())
     }
 
     pub fn terminate(&mut self) -> Result<(), String> {
-        self.state = State::Terminated;
+        self.state = if self.model_exchange {
+            State::MeTerminated
+        } else {
+            State::Terminated
+        };
         Ok(())
     }
 
@@ -348,7 +375,11 @@ impl Instance {
         self.time = 0.0;
         self.start_time = 0.0;
         self.stop_time = None;
-        self.state = State::Instantiated;
+        self.state = if self.model_exchange {
+            State::MeInstantiated
+        } else {
+            State::Instantiated
+        };
         Ok(())
     }
 
@@ -398,6 +429,8 @@ impl Instance {
             let f = self.flags.get(*vr as usize).copied().unwrap_or(0);
             if f & type_flag(t) == 0 {
                 self.variable_of_type(*vr, t)?;
+                // of type `t` but without its bit: a state derivative
+                return self.get_computed(vrs, out);
             }
             let state_output = flag::OUTPUT | flag::STATE_OUTPUT;
             if f & state_output == state_output && self.outputs_dirty && self.initialized {
@@ -415,7 +448,10 @@ impl Instance {
         {
             self.checked_get.2
         } else {
-            self.check_get(t, vrs)?
+            match self.check_get(t, vrs)? {
+                Some(outputs) => outputs,
+                None => return self.get_computed(vrs, out),
+            }
         };
         if outputs {
             self.ensure_outputs()?;
@@ -439,9 +475,11 @@ impl Instance {
     const REMEMBERED: usize = 2;
 
     /// Check a list of value references of [`Instance::get`] (known, of type
-    /// `t`) and remember it; whether it holds an output.
+    /// `t`) and remember it; whether it holds an output, or `None` for a
+    /// list with a state derivative (not remembered: it goes to
+    /// [`Instance::get_computed`] each time).
     #[inline(never)]
-    fn check_get(&mut self, t: VarType, vrs: &[u32]) -> Result<bool, String> {
+    fn check_get(&mut self, t: VarType, vrs: &[u32]) -> Result<Option<bool>, String> {
         // One flag byte per value reference: known, of type `t`, an output?
         let want = type_flag(t);
         let mut wrong = false;
@@ -455,6 +493,8 @@ impl Instance {
             for vr in vrs {
                 self.variable_of_type(*vr, t)?;
             }
+            // every one of type `t`, but one without its bit: a derivative
+            return Ok(None);
         }
         let outputs = flags & flag::OUTPUT != 0;
         if vrs.len() >= Self::REMEMBERED {
@@ -464,7 +504,34 @@ impl Instance {
             remembered.1.extend_from_slice(vrs);
             remembered.2 = outputs;
         }
-        Ok(outputs)
+        Ok(Some(outputs))
+    }
+
+    /// [`Instance::get`] of a list of known Real value references with a
+    /// state derivative among them (checked): the outputs and the
+    /// derivatives computed, then every value read.
+    #[cold]
+    #[inline(never)]
+    fn get_computed(&mut self, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
+        self.ensure_outputs()?;
+        self.compute_derivatives();
+        for (o, vr) in out.iter_mut().zip(vrs) {
+            *o = self.values.real(*vr);
+        }
+        self.check_finite(vrs, out, "")
+    }
+
+    /// The values of the `der(…)` variables ([`Model::derivatives`]) at the
+    /// current state and inputs (the model initialized).
+    fn compute_derivatives(&mut self) {
+        let Some(me) = self.info.model_exchange else {
+            return;
+        };
+        let mut dx = vec![0.0; me.states.len()];
+        self.model.derivatives(&self.values, &mut dx);
+        for (s, d) in me.states.iter().zip(dx) {
+            self.values.set(s.derivative, d);
+        }
     }
 
     /// Values handed to the importer with `fmi2OK` are never NaN or
@@ -494,7 +561,9 @@ impl Instance {
     /// type `t` needs to be set now.
     #[inline]
     fn settable(&self, t: VarType) -> (bool, u8) {
-        let in_step_mode = self.state == State::StepComplete;
+        // (the state table allows a set in these states and in step,
+        // event and continuous-time mode only)
+        let in_step_mode = self.state as u32 & crate::state_machine::BEFORE_INITIALIZATION == 0;
         let when = if in_step_mode {
             flag::SETTABLE_IN_STEP
         } else {
@@ -975,6 +1044,9 @@ impl Instance {
         dv_known: &[f64],
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
+        if self.model_exchange {
+            return self.me_directional_derivative(unknowns, knowns, dv_known, dv_unknown);
+        }
         // the usual case through the flag bytes, else the messages below
         let has = |vr: u32, bits: u8| {
             self.flags
@@ -1312,6 +1384,21 @@ impl Instance {
             return Err(format!(
                 "the FMU state belongs to GUID {}, not this FMU ({})",
                 snap.guid, self.info.guid
+            ));
+        }
+        if snap.state.is_model_exchange() != self.model_exchange {
+            let interface = |me: bool| {
+                if me {
+                    "Model Exchange"
+                } else {
+                    "Co-Simulation"
+                }
+            };
+            return Err(format!(
+                "the FMU state was taken by a {} instance (state {}), this is a {} instance",
+                interface(snap.state.is_model_exchange()),
+                snap.state.name(),
+                interface(self.model_exchange)
             ));
         }
         let same_parameters = self.initialized

@@ -1,7 +1,11 @@
-//! The FMI 2.0 Co-Simulation interface, written once for every model.
+//! The FMI 2.0 Co-Simulation and Model Exchange interfaces, written once
+//! for every model.
 //!
 //! A model implements [`Model`] (pure Rust, no pointers) and declares its
-//! variables in a [`ModelInfo`] table. The [`export_fmi2!`] macro, invoked
+//! variables in a [`ModelInfo`] table; a model that is an ODE also
+//! implements [`Ode`] and declares its states
+//! ([`ModelInfo::model_exchange`]), and the same binary then serves both
+//! interfaces. The [`export_fmi2!`] macro, invoked
 //! in a `cdylib`, emits every `fmi2…` C function; each one
 //!
 //! 1. runs inside `catch_unwind`, so a panic becomes `fmi2Fatal` and a
@@ -28,8 +32,9 @@ pub mod state_machine;
 pub mod values;
 pub mod variables;
 
-pub use model::{Model, ModelFactory};
+pub use model::{Model, ModelFactory, Ode};
 pub use values::Values;
 pub use variables::{
-    Capabilities, Causality, DefaultExperiment, Initial, ModelInfo, VarType, Variability, Variable,
+    Capabilities, Causality, ContinuousState, DefaultExperiment, Initial, ModelExchange, ModelInfo,
+    VarType, Variability, Variable,
 };

@@ -163,12 +163,70 @@ pub trait Model: Send {
     /// binary runs on; called once, right after creation, on a model that
     /// [`Model::needs_resources`].
     fn set_resource_dir(&mut self, _dir: &str) {}
+
+    /// For a model with continuous states ([`ModelInfo::model_exchange`]):
+    /// their time derivatives `ẋ = f(x, u)` at the current state and the
+    /// inputs in `values`, one per state in the declared order, into `dx`.
+    /// The values of the `der(…)` variables, in either interface, and the
+    /// right-hand side `fmi2GetDerivatives` gives in Model Exchange: the
+    /// law's equations, the ones its step integrates. The default writes
+    /// nothing (a model without continuous states).
+    fn derivatives(&self, _values: &Values, _dx: &mut [f64]) {}
+
+    /// The Model Exchange part of a model instantiated for it
+    /// ([`ModelFactory::create_model_exchange`]); `None` (the default) for
+    /// a Co-Simulation model.
+    fn ode(&self) -> Option<&dyn Ode> {
+        None
+    }
+
+    /// [`Model::ode`], mutable.
+    fn ode_mut(&mut self) -> Option<&mut dyn Ode> {
+        None
+    }
+}
+
+/// What a model adds for Model Exchange (FMI 2.0.4 §3): its continuous
+/// states, event indicators and their nominal scales, what happens at an
+/// event, and the partial derivatives of its right-hand side and outputs.
+/// The right-hand side itself is [`Model::derivatives`]. States are in the
+/// order of [`crate::ModelExchange::states`]; the layer checks every
+/// length, pointer and number before calling these.
+pub trait Ode {
+    /// The continuous states `x` into `x`.
+    fn continuous_states(&self, x: &mut [f64]);
+
+    /// Take the continuous states `x` (finite). `Err` (nothing changed)
+    /// for a state the model cannot take.
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String>;
+
+    /// The event indicators at the current state and inputs into `z`:
+    /// functions that change sign where the law switches.
+    fn event_indicators(&self, values: &Values, z: &mut [f64]);
+
+    /// Nominal magnitudes of the states (> 0), from the parameters in
+    /// `values` (also before initialization).
+    fn nominals(&self, values: &Values, nominal: &mut [f64]);
+
+    /// The event iteration at the current state and inputs
+    /// (`fmi2NewDiscreteStates`): switch what the law switches at this
+    /// event. Whether the continuous states changed.
+    fn event_update(&mut self, values: &Values) -> bool;
+
+    /// `∂unknown/∂known` at the current state and inputs: `unknown` a
+    /// state derivative or a Real output, `known` a continuous state or a
+    /// Real input (value references). `None` where the model does not give
+    /// it (the call is refused).
+    fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64>;
 }
 
 /// An entry of the binary's model registry: the GUID picks the model.
 pub struct ModelFactory {
     pub info: &'static ModelInfo,
     pub create: fn() -> Box<dyn Model>,
+    /// A model for Model Exchange, whose [`Model::ode`] answers; `None`
+    /// for a model offered as Co-Simulation only.
+    pub create_model_exchange: Option<fn() -> Box<dyn Model>>,
 }
 
 /// The `Model` methods of the state for a law with `state_len` /

@@ -1,5 +1,7 @@
 //! `modelDescription.xml` rendered from a [`ModelInfo`]: the variable table
-//! is the only place a variable is written down.
+//! is the only place a variable is written down. A model with a Model
+//! Exchange interface gets both `<ModelExchange>` and `<CoSimulation>`
+//! under one model identifier (one binary serves both).
 
 use crate::variables::{Causality, Initial, ModelInfo, VarType, Variability, LOG_CATEGORIES};
 use std::fmt::Write;
@@ -15,6 +17,7 @@ const UNITS: &[(&str, [i32; 4])] = &[
     ("m/s2", [0, 1, -2, 0]),
     ("s/m", [0, -1, 1, 0]),
     ("N", [1, 1, -2, 0]),
+    ("N/s", [1, 1, -3, 0]),
     ("N/m", [1, 0, -2, 0]),
     ("N.s/m", [1, 0, -1, 0]),
     ("Hz", [0, 0, -1, 0]),
@@ -69,12 +72,26 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     );
     let _ = writeln!(
         w,
-        r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="{}" description="{}" author="friction-fmu project" generationTool="{}" variableNamingConvention="structured" numberOfEventIndicators="0">"#,
+        r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="{}" description="{}" author="friction-fmu project" generationTool="{}" variableNamingConvention="structured" numberOfEventIndicators="{}">"#,
         escape(info.model_name),
         escape(info.guid),
         escape(&format!("{} Source: {}", info.description, info.source)),
-        escape(generation_tool)
+        escape(generation_tool),
+        info.model_exchange.map_or(0, |me| me.event_indicators)
     );
+    if info.model_exchange.is_some() {
+        // (before <CoSimulation>: the schema's order) The same binary and
+        // model identifier for both interfaces; no step events, so no call
+        // of fmi2CompletedIntegratorStep is needed.
+        let _ = writeln!(
+            w,
+            r#"  <ModelExchange modelIdentifier="{}" needsExecutionTool="false" completedIntegratorStepNotNeeded="true" canBeInstantiatedOnlyOncePerProcess="false" canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="{}" canSerializeFMUstate="{}" providesDirectionalDerivative="{}"/>"#,
+            escape(info.model_identifier),
+            caps.can_get_and_set_state,
+            caps.can_serialize_state,
+            caps.provides_directional_derivative
+        );
+    }
     let _ = writeln!(
         w,
         r#"  <CoSimulation modelIdentifier="{}" needsExecutionTool="false" canHandleVariableCommunicationStepSize="{}" canInterpolateInputs="{}" maxOutputDerivativeOrder="{}" canRunAsynchronuously="false" canBeInstantiatedOnlyOncePerProcess="false" canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="{}" canSerializeFMUstate="{}" providesDirectionalDerivative="{}"/>"#,
@@ -143,7 +160,9 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
         let initial = match (v.initial(), v.causality) {
             (Some(Initial::Exact), _) => r#" initial="exact""#,
             (Some(Initial::Approx), _) => r#" initial="approx""#,
-            (Some(Initial::Calculated), Causality::Output) => r#" initial="calculated""#,
+            (Some(Initial::Calculated), Causality::Output | Causality::Local) => {
+                r#" initial="calculated""#
+            }
             _ => "",
         };
         let _ = writeln!(
@@ -181,6 +200,15 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
         if let Some(s) = start {
             let _ = write!(attrs, r#" start="{s}""#);
         }
+        if let Some(me) = &info.model_exchange {
+            // a derivative names its state by index (value reference + 1)
+            if let Some(s) = me.states.iter().find(|s| s.derivative == v.vr) {
+                let _ = write!(attrs, r#" derivative="{}""#, s.state + 1);
+            }
+            if me.states_jump_at_events && me.is_state(v.vr) {
+                let _ = write!(attrs, r#" reinit="true""#);
+            }
+        }
         let _ = writeln!(w, "      <{tag}{attrs}/>");
         let _ = writeln!(w, "    </ScalarVariable>");
     }
@@ -193,9 +221,18 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
         .enumerate()
         .filter(|(_, v)| v.causality == Causality::Output)
         .collect();
-    let _ = writeln!(w, "    <Outputs>");
-    for (i, v) in &outputs {
-        let deps: Vec<String> = v.depends_on.iter().map(|d| (d + 1).to_string()).collect();
+    // An unknown with the knowns it depends on: its inputs and states, by
+    // index, ascending.
+    let unknown = |w: &mut String, i: usize, v: &crate::Variable| {
+        let mut deps: Vec<u32> = v
+            .depends_on
+            .iter()
+            .chain(v.depends_on_states)
+            .copied()
+            .collect();
+        deps.sort_unstable();
+        deps.dedup();
+        let deps: Vec<String> = deps.iter().map(|d| (d + 1).to_string()).collect();
         if deps.is_empty() {
             let _ = writeln!(w, r#"      <Unknown index="{}" dependencies=""/>"#, i + 1);
         } else {
@@ -207,10 +244,25 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
                 deps.join(" ")
             );
         }
+    };
+    let _ = writeln!(w, "    <Outputs>");
+    for (i, v) in &outputs {
+        unknown(w, *i, v);
     }
     let _ = writeln!(w, "    </Outputs>");
+    let mut initial_unknowns: Vec<usize> = outputs.iter().map(|(i, _)| *i).collect();
+    if let Some(me) = &info.model_exchange {
+        let _ = writeln!(w, "    <Derivatives>");
+        for s in me.states {
+            let i = s.derivative as usize;
+            unknown(w, i, &info.variables[i]);
+            initial_unknowns.push(i);
+        }
+        let _ = writeln!(w, "    </Derivatives>");
+    }
+    initial_unknowns.sort_unstable();
     let _ = writeln!(w, "    <InitialUnknowns>");
-    for (i, _) in &outputs {
+    for i in initial_unknowns {
         let _ = writeln!(w, r#"      <Unknown index="{}"/>"#, i + 1);
     }
     let _ = writeln!(w, "    </InitialUnknowns>");

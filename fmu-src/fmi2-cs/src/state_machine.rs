@@ -1,6 +1,16 @@
-//! The FMI 2.0 Co-Simulation state machine as one table: for each function,
-//! the set of instance states in which it may be called (FMI 2.0.4 §4.2.4;
-//! the same masks as the Modelica Reference FMUs).
+//! The FMI 2.0 state machines as tables: for each function, the set of
+//! instance states in which it may be called, one table for Co-Simulation
+//! (FMI 2.0.4 §4.2.4) and one for Model Exchange (§3.2.3), with the same
+//! masks as the Modelica Reference FMUs.
+//!
+//! The two machines have states of their own, even where the standard
+//! gives them the same name (a Model Exchange instance is never in the
+//! Co-Simulation `Instantiated`, but in [`State::MeInstantiated`]): a
+//! function's mask is the union of its two masks, so one test of the
+//! instance's state decides both whether the call is allowed now and
+//! whether it belongs to the interface the instance was created for (a
+//! Co-Simulation function on a Model Exchange instance is refused, and
+//! the reverse).
 
 /// Instance states, as bits so that a set of states is one integer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -15,6 +25,12 @@ pub enum State {
     Terminated = 1 << 6,
     Error = 1 << 7,
     Fatal = 1 << 8,
+    // Model Exchange (§3.2.3)
+    MeInstantiated = 1 << 9,
+    MeInitializationMode = 1 << 10,
+    EventMode = 1 << 11,
+    ContinuousTimeMode = 1 << 12,
+    MeTerminated = 1 << 13,
 }
 
 impl State {
@@ -29,7 +45,17 @@ impl State {
             State::Terminated => "Terminated",
             State::Error => "Error",
             State::Fatal => "Fatal",
+            State::MeInstantiated => "Instantiated (Model Exchange)",
+            State::MeInitializationMode => "InitializationMode (Model Exchange)",
+            State::EventMode => "EventMode",
+            State::ContinuousTimeMode => "ContinuousTimeMode",
+            State::MeTerminated => "Terminated (Model Exchange)",
         }
+    }
+
+    /// Whether this is a state of the Model Exchange machine.
+    pub fn is_model_exchange(self) -> bool {
+        self as u32 & ME_STATES != 0
     }
 
     pub fn to_u32(self) -> u32 {
@@ -47,6 +73,11 @@ impl State {
             State::Terminated,
             State::Error,
             State::Fatal,
+            State::MeInstantiated,
+            State::MeInitializationMode,
+            State::EventMode,
+            State::ContinuousTimeMode,
+            State::MeTerminated,
         ]
         .into_iter()
         .find(|s| *s as u32 == bits)
@@ -83,7 +114,27 @@ const AFTER_INSTANTIATE: u32 = mask(&[
     Error,
 ]);
 
-/// `(function, allowed states)`. Functions not named here take no instance.
+/// The states of the Model Exchange machine.
+const ME_STATES: u32 = mask(&[
+    MeInstantiated,
+    MeInitializationMode,
+    EventMode,
+    ContinuousTimeMode,
+    MeTerminated,
+]);
+
+/// States before initialization ends, of both machines: a variable is set
+/// there under the rules of initialization, anywhere else under those of
+/// simulation ([`crate::Variable::settable_in_step_mode`]).
+pub const BEFORE_INITIALIZATION: u32 = mask(&[
+    Instantiated,
+    InitializationMode,
+    MeInstantiated,
+    MeInitializationMode,
+]);
+
+/// Co-Simulation: `(function, allowed states)`. Functions named in
+/// neither table take no instance.
 pub const ALLOWED: &[(&str, u32)] = &[
     ("fmi2SetDebugLogging", ANY_LIVE | StepInProgress as u32),
     ("fmi2FreeInstance", ANY_LIVE),
@@ -151,19 +202,127 @@ pub const ALLOWED: &[(&str, u32)] = &[
     ),
 ];
 
-/// The allowed-state mask of `function`; panics on a name not in the table
-/// (a programming error caught by the tests, never by an importer). A
-/// `const fn`, so that the exports resolve their masks at compile time
-/// (`const { allowed_mask("fmi2DoStep") }`) and no call compares strings.
-pub const fn allowed_mask(function: &str) -> u32 {
+const ME_ANY_LIVE: u32 = mask(&[
+    MeInstantiated,
+    MeInitializationMode,
+    EventMode,
+    ContinuousTimeMode,
+    MeTerminated,
+]);
+const ME_AFTER_INSTANTIATE: u32 = mask(&[
+    MeInitializationMode,
+    EventMode,
+    ContinuousTimeMode,
+    MeTerminated,
+]);
+
+/// Model Exchange (FMI 2.0.4 §3.2.3): `(function, allowed states)`. An
+/// instance of this layer never enters an error state in Model Exchange
+/// (every failure is a refused call that changes nothing), so no function
+/// is listed for one.
+pub const ME_ALLOWED: &[(&str, u32)] = &[
+    ("fmi2SetDebugLogging", ME_ANY_LIVE),
+    ("fmi2FreeInstance", ME_ANY_LIVE),
+    ("fmi2SetupExperiment", MeInstantiated as u32),
+    ("fmi2EnterInitializationMode", MeInstantiated as u32),
+    ("fmi2ExitInitializationMode", MeInitializationMode as u32),
+    ("fmi2Terminate", mask(&[EventMode, ContinuousTimeMode])),
+    ("fmi2Reset", ME_ANY_LIVE),
+    ("fmi2GetReal", ME_AFTER_INSTANTIATE),
+    ("fmi2GetInteger", ME_AFTER_INSTANTIATE),
+    ("fmi2GetBoolean", ME_AFTER_INSTANTIATE),
+    ("fmi2GetString", ME_AFTER_INSTANTIATE),
+    // Real inputs also in continuous-time mode; the others at events only
+    (
+        "fmi2SetReal",
+        mask(&[
+            MeInstantiated,
+            MeInitializationMode,
+            EventMode,
+            ContinuousTimeMode,
+        ]),
+    ),
+    (
+        "fmi2SetInteger",
+        mask(&[MeInstantiated, MeInitializationMode, EventMode]),
+    ),
+    (
+        "fmi2SetBoolean",
+        mask(&[MeInstantiated, MeInitializationMode, EventMode]),
+    ),
+    (
+        "fmi2SetString",
+        mask(&[MeInstantiated, MeInitializationMode, EventMode]),
+    ),
+    ("fmi2GetFMUstate", ME_ANY_LIVE),
+    ("fmi2SetFMUstate", ME_ANY_LIVE),
+    ("fmi2FreeFMUstate", ME_ANY_LIVE),
+    ("fmi2SerializedFMUstateSize", ME_ANY_LIVE),
+    ("fmi2SerializeFMUstate", ME_ANY_LIVE),
+    ("fmi2DeSerializeFMUstate", ME_ANY_LIVE),
+    ("fmi2GetDirectionalDerivative", ME_AFTER_INSTANTIATE),
+    ("fmi2EnterEventMode", mask(&[EventMode, ContinuousTimeMode])),
+    ("fmi2NewDiscreteStates", EventMode as u32),
+    ("fmi2EnterContinuousTimeMode", EventMode as u32),
+    ("fmi2CompletedIntegratorStep", ContinuousTimeMode as u32),
+    ("fmi2SetTime", mask(&[EventMode, ContinuousTimeMode])),
+    ("fmi2SetContinuousStates", ContinuousTimeMode as u32),
+    ("fmi2GetEventIndicators", ME_AFTER_INSTANTIATE),
+    ("fmi2GetContinuousStates", ME_AFTER_INSTANTIATE),
+    (
+        "fmi2GetDerivatives",
+        mask(&[EventMode, ContinuousTimeMode, MeTerminated]),
+    ),
+    (
+        "fmi2GetNominalsOfContinuousStates",
+        mask(&[MeInstantiated, EventMode, ContinuousTimeMode, MeTerminated]),
+    ),
+];
+
+/// The mask of `function` in `table`, 0 if it is not there.
+const fn mask_in(table: &[(&str, u32)], function: &str) -> u32 {
     let mut i = 0;
-    while i < ALLOWED.len() {
-        if same_name(ALLOWED[i].0, function) {
-            return ALLOWED[i].1;
+    while i < table.len() {
+        if same_name(table[i].0, function) {
+            return table[i].1;
         }
         i += 1;
     }
-    panic!("function not in the state table")
+    0
+}
+
+/// The allowed-state mask of `function`: its Co-Simulation and its Model
+/// Exchange mask together (the states of the two machines are distinct
+/// bits). Panics on a name in neither table (a programming error caught
+/// by the tests, never by an importer). A `const fn`, so that the exports
+/// resolve their masks at compile time
+/// (`const { allowed_mask("fmi2DoStep") }`) and no call compares strings.
+pub const fn allowed_mask(function: &str) -> u32 {
+    let m = mask_in(ALLOWED, function) | mask_in(ME_ALLOWED, function);
+    if m == 0 && !is_named(function) {
+        panic!("function not in the state tables")
+    }
+    m
+}
+
+/// Whether `function` is named in either table (a function allowed in no
+/// state at all, none here, would still be named).
+const fn is_named(function: &str) -> bool {
+    let mut i = 0;
+    while i < ALLOWED.len() {
+        if same_name(ALLOWED[i].0, function) {
+            return true;
+        }
+        i += 1;
+    }
+    let mut i = 0;
+    while i < ME_ALLOWED.len() {
+        if same_name(ME_ALLOWED[i].0, function) {
+            return true;
+        }
+        i += 1;
+    }
+    false
 }
 
 /// `a == b` for `const fn`.
@@ -204,9 +363,52 @@ mod tests {
         }
     }
 
+    /// The two machines share no state (but `Fatal`, where nothing is
+    /// allowed): a Co-Simulation function is refused in every Model
+    /// Exchange state, and the reverse.
+    #[test]
+    fn the_two_machines_allow_nothing_of_each_other() {
+        for (f, m) in ALLOWED {
+            assert_eq!(m & ME_STATES, 0, "{f}");
+            assert_eq!(m & Fatal as u32, 0, "{f}");
+        }
+        for (f, m) in ME_ALLOWED {
+            assert_eq!(m & !ME_STATES, 0, "{f}");
+        }
+        for f in [
+            "fmi2DoStep",
+            "fmi2SetRealInputDerivatives",
+            "fmi2GetRealStatus",
+        ] {
+            for s in [MeInstantiated, EventMode, ContinuousTimeMode, MeTerminated] {
+                assert!(!is_allowed(f, s), "{f} in {s:?}");
+            }
+        }
+        for f in ["fmi2SetTime", "fmi2GetDerivatives", "fmi2NewDiscreteStates"] {
+            for s in [
+                Instantiated,
+                InitializationMode,
+                StepComplete,
+                Terminated,
+                Error,
+            ] {
+                assert!(!is_allowed(f, s), "{f} in {s:?}");
+            }
+        }
+        assert!(is_allowed("fmi2GetReal", EventMode) && is_allowed("fmi2GetReal", StepComplete));
+        assert!(ContinuousTimeMode.is_model_exchange() && !StepComplete.is_model_exchange());
+    }
+
     #[test]
     fn state_bits_round_trip() {
-        for s in [Instantiated, StepComplete, Terminated, Fatal] {
+        for s in [
+            Instantiated,
+            StepComplete,
+            Terminated,
+            Fatal,
+            EventMode,
+            MeTerminated,
+        ] {
             assert_eq!(State::from_u32(s.to_u32()), Some(s));
         }
         assert_eq!(State::from_u32(3), None);

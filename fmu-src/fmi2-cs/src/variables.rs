@@ -50,8 +50,15 @@ pub struct Variable {
     /// Scale used for finite-difference perturbations and declared as `nominal`.
     pub nominal: Option<f64>,
     /// Outputs only: the inputs this output depends on directly (direct
-    /// feedthrough), by value reference.
+    /// feedthrough), by value reference. (Also of a state derivative: the
+    /// inputs it depends on.)
     pub depends_on: &'static [u32],
+    /// Outputs and state derivatives of a model with continuous states
+    /// ([`ModelInfo::model_exchange`]): the states they depend on, by the
+    /// value reference of the state variable. Rendered with
+    /// [`Variable::depends_on`] into the model structure's dependencies
+    /// (FMI 2.0.4 §2.2.8: the knowns are inputs and continuous states).
+    pub depends_on_states: &'static [u32],
 }
 
 impl Variable {
@@ -69,6 +76,7 @@ impl Variable {
             max: None,
             nominal: None,
             depends_on: &[],
+            depends_on_states: &[],
         }
     }
 
@@ -176,6 +184,33 @@ impl Variable {
         v
     }
 
+    /// The time derivative of a continuous state, `der(<state>)`: a
+    /// local continuous real the model computes
+    /// ([`crate::Model::derivatives`]), depending on the inputs `inputs`
+    /// and the states `states` (value references).
+    pub const fn derivative(
+        vr: u32,
+        name: &'static str,
+        unit: &'static str,
+        description: &'static str,
+        inputs: &'static [u32],
+        states: &'static [u32],
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Real, Causality::Local);
+        v.unit = if unit.is_empty() { None } else { Some(unit) };
+        v.description = description;
+        v.depends_on = inputs;
+        v.depends_on_states = states;
+        v
+    }
+
+    /// The continuous states this output depends on (value references of
+    /// state variables).
+    pub const fn with_state_dependencies(mut self, states: &'static [u32]) -> Self {
+        self.depends_on_states = states;
+        self
+    }
+
     pub const fn with_min(mut self, min: f64) -> Self {
         self.min = Some(min);
         self
@@ -205,6 +240,38 @@ impl Variable {
     pub fn settable_in_step_mode(&self) -> bool {
         self.causality == Causality::Input
             || (self.causality == Causality::Parameter && self.variability == Variability::Tunable)
+    }
+}
+
+/// One continuous state of a model with a Model Exchange interface: the
+/// value reference of the state variable and of its derivative.
+#[derive(Clone, Copy, Debug)]
+pub struct ContinuousState {
+    pub state: u32,
+    pub derivative: u32,
+}
+
+/// The Model Exchange interface of a model (rendered into
+/// `<ModelExchange …/>`, the `derivative` attributes, `<Derivatives>` and
+/// `numberOfEventIndicators`): its continuous states in the order of
+/// `fmi2GetContinuousStates`, its number of event indicators, and whether
+/// its states may jump at events (`reinit`).
+#[derive(Clone, Copy, Debug)]
+pub struct ModelExchange {
+    pub states: &'static [ContinuousState],
+    pub event_indicators: usize,
+    pub states_jump_at_events: bool,
+}
+
+impl ModelExchange {
+    /// Whether `vr` is one of the state variables.
+    pub fn is_state(&self, vr: u32) -> bool {
+        self.states.iter().any(|s| s.state == vr)
+    }
+
+    /// Whether `vr` is one of the derivative variables.
+    pub fn is_derivative(&self, vr: u32) -> bool {
+        self.states.iter().any(|s| s.derivative == vr)
     }
 }
 
@@ -253,6 +320,9 @@ pub struct ModelInfo {
     pub variables: &'static [Variable],
     pub default_experiment: DefaultExperiment,
     pub capabilities: Capabilities,
+    /// The Model Exchange interface, for a model that is an ODE with its
+    /// states and event indicators; `None`: Co-Simulation only.
+    pub model_exchange: Option<ModelExchange>,
 }
 
 /// Log categories every FMU of this layer declares, in this order.
@@ -320,6 +390,40 @@ impl ModelInfo {
                             self.model_name, v.name, d
                         ))
                     }
+                }
+            }
+            let is_state = |vr: u32| self.model_exchange.is_some_and(|me| me.is_state(vr));
+            if let Some(d) = v.depends_on_states.iter().find(|d| !is_state(**d)) {
+                return Err(format!(
+                    "{}: {} depends on vr {d} which is not a continuous state",
+                    self.model_name, v.name
+                ));
+            }
+            let is_derivative = self.model_exchange.is_some_and(|me| me.is_derivative(v.vr));
+            if (v.causality == Causality::Local) != is_derivative {
+                return Err(format!(
+                    "{}: {} is {}a local variable but {}a state derivative (the layer computes only derivatives as locals)",
+                    self.model_name,
+                    v.name,
+                    if v.causality == Causality::Local { "" } else { "not " },
+                    if is_derivative { "" } else { "not " },
+                ));
+            }
+        }
+        if let Some(me) = &self.model_exchange {
+            for s in me.states {
+                let state = self.variable(s.state);
+                let derivative = self.variable(s.derivative);
+                let real_continuous = |v: Option<&Variable>| {
+                    v.is_some_and(|v| {
+                        v.var_type == VarType::Real && v.variability == Variability::Continuous
+                    })
+                };
+                if !real_continuous(state) || !real_continuous(derivative) {
+                    return Err(format!(
+                        "{}: continuous state vr {} or its derivative vr {} is not a continuous Real variable",
+                        self.model_name, s.state, s.derivative
+                    ));
                 }
             }
         }

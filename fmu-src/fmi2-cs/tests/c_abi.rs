@@ -31,6 +31,7 @@ static INFO: ModelInfo = ModelInfo {
         step_size: 0.1,
     },
     capabilities: Capabilities::FULL,
+    model_exchange: None,
 };
 
 #[derive(Clone)]
@@ -82,6 +83,7 @@ impl Model for Toy {
 static REGISTRY: [ModelFactory; 1] = [ModelFactory {
     info: &INFO,
     create: || Box::new(Toy { k: 1.0, s: 0.0 }),
+    create_model_exchange: None,
 }];
 fmi2_cs::export_fmi2!(&REGISTRY[..]);
 use fmi2_exports::*;

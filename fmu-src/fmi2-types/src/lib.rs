@@ -1,5 +1,5 @@
 //! The C types of the FMI 2.0 standard (`fmi2TypesPlatform.h`,
-//! `fmi2FunctionTypes.h`; FMI 2.0.4 §2.1.2–§2.1.5 and §4.2), written once
+//! `fmi2FunctionTypes.h`; FMI 2.0.4 §2.1.2–§2.1.5, §3.2 and §4.2), written once
 //! for both sides of the C ABI: the exporter (`fmi2-cs`, which the FMUs of
 //! this repository are built on) and the importer (`fricsim`, host/), which
 //! imports FMUs built by anyone and so depends on this crate, not on the
@@ -204,3 +204,39 @@ pub type fmi2GetBooleanStatusTYPE =
     unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Boolean) -> fmi2Status;
 pub type fmi2GetStringStatusTYPE =
     unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2String) -> fmi2Status;
+
+// Model Exchange (§3.2).
+
+/// `fmi2EventInfo` (§3.2.2): what `fmi2NewDiscreteStates` reports.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct fmi2EventInfo {
+    pub newDiscreteStatesNeeded: fmi2Boolean,
+    pub terminateSimulation: fmi2Boolean,
+    pub nominalsOfContinuousStatesChanged: fmi2Boolean,
+    pub valuesOfContinuousStatesChanged: fmi2Boolean,
+    pub nextEventTimeDefined: fmi2Boolean,
+    pub nextEventTime: fmi2Real,
+}
+
+pub type fmi2EnterEventModeTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+pub type fmi2NewDiscreteStatesTYPE =
+    unsafe extern "C" fn(fmi2Component, *mut fmi2EventInfo) -> fmi2Status;
+pub type fmi2EnterContinuousTimeModeTYPE = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+pub type fmi2CompletedIntegratorStepTYPE = unsafe extern "C" fn(
+    fmi2Component,
+    fmi2Boolean,
+    *mut fmi2Boolean,
+    *mut fmi2Boolean,
+) -> fmi2Status;
+pub type fmi2SetTimeTYPE = unsafe extern "C" fn(fmi2Component, fmi2Real) -> fmi2Status;
+pub type fmi2SetContinuousStatesTYPE =
+    unsafe extern "C" fn(fmi2Component, *const fmi2Real, usize) -> fmi2Status;
+pub type fmi2GetDerivativesTYPE =
+    unsafe extern "C" fn(fmi2Component, *mut fmi2Real, usize) -> fmi2Status;
+pub type fmi2GetEventIndicatorsTYPE =
+    unsafe extern "C" fn(fmi2Component, *mut fmi2Real, usize) -> fmi2Status;
+pub type fmi2GetContinuousStatesTYPE =
+    unsafe extern "C" fn(fmi2Component, *mut fmi2Real, usize) -> fmi2Status;
+pub type fmi2GetNominalsOfContinuousStatesTYPE =
+    unsafe extern "C" fn(fmi2Component, *mut fmi2Real, usize) -> fmi2Status;

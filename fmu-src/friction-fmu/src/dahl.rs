@@ -1,9 +1,13 @@
 //! `Dahl.fmu`: the Dahl law (Dahl 1968; Sun et al. 2016 eq. 2–3, 16–17;
 //! docs/models.md "Dahl"), integrated exactly in the displacement domain
-//! for every α.
+//! for every α in Co-Simulation; in Model Exchange the force `F` is the
+//! continuous state and `dF/dt` ([`Dahl::force_rate`]) its derivative.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi2_cs::{
+    Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
+    Variable,
+};
 use friction_laws::dahl::{Dahl, DahlParams};
 
 pub mod vr {
@@ -14,9 +18,10 @@ pub mod vr {
     pub const SIGMA: u32 = 4;
     pub const FC: u32 = 5;
     pub const ALPHA: u32 = 6;
+    pub const DER_F: u32 = 7;
 }
 
-static VARIABLES: [Variable; 7] = [
+static VARIABLES: [Variable; 8] = [
     sliding_velocity_input(vr::V),
     Variable::output(
         vr::F,
@@ -24,14 +29,17 @@ static VARIABLES: [Variable; 7] = [
         "N",
         "Friction force, resisting positive motion (the rig applies -F)",
         &[],
-    ),
-    Variable::output(vr::Z, "z", "m", "Bristle deflection z = F/sigma", &[]),
+    )
+    .with_state_dependencies(&[vr::F]),
+    Variable::output(vr::Z, "z", "m", "Bristle deflection z = F/sigma", &[])
+        .with_state_dependencies(&[vr::F]),
     Variable::boolean_output(
         vr::SLIDING,
         "sliding",
         "True when moving and |F| has reached 99 % of Fc",
         &[vr::V],
-    ),
+    )
+    .with_state_dependencies(&[vr::F]),
     Variable::parameter(
         vr::SIGMA,
         "sigma",
@@ -56,6 +64,14 @@ static VARIABLES: [Variable; 7] = [
         "Shape exponent (alpha = 1: classical Dahl)",
     )
     .with_min(0.0),
+    Variable::derivative(
+        vr::DER_F,
+        "der(F)",
+        "N/s",
+        "dF/dt = sigma*|y|^alpha*sgn(y)*v, y = 1 - F/Fc*sgn(v): the derivative of the continuous state F (Model Exchange)",
+        &[vr::V],
+        &[vr::F],
+    ),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -67,6 +83,14 @@ pub static INFO: ModelInfo = ModelInfo {
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
+    model_exchange: Some(ModelExchange {
+        states: &[ContinuousState {
+            state: vr::F,
+            derivative: vr::DER_F,
+        }],
+        event_indicators: 1,
+        states_jump_at_events: false,
+    }),
 };
 
 #[derive(Clone, Debug)]
@@ -134,6 +158,63 @@ impl Model for DahlFmu {
         match output {
             vr::F => Some(rate),
             vr::Z => Some(rate / p.sigma),
+            _ => None,
+        }
+    }
+
+    /// `dF/dt` at the current force and velocity: the law's rate, which its
+    /// step integrates exactly.
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        dx[0] = self.law.force_rate(self.law.force(), values.real(vr::V));
+    }
+
+    fn ode(&self) -> Option<&dyn Ode> {
+        Some(self)
+    }
+
+    fn ode_mut(&mut self) -> Option<&mut dyn Ode> {
+        Some(self)
+    }
+}
+
+/// Model Exchange: the state is `F`; the one event indicator is `v`, where
+/// `sgn v` switches the law's branch (the rate has a kink there); no
+/// discrete state, so an event changes nothing.
+impl Ode for DahlFmu {
+    fn continuous_states(&self, x: &mut [f64]) {
+        x[0] = self.law.force();
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        self.law.state_from_slice(x)
+    }
+
+    fn event_indicators(&self, values: &Values, z: &mut [f64]) {
+        z[0] = values.real(vr::V);
+    }
+
+    /// `F` on the scale of `Fc`.
+    fn nominals(&self, values: &Values, nominal: &mut [f64]) {
+        nominal[0] = Self::params(values).fc;
+    }
+
+    fn event_update(&mut self, _values: &Values) -> bool {
+        false
+    }
+
+    /// `∂(dF/dt)/∂F`, `∂(dF/dt)/∂v` ([`Dahl::force_rate_partials`]); the
+    /// outputs `F` (the state) and `z = F/σ` do not depend on `v`.
+    fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
+        let v = values.real(vr::V);
+        let (by_f, by_v) = match unknown {
+            vr::DER_F => self.law.force_rate_partials(self.law.force(), v),
+            vr::F => (1.0, 0.0),
+            vr::Z => (1.0 / self.law.params().sigma, 0.0),
+            _ => return None,
+        };
+        match known {
+            vr::F => Some(by_f),
+            vr::V => Some(by_v),
             _ => None,
         }
     }

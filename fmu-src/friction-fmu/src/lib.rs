@@ -2,7 +2,9 @@
 //! layer: its variable table (the single source of the model description)
 //! and a [`fmi2_cs::Model`] implementation. The same binary is packaged as
 //! `Dahl.fmu`, `LuGre.fmu`, `ResetIntegrator.fmu`, `Bristle.fmu` and
-//! `Bristle2D.fmu`; `fmi2Instantiate` picks the law by GUID.
+//! `Bristle2D.fmu`; `fmi2Instantiate` picks the law by GUID. Every law but
+//! the bristle one is also an ODE and is offered for Model Exchange too
+//! ([`fmi2_cs::Ode`]), from the same equations.
 #![forbid(unsafe_code)]
 
 pub mod bristle;
@@ -22,22 +24,29 @@ pub static REGISTRY: LazyLock<[ModelFactory; 5]> = LazyLock::new(|| {
         ModelFactory {
             info: &dahl::INFO,
             create: || Box::new(dahl::DahlFmu::default()),
+            create_model_exchange: Some(|| Box::new(dahl::DahlFmu::default())),
         },
         ModelFactory {
             info: &lugre::INFO,
             create: || Box::new(lugre::LuGreFmu::default()),
+            create_model_exchange: Some(|| Box::new(lugre::LuGreFmu::default())),
         },
         ModelFactory {
             info: &reset_integrator::INFO,
             create: || Box::new(reset_integrator::ResetFmu::default()),
+            create_model_exchange: Some(|| Box::new(reset_integrator::ResetFmu::default())),
         },
+        // Co-Simulation only: bristles that disconnect and reconnect at
+        // random relaxations are a discrete process, not an ODE (docs/fmu-reference.md)
         ModelFactory {
             info: &bristle::INFO,
             create: || Box::new(bristle::BristleFmu::default()),
+            create_model_exchange: None,
         },
         ModelFactory {
             info: &bristle2d::INFO,
             create: || Box::new(bristle2d::Bristle2DFmu::default()),
+            create_model_exchange: Some(|| Box::new(bristle2d::Bristle2DMe::default())),
         },
     ]
 });

@@ -3,10 +3,15 @@
 //! Thimmalapura 2004 and the tribometer of Dion et al. 2013 need:
 //! velocity-dependent micro-damping, direction-dependent levels,
 //! position-dependent levels (a table of scale factors over `x`), and the
-//! normal-force form.
+//! normal-force form. In Model Exchange, with every option, the deflection
+//! `z` is the continuous state and `dz/dt` ([`LuGre::z_rate`]) its
+//! derivative.
 
 use crate::{param_err, sliding_velocity_input};
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi2_cs::{
+    Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
+    Variable,
+};
 use friction_laws::lugre::{HeldInput, LuGre, LuGreInputs, LuGreParams, TABLE_POINTS};
 use friction_laws::Ramp;
 use std::sync::LazyLock;
@@ -36,6 +41,8 @@ pub mod vr {
     pub const X_TABLE: u32 = 20;
     pub const SCALE_POS: u32 = X_TABLE + super::TABLE_POINTS as u32;
     pub const SCALE_NEG: u32 = SCALE_POS + super::TABLE_POINTS as u32;
+    /// `der(z)`, after the tables.
+    pub const DER_Z: u32 = SCALE_NEG + super::TABLE_POINTS as u32;
 }
 
 const INPUTS: &[u32] = &[vr::V, vr::X, vr::FN];
@@ -66,14 +73,17 @@ fn variables() -> Vec<Variable> {
             "N",
             "Friction force F = sigma0*z + sigma1(v)*dz/dt + sigma2*v",
             INPUTS,
-        ),
-        Variable::output(vr::Z, "z", "m", "Mean bristle deflection", &[]),
+        )
+        .with_state_dependencies(&[vr::Z]),
+        Variable::output(vr::Z, "z", "m", "Mean bristle deflection", &[])
+            .with_state_dependencies(&[vr::Z]),
         Variable::boolean_output(
             vr::SLIDING,
             "sliding",
             "True when moving and sigma0*|z| has reached 99 % of g(v)",
             INPUTS,
-        ),
+        )
+        .with_state_dependencies(&[vr::Z]),
         Variable::parameter(
             vr::SIGMA0,
             "sigma0",
@@ -210,6 +220,15 @@ fn variables() -> Vec<Variable> {
             .with_min(0.0),
         );
     }
+    v.push(Variable::derivative(
+        vr::DER_Z,
+        "der(z)",
+        "m/s",
+        "dz/dt = v - sigma0*|v|*z/g(v): the derivative of the continuous state z (Model Exchange)",
+        // (x moves the level when position_dependent; Fn never enters)
+        &[vr::V, vr::X],
+        &[vr::Z],
+    ));
     v
 }
 
@@ -223,6 +242,11 @@ pub static INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
     variables: Box::leak(variables().into_boxed_slice()),
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
+    model_exchange: Some(ModelExchange {
+        states: &[ContinuousState { state: vr::Z, derivative: vr::DER_Z }],
+        event_indicators: 1,
+        states_jump_at_events: false,
+    }),
 }
 });
 
@@ -412,6 +436,75 @@ impl Model for LuGreFmu {
                     * (d_abs_v * z / g + v.abs() * z_dot / g - v.abs() * z * g_prime * a / (g * g));
                 Some(p.sigma0 * z_dot + p.sigma1 * z_ddot + p.sigma2 * a)
             }
+            _ => None,
+        }
+    }
+
+    /// `dz/dt` at the current deflection and inputs: the law's state
+    /// equation, which its step integrates exactly for held inputs.
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        let (v, x, fn_) = Self::inputs(values);
+        dx[0] = self.law.z_dot(v, x, fn_);
+    }
+
+    fn ode(&self) -> Option<&dyn Ode> {
+        Some(self)
+    }
+
+    fn ode_mut(&mut self) -> Option<&mut dyn Ode> {
+        Some(self)
+    }
+}
+
+/// Model Exchange: the state is `z`; the one event indicator is `v`, where
+/// `|v|` (and, direction-dependent, the levels) switch; no discrete state,
+/// so an event changes nothing.
+impl Ode for LuGreFmu {
+    fn continuous_states(&self, x: &mut [f64]) {
+        x[0] = self.law.z();
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        self.law.state_from_slice(x)
+    }
+
+    fn event_indicators(&self, values: &Values, z: &mut [f64]) {
+        z[0] = values.real(vr::V);
+    }
+
+    /// `z` on the scale of the largest steady deflection
+    /// ([`LuGreParams::deflection_scale`], Fs/σ0 by default).
+    fn nominals(&self, values: &Values, nominal: &mut [f64]) {
+        nominal[0] = Self::params(values).deflection_scale();
+    }
+
+    fn event_update(&mut self, _values: &Values) -> bool {
+        false
+    }
+
+    /// The law's closed forms ([`LuGre::rate_partials`],
+    /// [`LuGre::force_partials`]) for `der(z)` and `F`; the output `z` is
+    /// the state.
+    fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
+        let (v, x, fn_) = Self::inputs(values);
+        let z = self.law.z();
+        let by = match unknown {
+            vr::DER_Z => {
+                let r = self.law.rate_partials(z, v, x);
+                [r.z, r.v, r.x, 0.0]
+            }
+            vr::F => {
+                let f = self.law.force_partials(z, v, x, fn_);
+                [f.z, f.v, f.x, f.fn_]
+            }
+            vr::Z => [1.0, 0.0, 0.0, 0.0],
+            _ => return None,
+        };
+        match known {
+            vr::Z => Some(by[0]),
+            vr::V => Some(by[1]),
+            vr::X => Some(by[2]),
+            vr::FN => Some(by[3]),
             _ => None,
         }
     }

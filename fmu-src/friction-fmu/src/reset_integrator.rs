@@ -1,8 +1,15 @@
 //! `ResetIntegrator.fmu`: the 1-D reset integrator (Haessig & Friedland
-//! 1991; docs/models.md "Reset integrator"), integrated exactly.
+//! 1991; docs/models.md "Reset integrator"), integrated exactly in
+//! Co-Simulation; in Model Exchange the strain `z` is the continuous state,
+//! `dz/dt` ([`ResetIntegrator::z_dot`]) its derivative, and two event
+//! indicators locate where the strain reaches a limit and where a reversal
+//! releases it.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi2_cs::{
+    Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
+    Variable,
+};
 use friction_laws::reset_integrator::{ResetIntegrator, ResetParams};
 
 pub mod vr {
@@ -14,9 +21,10 @@ pub mod vr {
     pub const SIGMA1: u32 = 5;
     pub const A: u32 = 6;
     pub const Z0: u32 = 7;
+    pub const DER_Z: u32 = 8;
 }
 
-static VARIABLES: [Variable; 8] = [
+static VARIABLES: [Variable; 9] = [
     sliding_velocity_input(vr::V),
     Variable::output(
         vr::F,
@@ -24,14 +32,17 @@ static VARIABLES: [Variable; 8] = [
         "N",
         "Friction force F = (1 + a(z))*sigma0*z + sigma1*dz/dt",
         &[vr::V],
-    ),
-    Variable::output(vr::Z, "z", "m", "Bristle strain, |z| <= z0", &[]),
+    )
+    .with_state_dependencies(&[vr::Z]),
+    Variable::output(vr::Z, "z", "m", "Bristle strain, |z| <= z0", &[])
+        .with_state_dependencies(&[vr::Z]),
     Variable::boolean_output(
         vr::SLIDING,
         "sliding",
         "True when z is at the stiction limit and moving outward",
         &[vr::V],
-    ),
+    )
+    .with_state_dependencies(&[vr::Z]),
     Variable::parameter(vr::SIGMA0, "sigma0", 1e4, "N/m", "Bristle stiffness").with_min(0.0),
     Variable::parameter(vr::SIGMA1, "sigma1", 74.15, "N.s/m", "Bristle damping").with_min(0.0),
     Variable::parameter(
@@ -50,6 +61,14 @@ static VARIABLES: [Variable; 8] = [
         "Stiction range: sliding level sigma0*z0",
     )
     .with_min(0.0),
+    Variable::derivative(
+        vr::DER_Z,
+        "der(z)",
+        "m/s",
+        "dz/dt = v, or 0 at the stiction limit moving outward: the derivative of the continuous state z (Model Exchange)",
+        &[vr::V],
+        &[vr::Z],
+    ),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -61,6 +80,15 @@ pub static INFO: ModelInfo = ModelInfo {
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
+    model_exchange: Some(ModelExchange {
+        states: &[ContinuousState {
+            state: vr::Z,
+            derivative: vr::DER_Z,
+        }],
+        event_indicators: 2,
+        // an integrator's overshoot of the limit is put back at the event
+        states_jump_at_events: true,
+    }),
 };
 
 #[derive(Clone, Debug)]
@@ -131,6 +159,63 @@ impl Model for ResetFmu {
                 if inside { 1.0 + p.a } else { 1.0 } * p.sigma0 * z_dot
                     + p.sigma1 * slopes[vr::V as usize],
             ),
+            _ => None,
+        }
+    }
+
+    /// `dz/dt`: `v`, or 0 held at a limit (the law's `ż`).
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        dx[0] = self.law.z_dot(values.real(vr::V));
+    }
+
+    fn ode(&self) -> Option<&dyn Ode> {
+        Some(self)
+    }
+
+    fn ode_mut(&mut self) -> Option<&mut dyn Ode> {
+        Some(self)
+    }
+}
+
+/// Model Exchange: the state is `z`; two event indicators, one per limit
+/// ([`ResetIntegrator::switching_functions`]): each crosses zero where the
+/// strain reaches its limit and where a reversal releases it. At an event
+/// a strain the integrator carried past the limit is put on it
+/// ([`ResetIntegrator::stop_at_limit`]).
+impl Ode for ResetFmu {
+    fn continuous_states(&self, x: &mut [f64]) {
+        x[0] = self.law.z();
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        self.law.state_from_slice(x)
+    }
+
+    fn event_indicators(&self, values: &Values, z: &mut [f64]) {
+        z.copy_from_slice(&self.law.switching_functions(values.real(vr::V)));
+    }
+
+    /// `z` on the scale of the stiction range `z0`.
+    fn nominals(&self, values: &Values, nominal: &mut [f64]) {
+        nominal[0] = Self::params(values).z0;
+    }
+
+    fn event_update(&mut self, values: &Values) -> bool {
+        self.law.stop_at_limit(values.real(vr::V))
+    }
+
+    /// The law's closed forms ([`ResetIntegrator::partials`]).
+    fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
+        let (dzd_dz, dzd_dv, df_dz, df_dv) = self.law.partials(values.real(vr::V));
+        let (by_z, by_v) = match unknown {
+            vr::DER_Z => (dzd_dz, dzd_dv),
+            vr::F => (df_dz, df_dv),
+            vr::Z => (1.0, 0.0),
+            _ => return None,
+        };
+        match known {
+            vr::Z => Some(by_z),
+            vr::V => Some(by_v),
             _ => None,
         }
     }

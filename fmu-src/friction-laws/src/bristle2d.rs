@@ -91,6 +91,20 @@ fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[0] + a[1] * b[1]
 }
 
+/// The partial derivatives of [`Bristle2D::partials`], `[i][j]` =
+/// `∂(·)_i/∂(z or v)_j`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bristle2DPartials {
+    /// `∂ż/∂z`.
+    pub rate_z: [[f64; 2]; 2],
+    /// `∂ż/∂v`.
+    pub rate_v: [[f64; 2]; 2],
+    /// `∂F/∂z`.
+    pub force_z: [[f64; 2]; 2],
+    /// `∂F/∂v`.
+    pub force_v: [[f64; 2]; 2],
+}
+
 /// 2-D bristle state: deflection `z` (m), kept in the closed disc `|z| ≤ z0`.
 #[derive(Clone, Debug)]
 pub struct Bristle2D {
@@ -191,7 +205,104 @@ impl Bristle2D {
     /// Sliding: on the boundary of the stiction disc and slipping outward
     /// (`z·v > 0`).
     pub fn sliding(&self, v: [f64; 2]) -> bool {
-        self.on_boundary() && dot(self.z, v) > 0.0
+        self.sliding_of(self.z, v, self.on_boundary())
+    }
+
+    /// [`Bristle2D::sliding`] for any deflection `z` and contact state.
+    pub fn sliding_of(&self, z: [f64; 2], v: [f64; 2], on_boundary: bool) -> bool {
+        on_boundary && dot(z, v) > 0.0
+    }
+
+    /// The partial derivatives of [`Bristle2D::z_rate`] and
+    /// [`Bristle2D::force_of`] for a given contact state, in closed form,
+    /// as matrices indexed `[i][j]` = `∂(·)_i/∂(z or v)_j`. Inside the
+    /// disc (or on its boundary slipping inward) `ż = v`: `∂ż/∂z = 0`,
+    /// `∂ż/∂v = I`. Sliding, `ż = v − c·z` with `c = (z·v)/|z|²`:
+    /// `∂ż_i/∂v_j = δij − z_i·z_j/|z|²` and
+    /// `∂ż_i/∂z_j = −c·δij − z_i·(v_j − 2·c·z_j)/|z|²`. With
+    /// `Fi = gi·σ0i·zi + σ1i·d(|v|)·żi`, `d = exp(−|v|²/av²)`:
+    /// `∂Fi/∂zj = gi·σ0i·δij + σ1i·d·∂żi/∂zj` and
+    /// `∂Fi/∂vj = σ1i·(−2·vj/av²·d·żi + d·∂żi/∂vj)`.
+    pub fn partials(&self, z: [f64; 2], v: [f64; 2], on_boundary: bool) -> Bristle2DPartials {
+        let p = &self.p;
+        let mut rate_z = [[0.0; 2]; 2];
+        let mut rate_v = [[1.0, 0.0], [0.0, 1.0]];
+        if on_boundary && dot(z, v) > 0.0 {
+            let r2 = dot(z, z);
+            let c = dot(z, v) / r2;
+            for i in 0..2 {
+                for j in 0..2 {
+                    let delta = if i == j { 1.0 } else { 0.0 };
+                    rate_v[i][j] = delta - z[i] * z[j] / r2;
+                    rate_z[i][j] = -c * delta - z[i] * (v[j] - 2.0 * c * z[j]) / r2;
+                }
+            }
+        }
+        let zd = self.z_rate(z, v, on_boundary);
+        let (damp, damp_slope) = if p.av > 0.0 {
+            let d = (-dot(v, v) / (p.av * p.av)).exp();
+            (d, -2.0 / (p.av * p.av) * d)
+        } else {
+            (1.0, 0.0)
+        };
+        let gains = if on_boundary {
+            [1.0, 1.0]
+        } else {
+            [1.0 + p.a1, 1.0 + p.a2]
+        };
+        let sigma0 = [p.sigma01, p.sigma02];
+        let sigma1 = [p.sigma11, p.sigma12];
+        let mut force_z = [[0.0; 2]; 2];
+        let mut force_v = [[0.0; 2]; 2];
+        for i in 0..2 {
+            for j in 0..2 {
+                let delta = if i == j { 1.0 } else { 0.0 };
+                force_z[i][j] = gains[i] * sigma0[i] * delta + sigma1[i] * damp * rate_z[i][j];
+                force_v[i][j] = sigma1[i] * (damp_slope * v[j] * zd[i] + damp * rate_v[i][j]);
+            }
+        }
+        Bristle2DPartials {
+            rate_z,
+            rate_v,
+            force_z,
+            force_v,
+        }
+    }
+
+    /// The switching function of the contact state (Model Exchange's event
+    /// indicator): inside the disc `z0 − |z|`, which reaches 0 when the
+    /// deflection reaches the boundary; on the boundary `−(z·v)/|z|`,
+    /// negative while the slip strains the bristle outward (sliding) and
+    /// 0 when it turns inward and releases it.
+    pub fn switching_function(&self, z: [f64; 2], v: [f64; 2], on_boundary: bool) -> f64 {
+        let r = z[0].hypot(z[1]);
+        if on_boundary {
+            if r > 0.0 {
+                -dot(z, v) / r
+            } else {
+                0.0
+            }
+        } else {
+            self.p.z0 - r
+        }
+    }
+
+    /// The contact state after an event, and the deflection put back on the
+    /// circle where it is on the boundary (an integrator keeps `|z| = z0`
+    /// only to its tolerance, and carries it past `z0` before the event is
+    /// located): reaching the boundary (`|z| ≥ z0`) or on it, the bristle
+    /// is on the boundary while the slip does not turn inward (`z·v ≥ 0`,
+    /// as [`Bristle2D::advance_constant`] slides), else inside. Returns the
+    /// deflection and the contact state.
+    pub fn at_event(&self, z: [f64; 2], v: [f64; 2], on_boundary: bool) -> ([f64; 2], bool) {
+        let z0 = self.p.z0;
+        let r = z[0].hypot(z[1]);
+        if !(on_boundary || r >= z0) || r == 0.0 {
+            return (z, false);
+        }
+        let f = z0 / r;
+        let projected = [z[0] * f, z[1] * f];
+        (projected, dot(projected, v) >= 0.0)
     }
 
     /// Advances over `[0, h]` with `v = (v1(τ), v2(τ))`.
@@ -740,5 +851,84 @@ mod tests {
         let mut s = vec![f64::NAN; b.state_len()];
         b.write_state_into(&mut s);
         assert_eq!(s, b.state_to_vec());
+    }
+
+    /// The closed-form partials against central differences of `z_rate`
+    /// and `force_of` (inside, sliding, anisotropic, with and without the
+    /// damping decay); the switching function's signs and the contact
+    /// state after an event.
+    #[test]
+    fn partials_switching_function_and_events() {
+        let z0 = 1e-4;
+        for p in [
+            Bristle2DParams::default(),
+            Bristle2DParams::experimental(),
+            Bristle2DParams {
+                av: 0.0,
+                ..Bristle2DParams::default()
+            },
+        ] {
+            let b = Bristle2D::new(p).unwrap();
+            let cases = [
+                ([3e-5, -2e-5], [2e-3, 1e-3], false),
+                ([z0 * 0.6, z0 * 0.8], [2e-3, 1e-3], true),
+                ([-z0 * 0.28, z0 * 0.96], [-4e-3, 5e-3], true),
+                ([z0, 0.0], [1e-3, 3e-3], true),
+            ];
+            for (z, v, on) in cases {
+                let d = b.partials(z, v, on);
+                for j in 0..2 {
+                    let (hz, hv) = (1e-12, 1e-9);
+                    let (mut zp, mut zm, mut vp, mut vm) = (z, z, v, v);
+                    zp[j] += hz;
+                    zm[j] -= hz;
+                    vp[j] += hv;
+                    vm[j] -= hv;
+                    for i in 0..2 {
+                        let fd =
+                            |a: [f64; 2],
+                             b_: [f64; 2],
+                             h: f64,
+                             f: &dyn Fn([f64; 2]) -> [f64; 2]| {
+                                (f(a)[i] - f(b_)[i]) / (2.0 * h)
+                            };
+                        let rate_z = fd(zp, zm, hz, &|z| b.z_rate(z, v, on));
+                        let rate_v = fd(vp, vm, hv, &|v| b.z_rate(z, v, on));
+                        let force_z = fd(zp, zm, hz, &|z| b.force_of(z, v, on));
+                        let force_v = fd(vp, vm, hv, &|v| b.force_of(z, v, on));
+                        let at = format!("{p:?} z {z:?} v {v:?} on {on} [{i}][{j}]");
+                        let scale_rate = 1e-6 * (v[0].hypot(v[1]) / z0);
+                        assert!(
+                            (d.rate_z[i][j] - rate_z).abs() <= scale_rate.max(1e-6 * rate_z.abs()),
+                            "rate_z {at}: {} vs {rate_z}",
+                            d.rate_z[i][j]
+                        );
+                        assert!((d.rate_v[i][j] - rate_v).abs() <= 1e-6, "rate_v {at}");
+                        assert!(
+                            (d.force_z[i][j] - force_z).abs() <= 1e-6 * 1e4,
+                            "force_z {at}: {} vs {force_z}",
+                            d.force_z[i][j]
+                        );
+                        assert!(
+                            (d.force_v[i][j] - force_v).abs() <= 1e-6 * 300.0,
+                            "force_v {at}: {} vs {force_v}",
+                            d.force_v[i][j]
+                        );
+                    }
+                }
+            }
+            // inside: z0 − |z| > 0; on the boundary sliding: < 0; turning inward: > 0
+            assert!(b.switching_function([3e-5, 4e-5], [1.0, 0.0], false) == z0 - 5e-5);
+            assert!(b.switching_function([z0, 0.0], [1e-3, 1e-3], true) < 0.0);
+            assert!(b.switching_function([z0, 0.0], [-1e-3, 1e-3], true) > 0.0);
+            // an event: past the boundary moving out → on it, projected;
+            // on it turning inward → inside; inside → unchanged
+            let (z, on) = b.at_event([1.2 * z0, 0.0], [1e-3, 0.0], false);
+            assert!(on && z == [z0, 0.0]);
+            let (z, on) = b.at_event([0.0, z0 * (1.0 + 1e-9)], [1e-3, -1e-3], true);
+            assert!(!on && z == [0.0, z0]);
+            let (z, on) = b.at_event([3e-5, 0.0], [1e-3, 0.0], false);
+            assert!(!on && z == [3e-5, 0.0]);
+        }
     }
 }

@@ -83,12 +83,42 @@ impl Dahl {
             return 0.0;
         }
         let y = 1.0 - f / self.p.fc * v.signum();
-        let shape = if self.p.alpha == 1.0 {
+        self.p.sigma * self.shape(y) * v
+    }
+
+    /// `|y|^α·sgn(y)`, the shape of the law (`y` itself for α = 1).
+    #[inline]
+    fn shape(&self, y: f64) -> f64 {
+        if self.p.alpha == 1.0 {
             y
         } else {
             y.abs().powf(self.p.alpha) * y.signum()
+        }
+    }
+
+    /// The partial derivatives `(∂Ḟ/∂F, ∂Ḟ/∂v)` of [`Dahl::force_rate`]
+    /// at `(f, v)`, in closed form: with `s = sgn v`, `y = 1 − F·s/Fc`,
+    /// `Ḟ = σ·|y|^α·sgn(y)·v`, so `∂Ḟ/∂F = −σ·α·|y|^(α−1)·|v|/Fc` and,
+    /// `y` being constant in `v` for one sign, `∂Ḟ/∂v = σ·|y|^α·sgn(y)`.
+    /// At `v = 0` the rate is 0 for every `F` (`∂Ḟ/∂F = 0`) and has a kink
+    /// in `v` (`y` jumps from `1 + F/Fc` to `1 − F/Fc`): `∂Ḟ/∂v` is the
+    /// mean of the two one-sided slopes, the limit of central
+    /// differences. For α < 1 at `y = 0` (sliding, reached in finite
+    /// distance) `∂Ḟ/∂F` is infinite.
+    pub fn force_rate_partials(&self, f: f64, v: f64) -> (f64, f64) {
+        let p = &self.p;
+        if v == 0.0 {
+            let forward = p.sigma * self.shape(1.0 - f / p.fc);
+            let backward = p.sigma * self.shape(1.0 + f / p.fc);
+            return (0.0, 0.5 * (forward + backward));
+        }
+        let y = 1.0 - f / p.fc * v.signum();
+        let slope = if p.alpha == 1.0 {
+            1.0
+        } else {
+            p.alpha * y.abs().powf(p.alpha - 1.0)
         };
-        self.p.sigma * shape * v
+        (-p.sigma * slope * v.abs() / p.fc, p.sigma * self.shape(y))
     }
 
     /// `true` when moving (`v ≠ 0`) with `sgn(v)·F ≥ 0.99·Fc`.
@@ -360,6 +390,41 @@ mod tests {
         // the rate pulls F back: sgn(1 − F/Fc·sgn v) < 0.
         let d = Dahl::new(p).unwrap();
         assert!(d.force_rate(2.5 * p.fc, 1e-3) < 0.0);
+    }
+
+    /// The closed-form partials of the rate against central differences of
+    /// the rate itself, for several α, both directions, loading and
+    /// unloading; at v = 0, the mean of the two sides.
+    #[test]
+    fn force_rate_partials_match_differences_of_the_rate() {
+        for &alpha in &[0.5, 1.0, 2.5] {
+            let p = DahlParams {
+                alpha,
+                ..DahlParams::default()
+            };
+            let d = Dahl::new(p).unwrap();
+            for &(f, v) in &[
+                (0.3, 1e-3),
+                (0.3, -1e-3),
+                (-1.5, 2e-3),
+                (1.9, -5e-4),
+                (0.7, 0.0),
+            ] {
+                let (df, dv) = d.force_rate_partials(f, v);
+                let hf = 1e-7 * p.fc;
+                let fd_f = (d.force_rate(f + hf, v) - d.force_rate(f - hf, v)) / (2.0 * hf);
+                let hv = 1e-9;
+                let fd_v = (d.force_rate(f, v + hv) - d.force_rate(f, v - hv)) / (2.0 * hv);
+                assert!(
+                    (df - fd_f).abs() <= 1e-6 * fd_f.abs().max(1.0),
+                    "alpha {alpha}, F {f}, v {v}: {df} vs {fd_f}"
+                );
+                assert!(
+                    (dv - fd_v).abs() <= 1e-6 * fd_v.abs(),
+                    "alpha {alpha}, F {f}, v {v}: {dv} vs {fd_v}"
+                );
+            }
+        }
     }
 
     #[test]

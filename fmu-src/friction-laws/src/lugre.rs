@@ -125,6 +125,26 @@ impl LuGreParams {
         }
     }
 
+    /// The largest steady deflection `g/σ0` the parameters allow (the
+    /// larger static level, times the largest scale of the position table
+    /// when it is used): the magnitude of `z`, for an integrator's
+    /// tolerance. Of any parameters, valid or not.
+    pub fn deflection_scale(&self) -> f64 {
+        let mut level = self.fs;
+        if self.direction_dependent {
+            level = level.max(self.fs_neg);
+        }
+        if self.position_dependent {
+            let n = self.n_table.clamp(2, TABLE_POINTS);
+            let mut scale = self.scale_pos[..n].iter().cloned().fold(0.0, f64::max);
+            if self.direction_dependent {
+                scale = self.scale_neg[..n].iter().cloned().fold(scale, f64::max);
+            }
+            level *= scale;
+        }
+        level / self.sigma0
+    }
+
     /// σ0 > 0, σ1 ≥ 0, σ2 ≥ 0, Fc > 0, Fs ≥ Fc, vs > 0, δ > 0, vd ≥ 0, all
     /// finite; the negative levels likewise when direction-dependent; the
     /// table (2..=32 points, strictly increasing, scales > 0) when
@@ -240,6 +260,31 @@ pub struct StepSensitivity {
     pub z: f64,
     /// Of the force `F` (N per unit of the input).
     pub force: f64,
+}
+
+/// `λ` and its slopes ([`LuGre::rate_constant`]).
+#[derive(Clone, Copy, Debug)]
+struct RateConstant {
+    lambda: f64,
+    by_v: f64,
+    by_x: f64,
+}
+
+/// `∂ż/∂z`, `∂ż/∂v`, `∂ż/∂x` ([`LuGre::rate_partials`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RatePartials {
+    pub z: f64,
+    pub v: f64,
+    pub x: f64,
+}
+
+/// `∂F/∂z`, `∂F/∂v`, `∂F/∂x`, `∂F/∂Fn` ([`LuGre::force_partials`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ForcePartials {
+    pub z: f64,
+    pub v: f64,
+    pub x: f64,
+    pub fn_: f64,
 }
 
 /// LuGre state: the mean bristle deflection `z` (m).
@@ -678,15 +723,16 @@ impl LuGre {
         let (g, dg_dw, unscaled) = self.level_and_slope(w, s, x);
         let sigma0 = p.sigma0;
         let zss = g * s / sigma0;
-        let lambda = sigma0 * w / g;
+        let dg_dx = x_slope * unscaled;
+        let rate = self.rate_constant(w, s, g, dg_dw, dg_dx);
+        let lambda = rate.lambda;
         let lh = lambda * h;
         // 1 − E, exact for small λh too (1 to the last bit beyond λh = 40)
         let settled = if lh > 40.0 { 1.0 } else { -(-lh).exp_m1() };
         let (dzss, dlambda) = if by_v {
-            (dg_dw / sigma0, sigma0 * s * (g - w * dg_dw) / (g * g))
+            (dg_dw / sigma0, rate.by_v)
         } else {
-            let dg = x_slope * unscaled;
-            (s * dg / sigma0, -lambda * dg / g)
+            (s * dg_dx / sigma0, rate.by_x)
         };
         let dz = dzss * settled - h * dlambda * (z - zss);
         let direct = if by_v { 1.0 } else { 0.0 };
@@ -695,17 +741,133 @@ impl LuGre {
         let mut df = sigma0 * dz + s1 * dzd;
         if by_v {
             let zd = self.z_rate_at_level(z, v, g);
-            let ds1 = if p.vd > 0.0 {
-                -2.0 * v / (p.vd * p.vd) * s1
-            } else {
-                0.0
-            };
-            df += ds1 * zd + p.sigma2;
+            df += self.sigma1_slope(v, s1) * zd + p.sigma2;
         }
         Some(StepSensitivity {
             z: dz,
             force: df * self.fn_factor(fn_),
         })
+    }
+
+    /// The rate `λ = σ0·w/g` of the state equation `ż = v − λ·z` (for
+    /// `w = |v| > 0`, direction `s`, level `g` with slope `dg_dw` in `w`
+    /// and `dg_dx` in `x`) and its slopes `∂λ/∂v = σ0·s·(g − w·g′)/g²`
+    /// and `∂λ/∂x = −λ·(∂g/∂x)/g`: what the step sensitivities
+    /// ([`LuGre::held_step_sensitivity`]) and the partial derivatives of
+    /// the right-hand side ([`LuGre::rate_partials`]) are made of.
+    #[inline]
+    fn rate_constant(&self, w: f64, s: f64, g: f64, dg_dw: f64, dg_dx: f64) -> RateConstant {
+        let sigma0 = self.p.sigma0;
+        let lambda = sigma0 * w / g;
+        RateConstant {
+            lambda,
+            by_v: sigma0 * s * (g - w * dg_dw) / (g * g),
+            by_x: -lambda * dg_dx / g,
+        }
+    }
+
+    /// `σ1′(v) = −2·v/vd²·σ1(v)` of [`LuGre::sigma1_at`], with `s1` =
+    /// σ1(v); 0 for constant σ1 (vd = 0).
+    #[inline]
+    fn sigma1_slope(&self, v: f64, s1: f64) -> f64 {
+        let vd = self.p.vd;
+        if vd > 0.0 {
+            -2.0 * v / (vd * vd) * s1
+        } else {
+            0.0
+        }
+    }
+
+    /// The mean of the one-sided slopes `∂scale/∂x` of the position table
+    /// of direction `dir` at `x`: the slope of the segment `x` lies in
+    /// (0 beyond the ends), the mean of the two segments at a table point
+    /// (where the piecewise-linear scale has a kink; what central
+    /// differences converge to); 0 without the table.
+    fn scale_slope_mean(&self, dir: f64, x: f64) -> f64 {
+        let p = &self.p;
+        if !p.position_dependent || x.is_nan() {
+            return 0.0;
+        }
+        let n = p.n_table.clamp(2, TABLE_POINTS);
+        let xs = &p.x_table[..n];
+        let s = if dir < 0.0 && p.direction_dependent {
+            &p.scale_neg
+        } else {
+            &p.scale_pos
+        };
+        // segment k lies between points k − 1 and k (0 and n: beyond the ends)
+        let slope = |k: usize| {
+            if k == 0 || k >= n {
+                0.0
+            } else {
+                (s[k] - s[k - 1]) / (xs[k] - xs[k - 1])
+            }
+        };
+        let right = xs.partition_point(|&xi| xi <= x);
+        let left = xs.partition_point(|&xi| xi < x);
+        0.5 * (slope(left) + slope(right))
+    }
+
+    /// The partial derivatives of the state equation's right-hand side
+    /// [`LuGre::z_rate`] at `(z, v, x)` in closed form (it does not depend
+    /// on `Fn`). With `ż = v − λ·z`, `λ = σ0·|v|/g` ([`Self::rate_constant`]):
+    /// `∂ż/∂z = −λ`, `∂ż/∂v = 1 − z·∂λ/∂v`, `∂ż/∂x = −z·∂λ/∂x` (the slope
+    /// of the position table: [`Self::scale_slope_mean`]). At `v = 0`,
+    /// where `|v|` has its kink, `ż = 0` for every `z` and `x`, and
+    /// `∂ż/∂v` is the mean of the one-sided slopes `1 − s·σ0·z/g(0, s)`
+    /// (`s = ±1`; the levels may differ by direction).
+    pub fn rate_partials(&self, z: f64, v: f64, x: f64) -> RatePartials {
+        let sigma0 = self.p.sigma0;
+        if v == 0.0 {
+            let forward = 1.0 - sigma0 * z / self.g_unit(0.0, 1.0, x);
+            let backward = 1.0 + sigma0 * z / self.g_unit(0.0, -1.0, x);
+            return RatePartials {
+                z: 0.0,
+                v: 0.5 * (forward + backward),
+                x: 0.0,
+            };
+        }
+        let s = if v > 0.0 { 1.0 } else { -1.0 };
+        let w = v.abs();
+        let (g, dg_dw, unscaled) = self.level_and_slope(w, s, x);
+        let dg_dx = self.scale_slope_mean(s, x) * unscaled;
+        let rate = self.rate_constant(w, s, g, dg_dw, dg_dx);
+        RatePartials {
+            z: -rate.lambda,
+            v: 1.0 - z * rate.by_v,
+            x: -z * rate.by_x,
+        }
+    }
+
+    /// The partial derivatives of the output equation [`LuGre::force_of`]
+    /// at `(z, v, x, Fn)` in closed form: with
+    /// `F = (σ0·z + σ1(v)·ż + σ2·v)·φ(Fn)` and the partials of `ż` from
+    /// [`LuGre::rate_partials`], `∂F/∂z = (σ0 + σ1·∂ż/∂z)·φ`,
+    /// `∂F/∂v = (σ1′·ż + σ1·∂ż/∂v + σ2)·φ`, `∂F/∂x = σ1·∂ż/∂x·φ` and, in
+    /// the normal-force form, `∂F/∂Fn = F/φ` for `Fn > 0`, 0 for `Fn < 0`
+    /// and half of it at the kink `Fn = 0` (0 outside that form).
+    pub fn force_partials(&self, z: f64, v: f64, x: f64, fn_: f64) -> ForcePartials {
+        let p = &self.p;
+        let rate = self.rate_partials(z, v, x);
+        let zd = self.z_rate(z, v, x, fn_);
+        let s1 = self.sigma1_at(v);
+        let phi = self.fn_factor(fn_);
+        let by_fn = if !p.normal_force_form || fn_ < 0.0 {
+            0.0
+        } else {
+            let per_unit = self.force_at_rate(z, v, zd, 1.0);
+            if fn_ > 0.0 {
+                per_unit
+            } else {
+                0.5 * per_unit
+            }
+        };
+        ForcePartials {
+            z: (p.sigma0 + s1 * rate.z) * phi,
+            v: (self.sigma1_slope(v, s1) * zd + s1 * rate.v + p.sigma2) * phi,
+            x: s1 * rate.x * phi,
+            fn_: by_fn,
+        }
     }
 
     /// Sub-stepped integration over `[a, b]` on which `sgn v = s ≠ 0`.
@@ -1161,6 +1323,104 @@ mod tests {
                 "v {v}: {fd} vs {rate}"
             );
         }
+    }
+
+    /// The closed-form partials of the right-hand side and of the force
+    /// against central differences of `z_rate` and `force_of` themselves:
+    /// every option (direction- and position-dependent levels, normal-force
+    /// form, decaying micro-damping, Stribeck exponents 2, 1.4 and 0.6),
+    /// stick and slip, both directions; at v = 0, at a table point and at
+    /// Fn = 0 (kinks) the mean of the two sides, as the differences give.
+    #[test]
+    fn rate_and_force_partials_match_differences() {
+        let mut options = LuGreParams {
+            direction_dependent: true,
+            fc_neg: 0.7,
+            fs_neg: 1.2,
+            position_dependent: true,
+            n_table: 3,
+            vd: 2e-3,
+            normal_force_form: true,
+            ..LuGreParams::default()
+        };
+        options.x_table[..3].copy_from_slice(&[0.0, 0.1, 0.3]);
+        options.scale_pos[..3].copy_from_slice(&[1.0, 2.0, 0.5]);
+        options.scale_neg[..3].copy_from_slice(&[1.5, 1.0, 1.0]);
+        let sets = [
+            LuGreParams::default(),
+            LuGreParams::sun_2016(),
+            options,
+            LuGreParams {
+                stribeck_exponent: 1.4,
+                ..options
+            },
+            LuGreParams {
+                stribeck_exponent: 0.6,
+                ..LuGreParams::default()
+            },
+        ];
+        let points = [
+            (3e-6, 1e-3, 0.05, 2.0),
+            (-1e-5, -4e-3, 0.2, 1.0),
+            (1e-5, 0.3, -1.0, 0.5),
+            (1.4e-5, 2e-4, 0.15, 1.0),
+            (2e-6, 0.0, 0.05, 3.0),
+            (-5e-6, 0.0, 0.2, 1.0),
+            (4e-6, 2e-3, 0.1, 1.0),
+            (4e-6, -2e-3, 0.0, 0.0),
+        ];
+        let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-6 * b.abs().max(scale);
+        for p in sets {
+            let l = LuGre::new(p).unwrap();
+            for &(z, v, x, fn_) in &points {
+                let r = l.rate_partials(z, v, x);
+                let f = l.force_partials(z, v, x, fn_);
+                let (hz, hv, hx, hf) = (1e-12, 1e-9, 1e-7, 1e-7);
+                let dz = |g: &dyn Fn(f64, f64, f64, f64) -> f64| {
+                    (g(z + hz, v, x, fn_) - g(z - hz, v, x, fn_)) / (2.0 * hz)
+                };
+                let dv = |g: &dyn Fn(f64, f64, f64, f64) -> f64| {
+                    (g(z, v + hv, x, fn_) - g(z, v - hv, x, fn_)) / (2.0 * hv)
+                };
+                let dx = |g: &dyn Fn(f64, f64, f64, f64) -> f64| {
+                    (g(z, v, x + hx, fn_) - g(z, v, x - hx, fn_)) / (2.0 * hx)
+                };
+                let dfn = |g: &dyn Fn(f64, f64, f64, f64) -> f64| {
+                    (g(z, v, x, fn_ + hf) - g(z, v, x, fn_ - hf)) / (2.0 * hf)
+                };
+                let rate = |z, v, x, fn_| l.z_rate(z, v, x, fn_);
+                let force = |z, v, x, fn_| l.force_of(z, v, x, fn_);
+                let at = format!("z {z}, v {v}, x {x}, Fn {fn_} of {p:?}");
+                // each compared on the scale of its terms (rounding in the
+                // differences is relative to them, not to a small sum)
+                let lambda = p.sigma0 * v.abs() / p.fc.min(p.fc_neg);
+                let by_x = z.abs() * lambda * 20.0;
+                let checks = [
+                    ("dz/dz", r.z, dz(&rate), lambda),
+                    ("dz/dv", r.v, dv(&rate), 1.0),
+                    ("dz/dx", r.x, dx(&rate), by_x),
+                    ("dF/dz", f.z, dz(&force), p.sigma0 * fn_.max(1.0)),
+                    ("dF/dv", f.v, dv(&force), p.sigma1 * fn_.max(1.0)),
+                    ("dF/dx", f.x, dx(&force), p.sigma1 * by_x * fn_.max(1.0)),
+                    ("dF/dFn", f.fn_, dfn(&force), 1.0),
+                ];
+                for (what, closed, differences, scale) in checks {
+                    assert!(
+                        close(closed, differences, scale),
+                        "{what}: {closed} vs {differences} at {at}"
+                    );
+                }
+            }
+        }
+        // A table point is a kink of the level: at it, the mean of the two
+        // segments' slopes (2−1)/0.1 and (0.5−2)/0.2 of `scale_pos`.
+        let l = LuGre::new(options).unwrap();
+        let near = |a: f64, b: f64| (a - b).abs() <= 1e-12;
+        assert!(near(l.scale_slope_mean(1.0, 0.1), 0.5 * (10.0 + -7.5)));
+        assert!(near(l.scale_slope_mean(1.0, 0.05), 10.0));
+        assert!(near(l.scale_slope_mean(-1.0, 0.05), -5.0));
+        assert_eq!(l.scale_slope_mean(1.0, 0.5), 0.0);
+        assert!(near(l.scale_slope_mean(1.0, 0.0), 5.0));
     }
 
     #[test]

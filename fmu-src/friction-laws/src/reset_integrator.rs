@@ -101,6 +101,58 @@ impl ResetIntegrator {
         self.saturated(v)
     }
 
+    /// The partial derivatives of [`ResetIntegrator::z_dot`] and
+    /// [`ResetIntegrator::force`] at the current strain:
+    /// `(∂ż/∂z, ∂ż/∂v, ∂F/∂z, ∂F/∂v)`. `ż` is `v` or 0, piecewise
+    /// constant in `z`: `∂ż/∂z = 0`, `∂ż/∂v` = 1 inside the range and 0
+    /// saturated; at `v = 0` with `|z| ≥ z0` (saturated on one side of
+    /// `v = 0` only) the mean of the two sides, ½. `F = (1 + a(z))·σ0·z +
+    /// σ1·ż`: `∂F/∂z = (1 + a(z))·σ0`, `∂F/∂v = σ1·∂ż/∂v`.
+    pub fn partials(&self, v: f64) -> (f64, f64, f64, f64) {
+        let p = &self.p;
+        let at_limit = self.z.abs() >= p.z0;
+        let dzd_dv = if v == 0.0 && at_limit {
+            0.5
+        } else if self.saturated(v) {
+            0.0
+        } else {
+            1.0
+        };
+        let gain = if at_limit { 1.0 } else { 1.0 + p.a };
+        (0.0, dzd_dv, gain * p.sigma0, p.sigma1 * dzd_dv)
+    }
+
+    /// Two switching functions, each changing sign where `ż` switches
+    /// between `v` and 0 (Model Exchange's event indicators): for the upper
+    /// limit `z0 − z` while `z < z0` (it reaches 0 when the strain does)
+    /// and `−v` at or beyond it (negative while held there, 0 when the
+    /// motion reverses and releases it); for the lower limit likewise
+    /// `z + z0` and `v`. Each is positive while its limit does not hold the
+    /// strain and negative while it does.
+    pub fn switching_functions(&self, v: f64) -> [f64; 2] {
+        let z0 = self.p.z0;
+        let upper = if self.z < z0 { z0 - self.z } else { -v };
+        let lower = if self.z > -z0 { self.z + z0 } else { v };
+        [upper, lower]
+    }
+
+    /// At an event (Model Exchange): a strain an integrator carried beyond
+    /// the range in the direction of motion is put on its limit, where
+    /// [`ResetIntegrator::step`]'s exact update stops it. Whether the
+    /// strain changed.
+    pub fn stop_at_limit(&mut self, v: f64) -> bool {
+        let z0 = self.p.z0;
+        let limited = if self.z > z0 && v > 0.0 {
+            z0
+        } else if self.z < -z0 && v < 0.0 {
+            -z0
+        } else {
+            return false;
+        };
+        self.z = limited;
+        true
+    }
+
     /// Exact update over `[0, h]` for ramped `v`: split at the zero crossing;
     /// on each one-sign piece with exact displacement `Δx`,
     /// `v > 0: z ← max(z, min(z + Δx, z0))`, `v < 0: z ← min(z, max(z + Δx, −z0))`
@@ -245,5 +297,72 @@ mod tests {
         let mut s = vec![f64::NAN; r.state_len()];
         r.write_state_into(&mut s);
         assert_eq!(s, r.state_to_vec());
+    }
+
+    /// The switching functions change sign exactly where `ż` switches
+    /// (reaching ±z0 moving outward, reversing while held), the partials
+    /// match differences of `z_dot` and `force` away from the switches,
+    /// and an overshoot is put back on the limit only when moving outward.
+    #[test]
+    fn switching_functions_partials_and_the_stop_at_the_limit() {
+        let p = ResetParams::default();
+        let mut r = ResetIntegrator::new(p).unwrap();
+        let z0 = p.z0;
+        let v = 2e-3;
+        // inside: both positive; the upper one is z0 − z
+        r.set_z(0.4 * z0);
+        assert_eq!(r.switching_functions(v), [z0 - 0.4 * z0, 0.4 * z0 + z0]);
+        assert_eq!(r.z_dot(v), v);
+        // held at the upper limit moving up: the upper one negative
+        r.set_z(z0);
+        assert_eq!(r.z_dot(v), 0.0);
+        assert_eq!(r.switching_functions(v)[0], -v);
+        // reversing releases it: positive again, and ż = v
+        assert!(r.switching_functions(-v)[0] > 0.0 && r.z_dot(-v) == -v);
+        // the lower limit mirrors it
+        r.set_z(-z0);
+        assert!(r.switching_functions(-v)[1] < 0.0 && r.z_dot(-v) == 0.0);
+        assert!(r.switching_functions(v)[1] > 0.0 && r.z_dot(v) == v);
+        // an overshoot moving outward is stopped at the limit; moving
+        // inward, or inside, nothing changes
+        r.set_z(z0 * (1.0 + 1e-9));
+        assert!(!r.stop_at_limit(-v) && r.z() > z0);
+        assert!(r.stop_at_limit(v) && r.z() == z0);
+        r.set_z(-z0 * (1.0 + 1e-9));
+        assert!(r.stop_at_limit(-v) && r.z() == -z0);
+        r.set_z(0.5 * z0);
+        assert!(!r.stop_at_limit(v) && r.z() == 0.5 * z0);
+        // partials against differences, inside and held (and ½ at v = 0
+        // at the limit, the mean of the two sides)
+        for &(z, v) in &[
+            (0.3 * z0, 1e-3),
+            (-0.2 * z0, -1e-3),
+            (z0, 1e-3),
+            (-z0, 1e-3),
+            (z0, 0.0),
+        ] {
+            r.set_z(z);
+            let (dzd_dz, dzd_dv, df_dz, df_dv) = r.partials(v);
+            let h = 1e-9;
+            let fd_v = (r.z_dot(v + h) - r.z_dot(v - h)) / (2.0 * h);
+            let fdf_v = (r.force(v + h) - r.force(v - h)) / (2.0 * h);
+            assert_eq!(dzd_dz, 0.0);
+            assert!(
+                (dzd_dv - fd_v).abs() < 1e-9,
+                "z {z} v {v}: {dzd_dv} vs {fd_v}"
+            );
+            assert!((df_dv - fdf_v).abs() < 1e-6 * p.sigma1, "z {z} v {v}");
+            if z.abs() < z0 {
+                let hz = 1e-12;
+                let mut a = r.clone();
+                a.set_z(z + hz);
+                let mut b = r.clone();
+                b.set_z(z - hz);
+                let fdf_z = (a.force(v) - b.force(v)) / (2.0 * hz);
+                assert!((df_dz - fdf_z).abs() < 1e-6 * p.sigma0, "z {z} v {v}");
+            } else {
+                assert_eq!(df_dz, p.sigma0);
+            }
+        }
     }
 }

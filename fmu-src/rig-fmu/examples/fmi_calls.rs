@@ -67,10 +67,12 @@ fn main() {
         ModelFactory {
             info: rig.info,
             create: rig.create,
+            create_model_exchange: rig.create_model_exchange,
         },
         ModelFactory {
             info: lugre.info,
             create: lugre.create,
+            create_model_exchange: lugre.create_model_exchange,
         },
     ]));
     let functions = fmi2CallbackFunctions {

@@ -17,10 +17,12 @@ pub static REGISTRY: LazyLock<[ModelFactory; 2]> = LazyLock::new(|| {
         ModelFactory {
             info: &rig1d::INFO,
             create: || Box::new(rig1d::Rig1DFmu::default()),
+            create_model_exchange: None,
         },
         ModelFactory {
             info: &rig2d::INFO,
             create: || Box::new(rig2d::Rig2DFmu::default()),
+            create_model_exchange: None,
         },
     ]
 });

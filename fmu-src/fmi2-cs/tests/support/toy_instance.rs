@@ -25,6 +25,7 @@ pub fn toy_info(name: &'static str, variables: Vec<Variable>) -> &'static ModelI
             step_size: 0.1,
         },
         capabilities: Capabilities::FULL,
+        model_exchange: None,
     }))
 }
 
