@@ -801,7 +801,18 @@ fn a_refused_instantiation_says_why() {
             m.len() == 1 && m[0].contains("fmi2Instantiate") && m[0].contains("00000000-0000"),
             "{m:?}"
         );
-        // Model Exchange, NULL name, NULL GUID, NULL callbacks: NULL, no crash.
+        // Model Exchange where the FMU has no <ModelExchange> element: refused, naming it.
+        if f.loaded.model_exchange.is_none() {
+            let log = Instance::of_type(a, "me", &f.model().guid, false, MODEL_EXCHANGE)
+                .err()
+                .expect("Model Exchange must be refused");
+            let m = log.take_errors();
+            assert!(
+                m.len() == 1 && m[0].contains("fmuType = 0") && m[0].contains(&f.model().name),
+                "{m:?}"
+            );
+        }
+        // NULL name, NULL GUID, NULL callbacks, fmuType 7: NULL, no crash.
         let guid = std::ffi::CString::new(f.model().guid.clone()).unwrap();
         let name = c"x";
         let callbacks = Callbacks {
@@ -813,7 +824,7 @@ fn a_refused_instantiation_says_why() {
         };
         unsafe {
             for (n, t, g, cb) in [
-                (name.as_ptr(), 0, guid.as_ptr(), &callbacks as *const _),
+                (null(), 0, guid.as_ptr(), &callbacks as *const _),
                 (null(), 1, guid.as_ptr(), &callbacks as *const _),
                 (name.as_ptr(), 1, null(), &callbacks as *const _),
                 (name.as_ptr(), 1, guid.as_ptr(), null()),

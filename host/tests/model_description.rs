@@ -167,6 +167,38 @@ fn a_valid_description_is_read() {
     assert!(e.to_string().contains("\"nope\""), "{e}");
 }
 
+/// The shipped model descriptions with both interfaces are read for
+/// Co-Simulation, the Model Exchange element and the state derivatives
+/// noted; the ones without it have none.
+#[test]
+fn the_shipped_descriptions_with_model_exchange_are_read() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
+    for (name, states, indicators) in [
+        ("Dahl", &["F"][..], 1),
+        ("LuGre", &["z"][..], 1),
+        ("ResetIntegrator", &["z"][..], 2),
+        ("Bristle2D", &["z1", "z2"][..], 1),
+        ("Bristle", &[][..], 0),
+        ("Rig1D", &[][..], 0),
+    ] {
+        let d = ModelDescription::from_file(&dir.join(format!("{name}.xml"))).unwrap();
+        assert_eq!(d.co_simulation.model_identifier, name);
+        let me = d.model_exchange.as_deref();
+        assert_eq!(me, (!states.is_empty()).then_some(name), "{name}");
+        assert_eq!(d.number_of_event_indicators, indicators, "{name}");
+        for state in states {
+            let index = d.variable(state).unwrap().index;
+            let der = d.variable(&format!("der({state})")).unwrap();
+            assert_eq!(der.causality, Causality::Local, "{name}");
+            assert!(
+                matches!(der.kind, VariableKind::Real { derivative: Some(i), .. } if i == index),
+                "{name}: {:?}",
+                der.kind
+            );
+        }
+    }
+}
+
 #[test]
 fn a_minimal_description_uses_the_defaults() {
     let d = ModelDescription::parse(

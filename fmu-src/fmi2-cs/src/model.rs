@@ -259,3 +259,37 @@ macro_rules! delegate_state {
         }
     };
 }
+
+/// [`Model::ode`] and [`Model::ode_mut`] of a model that implements
+/// [`Ode`] itself: write `fmi2_cs::ode_is_self!();` inside its
+/// `impl Model`.
+#[macro_export]
+macro_rules! ode_is_self {
+    () => {
+        fn ode(&self) -> Option<&dyn $crate::Ode> {
+            Some(self)
+        }
+
+        fn ode_mut(&mut self) -> Option<&mut dyn $crate::Ode> {
+            Some(self)
+        }
+    };
+}
+
+/// [`Ode::continuous_states`] and [`Ode::set_continuous_states`] for a
+/// model whose continuous states are the whole state of the law in field
+/// `$law` (its `write_state_into` and `state_from_slice`, as
+/// [`delegate_state!`](crate::delegate_state) uses them): write
+/// `fmi2_cs::delegate_continuous_states!(law);` inside the `impl Ode`.
+#[macro_export]
+macro_rules! delegate_continuous_states {
+    ($law:ident) => {
+        fn continuous_states(&self, x: &mut [f64]) {
+            self.$law.write_state_into(x);
+        }
+
+        fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+            self.$law.state_from_slice(x)
+        }
+    };
+}

@@ -279,16 +279,16 @@ pub const ME_ALLOWED: &[(&str, u32)] = &[
     ),
 ];
 
-/// The mask of `function` in `table`, 0 if it is not there.
-const fn mask_in(table: &[(&str, u32)], function: &str) -> u32 {
+/// The mask of `function` in `table`, `None` if it is not there.
+const fn find(table: &[(&str, u32)], function: &str) -> Option<u32> {
     let mut i = 0;
     while i < table.len() {
         if same_name(table[i].0, function) {
-            return table[i].1;
+            return Some(table[i].1);
         }
         i += 1;
     }
-    0
+    None
 }
 
 /// The allowed-state mask of `function`: its Co-Simulation and its Model
@@ -298,31 +298,18 @@ const fn mask_in(table: &[(&str, u32)], function: &str) -> u32 {
 /// resolve their masks at compile time
 /// (`const { allowed_mask("fmi2DoStep") }`) and no call compares strings.
 pub const fn allowed_mask(function: &str) -> u32 {
-    let m = mask_in(ALLOWED, function) | mask_in(ME_ALLOWED, function);
-    if m == 0 && !is_named(function) {
-        panic!("function not in the state tables")
+    match (find(ALLOWED, function), find(ME_ALLOWED, function)) {
+        (None, None) => panic!("function not in the state tables"),
+        (cs, me) => unwrap_or_zero(cs) | unwrap_or_zero(me),
     }
-    m
 }
 
-/// Whether `function` is named in either table (a function allowed in no
-/// state at all, none here, would still be named).
-const fn is_named(function: &str) -> bool {
-    let mut i = 0;
-    while i < ALLOWED.len() {
-        if same_name(ALLOWED[i].0, function) {
-            return true;
-        }
-        i += 1;
+/// `m.unwrap_or(0)` for `const fn`.
+const fn unwrap_or_zero(m: Option<u32>) -> u32 {
+    match m {
+        Some(m) => m,
+        None => 0,
     }
-    let mut i = 0;
-    while i < ME_ALLOWED.len() {
-        if same_name(ME_ALLOWED[i].0, function) {
-            return true;
-        }
-        i += 1;
-    }
-    false
 }
 
 /// `a == b` for `const fn`.

@@ -91,6 +91,8 @@ use fmi2_exports::*;
 #[path = "support/recording_logger.rs"]
 mod recording_logger;
 use recording_logger::{callbacks, log_clear, log_snapshot};
+#[path = "support/probes.rs"]
+mod probes;
 
 fn last_error_containing(needle: &str) -> String {
     let log = log_snapshot();
@@ -295,9 +297,10 @@ fn invalid_parameter_is_refused_at_exit_initialization() {
     }
 }
 
-/// Every instance-taking function in every reachable state agrees with the
-/// state table: allowed calls do not fail for state reasons, others return
-/// fmi2Error with "illegal call sequence".
+/// Every instance-taking function (Model Exchange ones too) in every
+/// reachable state agrees with the state table: allowed calls do not fail
+/// for state reasons, others return fmi2Error with "illegal call
+/// sequence".
 #[test]
 fn state_table_is_enforced() {
     use fmi2_cs::state_machine::{is_allowed, State};
@@ -323,45 +326,13 @@ fn state_table_is_enforced() {
         }
         c
     };
-    type Probe = (&'static str, fn(fmi2Component) -> fmi2Status);
-    let probes: &[Probe] = &[
-        ("fmi2SetupExperiment", |c| unsafe {
-            fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0)
-        }),
-        ("fmi2EnterInitializationMode", |c| unsafe {
-            fmi2EnterInitializationMode(c)
-        }),
-        ("fmi2ExitInitializationMode", |c| unsafe {
-            fmi2ExitInitializationMode(c)
-        }),
-        ("fmi2Terminate", |c| unsafe { fmi2Terminate(c) }),
-        ("fmi2DoStep", |c| unsafe { fmi2DoStep(c, 0.0, 0.1, 0) }),
-        ("fmi2CancelStep", |c| unsafe { fmi2CancelStep(c) }),
-        ("fmi2GetReal", |c| {
-            let (vr, mut x) = (U, 0.0);
-            unsafe { fmi2GetReal(c, &vr, 1, &mut x) }
-        }),
-        ("fmi2SetReal", |c| set(c, U, 1.0)),
-        ("fmi2SetRealInputDerivatives", |c| {
-            let (vr, o, d) = (U, 1, 1.0);
-            unsafe { fmi2SetRealInputDerivatives(c, &vr, 1, &o, &d) }
-        }),
-        ("fmi2GetRealOutputDerivatives", |c| {
-            let (vr, o, mut d) = (Y, 1, 0.0);
-            unsafe { fmi2GetRealOutputDerivatives(c, &vr, 1, &o, &mut d) }
-        }),
-        ("fmi2GetRealStatus", |c| {
-            let mut t = 0.0;
-            unsafe { fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &mut t) }
-        }),
-    ];
     for state in [
         State::Instantiated,
         State::InitializationMode,
         State::StepComplete,
         State::Terminated,
     ] {
-        for (name, probe) in probes {
+        for (name, probe) in probes::probes() {
             let c = reach(state);
             log_clear();
             let status = probe(c);

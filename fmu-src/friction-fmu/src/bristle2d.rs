@@ -327,13 +327,7 @@ impl Model for Bristle2DMe {
         dx.copy_from_slice(&self.law.z_rate(self.z, slip(values), self.on_boundary));
     }
 
-    fn ode(&self) -> Option<&dyn Ode> {
-        Some(self)
-    }
-
-    fn ode_mut(&mut self) -> Option<&mut dyn Ode> {
-        Some(self)
-    }
+    fmi2_cs::ode_is_self!();
 }
 
 /// The states `z1`, `z2`; one event indicator, the switching function of

@@ -168,26 +168,14 @@ impl Model for DahlFmu {
         dx[0] = self.law.force_rate(self.law.force(), values.real(vr::V));
     }
 
-    fn ode(&self) -> Option<&dyn Ode> {
-        Some(self)
-    }
-
-    fn ode_mut(&mut self) -> Option<&mut dyn Ode> {
-        Some(self)
-    }
+    fmi2_cs::ode_is_self!();
 }
 
 /// Model Exchange: the state is `F`; the one event indicator is `v`, where
 /// `sgn v` switches the law's branch (the rate has a kink there); no
 /// discrete state, so an event changes nothing.
 impl Ode for DahlFmu {
-    fn continuous_states(&self, x: &mut [f64]) {
-        x[0] = self.law.force();
-    }
-
-    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
-        self.law.state_from_slice(x)
-    }
+    fmi2_cs::delegate_continuous_states!(law);
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         z[0] = values.real(vr::V);

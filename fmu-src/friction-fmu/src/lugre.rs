@@ -447,26 +447,14 @@ impl Model for LuGreFmu {
         dx[0] = self.law.z_dot(v, x, fn_);
     }
 
-    fn ode(&self) -> Option<&dyn Ode> {
-        Some(self)
-    }
-
-    fn ode_mut(&mut self) -> Option<&mut dyn Ode> {
-        Some(self)
-    }
+    fmi2_cs::ode_is_self!();
 }
 
 /// Model Exchange: the state is `z`; the one event indicator is `v`, where
 /// `|v|` (and, direction-dependent, the levels) switch; no discrete state,
 /// so an event changes nothing.
 impl Ode for LuGreFmu {
-    fn continuous_states(&self, x: &mut [f64]) {
-        x[0] = self.law.z();
-    }
-
-    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
-        self.law.state_from_slice(x)
-    }
+    fmi2_cs::delegate_continuous_states!(law);
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         z[0] = values.real(vr::V);

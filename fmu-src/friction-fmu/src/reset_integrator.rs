@@ -168,13 +168,7 @@ impl Model for ResetFmu {
         dx[0] = self.law.z_dot(values.real(vr::V));
     }
 
-    fn ode(&self) -> Option<&dyn Ode> {
-        Some(self)
-    }
-
-    fn ode_mut(&mut self) -> Option<&mut dyn Ode> {
-        Some(self)
-    }
+    fmi2_cs::ode_is_self!();
 }
 
 /// Model Exchange: the state is `z`; two event indicators, one per limit
@@ -183,13 +177,7 @@ impl Model for ResetFmu {
 /// a strain the integrator carried past the limit is put on it
 /// ([`ResetIntegrator::stop_at_limit`]).
 impl Ode for ResetFmu {
-    fn continuous_states(&self, x: &mut [f64]) {
-        x[0] = self.law.z();
-    }
-
-    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
-        self.law.state_from_slice(x)
-    }
+    fmi2_cs::delegate_continuous_states!(law);
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         z.copy_from_slice(&self.law.switching_functions(values.real(vr::V)));

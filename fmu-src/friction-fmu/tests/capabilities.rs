@@ -6,7 +6,7 @@
 //! derivatives, and invalid parameters (issue 2).
 
 mod common;
-use common::Fmu;
+use common::{Fmu, LUGRE_TABLE};
 use friction_laws::lugre::{HeldInput, LuGre, LuGreInputs};
 use friction_laws::Ramp;
 use std::f64::consts::PI;
@@ -32,17 +32,6 @@ fn drive(model: &str) -> Vec<Signal> {
         _ => unreachable!(),
     }
 }
-
-const LUGRE_TABLE: &[(&str, f64)] = &[
-    ("position_dependent", 1.0),
-    ("n_table", 3.0),
-    ("x_table[1]", 0.0),
-    ("x_table[2]", 0.5),
-    ("x_table[3]", 1.0),
-    ("scale_pos[1]", 1.0),
-    ("scale_pos[2]", 1.3),
-    ("scale_pos[3]", 0.8),
-];
 
 fn params(model: &str) -> &'static [(&'static str, f64)] {
     if model == "LuGre" {

@@ -30,7 +30,13 @@ pub fn render(d: &ModelDescription, platforms: &[String]) -> String {
     let _ = writeln!(w, "\nModel Info\n");
     let rows = [
         ("FMI Version", d.fmi_version.clone()),
-        ("FMI Type", "Co-Simulation".to_string()),
+        (
+            "FMI Type",
+            match &d.model_exchange {
+                None => "Co-Simulation".to_string(),
+                Some(_) => "Co-Simulation (fricsim's), Model Exchange".to_string(),
+            },
+        ),
         ("Model Name", d.model_name.clone()),
         ("Model Identifier", d.co_simulation.model_identifier.clone()),
         ("GUID", d.guid.clone()),

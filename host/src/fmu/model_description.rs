@@ -1,5 +1,9 @@
 //! `modelDescription.xml` of FMI 2.0 (FMI 2.0.4 §2.2, §4.3.1 for the
-//! `CoSimulation` element) parsed into typed structs and validated.
+//! `CoSimulation` element) parsed into typed structs and validated. An FMU
+//! that also offers Model Exchange (a `ModelExchange` element, state
+//! derivatives with a `derivative` attribute) is read for its
+//! Co-Simulation interface, which is the one fricsim uses; the other is
+//! only noted ([`ModelDescription::model_exchange`]).
 //!
 //! Parsing has two passes: the root element's `fmiVersion` is read first
 //! (an FMI 1.0 or 3.0 file has another schema, and saying "version 3.0" is
@@ -32,6 +36,12 @@ pub struct ModelDescription {
     pub generation_tool: Option<String>,
     pub generation_date_and_time: Option<String>,
     pub co_simulation: CoSimulation,
+    /// The `modelIdentifier` of the `ModelExchange` element, if the FMU
+    /// also offers Model Exchange (not used by fricsim, which
+    /// co-simulates).
+    pub model_exchange: Option<String>,
+    /// `numberOfEventIndicators` (Model Exchange), 0 when absent.
+    pub number_of_event_indicators: u32,
     /// Names of the units of `UnitDefinitions`; `None` without that element.
     pub unit_definitions: Option<Vec<String>>,
     pub log_categories: Vec<LogCategory>,
@@ -351,7 +361,7 @@ fn is_c_identifier(s: &str) -> bool {
 
 // The XML as it is, before validation. quick-xml maps attributes to `@name`
 // fields and child elements to fields named like the element; elements not
-// listed here (ModelExchange, TypeDefinitions, annotations, …) are skipped.
+// listed here (TypeDefinitions, annotations, …) are skipped.
 
 #[derive(Deserialize)]
 struct RawModelDescription {
@@ -371,6 +381,10 @@ struct RawModelDescription {
     generation_tool: Option<String>,
     #[serde(rename = "@generationDateAndTime")]
     generation_date_and_time: Option<String>,
+    #[serde(rename = "@numberOfEventIndicators")]
+    number_of_event_indicators: Option<u32>,
+    #[serde(rename = "ModelExchange")]
+    model_exchange: Option<RawModelExchange>,
     #[serde(rename = "CoSimulation")]
     co_simulation: Option<RawCoSimulation>,
     #[serde(rename = "UnitDefinitions")]
@@ -383,6 +397,13 @@ struct RawModelDescription {
     model_variables: Option<RawModelVariables>,
     #[serde(rename = "ModelStructure")]
     model_structure: Option<RawModelStructure>,
+}
+
+/// The one attribute of `ModelExchange` fricsim reports.
+#[derive(Deserialize)]
+struct RawModelExchange {
+    #[serde(rename = "@modelIdentifier")]
+    model_identifier: String,
 }
 
 #[derive(Deserialize)]
@@ -698,6 +719,8 @@ impl RawModelDescription {
             generation_tool: self.generation_tool,
             generation_date_and_time: self.generation_date_and_time,
             co_simulation,
+            model_exchange: self.model_exchange.map(|me| me.model_identifier),
+            number_of_event_indicators: self.number_of_event_indicators.unwrap_or(0),
             unit_definitions,
             log_categories: self
                 .log_categories

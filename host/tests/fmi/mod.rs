@@ -1,4 +1,5 @@
-//! Raw access to the FMI 2.0 Co-Simulation C functions of an FMU binary, for
+//! Raw access to the FMI 2.0 C functions of an FMU binary (Co-Simulation,
+//! and Model Exchange in [`MeApi`]), for
 //! tests that misuse them on purpose (`misuse.rs`, `fuzz_bounded.rs`,
 //! `parallel_instances.rs`) and for the fuzz targets in `fuzz/` (which
 //! include this file with `#[path]` and fill [`Api`] from the exports linked
@@ -45,21 +46,20 @@ pub struct Callbacks {
 }
 
 macro_rules! api {
-    ($($field:ident: fn($($arg:ty),*) $(-> $ret:ty)? = $symbol:literal,)*) => {
-        /// Every function of the FMI 2.0 Co-Simulation API (FMI 2.0.4 §2.1,
-        /// §4.2) as a typed pointer.
+    ($(#[$doc:meta])* $name:ident; $($field:ident: fn($($arg:ty),*) $(-> $ret:ty)? = $symbol:literal,)*) => {
+        $(#[$doc])*
         #[derive(Clone, Copy)]
-        pub struct Api {
+        pub struct $name {
             $(pub $field: unsafe extern "C" fn($($arg),*) $(-> $ret)?,)*
         }
 
-        impl Api {
+        impl $name {
             /// Resolve every function with `lookup` (symbol name → address).
             ///
             /// # Safety
             /// Each address must be the function the standard gives that name.
-            pub unsafe fn from_lookup(lookup: impl Fn(&str) -> *const c_void) -> Api {
-                Api {
+            pub unsafe fn from_lookup(lookup: impl Fn(&str) -> *const c_void) -> $name {
+                $name {
                     $($field: {
                         let address = lookup($symbol);
                         assert!(!address.is_null(), "{} is missing", $symbol);
@@ -73,6 +73,9 @@ macro_rules! api {
 }
 
 api! {
+    /// Every function of the FMI 2.0 Co-Simulation API (FMI 2.0.4 §2.1,
+    /// §4.2) as a typed pointer.
+    Api;
     get_types_platform: fn() -> *const c_char = "fmi2GetTypesPlatform",
     get_version: fn() -> *const c_char = "fmi2GetVersion",
     set_debug_logging: fn(Component, c_int, usize, *const *const c_char) -> Status = "fmi2SetDebugLogging",
@@ -109,6 +112,34 @@ api! {
     get_string_status: fn(Component, c_int, *mut *const c_char) -> Status = "fmi2GetStringStatus",
 }
 
+/// `fmi2EventInfo`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EventInfo {
+    pub new_discrete_states_needed: c_int,
+    pub terminate_simulation: c_int,
+    pub nominals_of_continuous_states_changed: c_int,
+    pub values_of_continuous_states_changed: c_int,
+    pub next_event_time_defined: c_int,
+    pub next_event_time: f64,
+}
+
+api! {
+    /// The functions Model Exchange adds (FMI 2.0.4 §3.2) as typed
+    /// pointers.
+    MeApi;
+    enter_event_mode: fn(Component) -> Status = "fmi2EnterEventMode",
+    new_discrete_states: fn(Component, *mut EventInfo) -> Status = "fmi2NewDiscreteStates",
+    enter_continuous_time_mode: fn(Component) -> Status = "fmi2EnterContinuousTimeMode",
+    completed_integrator_step: fn(Component, c_int, *mut c_int, *mut c_int) -> Status = "fmi2CompletedIntegratorStep",
+    set_time: fn(Component, f64) -> Status = "fmi2SetTime",
+    set_continuous_states: fn(Component, *const f64, usize) -> Status = "fmi2SetContinuousStates",
+    get_derivatives: fn(Component, *mut f64, usize) -> Status = "fmi2GetDerivatives",
+    get_event_indicators: fn(Component, *mut f64, usize) -> Status = "fmi2GetEventIndicators",
+    get_continuous_states: fn(Component, *mut f64, usize) -> Status = "fmi2GetContinuousStates",
+    get_nominals_of_continuous_states: fn(Component, *mut f64, usize) -> Status = "fmi2GetNominalsOfContinuousStates",
+}
+
 // ---- the model description, reduced to what the probes need ---------------
 
 /// A scalar variable: value reference, name, type (`Real`, `Integer`,
@@ -130,6 +161,10 @@ pub struct Model {
     pub guid: String,
     pub vars: Vec<Var>,
     pub log_categories: Vec<String>,
+    /// Continuous states (variables that are the `derivative` of one) and
+    /// event indicators, for Model Exchange (0 without it).
+    pub states: usize,
+    pub event_indicators: usize,
 }
 
 impl Model {
@@ -159,6 +194,20 @@ impl Model {
                 })
                 .collect(),
             log_categories: md.log_categories.iter().map(|c| c.name.clone()).collect(),
+            states: md
+                .variables
+                .iter()
+                .filter(|v| {
+                    matches!(
+                        v.kind,
+                        K::Real {
+                            derivative: Some(_),
+                            ..
+                        }
+                    )
+                })
+                .count(),
+            event_indicators: md.number_of_event_indicators as usize,
         }
     }
 
@@ -254,12 +303,25 @@ pub struct Instance {
 // The instance is only used by one thread at a time (moved, not shared).
 unsafe impl Send for Instance {}
 
+pub const MODEL_EXCHANGE: c_int = 0;
 pub const CO_SIMULATION: c_int = 1;
 
 impl Instance {
     /// `fmi2Instantiate` with a recording logger; if it returned NULL, the
     /// log with the FMU's reason instead.
     pub fn new(api: Api, name: &str, guid: &str, logging_on: bool) -> Result<Instance, Box<Log>> {
+        Instance::of_type(api, name, guid, logging_on, CO_SIMULATION)
+    }
+
+    /// [`Instance::new`] for `fmu_type` ([`MODEL_EXCHANGE`] or
+    /// [`CO_SIMULATION`]).
+    pub fn of_type(
+        api: Api,
+        name: &str,
+        guid: &str,
+        logging_on: bool,
+        fmu_type: c_int,
+    ) -> Result<Instance, Box<Log>> {
         let log = Box::<Log>::default();
         let callbacks = Box::new(Callbacks {
             logger: Some(record),
@@ -275,7 +337,7 @@ impl Instance {
         let c = unsafe {
             (api.instantiate)(
                 name.as_ptr(),
-                CO_SIMULATION,
+                fmu_type,
                 guid.as_ptr(),
                 resources.as_ptr(),
                 &*callbacks,
@@ -421,6 +483,9 @@ pub const SHIPPED: [&str; 7] = [
 pub struct Loaded {
     pub model: Model,
     pub api: Api,
+    pub me_api: MeApi,
+    /// The `modelIdentifier` of its `ModelExchange` element, if it has one.
+    pub model_exchange: Option<String>,
     _library: libloading::Library,
     _dir: tempfile::TempDir,
 }
@@ -448,18 +513,19 @@ pub fn load_shipped(name: &str) -> Loaded {
         .join(format!("{identifier}.so"));
     // SAFETY: our own FMU binary.
     let library = unsafe { libloading::Library::new(&so) }.unwrap();
-    // SAFETY: the symbols are the standard's functions.
-    let api = unsafe {
-        Api::from_lookup(|symbol| {
-            library
-                .get::<*const c_void>(symbol.as_bytes())
-                .map(|s| *s)
-                .unwrap_or(null())
-        })
+    let lookup = |symbol: &str| {
+        // SAFETY: looked up as an address only
+        unsafe { library.get::<*const c_void>(symbol.as_bytes()) }
+            .map(|s| *s)
+            .unwrap_or(null())
     };
+    // SAFETY: the symbols are the standard's functions.
+    let (api, me_api) = unsafe { (Api::from_lookup(lookup), MeApi::from_lookup(lookup)) };
     Loaded {
         model: Model::from_description(&md),
         api,
+        me_api,
+        model_exchange: md.model_exchange.clone(),
         _library: library,
         _dir: dir,
     }

@@ -233,29 +233,31 @@ impl Instance {
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
         let me = self.me();
-        for &u in unknowns {
-            let v = self.variable_of_type(u, VarType::Real)?;
-            if !(me.is_derivative(u) || v.causality == Causality::Output) {
-                return Err(format!(
-                    "unknown {} (value reference {u}) is neither a state derivative nor an output",
+        // unknowns: derivatives or outputs; knowns: states or inputs
+        let role = |vr: u32, known: bool| -> Result<(), String> {
+            let v = self.variable_of_type(vr, VarType::Real)?;
+            let (fits, what, neither) = if known {
+                let fits = me.is_state(vr) || v.causality == Causality::Input;
+                (fits, "known", "a continuous state nor an input")
+            } else {
+                let fits = me.is_derivative(vr) || v.causality == Causality::Output;
+                (fits, "unknown", "a state derivative nor an output")
+            };
+            match fits {
+                true => Ok(()),
+                false => Err(format!(
+                    "{what} {} (value reference {vr}) is neither {neither}",
                     v.name
-                ));
+                )),
             }
-        }
-        for (&k, dv) in knowns.iter().zip(dv_known) {
-            let v = self.variable_of_type(k, VarType::Real)?;
-            if !(me.is_state(k) || v.causality == Causality::Input) {
-                return Err(format!(
-                    "known {} (value reference {k}) is neither a continuous state nor an input",
-                    v.name
-                ));
-            }
-            if !dv.is_finite() {
-                return Err(format!(
-                    "seed dvKnown for {} must be finite but was {dv}",
-                    v.name
-                ));
-            }
+        };
+        unknowns.iter().try_for_each(|&u| role(u, false))?;
+        knowns.iter().try_for_each(|&k| role(k, true))?;
+        if let Some((&k, dv)) = knowns.iter().zip(dv_known).find(|(_, dv)| !dv.is_finite()) {
+            let name = self.info.variables[k as usize].name;
+            return Err(format!(
+                "seed dvKnown for {name} must be finite but was {dv}"
+            ));
         }
         self.ensure_initialized()?;
         let ode = self.ode();

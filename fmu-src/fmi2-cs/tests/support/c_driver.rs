@@ -40,7 +40,7 @@ pub fn last_error() -> String {
     })
 }
 
-fn callbacks() -> &'static fmi2CallbackFunctions {
+pub fn callbacks() -> &'static fmi2CallbackFunctions {
     // SAFETY: a five-argument non-variadic function called through the
     // variadic pointer type with no variadic arguments (as ctypes importers do).
     let logger = unsafe {
@@ -67,26 +67,35 @@ pub struct Fmu {
 
 pub const OK: fmi2Status = fmi2Status::fmi2OK;
 
+/// `fmi2Instantiate` of `model` for `fmu_type` with the recording logger:
+/// the instance (NULL if refused, the reason in the log) and the model's
+/// description.
+pub fn instantiate(model: &str, fmu_type: fmi2Type) -> (fmi2Component, &'static fmi2_cs::ModelInfo) {
+    let info = models()
+        .into_iter()
+        .find(|m| m.model_name == model)
+        .expect("model");
+    let guid = CString::new(info.guid).unwrap();
+    // SAFETY: valid strings and callbacks that live for the process.
+    let c = unsafe {
+        fmi2Instantiate(
+            c"test".as_ptr(),
+            fmu_type,
+            guid.as_ptr(),
+            null(),
+            callbacks(),
+            0,
+            0,
+        )
+    };
+    (c, info)
+}
+
 impl Fmu {
     /// Instantiate `model`, set `params` (by name; booleans and integers as
     /// f64) and leave it in initialization mode.
     pub fn instantiated(model: &'static str, params: &[(&str, f64)]) -> Fmu {
-        let info = models()
-            .into_iter()
-            .find(|m| m.model_name == model)
-            .expect("model");
-        let guid = CString::new(info.guid).unwrap();
-        let c = unsafe {
-            fmi2Instantiate(
-                c"test".as_ptr(),
-                fmi2CoSimulation,
-                guid.as_ptr(),
-                null(),
-                callbacks(),
-                0,
-                0,
-            )
-        };
+        let (c, info) = instantiate(model, fmi2CoSimulation);
         assert!(!c.is_null());
         let fmu = Fmu {
             c,

@@ -6,6 +6,19 @@
 fmi2_cs::export_fmi2!(&friction_fmu::REGISTRY[..]);
 pub use fmi2_exports::*;
 
+/// LuGre's levels scaled by a position table of three points (the
+/// position-dependent option).
+pub const LUGRE_TABLE: &[(&str, f64)] = &[
+    ("position_dependent", 1.0),
+    ("n_table", 3.0),
+    ("x_table[1]", 0.0),
+    ("x_table[2]", 0.5),
+    ("x_table[3]", 1.0),
+    ("scale_pos[1]", 1.0),
+    ("scale_pos[2]", 1.3),
+    ("scale_pos[3]", 0.8),
+];
+
 fn models() -> Vec<&'static fmi2_cs::ModelInfo> {
     friction_fmu::models()
 }

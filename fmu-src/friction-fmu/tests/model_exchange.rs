@@ -1,0 +1,490 @@
+//! Model Exchange of the friction FMUs through the C ABI (the exports the
+//! shipped library has): the right-hand side is the one the Co-Simulation
+//! step integrates (the same values, bit for bit, at the same state and
+//! inputs, and the slope of a tiny exact step), and the directional
+//! derivatives of the derivatives and outputs with respect to states and
+//! inputs, each entry the law's closed form, agree with central
+//! differences of the FMU's own right-hand side and outputs taken through
+//! fmi2SetContinuousStates / fmi2SetReal — for every law with a Model
+//! Exchange interface and every LuGre option, in stick, slip, both
+//! directions, held at a limit and sliding on the 2-D boundary.
+
+mod common;
+use common::*;
+use fmi2_cs::ffi::*;
+
+/// A Model Exchange instance of one of the friction FMUs.
+struct Me {
+    c: fmi2Component,
+    info: &'static fmi2_cs::ModelInfo,
+}
+
+impl Me {
+    /// Instantiated, `params` set, initialized, through the initial event
+    /// iteration, in continuous-time mode.
+    fn new(model: &str, params: &[(&str, f64)]) -> Me {
+        let (c, info) = instantiate(model, fmi2ModelExchange);
+        assert!(!c.is_null(), "{model}: {}", last_error());
+        let me = Me { c, info };
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+            assert_eq!(fmi2EnterInitializationMode(c), OK);
+        }
+        for (name, value) in params {
+            me.set(name, *value);
+        }
+        unsafe {
+            assert_eq!(fmi2ExitInitializationMode(c), OK, "{}", last_error());
+        }
+        me.event();
+        me
+    }
+
+    fn vr(&self, name: &str) -> u32 {
+        self.info
+            .by_name(name)
+            .unwrap_or_else(|| panic!("no {name}"))
+            .vr
+    }
+
+    fn set(&self, name: &str, value: f64) {
+        let v = self.info.by_name(name).unwrap();
+        let status = unsafe {
+            match v.var_type {
+                fmi2_cs::VarType::Real => fmi2SetReal(self.c, &v.vr, 1, &value),
+                fmi2_cs::VarType::Integer => fmi2SetInteger(self.c, &v.vr, 1, &(value as i32)),
+                fmi2_cs::VarType::Boolean => {
+                    fmi2SetBoolean(self.c, &v.vr, 1, &((value != 0.0) as i32))
+                }
+            }
+        };
+        assert_eq!(status, OK, "{name} = {value}: {}", last_error());
+    }
+
+    fn get(&self, name: &str) -> f64 {
+        let mut x = f64::NAN;
+        let vr = self.vr(name);
+        assert_eq!(
+            unsafe { fmi2GetReal(self.c, &vr, 1, &mut x) },
+            OK,
+            "{}",
+            last_error()
+        );
+        x
+    }
+
+    fn nx(&self) -> usize {
+        self.info.model_exchange.unwrap().states.len()
+    }
+
+    fn states(&self) -> Vec<f64> {
+        let mut x = vec![f64::NAN; self.nx()];
+        assert_eq!(
+            unsafe { fmi2GetContinuousStates(self.c, x.as_mut_ptr(), x.len()) },
+            OK,
+            "{}",
+            last_error()
+        );
+        x
+    }
+
+    fn set_states(&self, x: &[f64]) {
+        assert_eq!(
+            unsafe { fmi2SetContinuousStates(self.c, x.as_ptr(), x.len()) },
+            OK,
+            "{}",
+            last_error()
+        );
+    }
+
+    fn derivatives(&self) -> Vec<f64> {
+        let mut dx = vec![f64::NAN; self.nx()];
+        assert_eq!(
+            unsafe { fmi2GetDerivatives(self.c, dx.as_mut_ptr(), dx.len()) },
+            OK,
+            "{}",
+            last_error()
+        );
+        dx
+    }
+
+    /// An event here (the event iteration at the current state and
+    /// inputs), back in continuous-time mode.
+    fn event(&self) {
+        unsafe {
+            if fmi2EnterEventMode(self.c) != OK {
+                // (right after initialization the instance is in event mode)
+            }
+            let mut info = fmi2EventInfo::default();
+            assert_eq!(
+                fmi2NewDiscreteStates(self.c, &mut info),
+                OK,
+                "{}",
+                last_error()
+            );
+            assert_eq!(info.newDiscreteStatesNeeded, 0);
+            assert_eq!(fmi2EnterContinuousTimeMode(self.c), OK);
+        }
+    }
+
+    /// `∂unknown/∂known` from fmi2GetDirectionalDerivative with a unit seed.
+    fn partial(&self, unknown: &str, known: &str) -> f64 {
+        let (u, k) = (self.vr(unknown), self.vr(known));
+        let mut d = f64::NAN;
+        assert_eq!(
+            unsafe { fmi2GetDirectionalDerivative(self.c, &u, 1, &k, 1, &1.0, &mut d) },
+            OK,
+            "{unknown}/{known}: {}",
+            last_error()
+        );
+        d
+    }
+
+    /// The value of `unknown` (a derivative or an output) with `known` (a
+    /// state or an input) moved to `value`, everything else as it was.
+    fn value_with(&self, unknown: &str, known: &str, value: f64) -> f64 {
+        let me = self.info.model_exchange.unwrap();
+        let k = self.vr(known);
+        let saved_states = self.states();
+        let state_index = me.states.iter().position(|s| s.state == k);
+        let saved_input = self.get(known);
+        match state_index {
+            Some(i) => {
+                let mut x = saved_states.clone();
+                x[i] = value;
+                self.set_states(&x);
+            }
+            None => self.set(known, value),
+        }
+        let u = self.vr(unknown);
+        let y = match me.states.iter().position(|s| s.derivative == u) {
+            Some(i) => self.derivatives()[i],
+            None => self.get(unknown),
+        };
+        match state_index {
+            Some(_) => self.set_states(&saved_states),
+            None => self.set(known, saved_input),
+        }
+        y
+    }
+}
+
+impl Drop for Me {
+    fn drop(&mut self) {
+        unsafe { fmi2FreeInstance(self.c) };
+    }
+}
+
+/// Every closed-form entry `∂unknown/∂known` of `me` at its current point
+/// against the central difference over `±h·scale(known)`, within `rtol` of
+/// the larger of the entry and `floor(unknown)` (the scale of the terms it
+/// is made of, against which the differences round).
+fn check_partials(
+    me: &Me,
+    unknowns: &[(&str, f64)],
+    knowns: &[(&str, f64)],
+    rtol: f64,
+    context: &str,
+) {
+    for &(known, step) in knowns {
+        let at = me.get(known);
+        for &(unknown, floor) in unknowns {
+            let closed = me.partial(unknown, known);
+            let up = me.value_with(unknown, known, at + step);
+            let down = me.value_with(unknown, known, at - step);
+            let differences = (up - down) / (2.0 * step);
+            assert!(
+                (closed - differences).abs() <= rtol * closed.abs().max(floor),
+                "{context}: d{unknown}/d{known} = {closed}, differences {differences}"
+            );
+        }
+    }
+}
+
+#[test]
+fn dahl_partials_match_differences() {
+    for alpha in [1.0, 0.6, 2.5] {
+        let me = Me::new("Dahl", &[("alpha", alpha)]);
+        for (f, v) in [
+            (0.0, 1e-3),
+            (0.8, 2e-3),
+            (1.5, -1e-3),
+            (-1.9, 4e-4),
+            (0.6, 0.0),
+        ] {
+            me.set_states(&[f]);
+            me.set("v", v);
+            let context = format!("Dahl alpha {alpha} at F {f}, v {v}");
+            check_partials(
+                &me,
+                &[("der(F)", 87750.0 * 1e-3), ("F", 1.0), ("z", 1e-5)],
+                &[("F", 1e-7), ("v", 1e-9)],
+                1e-6,
+                &context,
+            );
+        }
+    }
+}
+
+/// LuGre with each option: the benchmark's parameters, direction- and
+/// position-dependent levels, the normal-force form with decaying
+/// micro-damping, a Stribeck exponent below 1.
+#[test]
+fn lugre_partials_match_differences_with_every_option() {
+    let direction_and_position = [
+        LUGRE_TABLE,
+        &[
+            ("direction_dependent", 1.0),
+            ("Fc_neg", 0.7),
+            ("Fs_neg", 1.2),
+            ("scale_neg[1]", 0.9),
+            ("scale_neg[2]", 1.0),
+            ("scale_neg[3]", 1.4),
+        ],
+    ]
+    .concat();
+    let options: [&[(&str, f64)]; 4] = [
+        &[],
+        &direction_and_position,
+        &[("normal_force_form", 1.0), ("vd", 2e-3)],
+        &[("stribeck_exponent", 0.6), ("vd", 5e-3)],
+    ];
+    for params in options {
+        let me = Me::new("LuGre", params);
+        for (z, v, x, fn_) in [
+            (3e-6, 1e-3, 0.3, 2.0),
+            (-1e-5, -4e-3, 0.7, 1.0),
+            (1.4e-5, 2e-4, 0.2, 1.0),
+            (9e-6, 0.05, 0.6, 0.5),
+            (2e-6, 0.0, 0.1, 3.0),
+        ] {
+            me.set_states(&[z]);
+            me.set("v", v);
+            me.set("x", x);
+            me.set("Fn", fn_);
+            let context = format!("LuGre {params:?} at z {z}, v {v}, x {x}, Fn {fn_}");
+            let lambda = 1e5 * v.abs() / 0.7;
+            check_partials(
+                &me,
+                &[
+                    ("der(z)", (lambda * 1e-5).max(1.0)),
+                    ("F", 1e5 * 3.0),
+                    ("z", 1.0),
+                ],
+                &[("z", 1e-12), ("v", 1e-9), ("x", 1e-6), ("Fn", 1e-6)],
+                1e-6,
+                &context,
+            );
+        }
+    }
+}
+
+/// The reset integrator inside the range, held at each limit (moving
+/// outward) and released (moving inward); the state is not moved across
+/// the limit, where `F` jumps by design.
+#[test]
+fn reset_integrator_partials_match_differences() {
+    let me = Me::new("ResetIntegrator", &[]);
+    let z0 = 1e-4;
+    for (z, v, move_z) in [
+        (3e-5, 1e-3, true),
+        (-6e-5, -2e-3, true),
+        (z0, 1e-3, false),
+        (-z0, -1e-3, false),
+        (z0, -1e-3, false),
+    ] {
+        me.set_states(&[z]);
+        me.set("v", v);
+        let context = format!("ResetIntegrator at z {z}, v {v}");
+        let knowns: &[(&str, f64)] = if move_z {
+            &[("z", 1e-11), ("v", 1e-9)]
+        } else {
+            &[("v", 1e-9)]
+        };
+        check_partials(
+            &me,
+            &[("der(z)", 1.0), ("F", 1e4), ("z", 1.0)],
+            knowns,
+            1e-6,
+            &context,
+        );
+    }
+}
+
+/// The 2-D bristle inside the disc and sliding on its boundary (reached by
+/// an event: the contact state is a discrete state), isotropic and not.
+#[test]
+fn bristle2d_partials_match_differences_inside_and_sliding() {
+    for params in [
+        &[][..],
+        &[("sigma02", 5572.08), ("sigma11", 209.2), ("a2", 0.2)][..],
+    ] {
+        let me = Me::new("Bristle2D", params);
+        let z0 = 1e-4;
+        for (z, v, boundary) in [
+            ([3e-5, -2e-5], [2e-3, 1e-3], false),
+            ([0.6 * z0, 0.8 * z0], [2e-3, 1e-3], true),
+            ([-0.28 * z0, 0.96 * z0], [-4e-3, 5e-3], true),
+        ] {
+            me.set("v1", v[0]);
+            me.set("v2", v[1]);
+            me.set_states(&z);
+            me.event();
+            // on the circle moving outward: sliding, the contact switched
+            let sliding = {
+                let vr = me.vr("sliding");
+                let mut b = 0;
+                assert_eq!(unsafe { fmi2GetBoolean(me.c, &vr, 1, &mut b) }, OK);
+                b != 0
+            };
+            assert_eq!(sliding, boundary, "{params:?} z {z:?} v {v:?}");
+            let context = format!("Bristle2D {params:?} at z {z:?}, v {v:?}");
+            check_partials(
+                &me,
+                &[
+                    ("der(z1)", 100.0),
+                    ("der(z2)", 100.0),
+                    ("F1", 1e4),
+                    ("F2", 1e4),
+                    ("z1", 1.0),
+                    ("z2", 1.0),
+                ],
+                &[("z1", 1e-12), ("z2", 1e-12), ("v1", 1e-9), ("v2", 1e-9)],
+                1e-6,
+                &context,
+            );
+            // back inside for the next point
+            me.set_states(&[0.0, 0.0]);
+            me.event();
+        }
+    }
+}
+
+/// The Model Exchange right-hand side is the law the Co-Simulation step
+/// integrates: a Co-Simulation instance driven somewhere, then a Model
+/// Exchange instance put in the same state with the same inputs give the
+/// same derivatives (the `der(…)` variables of the former, bit for bit)
+/// and outputs, and a tiny exact Co-Simulation step moves the state by
+/// the derivative.
+#[test]
+fn the_right_hand_side_is_the_one_the_step_integrates() {
+    let cases: [(&str, &[(&str, f64)], &[&str], &[&str]); 4] = [
+        ("Dahl", &[("v", 3e-4)], &["F"], &["F", "z"]),
+        ("LuGre", &[("v", 2e-3)], &["z"], &["F", "z"]),
+        ("ResetIntegrator", &[("v", 1e-3)], &["z"], &["F", "z"]),
+        (
+            "Bristle2D",
+            &[("v1", 1e-3), ("v2", -5e-4)],
+            &["z1", "z2"],
+            &["F1", "F2", "z1", "z2"],
+        ),
+    ];
+    for (model, inputs, states, outputs) in cases {
+        let mut cs = Fmu::new(model, &[]);
+        for (name, value) in inputs {
+            cs.set(name, *value);
+        }
+        // partway: inside the stiction range for the reset integrators
+        cs.step(2e-2);
+        let me = Me::new(model, &[]);
+        for (name, value) in inputs {
+            me.set(name, *value);
+        }
+        let x: Vec<f64> = states.iter().map(|s| cs.get(s)).collect();
+        me.set_states(&x);
+        let dx = me.derivatives();
+        for (k, s) in states.iter().enumerate() {
+            let der = cs.get(&format!("der({s})"));
+            assert_eq!(dx[k].to_bits(), der.to_bits(), "{model}: der({s})");
+            assert!(dx[k] != 0.0, "{model}: der({s}) is 0, nothing tested");
+        }
+        for o in outputs {
+            assert_eq!(me.get(o).to_bits(), cs.get(o).to_bits(), "{model}: {o}");
+        }
+        let h = 1e-9;
+        cs.step(h);
+        for (k, s) in states.iter().enumerate() {
+            let slope = (cs.get(s) - x[k]) / h;
+            assert!(
+                (slope - dx[k]).abs() <= 1e-5 * dx[k].abs(),
+                "{model}: {s} moved at {slope}, der {}",
+                dx[k]
+            );
+        }
+    }
+}
+
+/// At an event the reset integrator puts an overshoot of the limit back
+/// on it (and says the states changed), and its two event indicators
+/// change sign where the strain reaches a limit and where a reversal
+/// releases it.
+#[test]
+fn reset_integrator_events() {
+    let me = Me::new("ResetIntegrator", &[]);
+    let z0 = 1e-4;
+    let indicators = |me: &Me| {
+        let mut z = [f64::NAN; 2];
+        assert_eq!(
+            unsafe { fmi2GetEventIndicators(me.c, z.as_mut_ptr(), 2) },
+            OK
+        );
+        z
+    };
+    me.set("v", 1e-3);
+    me.set_states(&[0.9 * z0]);
+    assert!(indicators(&me)[0] > 0.0);
+    assert_eq!(me.derivatives(), [1e-3]);
+    // an integrator's step past the limit
+    me.set_states(&[z0 * (1.0 + 1e-6)]);
+    assert!(indicators(&me)[0] < 0.0);
+    unsafe {
+        assert_eq!(fmi2EnterEventMode(me.c), OK);
+        let mut info = fmi2EventInfo::default();
+        assert_eq!(fmi2NewDiscreteStates(me.c, &mut info), OK);
+        assert_eq!(info.valuesOfContinuousStatesChanged, fmi2True);
+        assert_eq!(fmi2EnterContinuousTimeMode(me.c), OK);
+    }
+    assert_eq!(me.states(), [z0]);
+    assert_eq!(me.derivatives(), [0.0]);
+    assert_eq!(me.get("F"), 1e4 * z0);
+    assert!(indicators(&me)[0] < 0.0);
+    // the reversal releases it: the indicator changes sign with v
+    me.set("v", -1e-3);
+    assert!(indicators(&me)[0] > 0.0);
+    assert_eq!(me.derivatives(), [-1e-3]);
+    // the lower limit: below it moving down
+    me.set_states(&[-z0 * (1.0 + 1e-6)]);
+    assert!(indicators(&me)[1] < 0.0);
+    me.event();
+    assert_eq!(me.states(), [-z0]);
+    // nothing to put back inside the range
+    me.set_states(&[0.5 * z0]);
+    unsafe {
+        assert_eq!(fmi2EnterEventMode(me.c), OK);
+        let mut info = fmi2EventInfo::default();
+        assert_eq!(fmi2NewDiscreteStates(me.c, &mut info), OK);
+        assert_eq!(info.valuesOfContinuousStatesChanged, fmi2False);
+        assert_eq!(fmi2EnterContinuousTimeMode(me.c), OK);
+    }
+    // the nominal is z0
+    let mut nominal = [0.0];
+    assert_eq!(
+        unsafe { fmi2GetNominalsOfContinuousStates(me.c, nominal.as_mut_ptr(), 1) },
+        OK
+    );
+    assert_eq!(nominal, [z0]);
+}
+
+/// The bristle law with random reconnection has no Model Exchange
+/// interface: instantiating it for Model Exchange is refused, naming it.
+#[test]
+fn the_bristle_law_is_co_simulation_only() {
+    let (c, info) = instantiate("Bristle", fmi2ModelExchange);
+    assert!(info.model_exchange.is_none());
+    assert!(c.is_null());
+    let m = last_error();
+    assert!(
+        m.contains("Bristle") && m.contains("Co-Simulation (1) only"),
+        "{m}"
+    );
+}
