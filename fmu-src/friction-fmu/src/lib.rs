@@ -34,7 +34,7 @@ pub static REGISTRY: LazyLock<[ModelFactory; 5]> = LazyLock::new(|| {
         ModelFactory {
             info: &reset_integrator::INFO,
             create: || Box::new(reset_integrator::ResetFmu::default()),
-            create_model_exchange: Some(|| Box::new(reset_integrator::ResetFmu::default())),
+            create_model_exchange: Some(|| Box::new(reset_integrator::ResetMe::default())),
         },
         // Co-Simulation only: bristles that disconnect and reconnect at
         // random relaxations are a discrete process, not an ODE (docs/fmu-reference.md)

@@ -1,9 +1,9 @@
 //! `ResetIntegrator.fmu`: the 1-D reset integrator (Haessig & Friedland
 //! 1991; docs/models.md "Reset integrator"), integrated exactly in
-//! Co-Simulation; in Model Exchange the strain `z` is the continuous state,
-//! `dz/dt` ([`ResetIntegrator::z_dot`]) its derivative, and two event
-//! indicators locate where the strain reaches a limit and where a reversal
-//! releases it.
+//! Co-Simulation; in Model Exchange ([`ResetMe`]) the strain `z` is the
+//! continuous state, `dz/dt` ([`ResetIntegrator::z_rate`]) its derivative,
+//! and two event indicators locate where the strain reaches a limit and
+//! where a reversal releases it.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
 use fmi2_cs::{
@@ -167,34 +167,118 @@ impl Model for ResetFmu {
     fn derivatives(&self, values: &Values, dx: &mut [f64]) {
         dx[0] = self.law.z_dot(values.real(vr::V));
     }
+}
+
+/// `ResetIntegrator.fmu` for Model Exchange: the law's equations
+/// ([`ResetIntegrator::z_rate`], [`ResetIntegrator::force_of`]) with the
+/// limit the strain is at (`contact`: +1, −1, 0) held as a discrete state
+/// that changes at events only: an integrator keeps a held strain at
+/// `±z0` only to the last bit, and deciding the contact from `z` would
+/// release and catch it again at every step. The continuous state is `z`;
+/// two event indicators, one per limit
+/// ([`ResetIntegrator::switching_functions`]), each crossing zero where
+/// the strain reaches its limit and where a reversal releases it; at an
+/// event the strain is put on its limit and caught or released
+/// ([`ResetIntegrator::at_event`]).
+#[derive(Clone, Debug)]
+pub struct ResetMe {
+    law: ResetIntegrator,
+    contact: i8,
+}
+
+impl Default for ResetMe {
+    fn default() -> Self {
+        ResetMe {
+            law: ResetFmu::default().law,
+            contact: 0,
+        }
+    }
+}
+
+impl Model for ResetMe {
+    fn info(&self) -> &'static ModelInfo {
+        &INFO
+    }
+
+    fn initialize(&mut self, values: &Values) -> Result<(), String> {
+        self.law = ResetIntegrator::new(ResetFmu::params(values)).map_err(param_err)?;
+        self.contact = 0;
+        Ok(())
+    }
+
+    fn compute_outputs(&self, values: &mut Values) {
+        let v = values.real(vr::V);
+        let z = self.law.z();
+        values.set(vr::F, self.law.force_of(z, v, self.contact));
+        values.set(vr::Z, z);
+        values.set_boolean(vr::SLIDING, self.law.sliding_of(v, self.contact));
+    }
+
+    /// Never called: a Model Exchange instance takes no communication
+    /// steps (the state table refuses `fmi2DoStep`); the importer
+    /// integrates.
+    fn do_step(&mut self, _values: &Values, _slopes: &[f64], _h: f64) -> Result<(), String> {
+        Err("a Model Exchange instance takes no communication steps".into())
+    }
+
+    /// `[z, contact]`.
+    fn save_state(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(&[self.law.z(), f64::from(self.contact)]);
+    }
+
+    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+        match state {
+            [z, c] if z.is_finite() && [-1.0, 0.0, 1.0].contains(c) => {
+                self.law.set_z(*z);
+                self.contact = *c as i8;
+                Ok(())
+            }
+            _ => Err(format!(
+                "reset-integrator state for Model Exchange is [z, contact (-1, 0 or 1)], got {state:?}"
+            )),
+        }
+    }
+
+    fn clone_model(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
+
+    fn supplies_partial_derivatives(&self) -> bool {
+        false
+    }
+
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        dx[0] = self.law.z_rate(values.real(vr::V), self.contact);
+    }
 
     fmi2_cs::ode_is_self!();
 }
 
-/// Model Exchange: the state is `z`; two event indicators, one per limit
-/// ([`ResetIntegrator::switching_functions`]): each crosses zero where the
-/// strain reaches its limit and where a reversal releases it. At an event
-/// a strain the integrator carried past the limit is put on it
-/// ([`ResetIntegrator::stop_at_limit`]).
-impl Ode for ResetFmu {
+impl Ode for ResetMe {
     fmi2_cs::delegate_continuous_states!(law);
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
-        z.copy_from_slice(&self.law.switching_functions(values.real(vr::V)));
+        let v = values.real(vr::V);
+        z.copy_from_slice(&self.law.switching_functions(self.law.z(), v, self.contact));
     }
 
     /// `z` on the scale of the stiction range `z0`.
     fn nominals(&self, values: &Values, nominal: &mut [f64]) {
-        nominal[0] = Self::params(values).z0;
+        nominal[0] = ResetFmu::params(values).z0;
     }
 
     fn event_update(&mut self, values: &Values) -> bool {
-        self.law.stop_at_limit(values.real(vr::V))
+        let z = self.law.z();
+        let (after, contact) = self.law.at_event(z, values.real(vr::V), self.contact);
+        self.law.set_z(after);
+        self.contact = contact;
+        after != z
     }
 
     /// The law's closed forms ([`ResetIntegrator::partials`]).
     fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
-        let (dzd_dz, dzd_dv, df_dz, df_dv) = self.law.partials(values.real(vr::V));
+        let v = values.real(vr::V);
+        let (dzd_dz, dzd_dv, df_dz, df_dv) = self.law.partials(v, self.contact);
         let (by_z, by_v) = match unknown {
             vr::DER_Z => (dzd_dz, dzd_dv),
             vr::F => (df_dz, df_dv),

@@ -279,35 +279,35 @@ fn lugre_partials_match_differences_with_every_option() {
     }
 }
 
-/// The reset integrator inside the range, held at each limit (moving
-/// outward) and released (moving inward); the state is not moved across
-/// the limit, where `F` jumps by design.
+/// The reset integrator inside the range, held at each limit (caught there
+/// by an event: the limit holding the strain is a discrete state) and
+/// released (moving inward, after the event of the reversal).
 #[test]
 fn reset_integrator_partials_match_differences() {
     let me = Me::new("ResetIntegrator", &[]);
     let z0 = 1e-4;
-    for (z, v, move_z) in [
-        (3e-5, 1e-3, true),
-        (-6e-5, -2e-3, true),
-        (z0, 1e-3, false),
-        (-z0, -1e-3, false),
-        (z0, -1e-3, false),
+    let past = 1.0 + 1e-9;
+    for (z, v, held) in [
+        (3e-5, 1e-3, false),
+        (-6e-5, -2e-3, false),
+        (z0 * past, 1e-3, true),
+        (-z0 * past, -1e-3, true),
     ] {
         me.set_states(&[z]);
         me.set("v", v);
+        me.event();
         let context = format!("ResetIntegrator at z {z}, v {v}");
-        let knowns: &[(&str, f64)] = if move_z {
-            &[("z", 1e-11), ("v", 1e-9)]
-        } else {
-            &[("v", 1e-9)]
-        };
-        check_partials(
-            &me,
-            &[("der(z)", 1.0), ("F", 1e4), ("z", 1.0)],
-            knowns,
-            1e-6,
-            &context,
-        );
+        assert_eq!(me.derivatives() == [0.0], held, "{context}");
+        let knowns = [("z", 1e-11), ("v", 1e-9)];
+        let unknowns = [("der(z)", 1.0), ("F", 1e4), ("z", 1.0)];
+        check_partials(&me, &unknowns, &knowns, 1e-6, &context);
+        if held {
+            // released by the reversal, and moving again
+            me.set("v", -v);
+            me.event();
+            assert_eq!(me.derivatives(), [-v], "{context}");
+            check_partials(&me, &unknowns, &knowns, 1e-6, &context);
+        }
     }
 }
 
@@ -448,16 +448,29 @@ fn reset_integrator_events() {
     assert_eq!(me.derivatives(), [0.0]);
     assert_eq!(me.get("F"), 1e4 * z0);
     assert!(indicators(&me)[0] < 0.0);
-    // the reversal releases it: the indicator changes sign with v
+    // held, a last bit below the limit (as an integrator may leave it):
+    // still held, the force still the sliding level
+    me.set_states(&[z0 * (1.0 - 1e-16)]);
+    assert_eq!(me.derivatives(), [0.0]);
+    assert!(indicators(&me)[0] < 0.0);
+    assert!((me.get("F") - 1e4 * z0).abs() <= 1e-15);
+    // the reversal releases it: the indicator changes sign with v, and the
+    // event lets it go from the limit
     me.set("v", -1e-3);
     assert!(indicators(&me)[0] > 0.0);
+    me.event();
+    assert_eq!(me.states(), [z0]);
     assert_eq!(me.derivatives(), [-1e-3]);
+    assert_eq!(indicators(&me)[0], 0.0);
     // the lower limit: below it moving down
     me.set_states(&[-z0 * (1.0 + 1e-6)]);
     assert!(indicators(&me)[1] < 0.0);
     me.event();
     assert_eq!(me.states(), [-z0]);
-    // nothing to put back inside the range
+    // released by the reversal; inside the range nothing to put back
+    me.set("v", 1e-3);
+    me.event();
+    assert_eq!(me.derivatives(), [1e-3]);
     me.set_states(&[0.5 * z0]);
     unsafe {
         assert_eq!(fmi2EnterEventMode(me.c), OK);

@@ -73,84 +73,116 @@ impl ResetIntegrator {
         self.z = z;
     }
 
-    fn saturated(&self, v: f64) -> bool {
-        (v > 0.0 && self.z >= self.p.z0) || (v < 0.0 && self.z <= -self.p.z0)
+    /// The limit the strain is at: `+1` at or beyond `z0`, `−1` at or
+    /// beyond `−z0`, 0 inside the range. The equations below take it as an
+    /// argument, so that an integrator can hold it as a discrete state
+    /// between events (Model Exchange), where `z` is kept at the limit
+    /// only to the last bit.
+    pub fn contact(&self) -> i8 {
+        if self.z >= self.p.z0 {
+            1
+        } else if self.z <= -self.p.z0 {
+            -1
+        } else {
+            0
+        }
     }
 
     /// `ż = 0` when saturated (`v > 0, z ≥ z0` or `v < 0, z ≤ −z0`), else `v`.
     pub fn z_dot(&self, v: f64) -> f64 {
-        if self.saturated(v) {
+        self.z_rate(v, self.contact())
+    }
+
+    /// The state equation with the contact given: `ż = 0` when the limit
+    /// the strain is at holds it (`contact·v > 0`: moving outward), else
+    /// `v`.
+    pub fn z_rate(&self, v: f64, contact: i8) -> f64 {
+        if Self::held(v, contact) {
             0.0
         } else {
             v
         }
     }
 
+    /// Whether the limit `contact` holds the strain moving at `v`.
+    #[inline]
+    fn held(v: f64, contact: i8) -> bool {
+        f64::from(contact) * v > 0.0
+    }
+
     /// `F = (1 + a(z))·σ0·z + σ1·ż(v)`, `a(z) = a` inside `|z| < z0`, else 0.
     pub fn force(&self, v: f64) -> f64 {
-        let gain = if self.z.abs() < self.p.z0 {
-            1.0 + self.p.a
-        } else {
-            1.0
-        };
-        gain * self.p.sigma0 * self.z + self.p.sigma1 * self.z_dot(v)
+        self.force_of(self.z, v, self.contact())
+    }
+
+    /// The output equation for any strain and contact: the stiction
+    /// gradient `a` acts inside the range only (`contact = 0`).
+    pub fn force_of(&self, z: f64, v: f64, contact: i8) -> f64 {
+        let gain = if contact == 0 { 1.0 + self.p.a } else { 1.0 };
+        gain * self.p.sigma0 * z + self.p.sigma1 * self.z_rate(v, contact)
     }
 
     /// Saturated and moving outward: `ż = 0` and the force is `σ0·z0·sgn v`.
     pub fn sliding(&self, v: f64) -> bool {
-        self.saturated(v)
+        Self::held(v, self.contact())
     }
 
-    /// The partial derivatives of [`ResetIntegrator::z_dot`] and
-    /// [`ResetIntegrator::force`] at the current strain:
-    /// `(∂ż/∂z, ∂ż/∂v, ∂F/∂z, ∂F/∂v)`. `ż` is `v` or 0, piecewise
-    /// constant in `z`: `∂ż/∂z = 0`, `∂ż/∂v` = 1 inside the range and 0
-    /// saturated; at `v = 0` with `|z| ≥ z0` (saturated on one side of
-    /// `v = 0` only) the mean of the two sides, ½. `F = (1 + a(z))·σ0·z +
-    /// σ1·ż`: `∂F/∂z = (1 + a(z))·σ0`, `∂F/∂v = σ1·∂ż/∂v`.
-    pub fn partials(&self, v: f64) -> (f64, f64, f64, f64) {
+    /// [`ResetIntegrator::sliding`] with the contact given.
+    pub fn sliding_of(&self, v: f64, contact: i8) -> bool {
+        Self::held(v, contact)
+    }
+
+    /// The partial derivatives of [`ResetIntegrator::z_rate`] and
+    /// [`ResetIntegrator::force_of`] at strain `z`, velocity `v` and
+    /// contact `contact`: `(∂ż/∂z, ∂ż/∂v, ∂F/∂z, ∂F/∂v)`. `ż` is `v` or 0,
+    /// constant in `z` for a given contact: `∂ż/∂z = 0`, `∂ż/∂v` = 1
+    /// unless held (0); at `v = 0` at a limit (held on one side of `v = 0`
+    /// only) the mean of the two sides, ½. `F = (1 + a(contact))·σ0·z +
+    /// σ1·ż`: `∂F/∂z = (1 + a(contact))·σ0`, `∂F/∂v = σ1·∂ż/∂v`.
+    pub fn partials(&self, v: f64, contact: i8) -> (f64, f64, f64, f64) {
         let p = &self.p;
-        let at_limit = self.z.abs() >= p.z0;
-        let dzd_dv = if v == 0.0 && at_limit {
+        let dzd_dv = if v == 0.0 && contact != 0 {
             0.5
-        } else if self.saturated(v) {
+        } else if Self::held(v, contact) {
             0.0
         } else {
             1.0
         };
-        let gain = if at_limit { 1.0 } else { 1.0 + p.a };
+        let gain = if contact == 0 { 1.0 + p.a } else { 1.0 };
         (0.0, dzd_dv, gain * p.sigma0, p.sigma1 * dzd_dv)
     }
 
     /// Two switching functions, each changing sign where `ż` switches
-    /// between `v` and 0 (Model Exchange's event indicators): for the upper
-    /// limit `z0 − z` while `z < z0` (it reaches 0 when the strain does)
-    /// and `−v` at or beyond it (negative while held there, 0 when the
-    /// motion reverses and releases it); for the lower limit likewise
-    /// `z + z0` and `v`. Each is positive while its limit does not hold the
-    /// strain and negative while it does.
-    pub fn switching_functions(&self, v: f64) -> [f64; 2] {
+    /// between `v` and 0 (Model Exchange's event indicators), for strain
+    /// `z`, velocity `v` and contact `contact`: for the upper limit `z0 −
+    /// z` while not at it (it reaches 0 when the strain does) and `−v` at
+    /// it (negative while it holds the strain, 0 when the motion reverses
+    /// and releases it); for the lower limit likewise `z + z0` and `v`.
+    /// Each is positive while its limit does not hold the strain and
+    /// negative while it does.
+    pub fn switching_functions(&self, z: f64, v: f64, contact: i8) -> [f64; 2] {
         let z0 = self.p.z0;
-        let upper = if self.z < z0 { z0 - self.z } else { -v };
-        let lower = if self.z > -z0 { self.z + z0 } else { v };
+        let upper = if contact == 1 { -v } else { z0 - z };
+        let lower = if contact == -1 { v } else { z + z0 };
         [upper, lower]
     }
 
-    /// At an event (Model Exchange): a strain an integrator carried beyond
-    /// the range in the direction of motion is put on its limit, where
-    /// [`ResetIntegrator::step`]'s exact update stops it. Whether the
-    /// strain changed.
-    pub fn stop_at_limit(&mut self, v: f64) -> bool {
+    /// The strain and contact after an event at strain `z`, velocity `v`,
+    /// contact `contact`: a strain that reached a limit moving outward is
+    /// put on it (an integrator carries it a little past; the exact
+    /// update [`ResetIntegrator::step`] stops it there) and held; a held
+    /// strain whose motion turned inward is released, at the limit; a
+    /// held one stays on its limit (to the last bit).
+    pub fn at_event(&self, z: f64, v: f64, contact: i8) -> (f64, i8) {
         let z0 = self.p.z0;
-        let limited = if self.z > z0 && v > 0.0 {
-            z0
-        } else if self.z < -z0 && v < 0.0 {
-            -z0
-        } else {
-            return false;
-        };
-        self.z = limited;
-        true
+        let limit = |c: i8| f64::from(c) * z0;
+        match contact {
+            0 if z >= z0 && v > 0.0 => (z0, 1),
+            0 if z <= -z0 && v < 0.0 => (-z0, -1),
+            0 => (z, 0),
+            c if f64::from(c) * v < 0.0 => (limit(c), 0),
+            c => (limit(c), c),
+        }
     }
 
     /// Exact update over `[0, h]` for ramped `v`: split at the zero crossing;
@@ -300,69 +332,74 @@ mod tests {
     }
 
     /// The switching functions change sign exactly where `ż` switches
-    /// (reaching ±z0 moving outward, reversing while held), the partials
-    /// match differences of `z_dot` and `force` away from the switches,
-    /// and an overshoot is put back on the limit only when moving outward.
+    /// (reaching ±z0 moving outward, reversing while held), an event puts
+    /// an overshoot back on the limit and holds it, and releases it when
+    /// the motion turns; the contact-given equations are the state's; the
+    /// partials match differences of `z_rate` and `force_of`.
     #[test]
-    fn switching_functions_partials_and_the_stop_at_the_limit() {
+    fn switching_functions_events_and_partials() {
         let p = ResetParams::default();
         let mut r = ResetIntegrator::new(p).unwrap();
         let z0 = p.z0;
         let v = 2e-3;
         // inside: both positive; the upper one is z0 − z
-        r.set_z(0.4 * z0);
-        assert_eq!(r.switching_functions(v), [z0 - 0.4 * z0, 0.4 * z0 + z0]);
-        assert_eq!(r.z_dot(v), v);
-        // held at the upper limit moving up: the upper one negative
-        r.set_z(z0);
-        assert_eq!(r.z_dot(v), 0.0);
-        assert_eq!(r.switching_functions(v)[0], -v);
-        // reversing releases it: positive again, and ż = v
-        assert!(r.switching_functions(-v)[0] > 0.0 && r.z_dot(-v) == -v);
+        let z = 0.4 * z0;
+        assert_eq!(r.switching_functions(z, v, 0), [z0 - z, z + z0]);
+        assert_eq!(r.z_rate(v, 0), v);
+        // an integrator's step past the limit: the indicator has changed
+        // sign; the event stops the strain there and holds it
+        let past = z0 * (1.0 + 1e-9);
+        assert!(r.switching_functions(past, v, 0)[0] < 0.0);
+        assert_eq!(r.at_event(past, v, 0), (z0, 1));
+        assert_eq!(r.switching_functions(z0, v, 1)[0], -v);
+        assert_eq!(r.z_rate(v, 1), 0.0);
+        // held a bit below the limit (an integrator's last bit): still held
+        let below = z0 * (1.0 - 1e-16);
+        assert_eq!(r.z_rate(v, 1), 0.0);
+        assert_eq!(r.at_event(below, v, 1), (z0, 1));
+        // the reversal releases it: positive again, ż = v, at the limit
+        assert!(r.switching_functions(z0, -v, 1)[0] > 0.0);
+        assert_eq!(r.at_event(below, -v, 1), (z0, 0));
+        assert_eq!(r.z_rate(-v, 0), -v);
         // the lower limit mirrors it
-        r.set_z(-z0);
-        assert!(r.switching_functions(-v)[1] < 0.0 && r.z_dot(-v) == 0.0);
-        assert!(r.switching_functions(v)[1] > 0.0 && r.z_dot(v) == v);
-        // an overshoot moving outward is stopped at the limit; moving
-        // inward, or inside, nothing changes
-        r.set_z(z0 * (1.0 + 1e-9));
-        assert!(!r.stop_at_limit(-v) && r.z() > z0);
-        assert!(r.stop_at_limit(v) && r.z() == z0);
-        r.set_z(-z0 * (1.0 + 1e-9));
-        assert!(r.stop_at_limit(-v) && r.z() == -z0);
-        r.set_z(0.5 * z0);
-        assert!(!r.stop_at_limit(v) && r.z() == 0.5 * z0);
-        // partials against differences, inside and held (and ½ at v = 0
-        // at the limit, the mean of the two sides)
-        for &(z, v) in &[
-            (0.3 * z0, 1e-3),
-            (-0.2 * z0, -1e-3),
-            (z0, 1e-3),
-            (-z0, 1e-3),
-            (z0, 0.0),
-        ] {
+        assert!(r.switching_functions(-past, -v, 0)[1] < 0.0);
+        assert_eq!(r.at_event(-past, -v, 0), (-z0, -1));
+        assert_eq!(r.z_rate(-v, -1), 0.0);
+        assert_eq!(r.at_event(-z0, v, -1), (-z0, 0));
+        // beyond the range moving inward, and inside: nothing changes
+        assert_eq!(r.at_event(past, -v, 0), (past, 0));
+        assert_eq!(r.at_event(z, v, 0), (z, 0));
+        // the state's contact gives the state's equations
+        for (z, c) in [(z, 0), (z0, 1), (-z0, -1), (past, 1), (-0.99 * z0, 0)] {
             r.set_z(z);
-            let (dzd_dz, dzd_dv, df_dz, df_dv) = r.partials(v);
-            let h = 1e-9;
-            let fd_v = (r.z_dot(v + h) - r.z_dot(v - h)) / (2.0 * h);
-            let fdf_v = (r.force(v + h) - r.force(v - h)) / (2.0 * h);
+            assert_eq!(r.contact(), c);
+            for v in [v, -v, 0.0] {
+                assert_eq!(r.z_dot(v), r.z_rate(v, c));
+                assert_eq!(r.force(v), r.force_of(z, v, c));
+                assert_eq!(r.sliding(v), r.sliding_of(v, c));
+            }
+        }
+        // partials against differences, inside and held (and ½ at v = 0
+        // at a limit, the mean of the two sides)
+        for &(z, v, c) in &[
+            (0.3 * z0, 1e-3, 0),
+            (-0.2 * z0, -1e-3, 0),
+            (z0, 1e-3, 1),
+            (-z0, 1e-3, -1),
+            (z0, 0.0, 1),
+        ] {
+            let (dzd_dz, dzd_dv, df_dz, df_dv) = r.partials(v, c);
+            let (h, hz) = (1e-9, 1e-12);
+            let fd_v = (r.z_rate(v + h, c) - r.z_rate(v - h, c)) / (2.0 * h);
+            let fdf_v = (r.force_of(z, v + h, c) - r.force_of(z, v - h, c)) / (2.0 * h);
+            let fdf_z = (r.force_of(z + hz, v, c) - r.force_of(z - hz, v, c)) / (2.0 * hz);
             assert_eq!(dzd_dz, 0.0);
             assert!(
                 (dzd_dv - fd_v).abs() < 1e-9,
                 "z {z} v {v}: {dzd_dv} vs {fd_v}"
             );
             assert!((df_dv - fdf_v).abs() < 1e-6 * p.sigma1, "z {z} v {v}");
-            if z.abs() < z0 {
-                let hz = 1e-12;
-                let mut a = r.clone();
-                a.set_z(z + hz);
-                let mut b = r.clone();
-                b.set_z(z - hz);
-                let fdf_z = (a.force(v) - b.force(v)) / (2.0 * hz);
-                assert!((df_dz - fdf_z).abs() < 1e-6 * p.sigma0, "z {z} v {v}");
-            } else {
-                assert_eq!(df_dz, p.sigma0);
-            }
+            assert!((df_dz - fdf_z).abs() < 1e-6 * p.sigma0, "z {z} v {v}");
         }
     }
 }
