@@ -1,5 +1,7 @@
-"""Every FMU passes FMPy's validation and declares the variables that
-scripts and other tools rely on (issue 2)."""
+"""Every FMU passes FMPy's validation (its model description against the
+schema, the model structure including the Model Exchange part: states,
+derivatives and their dependencies) and declares the variables and
+interfaces that scripts and other tools rely on (issues 2 and 22)."""
 
 import pytest
 from fmpy import read_model_description
@@ -9,6 +11,11 @@ from conftest import MODELS, fmu_path
 
 # the rig FMUs (the mechanical side), validated like the friction laws
 RIGS = ["Rig1D", "Rig2D"]
+
+# the FMUs with a Model Exchange interface: their states, in order, and
+# their number of event indicators
+MODEL_EXCHANGE = {"Dahl": (["F"], 1), "LuGre": (["z"], 1), "ResetIntegrator": (["z"], 2),
+                  "Bristle2D": (["z1", "z2"], 1)}
 
 EXPECTED = {
     "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma", "Fc", "alpha"}},
@@ -58,6 +65,19 @@ def test_declared_variables_and_capabilities(name):
     assert cs.maxOutputDerivativeOrder == 1
     if name == "LuGre":
         assert sum(1 for v in md.modelVariables if v.name.startswith("x_table[")) >= 16
+    # Model Exchange beside Co-Simulation, same binary, for the laws that
+    # are ODEs (issue 22); the bristle law and the rigs are Co-Simulation only
+    me = md.modelExchange
+    if name in MODEL_EXCHANGE:
+        states, indicators = MODEL_EXCHANGE[name]
+        assert me is not None and me.modelIdentifier == name
+        assert me.canGetAndSetFMUstate and me.canSerializeFMUstate and me.providesDirectionalDerivative
+        assert [d.variable.derivative.name for d in md.derivatives] == states
+        assert [d.variable.name for d in md.derivatives] == [f"der({s})" for s in states]
+        assert md.numberOfContinuousStates == len(states)
+        assert md.numberOfEventIndicators == indicators
+    else:
+        assert me is None and md.numberOfEventIndicators == 0 and not md.derivatives
     for v in md.modelVariables:
         if v.type == "Real" and v.causality in ("input", "output", "parameter") and v.name not in (
                 "alpha", "a", "a1", "a2", "stribeck_exponent", "mu_c", "ctrl_ff") and not v.name.startswith("scale_"):
