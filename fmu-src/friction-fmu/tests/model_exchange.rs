@@ -360,6 +360,14 @@ fn bristle2d_partials_match_differences_inside_and_sliding() {
     }
 }
 
+/// A model, its inputs, its states and the outputs compared.
+type Case = (
+    &'static str,
+    &'static [(&'static str, f64)],
+    &'static [&'static str],
+    &'static [&'static str],
+);
+
 /// The Model Exchange right-hand side is the law the Co-Simulation step
 /// integrates: a Co-Simulation instance driven somewhere, then a Model
 /// Exchange instance put in the same state with the same inputs give the
@@ -368,7 +376,7 @@ fn bristle2d_partials_match_differences_inside_and_sliding() {
 /// the derivative.
 #[test]
 fn the_right_hand_side_is_the_one_the_step_integrates() {
-    let cases: [(&str, &[(&str, f64)], &[&str], &[&str]); 4] = [
+    let cases: [Case; 4] = [
         ("Dahl", &[("v", 3e-4)], &["F"], &["F", "z"]),
         ("LuGre", &[("v", 2e-3)], &["z"], &["F", "z"]),
         ("ResetIntegrator", &[("v", 1e-3)], &["z"], &["F", "z"]),
