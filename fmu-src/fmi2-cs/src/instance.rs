@@ -1045,7 +1045,7 @@ impl Instance {
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
         if self.model_exchange {
-            return self.me_directional_derivative(unknowns, knowns, dv_known, dv_unknown);
+            return self.me_directional_derivative(unknowns, (knowns, dv_known), dv_unknown);
         }
         // the usual case through the flag bytes, else the messages below
         let has = |vr: u32, bits: u8| {

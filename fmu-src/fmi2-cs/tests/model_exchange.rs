@@ -12,8 +12,7 @@
 
 use fmi2_cs::ffi::*;
 use fmi2_cs::{
-    Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelFactory,
-    ModelInfo, Ode, Values, Variable,
+    ContinuousState, Model, ModelExchange, ModelFactory, ModelInfo, Ode, Values, Variable,
 };
 use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
@@ -32,35 +31,20 @@ static VARIABLES: [Variable; 5] = [
     Variable::derivative(DER_S, "der(s)", "", "-k*s + u", &[U], &[S]),
 ];
 
-fn info(name: &'static str, guid: &'static str, me: bool) -> ModelInfo {
-    ModelInfo {
-        model_name: name,
-        model_identifier: name,
-        guid,
-        description: "test model",
-        source: "test",
-        variables: &VARIABLES,
-        default_experiment: DefaultExperiment {
-            start_time: 0.0,
-            stop_time: 1.0,
-            step_size: 0.1,
-        },
-        capabilities: Capabilities::FULL,
-        model_exchange: me.then_some(ModelExchange {
-            states: &[ContinuousState {
-                state: S,
-                derivative: DER_S,
-            }],
-            event_indicators: 1,
-            states_jump_at_events: true,
-        }),
-    }
-}
-
-static ME_INFO: std::sync::LazyLock<ModelInfo> =
-    std::sync::LazyLock::new(|| info("ToyMe", "{toy-me}", true));
-static CS_INFO: std::sync::LazyLock<ModelInfo> =
-    std::sync::LazyLock::new(|| info("ToyCs", "{toy-cs}", false));
+/// The toy with a Model Exchange interface, and the same toy without one.
+static ME_INFO: std::sync::LazyLock<&'static ModelInfo> = std::sync::LazyLock::new(|| {
+    let me = ModelExchange {
+        states: &[ContinuousState {
+            state: S,
+            derivative: DER_S,
+        }],
+        event_indicators: 1,
+        states_jump_at_events: true,
+    };
+    toy_instance::toy_info_with("ToyMe", VARIABLES.to_vec(), Some(me))
+});
+static CS_INFO: std::sync::LazyLock<&'static ModelInfo> =
+    std::sync::LazyLock::new(|| toy_instance::toy_info("ToyCs", VARIABLES.to_vec()));
 
 #[derive(Clone)]
 struct Toy {
@@ -72,9 +56,9 @@ struct Toy {
 impl Model for Toy {
     fn info(&self) -> &'static ModelInfo {
         if self.me {
-            &ME_INFO
+            *ME_INFO
         } else {
-            &CS_INFO
+            *CS_INFO
         }
     }
     fn initialize(&mut self, v: &Values) -> Result<(), String> {
@@ -147,7 +131,7 @@ impl Ode for Toy {
 static REGISTRY: std::sync::LazyLock<[ModelFactory; 2]> = std::sync::LazyLock::new(|| {
     [
         ModelFactory {
-            info: &ME_INFO,
+            info: *ME_INFO,
             create: || {
                 Box::new(Toy {
                     k: 1.0,
@@ -164,7 +148,7 @@ static REGISTRY: std::sync::LazyLock<[ModelFactory; 2]> = std::sync::LazyLock::n
             }),
         },
         ModelFactory {
-            info: &CS_INFO,
+            info: *CS_INFO,
             create: || {
                 Box::new(Toy {
                     k: 1.0,
@@ -192,7 +176,7 @@ use toy_instance::one_value_toy_state;
 mod driver {
     pub use crate::fmi2_exports::*;
     fn models() -> Vec<&'static fmi2_cs::ModelInfo> {
-        vec![&crate::ME_INFO, &crate::CS_INFO]
+        vec![*crate::ME_INFO, *crate::CS_INFO]
     }
     include!("support/c_driver.rs");
 }
@@ -228,35 +212,32 @@ fn instantiate(kind: fmi2Type, model: &str) -> fmi2Component {
     driver::instantiate(model, kind).0
 }
 
-/// The Model Exchange states an importer can reach.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum St {
-    Instantiated,
-    InitializationMode,
-    EventMode,
-    ContinuousTimeMode,
-    Terminated,
-}
-use St::*;
+use fmi2_cs::state_machine::State;
+use State::{ContinuousTimeMode, EventMode};
+/// The Model Exchange states an importer reaches (the layer's names).
+const INSTANTIATED: State = State::MeInstantiated;
+const INITIALIZATION_MODE: State = State::MeInitializationMode;
+const TERMINATED: State = State::MeTerminated;
 
-fn me_instance_in(state: St) -> fmi2Component {
+fn me_instance_in(state: State) -> fmi2Component {
     let c = instantiate(fmi2ModelExchange, "ToyMe");
     assert!(!c.is_null(), "{:?}", take_errors());
     unsafe {
         let steps: &[unsafe extern "C" fn(fmi2Component) -> fmi2Status] = match state {
-            Instantiated => &[],
-            InitializationMode => &[fmi2EnterInitializationMode],
+            INSTANTIATED => &[],
+            INITIALIZATION_MODE => &[fmi2EnterInitializationMode],
             EventMode => &[fmi2EnterInitializationMode, fmi2ExitInitializationMode],
             ContinuousTimeMode => &[
                 fmi2EnterInitializationMode,
                 fmi2ExitInitializationMode,
                 fmi2EnterContinuousTimeMode,
             ],
-            Terminated => &[
+            TERMINATED => &[
                 fmi2EnterInitializationMode,
                 fmi2ExitInitializationMode,
                 fmi2Terminate,
             ],
+            other => unreachable!("{other:?}"),
         };
         assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
         for step in steps {
@@ -323,7 +304,7 @@ fn new_discrete_states(c: fmi2Component) -> fmi2EventInfo {
 /// iteration puts back.
 #[test]
 fn life_cycle_with_a_state_event() {
-    let c = me_instance_in(InitializationMode);
+    let c = me_instance_in(INITIALIZATION_MODE);
     unsafe {
         assert_eq!(fmi2SetReal(c, &K, 1, &4.0), OK);
         assert_eq!(fmi2SetReal(c, &U, 1, &0.5), OK);
@@ -405,17 +386,17 @@ fn every_function_in_every_model_exchange_state_follows_the_table() {
         "fmi2SetRealInputDerivatives",
     ];
     for state in [
-        Instantiated,
-        InitializationMode,
+        INSTANTIATED,
+        INITIALIZATION_MODE,
         EventMode,
         ContinuousTimeMode,
-        Terminated,
+        TERMINATED,
     ] {
         for (function, probe) in probes::probes() {
             let c = me_instance_in(state);
             let status = probe(c);
             let context = format!("{function} in {state:?}");
-            let allowed = fmi2_cs::state_machine::is_allowed(function, me_state(state));
+            let allowed = fmi2_cs::state_machine::is_allowed(function, state);
             assert!(!(allowed && cs_only.contains(&function)), "{context}");
             if allowed {
                 assert!(
@@ -426,7 +407,7 @@ fn every_function_in_every_model_exchange_state_follows_the_table() {
                 take_errors();
             } else {
                 assert_eq!(status, ERR, "{context} must be refused");
-                let name = me_state(state).name();
+                let name = state.name();
                 assert_logged(&context, &[function, "illegal call sequence", name]);
                 refused += 1;
             }
@@ -434,17 +415,6 @@ fn every_function_in_every_model_exchange_state_follows_the_table() {
         }
     }
     assert!(refused > 60, "{refused}");
-}
-
-fn me_state(s: St) -> fmi2_cs::state_machine::State {
-    use fmi2_cs::state_machine::State;
-    match s {
-        Instantiated => State::MeInstantiated,
-        InitializationMode => State::MeInitializationMode,
-        EventMode => State::EventMode,
-        ContinuousTimeMode => State::ContinuousTimeMode,
-        Terminated => State::MeTerminated,
-    }
 }
 
 /// A Model Exchange function on a Co-Simulation instance (of a model that
@@ -765,7 +735,7 @@ fn fmu_states_keep_to_their_interface() {
         // the Co-Simulation instance is untouched and steps on
         assert_eq!(fmi2DoStep(cs, 0.0, 0.1, 0), OK);
         // a fresh Model Exchange instance takes it
-        let d = me_instance_in(Instantiated);
+        let d = me_instance_in(INSTANTIATED);
         let mut mine = null_mut();
         assert_eq!(
             fmi2DeSerializeFMUstate(d, bytes.as_ptr(), size, &mut mine),

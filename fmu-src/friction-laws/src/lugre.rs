@@ -1268,8 +1268,10 @@ mod tests {
         assert!(rel(l.force(v, 0.0, 1.0), expect) < 1e-14);
     }
 
-    #[test]
-    fn pure_right_hand_side_matches_the_state_methods_and_the_stepper() {
+    /// Every option on: direction-dependent levels, a three-point position
+    /// table for each direction, decaying micro-damping, the normal-force
+    /// form.
+    fn every_option() -> LuGreParams {
         let mut p = LuGreParams {
             direction_dependent: true,
             fc_neg: 0.7,
@@ -1283,6 +1285,12 @@ mod tests {
         p.x_table[..3].copy_from_slice(&[0.0, 0.1, 0.3]);
         p.scale_pos[..3].copy_from_slice(&[1.0, 2.0, 0.5]);
         p.scale_neg[..3].copy_from_slice(&[1.5, 1.0, 1.0]);
+        p
+    }
+
+    #[test]
+    fn pure_right_hand_side_matches_the_state_methods_and_the_stepper() {
+        let p = every_option();
         let mut l = LuGre::new(p).unwrap();
         for &(z, v, x, fn_) in &[
             (3e-6, 1e-3, 0.05, 2.0),
@@ -1333,19 +1341,7 @@ mod tests {
     /// Fn = 0 (kinks) the mean of the two sides, as the differences give.
     #[test]
     fn rate_and_force_partials_match_differences() {
-        let mut options = LuGreParams {
-            direction_dependent: true,
-            fc_neg: 0.7,
-            fs_neg: 1.2,
-            position_dependent: true,
-            n_table: 3,
-            vd: 2e-3,
-            normal_force_form: true,
-            ..LuGreParams::default()
-        };
-        options.x_table[..3].copy_from_slice(&[0.0, 0.1, 0.3]);
-        options.scale_pos[..3].copy_from_slice(&[1.0, 2.0, 0.5]);
-        options.scale_neg[..3].copy_from_slice(&[1.5, 1.0, 1.0]);
+        let options = every_option();
         let sets = [
             LuGreParams::default(),
             LuGreParams::sun_2016(),

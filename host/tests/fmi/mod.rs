@@ -466,6 +466,183 @@ impl Drop for Instance {
     }
 }
 
+/// The single error `i` logged since the last check, which must contain
+/// every one of `parts`.
+pub fn assert_logged(i: &Instance, context: &str, parts: &[&str]) {
+    let errors = i.log.take_errors();
+    assert_eq!(
+        errors.len(),
+        1,
+        "{context}: expected one error, got {errors:?}"
+    );
+    for part in parts {
+        assert!(
+            errors[0].contains(part),
+            "{context}: {:?} does not contain {part:?}",
+            errors[0]
+        );
+    }
+}
+
+/// Call `function` (any function of the Co-Simulation API that takes an
+/// instance) on `i` with arguments that are valid apart from the state:
+/// `input` and `output` are value references of a Real input and output,
+/// `start` the input's start value. Its status (FMU states it creates are
+/// freed).
+pub fn call_function(i: &Instance, function: &str, input: Vr, output: Vr, start: f64) -> Status {
+    let a = i.api;
+    let c = i.c;
+    let input = [input];
+    let output = [output];
+    let mut real = [0.0f64];
+    let mut int = [0 as c_int];
+    let mut string: [*const c_char; 1] = [null()];
+    let order = [1 as c_int];
+    // SAFETY: every pointer is valid for the length passed.
+    unsafe {
+        match function {
+            "fmi2SetDebugLogging" => i.set_debug_logging(true, &[]),
+            "fmi2SetupExperiment" => i.setup(0.0),
+            "fmi2EnterInitializationMode" => i.enter_init(),
+            "fmi2ExitInitializationMode" => i.exit_init(),
+            "fmi2Terminate" => i.terminate(),
+            "fmi2Reset" => i.reset(),
+            "fmi2GetReal" => (a.get_real)(c, output.as_ptr(), 1, real.as_mut_ptr()),
+            "fmi2GetInteger" => (a.get_integer)(c, null(), 0, int.as_mut_ptr()),
+            "fmi2GetBoolean" => (a.get_boolean)(c, null(), 0, int.as_mut_ptr()),
+            "fmi2GetString" => (a.get_string)(c, null(), 0, string.as_mut_ptr()),
+            "fmi2SetReal" => {
+                let start = [start];
+                (a.set_real)(c, input.as_ptr(), 1, start.as_ptr())
+            }
+            "fmi2SetInteger" => (a.set_integer)(c, null(), 0, null()),
+            "fmi2SetBoolean" => (a.set_boolean)(c, null(), 0, null()),
+            "fmi2SetString" => (a.set_string)(c, null(), 0, null()),
+            "fmi2GetFMUstate" => {
+                let (s, st) = i.get_state();
+                i.free_state(st);
+                s
+            }
+            "fmi2SetFMUstate" => {
+                let (s, st) = i.get_state();
+                assert_eq!(s, OK);
+                let set = (a.set_fmu_state)(c, st);
+                i.free_state(st);
+                set
+            }
+            "fmi2FreeFMUstate" => {
+                let (s, st) = i.get_state();
+                assert_eq!(s, OK);
+                i.free_state(st)
+            }
+            "fmi2SerializedFMUstateSize" => {
+                let (_, st) = i.get_state();
+                let mut size = 0;
+                let s = (a.serialized_fmu_state_size)(c, st, &mut size);
+                i.free_state(st);
+                s
+            }
+            "fmi2SerializeFMUstate" => {
+                let (_, st) = i.get_state();
+                let mut bytes = vec![0u8; 4096];
+                let mut size = 0;
+                (a.serialized_fmu_state_size)(c, st, &mut size);
+                let s = (a.serialize_fmu_state)(c, st, bytes.as_mut_ptr() as _, size);
+                i.free_state(st);
+                s
+            }
+            "fmi2DeSerializeFMUstate" => {
+                let bytes = i.serialize();
+                let mut st = null_mut();
+                let s = (a.deserialize_fmu_state)(c, bytes.as_ptr() as _, bytes.len(), &mut st);
+                if !st.is_null() {
+                    i.free_state(st);
+                }
+                s
+            }
+            "fmi2GetDirectionalDerivative" => {
+                let dv = [1.0];
+                (a.get_directional_derivative)(
+                    c,
+                    output.as_ptr(),
+                    1,
+                    input.as_ptr(),
+                    1,
+                    dv.as_ptr(),
+                    real.as_mut_ptr(),
+                )
+            }
+            "fmi2SetRealInputDerivatives" => {
+                let slope = [0.0];
+                (a.set_real_input_derivatives)(c, input.as_ptr(), 1, order.as_ptr(), slope.as_ptr())
+            }
+            "fmi2GetRealOutputDerivatives" => {
+                (a.get_real_output_derivatives)(c, null(), 0, order.as_ptr(), real.as_mut_ptr())
+            }
+            "fmi2DoStep" => i.do_step(0.0, 1e-3),
+            "fmi2CancelStep" => (a.cancel_step)(c),
+            "fmi2GetStatus" => (a.get_status)(c, 0, int.as_mut_ptr()),
+            "fmi2GetRealStatus" => (a.get_real_status)(c, 2, real.as_mut_ptr()),
+            "fmi2GetIntegerStatus" => (a.get_integer_status)(c, 0, int.as_mut_ptr()),
+            "fmi2GetBooleanStatus" => (a.get_boolean_status)(c, 3, int.as_mut_ptr()),
+            "fmi2GetStringStatus" => (a.get_string_status)(c, 1, string.as_mut_ptr()),
+            other => panic!("no probe for {other}"),
+        }
+    }
+}
+
+/// A fixture for [`check_state_table`]: an FMU that can be driven into
+/// each of the states `S` of a state machine and called there.
+pub trait StateProbe<S: Copy + PartialEq + std::fmt::Debug> {
+    /// The FMU's name, for messages.
+    fn name(&self) -> String;
+    /// A fresh instance in `state`.
+    fn instance_in(&self, state: S) -> Instance;
+    /// `function` called on `i` with arguments valid apart from the state.
+    fn call(&self, i: &Instance, function: &str) -> Status;
+    /// The FMUs' word for `state` in their messages.
+    fn state_word(&self, state: S) -> String;
+    /// The rest of a normal run from `state`: every call must succeed.
+    fn finish_run(&self, i: &Instance, state: S);
+}
+
+/// Every function of `table` (with the states of `states` in which the
+/// standard allows it) called in every one of `states`: an allowed call
+/// returns less than fmi2Error; any other returns fmi2Error, logs one
+/// message naming the function, "not allowed in state" and the state, and
+/// changes nothing (the run goes on from that state). The numbers of
+/// refused and accepted calls.
+pub fn check_state_table<S: Copy + PartialEq + std::fmt::Debug>(
+    f: &impl StateProbe<S>,
+    table: &[(&str, &[S])],
+    states: &[S],
+) -> (usize, usize) {
+    let (mut refused, mut accepted) = (0, 0);
+    let name = f.name();
+    for (function, allowed) in table {
+        for &state in states {
+            let i = f.instance_in(state);
+            let status = f.call(&i, function);
+            let context = format!("{name}: {function} in {state:?}");
+            if allowed.contains(&state) {
+                assert!(
+                    status < ERROR,
+                    "{context} is allowed but returned {status}: {:?}",
+                    i.log.take_errors()
+                );
+                accepted += 1;
+            } else {
+                assert_eq!(status, ERROR, "{context} must be refused");
+                let word = f.state_word(state);
+                assert_logged(&i, &context, &[function, "not allowed in state", &word]);
+                f.finish_run(&i, state);
+                refused += 1;
+            }
+        }
+    }
+    (refused, accepted)
+}
+
 // ---- the shipped FMUs ------------------------------------------------------
 
 /// The FMUs `build-fmu.sh` writes into `dist/`.

@@ -221,15 +221,15 @@ impl Instance {
     // ---- directional derivatives -----------------------------------------
 
     /// `fmi2GetDirectionalDerivative` of a Model Exchange instance:
-    /// `dv_unknown = J·dv_known` with `J` the partial derivatives of state
+    /// `dv_unknown = J·dv_known` (the knowns with their seeds) with `J`
+    /// the partial derivatives of state
     /// derivatives and Real outputs (`unknowns`) with respect to continuous
     /// states and Real inputs (`knowns`) at the current point, each given
     /// by the model in closed form ([`Ode::partial_derivative`]).
     pub(super) fn me_directional_derivative(
         &mut self,
         unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
+        (knowns, dv_known): (&[u32], &[f64]),
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
         let me = self.me();
@@ -261,24 +261,24 @@ impl Instance {
         }
         self.ensure_initialized()?;
         let ode = self.ode();
+        let values = &self.values;
         for (out, &u) in dv_unknown.iter_mut().zip(unknowns) {
-            let mut acc = 0.0;
-            for (&k, &dv) in knowns.iter().zip(dv_known) {
-                if dv == 0.0 {
-                    continue;
-                }
-                match ode.partial_derivative(&self.values, u, k) {
-                    Some(d) => acc += d * dv,
-                    None => {
-                        return Err(format!(
-                            "the partial derivative of {} with respect to {} is not available",
-                            self.info.variables[u as usize].name,
-                            self.info.variables[k as usize].name
-                        ))
-                    }
-                }
-            }
-            *out = acc;
+            // Σ ∂u/∂k·dv_k over the seeds that move (an infinite partial
+            // times a zero seed would be NaN)
+            let sum = knowns
+                .iter()
+                .zip(dv_known)
+                .filter(|(_, dv)| **dv != 0.0)
+                .try_fold(0.0, |acc, (&k, &dv)| {
+                    let d = ode.partial_derivative(values, u, k).ok_or(k)?;
+                    Ok(acc + d * dv)
+                });
+            *out = sum.map_err(|k: u32| {
+                format!(
+                    "the partial derivative of {} with respect to {} is not available",
+                    self.info.variables[u as usize].name, self.info.variables[k as usize].name
+                )
+            })?;
         }
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }

@@ -12,6 +12,15 @@ use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Variable};
 /// A model description of `variables` named `name` (kept for the
 /// process, as a model's static description is).
 pub fn toy_info(name: &'static str, variables: Vec<Variable>) -> &'static ModelInfo {
+    toy_info_with(name, variables, None)
+}
+
+/// [`toy_info`] with a Model Exchange interface `model_exchange`.
+pub fn toy_info_with(
+    name: &'static str,
+    variables: Vec<Variable>,
+    model_exchange: Option<fmi2_cs::ModelExchange>,
+) -> &'static ModelInfo {
     Box::leak(Box::new(ModelInfo {
         model_name: name,
         model_identifier: name,
@@ -25,7 +34,7 @@ pub fn toy_info(name: &'static str, variables: Vec<Variable>) -> &'static ModelI
             step_size: 0.1,
         },
         capabilities: Capabilities::FULL,
-        model_exchange: None,
+        model_exchange,
     }))
 }
 
