@@ -430,7 +430,7 @@ impl Instance {
             if f & type_flag(t) == 0 {
                 self.variable_of_type(*vr, t)?;
                 // of type `t` but without its bit: a state derivative
-                return self.get_computed(vrs, out);
+                self.refresh_derivatives()?;
             }
             let state_output = flag::OUTPUT | flag::STATE_OUTPUT;
             if f & state_output == state_output && self.outputs_dirty && self.initialized {
@@ -448,10 +448,7 @@ impl Instance {
         {
             self.checked_get.2
         } else {
-            match self.check_get(t, vrs)? {
-                Some(outputs) => outputs,
-                None => return self.get_computed(vrs, out),
-            }
+            self.check_get(t, vrs)?
         };
         if outputs {
             self.ensure_outputs()?;
@@ -475,11 +472,11 @@ impl Instance {
     const REMEMBERED: usize = 2;
 
     /// Check a list of value references of [`Instance::get`] (known, of type
-    /// `t`) and remember it; whether it holds an output, or `None` for a
-    /// list with a state derivative (not remembered: it goes to
-    /// [`Instance::get_computed`] each time).
+    /// `t`) and remember it; whether it holds an output. A list with a
+    /// state derivative has the derivatives brought up to date here, and is
+    /// not remembered (it comes here each time).
     #[inline(never)]
-    fn check_get(&mut self, t: VarType, vrs: &[u32]) -> Result<Option<bool>, String> {
+    fn check_get(&mut self, t: VarType, vrs: &[u32]) -> Result<bool, String> {
         // One flag byte per value reference: known, of type `t`, an output?
         let want = type_flag(t);
         let mut wrong = false;
@@ -494,7 +491,8 @@ impl Instance {
                 self.variable_of_type(*vr, t)?;
             }
             // every one of type `t`, but one without its bit: a derivative
-            return Ok(None);
+            self.refresh_derivatives()?;
+            return Ok(true);
         }
         let outputs = flags & flag::OUTPUT != 0;
         if vrs.len() >= Self::REMEMBERED {
@@ -504,21 +502,18 @@ impl Instance {
             remembered.1.extend_from_slice(vrs);
             remembered.2 = outputs;
         }
-        Ok(Some(outputs))
+        Ok(outputs)
     }
 
-    /// [`Instance::get`] of a list of known Real value references with a
-    /// state derivative among them (checked): the outputs and the
-    /// derivatives computed, then every value read.
+    /// The outputs and the `der(…)` variables brought up to date, for a
+    /// read of a derivative (which [`Instance::get`] then reads as any
+    /// value).
     #[cold]
     #[inline(never)]
-    fn get_computed(&mut self, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
+    fn refresh_derivatives(&mut self) -> Result<(), String> {
         self.ensure_outputs()?;
         self.compute_derivatives();
-        for (o, vr) in out.iter_mut().zip(vrs) {
-            *o = self.values.real(*vr);
-        }
-        self.check_finite(vrs, out, "")
+        Ok(())
     }
 
     /// The values of the `der(…)` variables ([`Model::derivatives`]) at the

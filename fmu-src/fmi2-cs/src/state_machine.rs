@@ -25,12 +25,15 @@ pub enum State {
     Terminated = 1 << 6,
     Error = 1 << 7,
     Fatal = 1 << 8,
-    // Model Exchange (§3.2.3)
-    MeInstantiated = 1 << 9,
-    MeInitializationMode = 1 << 10,
-    EventMode = 1 << 11,
-    ContinuousTimeMode = 1 << 12,
-    MeTerminated = 1 << 13,
+    // Model Exchange (§3.2.3), in the third byte: a mask of both machines
+    // is then tested with one 32-bit test of the state, as a mask of the
+    // first byte alone was (one in the first two bytes takes a 16-bit
+    // load and a test, an instruction more in every call)
+    MeInstantiated = 1 << 16,
+    MeInitializationMode = 1 << 17,
+    EventMode = 1 << 18,
+    ContinuousTimeMode = 1 << 19,
+    MeTerminated = 1 << 20,
 }
 
 impl State {
