@@ -183,30 +183,26 @@ fn variables_recorded_after_the_build_move_the_columns_the_plan_reads() {
 
 #[test]
 fn inputs_read_from_columns_in_another_order_take_the_general_path() {
-    // the rig's inputs F and F_ext (in connection order) from LuGre's
-    // outputs F and z (consecutive columns): in this order one run of
-    // columns, in the other not; from outputs of two components, not
+    // LuGre's inputs x and v (in connection order) from the rig's outputs
+    // x and v (consecutive columns): in this order one run of columns, in
+    // the other not; the rig's inputs F and F_ext from outputs of two
+    // components, not. (Each connection joins ports of the same unit,
+    // which System::build checks.)
     for connections in [
         [
-            ("friction.F", "rig.F"),
-            ("friction.z", "rig.F_ext"),
+            ("rig.x", "friction.x"),
             ("rig.v", "friction.v"),
+            ("friction.F", "rig.F"),
         ],
         [
-            ("friction.z", "rig.F_ext"),
-            ("friction.F", "rig.F"),
             ("rig.v", "friction.v"),
+            ("rig.x", "friction.x"),
+            ("friction.F", "rig.F"),
         ],
         [
             ("rig.v", "friction.v"),
             ("friction.F", "rig.F"),
             ("rig.F_spring", "rig.F_ext"),
-        ],
-        // LuGre's inputs x and v from the rig's x and v
-        [
-            ("rig.x", "friction.x"),
-            ("rig.v", "friction.v"),
-            ("friction.F", "rig.F"),
         ],
     ] {
         assert_same(|| system(&connections), nothing);
