@@ -220,8 +220,10 @@ fn a_fixed_parameter_declared_tunable_is_refused_after_initialization() {
 fn a_capability_the_binary_lacks_is_refused_when_loading() {
     let s = Sandbox::new();
     // The binary lives under another model identifier: Dahl.so is missing.
+    // (Every identifier: the Co-Simulation one follows the Model Exchange
+    // one in the description.)
     let fmu = lying_fmu(s.files.path(), |md| {
-        md.replacen("modelIdentifier=\"Dahl\"", "modelIdentifier=\"Other\"", 1)
+        md.replace("modelIdentifier=\"Dahl\"", "modelIdentifier=\"Other\"")
     });
     let e = s.open(&fmu).unwrap_err();
     assert_message(&e, &["Lying.fmu", "binaries/linux64/Other.so"]);
