@@ -30,6 +30,7 @@ const fn info(name: &'static str, guid: &'static str) -> ModelInfo {
             step_size: 0.1,
         },
         capabilities: Capabilities::FULL,
+        model_exchange: None,
     }
 }
 static PLAIN: ModelInfo = info("Plain", "{plain}");
@@ -90,6 +91,7 @@ static REGISTRY: [ModelFactory; 2] = [
                 s: 0.0,
             })
         },
+        create_model_exchange: None,
     },
     ModelFactory {
         info: &READER,
@@ -99,6 +101,7 @@ static REGISTRY: [ModelFactory; 2] = [
                 s: 0.0,
             })
         },
+        create_model_exchange: None,
     },
 ];
 fmi2_cs::export_fmi2!(&REGISTRY[..]);
