@@ -47,24 +47,6 @@ extern "C" fn shared_log(
     }
 }
 
-fn shared_callbacks() -> &'static fmi2CallbackFunctions {
-    // SAFETY: a five-argument non-variadic function called through the
-    // variadic pointer type with no variadic arguments (as ctypes importers do).
-    let logger = unsafe {
-        std::mem::transmute::<
-            *const (),
-            unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...),
-        >(shared_log as *const ())
-    };
-    Box::leak(Box::new(fmi2CallbackFunctions {
-        logger: Some(logger),
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: null_mut(),
-    }))
-}
-
 /// An fmi2Component that may cross threads (the point of the test).
 #[derive(Clone, Copy)]
 struct Shared(fmi2Component);
@@ -91,7 +73,7 @@ fn lugre(name: &str) -> Shared {
             fmi2CoSimulation,
             guid.as_ptr(),
             null(),
-            shared_callbacks(),
+            callbacks_logging_to(shared_log),
             0,
             0,
         );

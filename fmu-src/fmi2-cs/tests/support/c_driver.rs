@@ -41,13 +41,20 @@ pub fn last_error() -> String {
 }
 
 pub fn callbacks() -> &'static fmi2CallbackFunctions {
+    callbacks_logging_to(record)
+}
+
+/// The importer's callbacks with `log` as the logger (no memory functions).
+pub fn callbacks_logging_to(
+    log: extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char),
+) -> &'static fmi2CallbackFunctions {
     // SAFETY: a five-argument non-variadic function called through the
     // variadic pointer type with no variadic arguments (as ctypes importers do).
     let logger = unsafe {
         std::mem::transmute::<
             *const (),
             unsafe extern "C" fn(*mut c_void, fmi2String, c_int, fmi2String, fmi2String, ...),
-        >(record as *const ())
+        >(log as *const ())
     };
     Box::leak(Box::new(fmi2CallbackFunctions {
         logger: Some(logger),
