@@ -549,6 +549,7 @@ mod tests {
             f: vec![0.0; n],
             source: String::new(),
             position_resolution: None,
+            position_step: None,
             normal_force_measured: false,
             trusted: vec![true; n],
             t,

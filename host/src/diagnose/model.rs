@@ -620,6 +620,11 @@ pub struct Context {
     /// ([`super::quality::resolution`]); [`STIFF_PRESLIDING_DISTANCE`]
     /// when the position is not measured.
     pub position_resolution: f64,
+    /// The smallest displacement one reading registers (m): the encoder's
+    /// count, or the resolution when the position is not quantised
+    /// ([`super::quality::step`]); [`STIFF_PRESLIDING_DISTANCE`] when the
+    /// position is not measured.
+    pub position_step: f64,
 }
 
 #[cfg(test)]
@@ -651,6 +656,7 @@ mod tests {
             mean_normal_force: 1.0,
             position_knots: 6,
             position_resolution: 1e-6,
+            position_step: 1e-6,
         };
         let mut interacting = Vec::new();
         for (i, &a) in Effect::ALL.iter().enumerate() {

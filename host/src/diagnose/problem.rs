@@ -236,6 +236,9 @@ pub struct FrictionData {
     /// What the measured position resolves (m, [`quality::resolution`]),
     /// when the law's position comes from a measured column.
     pub position_resolution: Option<f64>,
+    /// The smallest displacement one reading of that column registers (m,
+    /// [`quality::step`]): its encoder's count.
+    pub position_step: Option<f64>,
     /// Whether a normal force is measured (and varies).
     pub normal_force_measured: bool,
     /// Whether the interval's force is trusted for fitting: not within the
@@ -467,6 +470,10 @@ impl Setup {
                 .input_source(system, "x")
                 .and_then(|src| data.column(&src))
                 .map(quality::resolution),
+            position_step: self
+                .input_source(system, "x")
+                .and_then(|src| data.column(&src))
+                .map(quality::step),
             normal_force_measured: data.column(&format!("{f}.Fn")).is_some()
                 && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
                     > fn_.iter().cloned().fold(f64::INFINITY, f64::min),
@@ -585,14 +592,13 @@ impl Setup {
         };
         let v = law_input("v")?;
         let x = law_input("x")?;
-        let position_resolution = data
-            .column(&format!("{f}.x"))
-            .or_else(|| {
-                self.rig
-                    .as_ref()
-                    .and_then(|(r, _)| data.column(&format!("{r}.x")))
-            })
-            .map(quality::resolution);
+        let position_column = data.column(&format!("{f}.x")).or_else(|| {
+            self.rig
+                .as_ref()
+                .and_then(|(r, _)| data.column(&format!("{r}.x")))
+        });
+        let position_resolution = position_column.map(quality::resolution);
+        let position_step = position_column.map(quality::step);
         let fn_ = law_input("Fn")?;
         let normal_force_measured = data.column(&format!("{f}.Fn")).is_some()
             && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
@@ -634,6 +640,7 @@ impl Setup {
             f: force,
             source,
             position_resolution,
+            position_step,
             normal_force_measured,
             trusted,
         })
@@ -737,6 +744,10 @@ impl Setup {
             position_knots,
             position_resolution: d
                 .position_resolution
+                .filter(|r| *r > 0.0)
+                .unwrap_or(super::model::STIFF_PRESLIDING_DISTANCE),
+            position_step: d
+                .position_step
                 .filter(|r| *r > 0.0)
                 .unwrap_or(super::model::STIFF_PRESLIDING_DISTANCE),
         }

@@ -213,6 +213,18 @@ pub fn resolution(y: &[f64]) -> f64 {
     quantum(y).max(2.0 * noise_sigma(y))
 }
 
+/// The smallest displacement a single reading of a position channel
+/// registers: its quantisation step (an encoder's count), or its
+/// resolution when it is not quantised (m).
+pub fn step(y: &[f64]) -> f64 {
+    let q = quantum(y);
+    if q > 0.0 {
+        q
+    } else {
+        resolution(y)
+    }
+}
+
 /// Inspect `time` and the `columns` (name, values; `lines[k]` the file line
 /// of row k), repair spikes and dropouts in place, and return what was
 /// found.

@@ -163,6 +163,7 @@ pub fn generate(
         f: vec![0.0; n],
         source: String::new(),
         position_resolution: None,
+        position_step: None,
         normal_force_measured: true,
         trusted: vec![true; n],
     };
