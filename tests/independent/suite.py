@@ -251,7 +251,7 @@ def table(rows: list[dict], summary: dict) -> str:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="10 % only")
+    ap.add_argument("--quick", action="store_true", help="10 %% only")
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=cases.ROOT / "out" / "independent-suite")
