@@ -29,7 +29,7 @@ impl CsvFile {
     pub fn new(path: &Path, columns: &[String]) -> CsvFile {
         CsvFile {
             path: path.to_path_buf(),
-            header: format!("time,{}", columns.join(",")),
+            header: header(columns),
             out: None,
         }
     }
@@ -77,6 +77,15 @@ impl CsvFile {
 }
 
 /// Write `run` (rows held in memory) as a CSV result file.
+/// The header line: `time`, then the columns, comma-separated (`time`
+/// alone when nothing else is recorded, not `time,`).
+fn header(columns: &[String]) -> String {
+    std::iter::once("time")
+        .chain(columns.iter().map(String::as_str))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
 pub fn write_csv(run: &Run, path: &Path) -> std::io::Result<()> {
     let mut file = CsvFile::new(path, &run.columns);
     file.write_rows(&run.time, &run.rows)?;
@@ -272,7 +281,17 @@ pub fn push_number(line: &mut Vec<u8>, digits: &mut zmij::Buffer, x: f64) {
 
 #[cfg(test)]
 mod tests {
-    use super::push_number;
+    use super::{header, push_number};
+
+    /// No trailing comma when nothing but time is recorded.
+    #[test]
+    fn the_header_is_time_then_the_columns() {
+        assert_eq!(header(&[]), "time");
+        assert_eq!(
+            header(&["rig.x".to_string(), "friction.F".to_string()]),
+            "time,rig.x,friction.F"
+        );
+    }
 
     fn written(x: f64) -> String {
         let mut line = Vec::new();
