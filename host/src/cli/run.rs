@@ -6,6 +6,7 @@
 
 use fricsim::inputs::{ExternalInputs, InputTable};
 use fricsim::master::{by_name, simulate_streaming, step_count, Observer, Streamed};
+use fricsim::output_file::OutputFile;
 use fricsim::results::{ColumnStats, ResultWriter};
 use fricsim::ssp::SystemFile;
 use fricsim::system::System;
@@ -82,6 +83,16 @@ impl Observer for Watch {
 pub fn run(a: &RunArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
     let (start, stop, step) = a.grid.resolve(&file)?;
+    // the result file is claimed before the FMUs are opened: a run that
+    // would overwrite an input or another run's result stops here
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, ""));
+    let mut inputs = file.files_read();
+    inputs.extend(a.input.as_deref().map(|p| ("the --input table", p)));
+    inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
+    let output = OutputFile::create(&out, &inputs).map_err(|e| e.to_string())?;
     let mut master = by_name(&super::master_name(&a.master, &file))?;
 
     let mut system = file.build(start).map_err(|e| e.to_string())?;
@@ -114,12 +125,8 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         bar
     };
     let mut watch = Watch { inputs, bar };
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::default_out(&a.system, ""));
     let columns = system.columns();
-    let mut writer = ResultWriter::new(&out, &columns);
+    let mut writer = ResultWriter::new(output, &columns);
     let plot_signals = if plot_signals.is_empty() {
         columns.clone()
     } else {
@@ -148,7 +155,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     let stats = writer.stats.clone();
     writer
         .finish(run.error.as_deref())
-        .map_err(|e| format!("{}: {e}", out.display()))?;
+        .map_err(|e| e.to_string())?;
     if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
         let title = format!(
             "{} ({})",
