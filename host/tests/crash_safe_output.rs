@@ -216,6 +216,45 @@ fn check_rows(csv: &str) -> (usize, String) {
     (rows, last)
 }
 
+/// `fricsim cosim` of BeltOscillator (`rig`) and LuGre at steps of 1e-4 s
+/// to `stop`, the rig's `fault` at its 5000th step, `TMPDIR` = `tmp/`.
+fn belt_cosim(setup: &Setup, rig: &Path, fault: i32, stop: f64, out: &Path) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_fricsim"));
+    c.arg("cosim")
+        .arg("--fmu")
+        .arg(format!("rig={}", rig.display()))
+        .arg("--fmu")
+        .arg(format!("friction={}", setup.path("LuGre.fmu").display()))
+        .args([
+            "--connect",
+            "rig.v->friction.v",
+            "--connect",
+            "friction.F->rig.F",
+        ])
+        .args([
+            "--set",
+            &format!("rig.fault={fault}"),
+            "--set",
+            "rig.fault_step=5000",
+        ])
+        .args(["--step", "1e-4", "--stop", &stop.to_string()])
+        .arg("--out")
+        .arg(out)
+        .env("TMPDIR", setup.path("tmp"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    c
+}
+
+/// `out/` holds the result `r.csv` and nothing else: no temporary file,
+/// no lock file.
+fn assert_only_the_result(setup: &Setup) {
+    assert_eq!(
+        leftovers(&setup.path("out"), &["r.csv"]),
+        Vec::<String>::new()
+    );
+}
+
 #[test]
 fn sigint_and_sigterm_put_the_rows_so_far_in_place_marked_and_remove_temporary_directories() {
     for (signal, name, status) in [
@@ -248,10 +287,7 @@ fn sigint_and_sigterm_put_the_rows_so_far_in_place_marked_and_remove_temporary_d
             format!("# INCOMPLETE: the run stopped early: interrupted by {name}")
         );
         assert_eq!(setup.temporary_entries(), 0, "{name}: TMPDIR not empty");
-        assert_eq!(
-            leftovers(&setup.path("out"), &["r.csv"]),
-            Vec::<String>::new()
-        );
+        assert_only_the_result(&setup);
     }
 }
 
@@ -277,10 +313,7 @@ fn sigkill_mid_run_leaves_the_previous_result_and_the_next_run_cleans_up() {
     let again = setup.previous_result(&out);
     assert_eq!(again, previous, "the same run, the same bytes");
     assert!(!partial.exists());
-    assert_eq!(
-        leftovers(&setup.path("out"), &["r.csv"]),
-        Vec::<String>::new()
-    );
+    assert_only_the_result(&setup);
 }
 
 #[test]
@@ -289,31 +322,9 @@ fn a_second_writer_of_the_same_path_is_refused_and_the_first_result_is_whole() {
     let rig = belt::build_fmu(setup.dir.path());
     let out = setup.path("out/r.csv");
     // the first writer: 6000 steps, of which the 5000th sleeps 0.6 s
-    let mut first = Command::new(env!("CARGO_BIN_EXE_fricsim"));
-    first
-        .arg("cosim")
-        .arg("--fmu")
-        .arg(format!("rig={}", rig.display()))
-        .arg("--fmu")
-        .arg(format!("friction={}", setup.path("LuGre.fmu").display()))
-        .args([
-            "--connect",
-            "rig.v->friction.v",
-            "--connect",
-            "friction.F->rig.F",
-        ])
-        .args(["--set", "rig.fault=5", "--set", "rig.fault_step=5000"])
-        .args([
-            "--step",
-            "1e-4",
-            "--stop",
-            "0.6",
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    let first = first.spawn().unwrap();
+    let first = belt_cosim(&setup, &rig, belt::SLOW, 0.6, &out)
+        .spawn()
+        .unwrap();
     let pid = first.id();
     // the lock file holds the pid once the path is locked
     let lock = setup.path("out/.r.csv.fricsim-lock");
@@ -339,10 +350,7 @@ fn a_second_writer_of_the_same_path_is_refused_and_the_first_result_is_whole() {
     let (rows, last) = check_rows(&csv);
     assert_eq!(rows, 6001, "{last}");
     assert!(!last.starts_with('#'));
-    assert_eq!(
-        leftovers(&setup.path("out"), &["r.csv"]),
-        Vec::<String>::new()
-    );
+    assert_only_the_result(&setup);
 }
 
 #[test]
@@ -432,10 +440,7 @@ fn a_write_error_leaves_the_previous_result_names_the_path_and_no_temporary_file
         assert!(stderr.contains(part), "{part} not in {stderr}");
     }
     assert_eq!(std::fs::read(&out).unwrap(), previous);
-    assert_eq!(
-        leftovers(&setup.path("out"), &["r.csv"]),
-        Vec::<String>::new()
-    );
+    assert_only_the_result(&setup);
     assert_eq!(setup.temporary_entries(), 0);
 }
 
@@ -445,29 +450,8 @@ fn an_fmu_failing_mid_run_puts_its_rows_so_far_marked_in_place() {
     let rig = belt::build_fmu(setup.dir.path());
     let out = setup.path("out/r.csv");
     let previous = setup.previous_result(&out);
-    let o = Command::new(env!("CARGO_BIN_EXE_fricsim"))
-        .arg("cosim")
-        .arg("--fmu")
-        .arg(format!("rig={}", rig.display()))
-        .arg("--fmu")
-        .arg(format!("friction={}", setup.path("LuGre.fmu").display()))
-        .args([
-            "--connect",
-            "rig.v->friction.v",
-            "--connect",
-            "friction.F->rig.F",
-        ])
-        // fmi2Error at the 5000th step: past the first chunk of rows
-        .args(["--set", "rig.fault=3", "--set", "rig.fault_step=5000"])
-        .args([
-            "--step",
-            "1e-4",
-            "--stop",
-            "1",
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .env("TMPDIR", setup.path("tmp"))
+    // fmi2Error at the 5000th step: past the first chunk of rows
+    let o = belt_cosim(&setup, &rig, belt::ERROR, 1.0, &out)
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
@@ -480,9 +464,6 @@ fn an_fmu_failing_mid_run_puts_its_rows_so_far_marked_in_place() {
         "{last}"
     );
     assert!(last.contains("fault injected at step 5000"), "{last}");
-    assert_eq!(
-        leftovers(&setup.path("out"), &["r.csv"]),
-        Vec::<String>::new()
-    );
+    assert_only_the_result(&setup);
     assert_eq!(setup.temporary_entries(), 0);
 }
