@@ -11,6 +11,7 @@
 
 use crate::master::{RowSink, Run};
 use crate::rows::Rows;
+use crate::system::RecordedType;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -22,6 +23,9 @@ pub struct CsvFile {
     path: PathBuf,
     header: String,
     out: Option<BufWriter<File>>,
+    /// Per column, whether it holds whole numbers (an Integer or a
+    /// Boolean variable), written as such: `3`, not `3.0`; empty: none.
+    whole: Vec<bool>,
 }
 
 impl CsvFile {
@@ -31,6 +35,18 @@ impl CsvFile {
             path: path.to_path_buf(),
             header: header(columns),
             out: None,
+            whole: Vec::new(),
+        }
+    }
+
+    /// Write the columns whose `types` are Integer or Boolean as whole
+    /// numbers (`3`, a Boolean `0` or `1`, as FMPy's `write_csv` does),
+    /// not as Reals (`3.0`); `types` has one entry per column
+    /// ([`crate::system::System::column_types`]).
+    pub fn whole_number_columns(&mut self, types: &[RecordedType]) {
+        self.whole = types.iter().map(|t| *t != RecordedType::Real).collect();
+        if !self.whole.contains(&true) {
+            self.whole.clear();
         }
     }
 
@@ -48,15 +64,28 @@ impl CsvFile {
 
     /// The first `times.len()` rows of `rows`, at `times`.
     pub fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
-        let out = self.out()?;
+        self.out()?;
+        let (out, whole) = (self.out.as_mut().expect("opened above"), &self.whole);
         let mut digits = zmij::Buffer::new();
         let mut line = Vec::with_capacity(32 * (rows.width() + 1));
         for (t, row) in times.iter().zip(rows) {
             line.clear();
             push_number(&mut line, &mut digits, *t);
-            for x in row {
-                line.push(b',');
-                push_number(&mut line, &mut digits, *x);
+            if whole.is_empty() {
+                for x in row {
+                    line.push(b',');
+                    push_number(&mut line, &mut digits, *x);
+                }
+            } else {
+                for (x, whole) in row.iter().zip(whole) {
+                    line.push(b',');
+                    if *whole {
+                        // an i32 or a Boolean read into an f64: exact
+                        write!(line, "{}", *x as i64)?;
+                    } else {
+                        push_number(&mut line, &mut digits, *x);
+                    }
+                }
             }
             line.push(b'\n');
             out.write_all(&line)?;
@@ -157,6 +186,11 @@ impl ResultWriter {
             stats: ColumnStats::new(columns.len()),
             kept: None,
         }
+    }
+
+    /// See [`CsvFile::whole_number_columns`].
+    pub fn whole_number_columns(&mut self, types: &[RecordedType]) {
+        self.file.whole_number_columns(types);
     }
 
     /// Keep the columns `names` in memory besides writing them (for a
