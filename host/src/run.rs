@@ -415,7 +415,8 @@ impl RowSink for Recorder<'_> {
                 self.picked_times.push(*t);
             }
         }
-        self.pending = match (times.last(), rows.iter().take(times.len()).last()) {
+        let last_row = times.len().checked_sub(1).and_then(|i| rows.get(i));
+        self.pending = match (times.last(), last_row) {
             (Some(&t), Some(row)) if !(self.seen - 1).is_multiple_of(self.every) => {
                 Some((t, Rows::from_rows(row.len(), [row])))
             }

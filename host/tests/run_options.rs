@@ -91,12 +91,8 @@ fn an_fmu_that_ends_the_simulation_ends_the_run_normally_with_its_last_row() {
 fn fricsim_run_writes_integer_and_boolean_columns_exactly_and_exits_0() {
     let (dir, ssd) = stair_system(1.0);
     let out = dir.path().join("stair.csv");
-    let (code, stdout, stderr) = fricsim(&[
-        "run",
-        ssd.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (code, stdout, stderr) =
+        fricsim(&["run", ssd.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert_eq!(code, Some(0), "{stdout}{stderr}");
     assert!(
         stdout.contains("9 of 10 macro steps")
@@ -201,13 +197,33 @@ fn a_start_value_that_cannot_be_set_is_refused_naming_the_variable_and_the_value
     for (port, value, expected) in [
         ("stair.floor", "1", "`stair` has no variable `floor`"),
         ("lift.top", "1", "no component `lift`"),
-        ("stair.top", "ten", "cannot set `stair.top` to \"ten\": not a Integer value"),
-        ("stair.top", "2.5", "cannot set `stair.top` to \"2.5\": not a Integer value"),
-        ("stair.top", "1", "cannot set `stair.top` to \"1\": below the declared min = 2"),
+        (
+            "stair.top",
+            "ten",
+            "cannot set `stair.top` to \"ten\": not a Integer value",
+        ),
+        (
+            "stair.top",
+            "2.5",
+            "cannot set `stair.top` to \"2.5\": not a Integer value",
+        ),
+        (
+            "stair.top",
+            "1",
+            "cannot set `stair.top` to \"1\": below the declared min = 2",
+        ),
         ("stair.step_height", "10.5", "above the declared max = 10"),
         ("stair.step_height", "nan", "not a finite number"),
-        ("stair.terminates", "yes", "not a Boolean value (true, false, 1 or 0)"),
-        ("stair.height", "3", "causality \"output\", variability \"discrete\" and initial \"calculated\""),
+        (
+            "stair.terminates",
+            "yes",
+            "not a Boolean value (true, false, 1 or 0)",
+        ),
+        (
+            "stair.height",
+            "3",
+            "causality \"output\", variability \"discrete\" and initial \"calculated\"",
+        ),
         ("stair.end_time", "3", "causality \"calculatedParameter\""),
     ] {
         let options = RunOptions {
@@ -301,9 +317,18 @@ fn an_output_interval_that_is_not_a_multiple_of_the_step_is_refused_with_both() 
     let (dir, ssd) = stair_system(0.5);
     let out = dir.path().join("stair.csv");
     for (interval, expected) in [
-        ("0.75", "--output-interval 0.75 s is not a whole multiple of the step 0.5 s"),
-        ("0.25", "--output-interval 0.25 s is not a whole multiple of the step 0.5 s"),
-        ("-1", "--output-interval must be a positive number of seconds, got -1"),
+        (
+            "0.75",
+            "--output-interval 0.75 s is not a whole multiple of the step 0.5 s",
+        ),
+        (
+            "0.25",
+            "--output-interval 0.25 s is not a whole multiple of the step 0.5 s",
+        ),
+        (
+            "-1",
+            "--output-interval must be a positive number of seconds, got -1",
+        ),
     ] {
         let (code, stdout, stderr) = fricsim(&[
             "run",

@@ -87,7 +87,6 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
             None => None,
         },
         call_time_limit: super::call_time_limit(a.step_timeout)?,
-        ..RunOptions::default()
     };
     let prepared = PreparedRun::new(&file, &options)?;
     super::print_warnings(prepared.warnings());

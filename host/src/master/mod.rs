@@ -410,7 +410,8 @@ pub fn simulate_streaming(
             done
         };
         if end > done {
-            (error, ended) = Stop::split(step_range(system, master, observer, start, h, done..end, n));
+            (error, ended) =
+                Stop::split(step_range(system, master, observer, start, h, done..end, n));
             done = end;
         }
         let last_chunk = error.is_some() || ended.is_some() || done == n;

@@ -5,7 +5,7 @@
 //! `fmi2Terminated` = true. Compiled and zipped into a `.fmu` at test time.
 #![allow(dead_code)]
 
-use crate::common::{compile_shared, zip_dir};
+use crate::common::c_fmu;
 use std::path::{Path, PathBuf};
 
 /// The folder with `stair.c` and `modelDescription.xml`.
@@ -14,22 +14,7 @@ pub const SOURCE_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/c/stair
 /// Compile the C source and zip it with its model description into
 /// `dir/Stair.fmu`.
 pub fn build_fmu(dir: &Path) -> PathBuf {
-    let root = dir.join("Stair");
-    let binaries = root.join("binaries/linux64");
-    std::fs::create_dir_all(&binaries).unwrap();
-    std::fs::copy(
-        Path::new(SOURCE_DIR).join("modelDescription.xml"),
-        root.join("modelDescription.xml"),
-    )
-    .unwrap();
-    compile_shared(
-        &Path::new(SOURCE_DIR).join("stair.c"),
-        &binaries.join("Stair.so"),
-        &[],
-    );
-    let fmu = dir.join("Stair.fmu");
-    zip_dir(&root, &fmu);
-    fmu
+    c_fmu(Path::new(SOURCE_DIR), "stair.c", "Stair", dir)
 }
 
 /// A system file `dir/stair.ssd` of one component `stair` (Stair.fmu in
