@@ -14,6 +14,7 @@
 use crate::master::{RowSink, Run};
 use crate::output_file::{OutputError, OutputFile};
 use crate::rows::Rows;
+use crate::system::RecordedType;
 use std::io::Write;
 use std::path::Path;
 
@@ -23,6 +24,9 @@ pub struct CsvFile {
     header: String,
     header_written: bool,
     out: OutputFile,
+    /// Per column, whether it holds whole numbers (an Integer or a
+    /// Boolean variable), written as such: `3`, not `3.0`; empty: none.
+    whole: Vec<bool>,
 }
 
 impl CsvFile {
@@ -32,6 +36,18 @@ impl CsvFile {
             header: header(columns),
             header_written: false,
             out,
+            whole: Vec::new(),
+        }
+    }
+
+    /// Write the columns whose `types` are Integer or Boolean as whole
+    /// numbers (`3`, a Boolean `0` or `1`, as FMPy's `write_csv` does),
+    /// not as Reals (`3.0`); `types` has one entry per column
+    /// ([`crate::system::System::column_types`]).
+    pub fn whole_number_columns(&mut self, types: &[RecordedType]) {
+        self.whole = types.iter().map(|t| *t != RecordedType::Real).collect();
+        if !self.whole.contains(&true) {
+            self.whole.clear();
         }
     }
 
@@ -50,15 +66,28 @@ impl CsvFile {
 
     /// The first `times.len()` rows of `rows`, at `times`.
     pub fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
-        let out = self.out()?;
+        self.out()?;
+        let (out, whole) = (&mut self.out, &self.whole);
         let mut digits = zmij::Buffer::new();
         let mut line = Vec::with_capacity(32 * (rows.width() + 1));
         for (t, row) in times.iter().zip(rows) {
             line.clear();
             push_number(&mut line, &mut digits, *t);
-            for x in row {
-                line.push(b',');
-                push_number(&mut line, &mut digits, *x);
+            if whole.is_empty() {
+                for x in row {
+                    line.push(b',');
+                    push_number(&mut line, &mut digits, *x);
+                }
+            } else {
+                for (x, whole) in row.iter().zip(whole) {
+                    line.push(b',');
+                    if *whole {
+                        // an i32 or a Boolean read into an f64: exact
+                        write!(line, "{}", *x as i64)?;
+                    } else {
+                        push_number(&mut line, &mut digits, *x);
+                    }
+                }
             }
             line.push(b'\n');
             out.write_all(&line)?;
@@ -163,6 +192,11 @@ impl ResultWriter {
             stats: ColumnStats::new(columns.len()),
             kept: None,
         }
+    }
+
+    /// See [`CsvFile::whole_number_columns`].
+    pub fn whole_number_columns(&mut self, types: &[RecordedType]) {
+        self.file.whole_number_columns(types);
     }
 
     /// Keep the columns `names` in memory besides writing them (for a

@@ -30,11 +30,11 @@ use crate::fmu::model_description::{Causality, Initial, Variability, VariableKin
 use crate::fmu::{Fmu, ScalarVariable};
 use crate::inputs::{ExternalInputs, InputTable};
 use crate::master::{
-    by_name, simulate_streaming, step_count, MasterAlgorithm, Observer, RowSink, Rows,
+    by_name, simulate_streaming, step_count, Ended, MasterAlgorithm, Observer, RowSink, Rows,
 };
 use crate::results::ColumnStats;
-use crate::ssp::SystemFile;
-use crate::system::{ParameterValue, System};
+use crate::ssp::{SystemFile, Value};
+use crate::system::{ParameterValue, RecordedType, System};
 use crate::FmuError;
 use std::time::Duration;
 
@@ -121,6 +121,29 @@ pub fn time_grid(
     Ok((start, stop, step))
 }
 
+/// The start values of an SSP parameter-value file (`.ssv`) at `path`,
+/// naming `component.variable` of `file`'s system, in file order.
+pub fn start_values_file(
+    file: &SystemFile,
+    path: &std::path::Path,
+) -> Result<Vec<(String, StartValue)>, String> {
+    let values = file
+        .parameter_values_file(path)
+        .map_err(|e| e.to_string())?;
+    Ok(values
+        .into_iter()
+        .map(|p| {
+            let value = match p.value {
+                Value::Real(x) => StartValue::Real(x),
+                Value::Integer(i) => StartValue::Integer(i.into()),
+                Value::Boolean(b) => StartValue::Boolean(b),
+                Value::String(s) => StartValue::String(s),
+            };
+            (format!("{}.{}", p.component, p.variable), value)
+        })
+        .collect())
+}
+
 /// A run checked and set up: the system built with its start values, the
 /// master chosen, the inputs bound. [`PreparedRun::run`] runs it.
 pub struct PreparedRun {
@@ -179,6 +202,13 @@ impl PreparedRun {
     /// The recorded columns, `component.variable`, after `time`.
     pub fn columns(&self) -> Vec<String> {
         self.system.columns()
+    }
+
+    /// The type of each column of [`PreparedRun::columns`]: Integer and
+    /// Boolean columns hold whole numbers (see
+    /// [`crate::results::CsvFile::whole_number_columns`]).
+    pub fn column_types(&self) -> Vec<RecordedType> {
+        self.system.column_types()
     }
 
     /// `(start, stop, step)`, as resolved.
@@ -242,6 +272,7 @@ impl PreparedRun {
             rows: recorder.stats.rows,
             steps: streamed.rows.saturating_sub(1),
             error,
+            ended: streamed.ended,
             stats: recorder.stats,
             master_report: self.master.report(),
             wall_time: started.elapsed().as_secs_f64(),
@@ -270,6 +301,10 @@ pub struct RunOutcome {
     /// Why the run stopped before its stop time, if it did: an FMU's
     /// failure, the sink's error or its request to stop.
     pub error: Option<String>,
+    /// The component that ended the simulation before the stop time, if
+    /// one did: a normal end (FMI 2.0.4 §4.2.3, see [`Ended`]), its last
+    /// row recorded at the time it reached.
+    pub ended: Option<Ended>,
     /// Each column's least, greatest and last value over the rows
     /// recorded, and the rows' first and last times.
     pub stats: ColumnStats,
@@ -380,7 +415,8 @@ impl RowSink for Recorder<'_> {
                 self.picked_times.push(*t);
             }
         }
-        self.pending = match (times.last(), rows.iter().take(times.len()).last()) {
+        let last_row = times.len().checked_sub(1).and_then(|i| rows.get(i));
+        self.pending = match (times.last(), last_row) {
             (Some(&t), Some(row)) if !(self.seen - 1).is_multiple_of(self.every) => {
                 Some((t, Rows::from_rows(row.len(), [row])))
             }

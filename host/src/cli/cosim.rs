@@ -101,6 +101,7 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     super::print_warnings(system.warnings());
     let columns = system.columns();
     let mut writer = ResultWriter::new(output, &columns);
+    writer.whole_number_columns(&system.column_types());
     let signals = if a.plot_signals.is_empty() {
         columns.clone()
     } else {
@@ -153,6 +154,9 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     }
     if let Some(report) = master.report() {
         print!("{report}");
+    }
+    if let Some(ended) = &run.ended {
+        println!("{ended}");
     }
     println!("wrote {}", a.out.display());
     if let Some(p) = &a.plot {

@@ -7,7 +7,7 @@
 use fricsim::inputs::InputTable;
 use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
-use fricsim::run::{PreparedRun, RunOptions, RunOutcome};
+use fricsim::run::{PreparedRun, RunOptions, RunOutcome, StartValue};
 use fricsim::ssp::SystemFile;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -35,10 +35,23 @@ pub struct RunArgs {
     /// Plot annotation, else every recorded column].
     #[arg(long = "plot-signal")]
     pub plot_signals: Vec<String>,
-    /// Record a Real variable besides the outputs, component.variable
-    /// (repeat): e.g. a connected input.
+    /// Record a variable besides the outputs, component.variable (repeat):
+    /// e.g. a connected input. Real, Integer and Boolean variables.
     #[arg(long = "record")]
     pub record: Vec<String>,
+    /// A start value, component.variable=value (repeat), read as the
+    /// variable's type (Boolean: true/false/1/0); set after the system
+    /// file's parameter values and --start-values, the last one winning.
+    #[arg(long = "set", value_name = "COMPONENT.VARIABLE=VALUE")]
+    pub set: Vec<String>,
+    /// Start values from an SSP parameter-value file (.ssv) naming
+    /// component.variable, set after the system file's own.
+    #[arg(long = "start-values", value_name = "FILE.ssv")]
+    pub start_values: Option<PathBuf>,
+    /// Record every SECONDS instead of at every step: a whole multiple of
+    /// the step; the last point is always recorded.
+    #[arg(long = "output-interval", value_name = "SECONDS")]
+    pub output_interval: Option<f64>,
     /// External inputs: CSV with `time` first, then component.variable
     /// columns for unconnected inputs (bare names for a one-component
     /// system), interpolated linearly in time as FMPy does.
@@ -65,6 +78,11 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         .unwrap_or_else(|| super::default_out(&a.system, ""));
     let mut inputs = file.files_read();
     inputs.extend(a.input.as_deref().map(|p| ("the --input table", p)));
+    inputs.extend(
+        a.start_values
+            .as_deref()
+            .map(|p| ("the --start-values file", p)),
+    );
     inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
     let output = OutputFile::create(&out, &inputs).map_err(|e| e.to_string())?;
     let plot_signals = if !a.plot_signals.is_empty() {
@@ -78,12 +96,13 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         step: a.grid.step,
         master: a.master.clone(),
         record: a.record.iter().chain(&plot_signals).cloned().collect(),
+        start_values: start_values(&file, a)?,
+        output_interval: a.output_interval,
         inputs: match &a.input {
             Some(path) => Some(InputTable::read(path)?),
             None => None,
         },
         call_time_limit: super::call_time_limit(a.step_timeout)?,
-        ..RunOptions::default()
     };
     let prepared = PreparedRun::new(&file, &options)?;
     super::print_warnings(prepared.warnings());
@@ -104,6 +123,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     };
     let columns = prepared.columns();
     let mut writer = ResultWriter::new(output, &columns);
+    writer.whole_number_columns(&prepared.column_types());
     let plot_signals = if plot_signals.is_empty() {
         columns.clone()
     } else {
@@ -154,6 +174,21 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     }
 }
 
+/// `--start-values`, then `--set`, in the order they apply.
+fn start_values(file: &SystemFile, a: &RunArgs) -> Result<Vec<(String, StartValue)>, String> {
+    let mut values = match &a.start_values {
+        Some(path) => fricsim::run::start_values_file(file, path)?,
+        None => Vec::new(),
+    };
+    for s in &a.set {
+        let (port, value) = s
+            .split_once('=')
+            .ok_or(format!("--set expects component.variable=value, got `{s}`"))?;
+        values.push((port.trim().to_string(), StartValue::Text(value.to_string())));
+    }
+    Ok(values)
+}
+
 /// The summary: what ran, how long, each column's min/max/final value,
 /// and whether the run completed.
 fn summary(file: &SystemFile, run: &RunOutcome, n: usize, step: f64, master: &str) -> String {
@@ -173,7 +208,11 @@ fn summary(file: &SystemFile, run: &RunOutcome, n: usize, step: f64, master: &st
         "{done} of {n} macro steps of {step} s with {master} ({} to {} s), {wall:.3} s wall time: {}",
         stats.first_time.unwrap_or(0.0),
         stats.last_time.unwrap_or(0.0),
-        if run.error.is_none() { "completed" } else { "INCOMPLETE" }
+        match (&run.error, &run.ended) {
+            (Some(_), _) => "INCOMPLETE".to_string(),
+            (None, Some(ended)) => ended.to_string(),
+            (None, None) => "completed".to_string(),
+        }
     );
     let width = run
         .columns

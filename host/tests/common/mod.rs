@@ -87,6 +87,28 @@ pub fn repacked(name: &str, out: &Path, edit: impl Fn(&str) -> String) -> PathBu
     out.to_path_buf()
 }
 
+/// An FMU written by hand in C: compile `source_dir/c_file` into
+/// `binaries/linux64/<identifier>.so`, zip it with
+/// `source_dir/modelDescription.xml` into `dir/<identifier>.fmu`.
+pub fn c_fmu(source_dir: &Path, c_file: &str, identifier: &str, dir: &Path) -> PathBuf {
+    let root = dir.join(identifier);
+    let binaries = root.join("binaries/linux64");
+    std::fs::create_dir_all(&binaries).unwrap();
+    std::fs::copy(
+        source_dir.join("modelDescription.xml"),
+        root.join("modelDescription.xml"),
+    )
+    .unwrap();
+    compile_shared(
+        &source_dir.join(c_file),
+        &binaries.join(format!("{identifier}.so")),
+        &[],
+    );
+    let fmu = dir.join(format!("{identifier}.fmu"));
+    zip_dir(&root, &fmu);
+    fmu
+}
+
 /// Zip the files below `dir` into `out`.
 pub fn zip_dir(dir: &Path, out: &Path) {
     fn add(zip: &mut zip::ZipWriter<std::fs::File>, root: &Path, dir: &Path) {
