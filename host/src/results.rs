@@ -7,13 +7,59 @@
 //! ([`crate::master::simulate_streaming`]) and writes them at once, keeping
 //! only a summary of each column and the columns to be plotted, so that a
 //! run's memory does not grow with its length; [`write_csv`] writes a
-//! [`Run`] held in memory as the same file.
+//! [`Run`] held in memory as the same file. A path ending in `.mat` gets
+//! a MAT v4 file instead ([`crate::matfile`], [`create`]).
 
 use crate::master::{RowSink, Run};
+use crate::matfile::MatFile;
 use crate::rows::Rows;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+
+/// A result file written row by row, whatever its format.
+pub trait RowFile {
+    fn path(&self) -> &Path;
+    /// The first `times.len()` rows of `rows`, at `times`.
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()>;
+    /// The end of the file, saying why the run stopped early if `error`
+    /// is given.
+    fn finish(self: Box<Self>, error: Option<&str>) -> std::io::Result<()>;
+}
+
+/// The result file at `path` for the columns `time` and `columns`: MAT v4
+/// when its extension is `.mat` ([`crate::matfile::is_mat`]), else CSV.
+pub fn create(path: &Path, columns: &[String]) -> Box<dyn RowFile> {
+    if crate::matfile::is_mat(path) {
+        Box::new(MatFile::new(path, columns))
+    } else {
+        Box::new(CsvFile::new(path, columns))
+    }
+}
+
+impl RowFile for CsvFile {
+    fn path(&self) -> &Path {
+        &self.path
+    }
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
+        CsvFile::write_rows(self, times, rows)
+    }
+    fn finish(self: Box<Self>, error: Option<&str>) -> std::io::Result<()> {
+        CsvFile::finish(*self, error)
+    }
+}
+
+impl RowFile for MatFile {
+    fn path(&self) -> &Path {
+        MatFile::path(self)
+    }
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
+        MatFile::write_rows(self, times, rows)
+    }
+    fn finish(self: Box<Self>, error: Option<&str>) -> std::io::Result<()> {
+        MatFile::finish(*self, error)
+    }
+}
 
 /// A CSV result file written row by row: created (with its directory) at
 /// the first rows, so that a run that fails before its first row leaves
@@ -133,10 +179,10 @@ impl ColumnStats {
     }
 }
 
-/// The rows of a run as they come: written to a CSV file, summed up in
-/// [`ColumnStats`], and the columns to be plotted kept.
+/// The rows of a run as they come: written to a result file ([`create`]),
+/// summed up in [`ColumnStats`], and the columns to be plotted kept.
 pub struct ResultWriter {
-    file: CsvFile,
+    file: Box<dyn RowFile>,
     pub stats: ColumnStats,
     /// The columns kept (their indices), their names, their times and rows.
     kept: Option<Kept>,
@@ -150,10 +196,11 @@ struct Kept {
 }
 
 impl ResultWriter {
-    /// A writer of the rows of `columns` to the CSV file `path`.
+    /// A writer of the rows of `columns` to the result file `path` (CSV,
+    /// or MAT v4 if it ends in `.mat`: [`create`]).
     pub fn new(path: &Path, columns: &[String]) -> ResultWriter {
         ResultWriter {
-            file: CsvFile::new(path, columns),
+            file: create(path, columns),
             stats: ColumnStats::new(columns.len()),
             kept: None,
         }
@@ -193,7 +240,7 @@ impl ResultWriter {
         })
     }
 
-    /// The end of the file (see [`CsvFile::finish`]).
+    /// The end of the file (see [`CsvFile::finish`], [`MatFile::finish`]).
     pub fn finish(self, error: Option<&str>) -> std::io::Result<()> {
         self.file.finish(error)
     }
@@ -203,7 +250,7 @@ impl RowSink for ResultWriter {
     fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String> {
         self.file
             .write_rows(times, rows)
-            .map_err(|e| format!("{}: {e}", self.file.path.display()))?;
+            .map_err(|e| format!("{}: {e}", self.file.path().display()))?;
         self.stats.add(times, rows);
         if let Some(k) = &mut self.kept {
             k.time.extend_from_slice(times);

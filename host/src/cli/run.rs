@@ -25,7 +25,8 @@ pub struct RunArgs {
     /// file's annotation, else jacobi].
     #[arg(long)]
     pub master: Option<String>,
-    /// Result CSV [default: out/<file name>.csv].
+    /// Result file: CSV, or MAT v4 in the Dymola/OpenModelica layout if
+    /// it ends in .mat [default: out/<file name>.csv].
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Plot of the chosen signals (.png or .svg) [default: no plot; the
