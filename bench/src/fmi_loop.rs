@@ -265,7 +265,8 @@ pub fn jacobi_run(
             if let Some((vr, column)) = u.input {
                 unsafe { ok((u.f.set_real)(u.c, &vr, 1, &row[column]), "fmi2SetReal")? };
             }
-            unsafe { ok((u.f.do_step)(u.c, t, h, 1), "fmi2DoStep")? };
+            // noSetFMUStatePriorToCurrentPoint false, as the host calls it
+            unsafe { ok((u.f.do_step)(u.c, t, h, 0), "fmi2DoStep")? };
         }
         sample(&units, &mut next[..width])?;
         times[held] = (i + 1) as f64 * h;

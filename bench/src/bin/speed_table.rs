@@ -98,9 +98,10 @@ struct Args {
     /// Run only one side of the stick-slip benchmark and print its time
     /// (the best of `--repeats` runs in this process, one by default) and
     /// final force, for profilers such as callgrind and for timing one
-    /// build against another: `host` or `monolithic`, with `--master` and
+    /// build against another: `host`, `monolithic` or `fmi-loop` (the
+    /// hand-written FMI loop, Jacobi only), with `--master` and
     /// `--stop`; no table is written.
-    #[arg(long, value_parser = ["host", "monolithic"])]
+    #[arg(long, value_parser = ["host", "monolithic", "fmi-loop"])]
     only: Option<String>,
     /// The master of `--only`: jacobi or newton.
     #[arg(long, default_value = "jacobi", value_parser = ["jacobi", "newton"])]
@@ -110,6 +111,11 @@ struct Args {
     stop: Option<f64>,
     #[command(flatten)]
     file: TableFileArgs,
+    /// Run this command, wait for it and print its wall time (s) and
+    /// peak resident memory (bytes): how the memory figures are taken
+    /// ([`fricsim_process`]).
+    #[arg(long, hide = true, num_args = 1.., allow_hyphen_values = true)]
+    peak_memory_of: Vec<String>,
 }
 
 fn main() -> std::process::ExitCode {
@@ -129,6 +135,11 @@ struct Sizes {
 }
 
 fn run(args: &Args) -> Result<(), String> {
+    if let [command, arguments @ ..] = args.peak_memory_of.as_slice() {
+        let (wall, peak) = wait_for(std::process::Command::new(command).args(arguments))?;
+        println!("{wall} {peak}");
+        return Ok(());
+    }
     let root = args.file.root();
     if let Some(side) = &args.only {
         let repeats = args.repeats.unwrap_or(1);
@@ -447,16 +458,8 @@ fn fmi_loop_row(root: &Path, sizes: &Sizes) -> Result<FmiLoopRow, String> {
             Ok(wall)
         },
         || {
-            // the stick-slip system's parameters are Rig1D's and LuGre's
-            // defaults (the 1995 values), which the loop keeps
-            let (wall, last) = fricsim_bench::fmi_loop::jacobi_run(
-                &[("rig", &rig), ("friction", &lugre)],
-                &[("rig.v", "friction.v"), ("friction.F", "rig.F")],
-                h,
-                stop,
-            )?;
-            // friction's outputs F, z follow rig's ten
-            hand_final = last[last.len() - 2];
+            let (wall, force) = hand_loop_run(&rig, &lugre, h, stop)?;
+            hand_final = force;
             Ok(wall)
         },
     )?;
@@ -466,6 +469,29 @@ fn fmi_loop_row(root: &Path, sizes: &Sizes) -> Result<FmiLoopRow, String> {
         hand,
         finals: [host_final, hand_final],
     })
+}
+
+/// The stick-slip system's FMUs: Rig1D and LuGre.
+fn stick_slip_fmus(root: &Path) -> Result<(Fmu, Fmu), String> {
+    let open = |name: &str| {
+        Fmu::open(root.join("dist").join(name))
+            .map_err(|e| format!("{name}: {e} (run ./build-fmu.sh)"))
+    };
+    Ok((open("Rig1D.fmu")?, open("LuGre.fmu")?))
+}
+
+/// A run of the hand-written FMI loop on the stick-slip system: its wall
+/// time, s, and final friction force. The system's parameters are
+/// Rig1D's and LuGre's defaults (the 1995 values), which the loop keeps.
+fn hand_loop_run(rig: &Fmu, lugre: &Fmu, h: f64, stop: f64) -> Result<(f64, f64), String> {
+    let (wall, last) = fricsim_bench::fmi_loop::jacobi_run(
+        &[("rig", rig), ("friction", lugre)],
+        &[("rig.v", "friction.v"), ("friction.F", "rig.F")],
+        h,
+        stop,
+    )?;
+    // friction's outputs F, z follow rig's ten
+    Ok((wall, last[last.len() - 2]))
 }
 
 /// The whole `fricsim run` command as a user runs it, and its memory.
@@ -480,13 +506,17 @@ struct ProcessTable {
 
 /// `fricsim run examples/stick_slip.ssd --stop STOP --out OUT`, a fresh
 /// process: its wall time from spawn to exit, s, and its peak resident
-/// memory, bytes (`ru_maxrss` of `wait4`).
+/// memory, bytes. Linux counts in a child's peak (`ru_maxrss`) the memory
+/// of the process it was forked from, so the command is started by a
+/// fresh `speed-table --peak-memory-of …` (a few MB), not from this
+/// process, whose tables by then hold more than `fricsim run` ever does.
 fn fricsim_process(root: &Path, stop: f64, out: &Path) -> Result<(f64, u64), String> {
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let fricsim = exe.with_file_name("fricsim");
-    let clock = Instant::now();
-    let child = std::process::Command::new(&fricsim)
+    let output = std::process::Command::new(&exe)
         .current_dir(root)
+        .arg("--peak-memory-of")
+        .arg(&fricsim)
         .args([
             "run",
             STICK_SLIP,
@@ -496,10 +526,32 @@ fn fricsim_process(root: &Path, stop: f64, out: &Path) -> Result<(f64, u64), Str
             "--out",
         ])
         .arg(out)
+        .output()
+        .map_err(|e| format!("{}: {e}", exe.display()))?;
+    let text = String::from_utf8_lossy(&output.stdout);
+    let figures: Vec<f64> = text
+        .split_whitespace()
+        .filter_map(|x| x.parse().ok())
+        .collect();
+    match (output.status.success(), figures.as_slice()) {
+        (true, &[wall, peak]) => Ok((wall, peak as u64)),
+        _ => Err(format!(
+            "fricsim run {STICK_SLIP} --stop {stop}: {}",
+            String::from_utf8_lossy(&output.stderr).trim()
+        )),
+    }
+}
+
+/// Run `command` to its end, its output dropped: its wall time from spawn
+/// to exit, s, and its peak resident memory, bytes (`wait4`'s
+/// `ru_maxrss`, in kB on Linux).
+fn wait_for(command: &mut std::process::Command) -> Result<(f64, u64), String> {
+    let clock = Instant::now();
+    let child = command
         .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::inherit())
         .spawn()
-        .map_err(|e| format!("{}: {e}", fricsim.display()))?;
+        .map_err(|e| e.to_string())?;
     let mut status = 0;
     // SAFETY: an all-zero rusage is a valid value; wait4 fills it for
     // this child, which nothing else waits for
@@ -510,9 +562,7 @@ fn fricsim_process(root: &Path, stop: f64, out: &Path) -> Result<(f64, u64), Str
     }
     let wall = clock.elapsed().as_secs_f64();
     if !libc::WIFEXITED(status) || libc::WEXITSTATUS(status) != 0 {
-        return Err(format!(
-            "fricsim run {STICK_SLIP} --stop {stop} failed (status {status})"
-        ));
+        return Err(format!("failed (wait status {status})"));
     }
     Ok((wall, usage.ru_maxrss as u64 * 1024))
 }
@@ -548,15 +598,28 @@ fn process_table(root: &Path, sizes: &Sizes) -> Result<ProcessTable, String> {
 fn run_one(root: &Path, side: &str, master: &str, stop: f64, repeats: usize) -> Result<(), String> {
     let file = SystemFile::open(root.join(STICK_SLIP)).map_err(|e| e.to_string())?;
     let h = STICK_SLIP_STEP;
-    let model = if side == "host" {
-        None
-    } else {
+    let model = if side == "monolithic" {
         Some(StickSlipModel::from_file(&file)?)
+    } else {
+        None
+    };
+    let fmus = if side == "fmi-loop" {
+        if master != "jacobi" {
+            return Err("--only fmi-loop runs the Jacobi scheme only".into());
+        }
+        Some(stick_slip_fmus(root)?)
+    } else {
+        None
     };
     let (mut best, mut force) = (f64::INFINITY, f64::NAN);
     for _ in 0..repeats.max(1) {
-        let wall = match &model {
-            None => {
+        let wall = match (&model, &fmus) {
+            (_, Some((rig, lugre))) => {
+                let (wall, f) = hand_loop_run(rig, lugre, h, stop)?;
+                force = f;
+                wall
+            }
+            (None, None) => {
                 let (wall, f, algorithm) = host_run(&file, master, h, stop)?;
                 if let Some(report) = algorithm.report() {
                     eprintln!("{report}");
@@ -564,7 +627,7 @@ fn run_one(root: &Path, side: &str, master: &str, stop: f64, repeats: usize) -> 
                 force = f;
                 wall
             }
-            Some(model) => {
+            (Some(model), None) => {
                 let (wall, f, iterations) = match master {
                     "jacobi" => model.monolithic_jacobi(h, stop),
                     _ => model.monolithic_newton(h, stop)?,
