@@ -181,11 +181,15 @@ impl MatFile {
                 "more than {MAX_POINTS} time points, the most a MAT v4 file holds: write a CSV (--out NAME.csv)"
             )));
         }
-        file.bytes.clear();
-        for (t, row) in times.iter().zip(rows) {
-            file.bytes.extend_from_slice(&t.to_le_bytes());
-            for x in row {
-                file.bytes.extend_from_slice(&x.to_le_bytes());
+        // the chunk's bytes laid out first, then filled 8 at a time: no
+        // growth check per number (a third of the cost of writing them)
+        let point = 8 * (rows.width() + 1);
+        file.bytes.resize(point * times.len(), 0);
+        for ((bytes, t), row) in file.bytes.chunks_exact_mut(point).zip(times).zip(rows) {
+            let (time, values) = bytes.split_at_mut(8);
+            time.copy_from_slice(&t.to_le_bytes());
+            for (b, x) in values.chunks_exact_mut(8).zip(row) {
+                b.copy_from_slice(&x.to_le_bytes());
             }
         }
         file.out.write_all(&file.bytes)?;

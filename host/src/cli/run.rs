@@ -64,6 +64,13 @@ struct Watch {
 }
 
 impl Observer for Watch {
+    /// Nothing to do between steps without external inputs and with the
+    /// bar hidden (`--quiet`, or stderr not a terminal): the run then
+    /// takes its loop without the two calls per step.
+    fn between_steps(&self) -> bool {
+        self.inputs.is_some() || !self.bar.is_hidden()
+    }
+
     fn before_step(&mut self, system: &mut System, t: f64, init: bool) -> Result<(), FmuError> {
         match &mut self.inputs {
             Some(i) => i.before_step(system, t, init),
