@@ -64,6 +64,10 @@ impl Functions {
     }
 }
 
+/// The logger's five fixed arguments (see [`print_message`]).
+type FixedArgumentsLogger =
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String);
+
 /// The importer's logger: the message printed on stderr as it comes, its
 /// `%` arguments not expanded. FMI 2.0 declares it variadic (§2.1.5),
 /// which stable Rust cannot define; a function of the five fixed
@@ -122,25 +126,7 @@ pub fn jacobi_run(
 ) -> Result<(f64, Vec<f64>), String> {
     let callbacks = fmi2CallbackFunctions {
         // SAFETY: see `print_message`
-        logger: Some(unsafe {
-            std::mem::transmute::<
-                unsafe extern "C" fn(
-                    fmi2ComponentEnvironment,
-                    fmi2String,
-                    fmi2Status,
-                    fmi2String,
-                    fmi2String,
-                ),
-                unsafe extern "C" fn(
-                    fmi2ComponentEnvironment,
-                    fmi2String,
-                    fmi2Status,
-                    fmi2String,
-                    fmi2String,
-                    ...
-                ),
-            >(print_message)
-        }),
+        logger: Some(unsafe { std::mem::transmute::<FixedArgumentsLogger, _>(print_message) }),
         allocateMemory: Some(libc_calloc),
         freeMemory: Some(libc_free),
         stepFinished: None,
