@@ -28,6 +28,7 @@ pub mod error;
 pub mod fmu;
 pub mod inputs;
 pub mod master;
+pub mod matfile;
 pub mod output_file;
 pub mod plot;
 pub mod reference;

@@ -7,16 +7,69 @@
 //! ([`crate::master::simulate_streaming`]) and writes them at once, keeping
 //! only a summary of each column and the columns to be plotted, so that a
 //! run's memory does not grow with its length; [`write_csv`] writes a
-//! [`Run`] held in memory as the same file. Both write through an
-//! [`OutputFile`]: a result is put in place whole (or marked incomplete)
-//! or not at all.
+//! [`Run`] held in memory as the same file. A path ending in `.mat` gets
+//! a MAT v4 file instead ([`crate::matfile`], [`create`]). Both write
+//! through an [`OutputFile`]: a result is put in place whole (or marked
+//! incomplete) or not at all.
 
 use crate::master::{RowSink, Run};
+use crate::matfile::MatFile;
 use crate::output_file::{OutputError, OutputFile};
 use crate::rows::Rows;
 use crate::system::RecordedType;
 use std::io::Write;
 use std::path::Path;
+
+/// A result file written row by row, whatever its format.
+pub trait RowFile {
+    fn path(&self) -> &Path;
+    /// Write the Integer and Boolean columns as whole numbers, where the
+    /// format distinguishes them (CSV); `types` has one entry per column.
+    fn whole_number_columns(&mut self, _types: &[RecordedType]) {}
+    /// The first `times.len()` rows of `rows`, at `times`.
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()>;
+    /// The end of the file, saying why the run stopped early if `error`
+    /// is given; then the file is put in place ([`OutputFile::commit`]).
+    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError>;
+}
+
+/// The result file written to `out` for the columns `time` and `columns`:
+/// MAT v4 when its path's extension is `.mat` ([`crate::matfile::is_mat`]),
+/// else CSV.
+pub fn create(out: OutputFile, columns: &[String]) -> Box<dyn RowFile> {
+    if crate::matfile::is_mat(out.path()) {
+        Box::new(MatFile::new(out, columns))
+    } else {
+        Box::new(CsvFile::new(out, columns))
+    }
+}
+
+impl RowFile for CsvFile {
+    fn path(&self) -> &Path {
+        CsvFile::path(self)
+    }
+    fn whole_number_columns(&mut self, types: &[RecordedType]) {
+        CsvFile::whole_number_columns(self, types)
+    }
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
+        CsvFile::write_rows(self, times, rows)
+    }
+    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError> {
+        CsvFile::finish(*self, error)
+    }
+}
+
+impl RowFile for MatFile {
+    fn path(&self) -> &Path {
+        MatFile::path(self)
+    }
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
+        MatFile::write_rows(self, times, rows)
+    }
+    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError> {
+        MatFile::finish(*self, error)
+    }
+}
 
 /// A CSV result file written row by row to an [`OutputFile`] (so that it
 /// is put in place whole, or marked incomplete, or not at all).
@@ -168,10 +221,10 @@ impl ColumnStats {
     }
 }
 
-/// The rows of a run as they come: written to a CSV file, summed up in
-/// [`ColumnStats`], and the columns to be plotted kept.
+/// The rows of a run as they come: written to a result file ([`create`]),
+/// summed up in [`ColumnStats`], and the columns to be plotted kept.
 pub struct ResultWriter {
-    file: CsvFile,
+    file: Box<dyn RowFile>,
     pub stats: ColumnStats,
     /// The columns kept (their indices), their names, their times and rows.
     kept: Option<Kept>,
@@ -185,10 +238,11 @@ struct Kept {
 }
 
 impl ResultWriter {
-    /// A writer of the rows of `columns` to the CSV file `out`.
+    /// A writer of the rows of `columns` to the result file `out` (CSV,
+    /// or MAT v4 if its path ends in `.mat`: [`create`]).
     pub fn new(out: OutputFile, columns: &[String]) -> ResultWriter {
         ResultWriter {
-            file: CsvFile::new(out, columns),
+            file: create(out, columns),
             stats: ColumnStats::new(columns.len()),
             kept: None,
         }
@@ -233,7 +287,7 @@ impl ResultWriter {
         })
     }
 
-    /// The end of the file (see [`CsvFile::finish`]).
+    /// The end of the file (see [`CsvFile::finish`], [`MatFile::finish`]).
     pub fn finish(self, error: Option<&str>) -> Result<(), OutputError> {
         self.file.finish(error)
     }

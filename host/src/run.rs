@@ -238,14 +238,16 @@ impl PreparedRun {
     }
 
     /// Run from start to stop, handing the recorded rows to `sink` as
-    /// they come; `progress(done, total)` is told of the macro steps as
-    /// they complete (every 256 steps and at the last). An FMU that fails
+    /// they come; `progress(done, total)`, if given, is told of the macro
+    /// steps as they complete (every 256 steps and at the last). Without
+    /// progress and external inputs the run takes its loop without any
+    /// call between steps ([`Observer::between_steps`]). An FMU that fails
     /// in initialization is an `Err`; a failure after it is the outcome's
     /// [`RunOutcome::error`], with the rows up to it handed on.
     pub fn run(
         mut self,
         sink: &mut dyn RowSink,
-        progress: &mut dyn FnMut(usize, usize),
+        progress: Option<&mut dyn FnMut(usize, usize)>,
     ) -> Result<RunOutcome, String> {
         let started = std::time::Instant::now();
         let mut watch = Watch {
@@ -286,7 +288,7 @@ pub fn run(
     options: &RunOptions,
     sink: &mut dyn RowSink,
 ) -> Result<RunOutcome, String> {
-    PreparedRun::new(file, options)?.run(sink, &mut |_, _| {})
+    PreparedRun::new(file, options)?.run(sink, None)
 }
 
 /// What a run did.
@@ -317,10 +319,15 @@ pub struct RunOutcome {
 /// The external inputs and the progress callback, consulted by the run.
 struct Watch<'p> {
     inputs: Option<ExternalInputs>,
-    progress: &'p mut dyn FnMut(usize, usize),
+    progress: Option<&'p mut dyn FnMut(usize, usize)>,
 }
 
 impl Observer for Watch<'_> {
+    /// Nothing to do between steps without external inputs or progress.
+    fn between_steps(&self) -> bool {
+        self.inputs.is_some() || self.progress.is_some()
+    }
+
     fn before_step(&mut self, system: &mut System, t: f64, init: bool) -> Result<(), FmuError> {
         match &mut self.inputs {
             Some(i) => i.before_step(system, t, init),
@@ -330,8 +337,10 @@ impl Observer for Watch<'_> {
 
     fn after_step(&mut self, done: usize, total: usize) {
         // every 256 steps keeps even the callback out of the step loop's cost
-        if done.is_multiple_of(256) || done == total {
-            (self.progress)(done, total);
+        if let Some(progress) = &mut self.progress {
+            if done.is_multiple_of(256) || done == total {
+                progress(done, total);
+            }
         }
     }
 }

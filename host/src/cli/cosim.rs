@@ -32,7 +32,8 @@ pub struct CosimArgs {
     /// Stop time in seconds.
     #[arg(long, default_value_t = 1.0)]
     pub stop: f64,
-    /// Result CSV.
+    /// Result file: CSV, or MAT v4 in the Dymola/OpenModelica layout if
+    /// it ends in .mat.
     #[arg(long, default_value = "out/result.csv")]
     pub out: PathBuf,
     /// Plot of the chosen signals (.png or .svg) [default: no plot].

@@ -23,7 +23,8 @@ pub struct DiagnoseArgs {
     /// with one LuGre friction component.
     pub system: PathBuf,
     /// Measurements: CSV with `time` first, then `component.variable`
-    /// columns; unconnected inputs drive the system, outputs are compared.
+    /// columns, or a .mat result file; unconnected inputs drive the
+    /// system, outputs are compared.
     pub data: PathBuf,
     /// Held-out measurements (same channels) to score on [default: every
     /// third of 30 equal time blocks of DATA, from the second on, is held

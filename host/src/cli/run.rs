@@ -24,7 +24,8 @@ pub struct RunArgs {
     /// file's annotation, else jacobi].
     #[arg(long)]
     pub master: Option<String>,
-    /// Result CSV [default: out/<file name>.csv].
+    /// Result file: CSV, or MAT v4 in the Dymola/OpenModelica layout if
+    /// it ends in .mat [default: out/<file name>.csv].
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Plot of the chosen signals (.png or .svg) [default: no plot; the
@@ -134,7 +135,14 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         Some(_) => writer.keep_columns(&columns, &plot_signals).err(),
         None => None,
     };
-    let run = prepared.run(&mut writer, &mut |done, _| bar.set_position(done as u64))?;
+    // a hidden bar (--quiet, stderr not a terminal) needs no progress
+    let mut progress = |done: usize, _| bar.set_position(done as u64);
+    let progress: Option<&mut dyn FnMut(usize, usize)> = if bar.is_hidden() {
+        None
+    } else {
+        Some(&mut progress)
+    };
+    let run = prepared.run(&mut writer, progress)?;
     bar.finish_and_clear();
 
     let kept = writer.kept();
