@@ -104,8 +104,10 @@ def run(
     stop: Optional[float] = None,
     step: Optional[float] = None,
     master: Optional[str] = None,
+    output_interval: Optional[float] = None,
     input: Any = None,
     record: Sequence[str] = (),
+    step_timeout: Optional[float] = None,
 ) -> np.ndarray:
     """Co-simulate the system file ``system`` (``.ssd`` or ``.ssp``) as
     ``fricsim run`` does, and return its rows as a numpy structured array:
@@ -114,10 +116,12 @@ def run(
     ``start_values`` maps ``component.variable`` to a value set after the
     file's own parameter values (numbers; text for String variables).
     ``start``, ``stop``, ``step`` and ``master`` default to the file's
-    ``DefaultExperiment`` and annotation. ``input`` is a CSV path, a
+    ``DefaultExperiment`` and annotation; ``output_interval`` (a whole
+    multiple of the step) records every k-th communication point only. ``input`` is a CSV path, a
     structured array or a DataFrame with ``time`` first and a column per
     unconnected input, interpolated linearly in time as FMPy does.
-    ``record`` names further Real variables to record.
+    ``record`` names further Real variables to record. ``step_timeout``
+    limits each FMI call, in seconds.
 
     A run that stops early raises :class:`FricsimError`; the rows up to the
     failure are its ``result`` attribute.
@@ -134,8 +138,10 @@ def run(
             step=step,
             master=master,
             start_values=values,
+            output_interval=output_interval,
             record=list(record),
             input=input_path,
+            step_timeout=step_timeout,
         )
     dtype = np.dtype([(c, np.float64) for c in columns])
     result = np.frombuffer(data, dtype=dtype).copy()

@@ -19,12 +19,12 @@ use fricsim::diagnose::{diagnose as run_diagnosis, report, CrossValidate, Option
 use fricsim::fmu::archive::{unpack, UnpackOptions};
 use fricsim::fmu::library::platforms;
 use fricsim::fmu::ModelDescription;
-use fricsim::inputs::{ExternalInputs, InputTable};
-use fricsim::master::{by_name, simulate_streaming, Observer, RowSink};
+use fricsim::inputs::InputTable;
+use fricsim::master::{by_name, RowSink};
 use fricsim::rows::Rows;
+use fricsim::run::{time_grid, PreparedRun, RunOptions, StartValue};
 use fricsim::ssp::SystemFile;
 use fricsim::sweep::{check_axes, run_all, Axis, Plan};
-use fricsim::system::{ParameterValue, System};
 use fricsim::FmuError;
 use pyo3::create_exception;
 use pyo3::exceptions::PyRuntimeError;
@@ -33,6 +33,7 @@ use pyo3::types::PyBytes;
 use serde_json::json;
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 create_exception!(
     fricsim,
@@ -45,57 +46,26 @@ fn host_error(message: impl Into<String>) -> PyErr {
     FricsimError::new_err(message.into())
 }
 
-/// A start value or swept value from Python: a number (float, int, bool)
-/// or text (a String variable).
+/// A start value from Python, typed as Python types it: `bool`, `int`,
+/// `float`, `str` (checked against the variable's type by
+/// [`fricsim::run::check_start_value`]).
 #[derive(FromPyObject)]
 enum Value {
-    Number(f64),
+    Boolean(bool),
+    Integer(i64),
+    Real(f64),
     Text(String),
 }
 
-impl Value {
-    fn into_parameter(self) -> ParameterValue {
-        match self {
-            Value::Number(x) => ParameterValue::Number(x),
-            Value::Text(s) => ParameterValue::Text(s),
+impl From<Value> for StartValue {
+    fn from(value: Value) -> StartValue {
+        match value {
+            Value::Boolean(b) => StartValue::Boolean(b),
+            Value::Integer(i) => StartValue::Integer(i),
+            Value::Real(x) => StartValue::Real(x),
+            Value::Text(s) => StartValue::String(s),
         }
     }
-}
-
-/// `(start, stop, step)`: the arguments where given, else the file's
-/// `DefaultExperiment` and stepSize annotation, as `fricsim run` resolves
-/// them.
-fn time_grid(
-    file: &SystemFile,
-    start: Option<f64>,
-    stop: Option<f64>,
-    step: Option<f64>,
-) -> Result<(f64, f64, f64), String> {
-    let start = start.or(file.start_time).unwrap_or(0.0);
-    if !start.is_finite() {
-        return Err(format!("start must be finite, got {start}"));
-    }
-    let stop = stop.or(file.stop_time).ok_or_else(|| {
-        format!(
-            "{}: no stop time: give stop= or <ssd:DefaultExperiment stopTime=\"…\">",
-            file.ssd
-        )
-    })?;
-    if !(stop.is_finite() && stop > start) {
-        return Err(format!(
-            "the stop time {stop} must be after the start time {start}"
-        ));
-    }
-    let step = step.or(file.settings.step_size).ok_or_else(|| {
-        format!(
-            "{}: no step size: give step= or the stepSize of the fricsim annotation",
-            file.ssd
-        )
-    })?;
-    if !(step.is_finite() && step > 0.0) {
-        return Err(format!("step must be a positive number, got {step}"));
-    }
-    Ok((start, stop, step))
 }
 
 /// `fricsim.info`: the model description of an FMU (the archive and its
@@ -160,22 +130,6 @@ fn description_json(d: &ModelDescription, platforms: &[String]) -> serde_json::V
     })
 }
 
-/// The external inputs of a run, consulted before each step.
-struct Inputs(Option<ExternalInputs>);
-
-impl Observer for Inputs {
-    fn before_step(&mut self, system: &mut System, t: f64, init: bool) -> Result<(), FmuError> {
-        match &mut self.0 {
-            Some(i) => i.before_step(system, t, init),
-            None => Ok(()),
-        }
-    }
-
-    fn between_steps(&self) -> bool {
-        self.0.is_some()
-    }
-}
-
 /// The rows of a run, `time` then the columns, row after row; between
 /// chunks, a look for Ctrl-C.
 struct Collect {
@@ -202,15 +156,15 @@ impl RowSink for Collect {
     }
 }
 
-/// What `run` hands back: the column names (`time` first), the rows as
-/// native-endian f64 bytes, and why the run stopped early, if it did.
+/// What `run` hands back: the column names (`time` first), the rows, and
+/// why the run stopped early, if it did.
 type RunResult = (Vec<String>, Vec<f64>, Option<String>);
 
 /// `fricsim.run`: co-simulate a system file exactly as `fricsim run` does
-/// (the same master, time grid, start values and inputs), returning the
-/// rows instead of writing a CSV.
+/// (one code path: [`fricsim::run::PreparedRun`]), returning the rows
+/// instead of writing a CSV.
 #[pyfunction]
-#[pyo3(signature = (system, start=None, stop=None, step=None, master=None, start_values=Vec::new(), record=Vec::new(), input=None))]
+#[pyo3(signature = (system, start=None, stop=None, step=None, master=None, start_values=Vec::new(), output_interval=None, record=Vec::new(), input=None, step_timeout=None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -220,54 +174,53 @@ fn run(
     step: Option<f64>,
     master: Option<String>,
     start_values: Vec<(String, Value)>,
+    output_interval: Option<f64>,
     record: Vec<String>,
     input: Option<PathBuf>,
+    step_timeout: Option<f64>,
 ) -> PyResult<(Vec<String>, Py<PyBytes>, Option<String>)> {
-    let overrides: Vec<(String, ParameterValue)> = start_values
-        .into_iter()
-        .map(|(k, v)| (k, v.into_parameter()))
-        .collect();
-    let outcome = py.allow_threads(move || -> Result<RunResult, PyErr> {
-        let file = SystemFile::open(&system).map_err(|e| host_error(e.to_string()))?;
-        let (start, stop, step) = time_grid(&file, start, stop, step).map_err(host_error)?;
-        let master = master.unwrap_or_else(|| file.settings.master_or_default());
-        let mut master = by_name(&master).map_err(host_error)?;
-        let mut built = file
-            .build_with(start, &overrides)
-            .map_err(|e| host_error(e.to_string()))?;
-        for port in &record {
-            built.record(port).map_err(|e| host_error(e.to_string()))?;
+    let call_time_limit = match step_timeout {
+        None => None,
+        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
+        Some(s) => {
+            return Err(host_error(format!(
+                "step_timeout must be a positive number of seconds, got {s}"
+            )))
         }
-        let inputs = match &input {
-            Some(path) => Some(
-                InputTable::read(path)
-                    .and_then(|table| ExternalInputs::bind(table, &built))
-                    .map_err(host_error)?,
-            ),
-            None => None,
+    };
+    let start_values = start_values
+        .into_iter()
+        .map(|(k, v)| (k, StartValue::from(v)))
+        .collect();
+    let (columns, values, error) = py.allow_threads(move || -> Result<RunResult, PyErr> {
+        let file = SystemFile::open(&system).map_err(|e| host_error(e.to_string()))?;
+        let options = RunOptions {
+            start,
+            stop,
+            step,
+            master,
+            start_values,
+            output_interval,
+            record,
+            inputs: match &input {
+                Some(path) => Some(InputTable::read(path).map_err(host_error)?),
+                None => None,
+            },
+            call_time_limit,
         };
+        let prepared = PreparedRun::new(&file, &options).map_err(host_error)?;
         let mut sink = Collect {
             values: Vec::new(),
             interrupt: RefCell::new(None),
         };
-        let streamed = simulate_streaming(
-            &mut built,
-            master.as_mut(),
-            start,
-            step,
-            stop,
-            &mut Inputs(inputs),
-            &mut sink,
-        )
-        .map_err(|e| host_error(format!("initialization failed: {e}")))?;
+        let outcome = prepared.run(&mut sink, &mut |_, _| {}).map_err(host_error)?;
         if let Some(signal) = sink.interrupt.into_inner() {
             return Err(signal);
         }
         let mut columns = vec!["time".to_string()];
-        columns.extend(streamed.columns);
-        Ok((columns, sink.values, streamed.error))
+        columns.extend(outcome.columns);
+        Ok((columns, sink.values, outcome.error))
     })?;
-    let (columns, values, error) = outcome;
     let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_ne_bytes()).collect();
     Ok((columns, PyBytes::new(py, &bytes).unbind(), error))
 }
