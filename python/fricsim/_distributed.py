@@ -124,16 +124,29 @@ def _frame(names: list, points: list, rows: list):
 
 def _payload(system: PathLike, shared_path: bool) -> Union[str, tuple]:
     """What travels to the workers: the path (a shared file system), or
-    ``(file name, bytes of the .ssp)``."""
+    ``(file name, bytes of the .ssp, the path as the caller gave it)``."""
+    label = os.fspath(system)
     system = Path(system)
     if shared_path:
         return os.fspath(system.resolve())
     if system.suffix.lower() == ".ssp":
-        return (system.name, system.read_bytes())
+        return (system.name, system.read_bytes(), label)
     with tempfile.TemporaryDirectory(prefix="fricsim-pack-") as tmp:
         packed = Path(tmp) / (system.stem + ".ssp")
         _native.pack(os.fspath(system), os.fspath(packed))
-        return (packed.name, packed.read_bytes())
+        return (packed.name, packed.read_bytes(), label)
+
+
+def _as_given(message: Optional[str], payload, local: str) -> Optional[str]:
+    """A message of a worker with the system named as the caller named it
+    (not by the worker's temporary copy): the same text as a run of the
+    caller's file in this process."""
+    if message is None or isinstance(payload, str):
+        return message
+    label = payload[2]
+    if label.lower().endswith(".ssd"):
+        message = message.replace(f"{local}!/SystemStructure.ssd", label)
+    return message.replace(local, label)
 
 
 def _carry(payload):
@@ -151,7 +164,7 @@ def _local_system(payload) -> str:
     process exits)."""
     if isinstance(payload, str):
         return payload
-    name, data = payload
+    name, data = payload[0], payload[1]
     key = hashlib.sha256(data).hexdigest()
     path = _WRITTEN.get(key)
     if path is None or not os.path.exists(path):
@@ -167,10 +180,14 @@ def _local_system(payload) -> str:
 def _sweep_task(payload, names: list, points: list, settings: dict) -> list:
     """One chunk of a sweep, in a worker: the rows, or an error row per
     point when the chunk cannot run at all."""
+    local = "?"
     try:
-        return _native.sweep(_local_system(payload), names, points, threads=1, **settings)
+        local = _local_system(payload)
+        rows = _native.sweep(local, names, points, threads=1, **settings)
+        return [(*r[:5], _as_given(r[5], payload, local)) for r in rows]
     except Exception as e:  # a failing chunk is rows that say so
-        return [([], [], [], 0, 0.0, f"{type(e).__name__}: {e}") for _ in points]
+        error = _as_given(f"{type(e).__name__}: {e}", payload, local)
+        return [([], [], [], 0, 0.0, error) for _ in points]
 
 
 def _sweep_on(client, system, names, points, settings, per_task, shared_path) -> list:
@@ -193,17 +210,25 @@ def _sweep_on(client, system, names, points, settings, per_task, shared_path) ->
 
 def _diagnose_task(payload, data, heldout, options: dict) -> dict:
     """One diagnosis, in a worker: the report's main figures, the report
-    itself and the refitted system's bytes, or the error."""
+    itself and the refitted system's bytes, or the error; the files named
+    as the caller named them."""
     from . import diagnose
 
+    renames = []
     try:
         system = _local_system(payload)
+        renames.append((system, payload))
         with tempfile.TemporaryDirectory(prefix="fricsim-diagnose-") as tmp:
-            data = _materialise(data, Path(tmp) / "data.csv")
+            local_data = _materialise(data, Path(tmp) / "data.csv", renames)
+            local_heldout = None
             if heldout is not None:
-                heldout = _materialise(heldout, Path(tmp) / "heldout.csv")
-            d = diagnose(system, data, heldout, out=Path(tmp) / "out", **options)
+                local_heldout = _materialise(heldout, Path(tmp) / "heldout.csv", renames)
+            d = diagnose(system, local_data, local_heldout, out=Path(tmp) / "out", **options)
             refitted = d.refitted_system.read_bytes()
+        report = d.report
+        for key in ("system", "data", "heldout"):
+            if isinstance(report.get(key), str):
+                report[key] = _renamed(report[key], renames)
         return {
             "effects": d.effect_names,
             "nominal_rms": d.nominal_rms,
@@ -211,27 +236,35 @@ def _diagnose_task(payload, data, heldout, options: dict) -> dict:
             "floor_rms": d.floor_rms,
             "unexplained": d.unexplained,
             "wall_seconds": d.wall_seconds,
-            "report": d.report,
+            "report": report,
             "refitted_ssp": refitted,
             "error": None,
         }
     except Exception as e:  # one failing dataset is a row that says so
-        return {"error": f"{type(e).__name__}: {e}"}
+        return {"error": _renamed(f"{type(e).__name__}: {e}", renames)}
 
 
-def _materialise(table, path: Path):
-    """A dataset sent as ``("csv", bytes)`` written to ``path``; a
+def _renamed(message: str, renames: list) -> str:
+    for local, payload in renames:
+        message = _as_given(message, payload, os.fspath(local))
+    return message
+
+
+def _materialise(table, path: Path, renames: list):
+    """A dataset sent as ``("csv", bytes, name)`` written to ``path``; a
     DataFrame as it is."""
     if isinstance(table, tuple) and table[0] == "csv":
         path.write_bytes(table[1])
+        renames.append((path, (None, None, table[2])))
         return path
     return table
 
 
 def _dataset(table):
-    """A dataset as it travels: a CSV file's bytes, a DataFrame as it is."""
+    """A dataset as it travels: a CSV file's bytes and name, a DataFrame as
+    it is."""
     if isinstance(table, (str, os.PathLike)):
-        return ("csv", Path(table).read_bytes())
+        return ("csv", Path(table).read_bytes(), os.fspath(table))
     return table
 
 
@@ -277,4 +310,7 @@ def diagnose_many(
     for p, r in zip(pairs, results):
         label = os.fspath(p[1]) if isinstance(p[1], (str, os.PathLike)) else type(p[1]).__name__
         rows.append({"system": os.fspath(p[0]), "data": label, **r})
-    return pd.DataFrame(rows)
+    frame = pd.DataFrame(rows)
+    # object, so that a diagnosis without error holds None (not NaN)
+    frame["error"] = pd.Series([r.get("error") for r in results], dtype=object)
+    return frame
