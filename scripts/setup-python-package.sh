@@ -7,8 +7,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup-venv.sh
-# the extension's build beside the workspace's, not in python/target
-export CARGO_TARGET_DIR="$PWD/target/python"
+# in the workspace's target/, whose release-test build (run-tests.sh's
+# cargo test) has compiled the host and its dependencies already
+export CARGO_TARGET_DIR="$PWD/target"
 # maturin, the build backend, from the venv (pinned in tests/requirements.txt)
 export PATH="$PWD/.venv/bin:$PATH"
 .venv/bin/pip install --quiet --disable-pip-version-check --no-deps \
