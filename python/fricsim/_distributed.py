@@ -124,17 +124,20 @@ def _frame(names: list, points: list, rows: list):
 
 def _payload(system: PathLike, shared_path: bool) -> Union[str, tuple]:
     """What travels to the workers: the path (a shared file system), or
-    ``(file name, bytes of the .ssp, the path as the caller gave it)``."""
+    ``(file name, bytes of the .ssp, the path as the caller gave it, the
+    bytes' SHA-256)``, hashed here once rather than by every task."""
     label = os.fspath(system)
     system = Path(system)
     if shared_path:
         return os.fspath(system.resolve())
     if system.suffix.lower() == ".ssp":
-        return (system.name, system.read_bytes(), label)
+        data = system.read_bytes()
+        return (system.name, data, label, hashlib.sha256(data).hexdigest())
     with tempfile.TemporaryDirectory(prefix="fricsim-pack-") as tmp:
         packed = Path(tmp) / (system.stem + ".ssp")
         _native.pack(os.fspath(system), os.fspath(packed))
-        return (packed.name, packed.read_bytes(), label)
+        data = packed.read_bytes()
+        return (packed.name, data, label, hashlib.sha256(data).hexdigest())
 
 
 def _as_given(message: Optional[str], payload, local: str) -> Optional[str]:
@@ -164,8 +167,7 @@ def _local_system(payload) -> str:
     process exits)."""
     if isinstance(payload, str):
         return payload
-    name, data = payload[0], payload[1]
-    key = hashlib.sha256(data).hexdigest()
+    name, data, _, key = payload
     path = _WRITTEN.get(key)
     if path is None or not os.path.exists(path):
         folder = tempfile.mkdtemp(prefix="fricsim-worker-")
@@ -255,7 +257,7 @@ def _materialise(table, path: Path, renames: list):
     DataFrame as it is."""
     if isinstance(table, tuple) and table[0] == "csv":
         path.write_bytes(table[1])
-        renames.append((path, (None, None, table[2])))
+        renames.append((path, (None, None, table[2], None)))
         return path
     return table
 
