@@ -213,7 +213,9 @@ fn run(
             values: Vec::new(),
             interrupt: RefCell::new(None),
         };
-        let outcome = prepared.run(&mut sink, &mut |_, _| {}).map_err(host_error)?;
+        let outcome = prepared
+            .run(&mut sink, &mut |_, _| {})
+            .map_err(host_error)?;
         if let Some(signal) = sink.interrupt.into_inner() {
             return Err(signal);
         }
