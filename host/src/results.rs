@@ -7,43 +7,45 @@
 //! ([`crate::master::simulate_streaming`]) and writes them at once, keeping
 //! only a summary of each column and the columns to be plotted, so that a
 //! run's memory does not grow with its length; [`write_csv`] writes a
-//! [`Run`] held in memory as the same file.
+//! [`Run`] held in memory as the same file. Both write through an
+//! [`OutputFile`]: a result is put in place whole (or marked incomplete)
+//! or not at all.
 
 use crate::master::{RowSink, Run};
+use crate::output_file::{OutputError, OutputFile};
 use crate::rows::Rows;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::Path;
 
-/// A CSV result file written row by row: created (with its directory) at
-/// the first rows, so that a run that fails before its first row leaves
-/// no file.
+/// A CSV result file written row by row to an [`OutputFile`] (so that it
+/// is put in place whole, or marked incomplete, or not at all).
 pub struct CsvFile {
-    path: PathBuf,
     header: String,
-    out: Option<BufWriter<File>>,
+    header_written: bool,
+    out: OutputFile,
 }
 
 impl CsvFile {
-    /// A file at `path` with the columns `time` and `columns`.
-    pub fn new(path: &Path, columns: &[String]) -> CsvFile {
+    /// A CSV file in `out` with the columns `time` and `columns`.
+    pub fn new(out: OutputFile, columns: &[String]) -> CsvFile {
         CsvFile {
-            path: path.to_path_buf(),
             header: header(columns),
-            out: None,
+            header_written: false,
+            out,
         }
     }
 
-    fn out(&mut self) -> std::io::Result<&mut BufWriter<File>> {
-        if self.out.is_none() {
-            if let Some(dir) = self.path.parent() {
-                std::fs::create_dir_all(dir)?;
-            }
-            let mut out = BufWriter::with_capacity(1 << 16, File::create(&self.path)?);
-            writeln!(out, "{}", self.header)?;
-            self.out = Some(out);
+    /// The path the file is put at.
+    pub fn path(&self) -> &Path {
+        self.out.path()
+    }
+
+    fn out(&mut self) -> std::io::Result<&mut OutputFile> {
+        if !self.header_written {
+            self.header_written = true;
+            writeln!(self.out, "{}", self.header)?;
         }
-        Ok(self.out.as_mut().expect("opened above"))
+        Ok(&mut self.out)
     }
 
     /// The first `times.len()` rows of `rows`, at `times`.
@@ -65,18 +67,20 @@ impl CsvFile {
     }
 
     /// The end of the file: `# INCOMPLETE: the run stopped early: …` if
-    /// `error` says why the run stopped early.
-    pub fn finish(mut self, error: Option<&str>) -> std::io::Result<()> {
-        let out = self.out()?;
-        if let Some(e) = error {
-            let one_line = e.replace(['\n', '\r'], " ");
-            writeln!(out, "# INCOMPLETE: the run stopped early: {one_line}")?;
+    /// `error` says why the run stopped early; then the file is put in
+    /// place ([`OutputFile::commit`]: not after a write error).
+    pub fn finish(mut self, error: Option<&str>) -> Result<(), OutputError> {
+        // a write error is kept by the OutputFile and reported by commit
+        if let Ok(out) = self.out() {
+            if let Some(e) = error {
+                let one_line = e.replace(['\n', '\r'], " ");
+                let _ = writeln!(out, "# INCOMPLETE: the run stopped early: {one_line}");
+            }
         }
-        out.flush()
+        self.out.commit()
     }
 }
 
-/// Write `run` (rows held in memory) as a CSV result file.
 /// The header line: `time`, then the columns, comma-separated (`time`
 /// alone when nothing else is recorded, not `time,`).
 fn header(columns: &[String]) -> String {
@@ -86,9 +90,11 @@ fn header(columns: &[String]) -> String {
         .join(",")
 }
 
-pub fn write_csv(run: &Run, path: &Path) -> std::io::Result<()> {
-    let mut file = CsvFile::new(path, &run.columns);
-    file.write_rows(&run.time, &run.rows)?;
+/// Write `run` (rows held in memory) as a CSV result file to `out`.
+pub fn write_csv(run: &Run, out: OutputFile) -> Result<(), OutputError> {
+    let mut file = CsvFile::new(out, &run.columns);
+    // a write error is reported by finish, with the path
+    let _ = file.write_rows(&run.time, &run.rows);
     file.finish(run.error.as_deref())
 }
 
@@ -150,10 +156,10 @@ struct Kept {
 }
 
 impl ResultWriter {
-    /// A writer of the rows of `columns` to the CSV file `path`.
-    pub fn new(path: &Path, columns: &[String]) -> ResultWriter {
+    /// A writer of the rows of `columns` to the CSV file `out`.
+    pub fn new(out: OutputFile, columns: &[String]) -> ResultWriter {
         ResultWriter {
-            file: CsvFile::new(path, columns),
+            file: CsvFile::new(out, columns),
             stats: ColumnStats::new(columns.len()),
             kept: None,
         }
@@ -194,7 +200,7 @@ impl ResultWriter {
     }
 
     /// The end of the file (see [`CsvFile::finish`]).
-    pub fn finish(self, error: Option<&str>) -> std::io::Result<()> {
+    pub fn finish(self, error: Option<&str>) -> Result<(), OutputError> {
         self.file.finish(error)
     }
 }
@@ -203,7 +209,7 @@ impl RowSink for ResultWriter {
     fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String> {
         self.file
             .write_rows(times, rows)
-            .map_err(|e| format!("{}: {e}", self.file.path.display()))?;
+            .map_err(|e| format!("{}: {e}", self.file.path().display()))?;
         self.stats.add(times, rows);
         if let Some(k) = &mut self.kept {
             k.time.extend_from_slice(times);
@@ -215,6 +221,11 @@ impl RowSink for ResultWriter {
             }
         }
         Ok(())
+    }
+
+    /// A termination signal stops the run ([`crate::signals`]).
+    fn stop_requested(&self) -> Option<String> {
+        crate::signals::stop_reason()
     }
 }
 

@@ -2,6 +2,7 @@
 //! with a fixed macro step, write a CSV and a plot, print a summary.
 
 use fricsim::master::{simulate_streaming, NoObserver};
+use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
@@ -90,13 +91,16 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
         .collect::<Result<Vec<_>, _>>()?;
     let components: Vec<(String, &Path)> =
         components.iter().map(|(n, p)| (n.clone(), *p)).collect();
+    let mut inputs: Vec<(&str, &Path)> = components.iter().map(|(_, p)| ("the FMU", *p)).collect();
+    inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
+    let output = OutputFile::create(&a.out, &inputs).map_err(|e| e.to_string())?;
     let mut system =
         System::build(&components, &parameters, &connections).map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
     let mut master = fricsim::master::by_name(&a.master)?;
     super::print_warnings(system.warnings());
     let columns = system.columns();
-    let mut writer = ResultWriter::new(&a.out, &columns);
+    let mut writer = ResultWriter::new(output, &columns);
     let signals = if a.plot_signals.is_empty() {
         columns.clone()
     } else {
@@ -123,7 +127,7 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     let stats = writer.stats.clone();
     writer
         .finish(run.error.as_deref())
-        .map_err(|e| format!("{}: {e}", a.out.display()))?;
+        .map_err(|e| e.to_string())?;
     if let Some(e) = plot_error {
         return Err(e);
     }

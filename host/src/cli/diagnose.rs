@@ -13,6 +13,7 @@ pub enum CrossValidateArg {
     Always,
     Never,
 }
+use fricsim::output_file::same_file;
 use fricsim::ssp::SystemFile;
 use std::path::PathBuf;
 
@@ -110,6 +111,29 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             .map(|c| Effect::from_name(c))
             .collect::<Result<_, _>>()?;
     }
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, "-diagnosis").with_extension(""));
+    // the report directory is written whole (diagnose::report), but never
+    // over one of the inputs
+    let inputs = [
+        Some(("the system file", &a.system)),
+        Some(("the measured data", &a.data)),
+        a.heldout.as_ref().map(|p| ("the held-out data", p)),
+        a.lugre.as_ref().map(|p| ("the LuGre FMU", p)),
+    ];
+    if let Some((what, input)) = inputs
+        .into_iter()
+        .flatten()
+        .find(|(_, p)| same_file(&out, p))
+    {
+        return Err(format!(
+            "the report directory {} is {what} {}, an input of the run: choose another --out",
+            out.display(),
+            input.display()
+        ));
+    }
     let mut file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
     let moved = fricsim::diagnose::dahl::move_to_lugre(&mut file, a.lugre.as_deref())?;
     let mut d = diagnose(&file, &a.data, a.heldout.as_deref(), &options)?;
@@ -117,10 +141,6 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         println!("note: {note}");
         d.notes.push(note);
     }
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::default_out(&a.system, "-diagnosis").with_extension(""));
     report::write(&d, &file, &d.friction_component, &out)?;
     let names: Vec<&str> = d.effects.iter().map(|e| e.name.name()).collect();
     println!(

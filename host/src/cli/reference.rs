@@ -84,7 +84,9 @@ pub fn run(a: &ReferenceArgs) -> Result<(), String> {
         error: None,
     };
     // The writer of `fricsim run`: the same format to the digit.
-    fricsim::results::write_csv(&run, &out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let output = fricsim::output_file::OutputFile::create(&out, &file.files_read())
+        .map_err(|e| e.to_string())?;
+    fricsim::results::write_csv(&run, output).map_err(|e| e.to_string())?;
 
     println!("{}: {}", file.ssd, model.description());
     print!(

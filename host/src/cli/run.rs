@@ -5,6 +5,7 @@
 //! (`DefaultExperiment`, our annotation), else from defaults.
 
 use fricsim::inputs::InputTable;
+use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
 use fricsim::run::{PreparedRun, RunOptions, RunOutcome};
 use fricsim::ssp::SystemFile;
@@ -56,6 +57,16 @@ pub struct RunArgs {
 
 pub fn run(a: &RunArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
+    // the result file is claimed before the FMUs are opened: a run that
+    // would overwrite an input or another run's result stops here
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, ""));
+    let mut inputs = file.files_read();
+    inputs.extend(a.input.as_deref().map(|p| ("the --input table", p)));
+    inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
+    let output = OutputFile::create(&out, &inputs).map_err(|e| e.to_string())?;
     let plot_signals = if !a.plot_signals.is_empty() {
         a.plot_signals.clone()
     } else {
@@ -91,12 +102,8 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         );
         bar
     };
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::default_out(&a.system, ""));
     let columns = prepared.columns();
-    let mut writer = ResultWriter::new(&out, &columns);
+    let mut writer = ResultWriter::new(output, &columns);
     let plot_signals = if plot_signals.is_empty() {
         columns.clone()
     } else {
@@ -113,7 +120,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     let kept = writer.kept();
     writer
         .finish(run.error.as_deref())
-        .map_err(|e| format!("{}: {e}", out.display()))?;
+        .map_err(|e| e.to_string())?;
     if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
         let title = format!(
             "{} ({master})",

@@ -217,6 +217,8 @@ pub struct SystemFile {
     /// Whether sources must stay inside the base directory (an archive).
     in_archive: bool,
     base: PathBuf,
+    /// The `.ssv` files of the parameter bindings (outside an archive).
+    parameter_files: Vec<PathBuf>,
     _unpacked: Option<TempDir>,
 }
 
@@ -313,6 +315,26 @@ fn parse_number(text: &str) -> Option<f64> {
 }
 
 impl SystemFile {
+    /// The files a run of this system reads, each with what it is: the
+    /// system file, and outside an archive the FMUs and `.ssv` files it
+    /// points at (an archive's are unpacked copies).
+    pub fn files_read(&self) -> Vec<(&'static str, &Path)> {
+        let mut files = vec![("the system file", self.path.as_path())];
+        if !self.in_archive {
+            files.extend(
+                self.components
+                    .iter()
+                    .map(|c| ("the FMU", c.source.as_path())),
+            );
+            files.extend(
+                self.parameter_files
+                    .iter()
+                    .map(|p| ("the parameter file", p.as_path())),
+            );
+        }
+        files
+    }
+
     /// Read a `.ssd` file or an `.ssp` archive (by its extension).
     pub fn open(path: impl AsRef<Path>) -> Result<SystemFile, SspError> {
         let path = path.as_ref();
@@ -361,6 +383,7 @@ impl SystemFile {
             settings: Settings::default(),
             in_archive,
             base,
+            parameter_files: Vec::new(),
             _unpacked: None,
         };
         file.parse(&text)?;
@@ -584,6 +607,11 @@ impl SystemFile {
                 None => String::new(),
             };
             let location = at("ParameterBinding", k, format!("{owner_text}{shown}"));
+            if let (Some(source), false) = (&b.source, self.in_archive) {
+                if let Ok(path) = self.resolve(source) {
+                    self.parameter_files.push(path);
+                }
+            }
             let params = self.binding(owner.as_deref(), b, &location, &lines, first_parameter)?;
             applied.push((owner, params));
         }
