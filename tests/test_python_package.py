@@ -161,6 +161,13 @@ def test_errors_carry_the_host_messages(tmp_path):
     with pytest.raises(fricsim.FricsimError, match="unknown master algorithm `nosuch`"):
         fricsim.run(STICK_SLIP, stop=1.0, master="nosuch")
 
+    with pytest.raises(fricsim.FricsimError, match="alpha 2: must be between 0 and 1"):
+        fricsim.diagnose(EMPS, EMPS_TRAIN, out=tmp_path / "d", alpha=2.0)
+    with pytest.raises(fricsim.FricsimError, match="unknown effect|nosuch"):
+        fricsim.diagnose(EMPS, EMPS_TRAIN, out=tmp_path / "d", candidates=["nosuch"])
+    with pytest.raises(TypeError, match="unknown option.*alhpa"):
+        fricsim.diagnose(EMPS, EMPS_TRAIN, out=tmp_path / "d", alhpa=0.1)
+
 
 def test_sweep_equals_the_command_sweep_bit_for_bit(tmp_path):
     grid = {"friction.Fs": [1.5, 2.0], "rig.k": [2.0, 3.0]}

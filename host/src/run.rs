@@ -380,7 +380,7 @@ impl RowSink for Recorder<'_> {
                 self.picked_times.push(*t);
             }
         }
-        self.pending = match (times.last(), rows.iter().take(times.len()).last()) {
+        self.pending = match (times.last(), rows.iter().take(times.len()).next_back()) {
             (Some(&t), Some(row)) if !(self.seen - 1).is_multiple_of(self.every) => {
                 Some((t, Rows::from_rows(row.len(), [row])))
             }

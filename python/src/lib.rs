@@ -319,7 +319,7 @@ fn diagnose(
             smooth: smooth.unwrap_or(defaults.smooth),
             blocks: blocks.unwrap_or(defaults.blocks),
             polish,
-            master: master.clone(),
+            master,
             cross_validate: match cross_validate.as_deref() {
                 None | Some("auto") => CrossValidate::Auto,
                 Some("always") => CrossValidate::Always,
@@ -332,24 +332,7 @@ fn diagnose(
             },
             ..defaults
         };
-        if let Some(m) = &master {
-            by_name(m).map_err(|e| format!("master: {e}"))?;
-        }
-        if !(options.alpha > 0.0 && options.alpha < 1.0) {
-            return Err(format!("alpha {}: must be between 0 and 1", options.alpha));
-        }
-        if !(2..=32).contains(&options.position_knots) {
-            return Err(format!(
-                "position_knots {}: must be in 2..=32 (the LuGre table holds 32 points)",
-                options.position_knots
-            ));
-        }
-        if options.blocks < 3 {
-            return Err(format!(
-                "blocks {}: at least 3 (every third block is held out)",
-                options.blocks
-            ));
-        }
+        options.check()?;
         if !candidates.is_empty() {
             options.candidates = candidates
                 .iter()
