@@ -252,3 +252,17 @@ def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt(tmp_path):
     assert child.returncode == 3, err
     assert out.strip() == "KeyboardInterrupt"
     assert list(temp.iterdir()) == []
+
+
+def test_seeds_equal_the_command_sweep_with_seeds(tmp_path):
+    piezo = ROOT / "examples" / "piezo_push.ssd"
+    frame = fricsim.sweep(piezo, {}, stop=2.0, seeds=3)
+    out = tmp_path / "seeds.csv"
+    done = cli("sweep", piezo, "--seeds", 3, "--stop", 2.0, "--out", out)
+    assert done.returncode == 0, done.stderr
+    expected = read_exact_csv_mixed(out)
+    assert list(frame["friction.seed"]) == [1.0, 2.0, 3.0]
+    assert len(set(frame["rms:friction.F"])) == 3  # three realisations
+    for i, row in enumerate(expected):
+        assert same_bits(frame["rms:friction.F"][i], float(row["rms:friction.F"]))
+        assert same_bits(frame["final:friction.F"][i], float(row["final:friction.F"]))
