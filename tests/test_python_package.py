@@ -266,3 +266,25 @@ def test_seeds_equal_the_command_sweep_with_seeds(tmp_path):
     for i, row in enumerate(expected):
         assert same_bits(frame["rms:friction.F"][i], float(row["rms:friction.F"]))
         assert same_bits(frame["final:friction.F"][i], float(row["final:friction.F"]))
+
+
+def test_the_gil_is_released_while_a_run_goes_on(tmp_path, monkeypatch):
+    """Python code in another thread runs while Rust runs: this thread sees
+    the run's unpacked FMUs (which exist only inside the Rust call) while
+    the run's thread is still in it. With the GIL held, this thread could
+    only look after the call had returned and removed them."""
+    import threading
+
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    monkeypatch.setenv("TMPDIR", str(temp))
+    done = {}
+    runner = threading.Thread(target=lambda: done.setdefault("rows", len(fricsim.run(STICK_SLIP, stop=60.0))))
+    runner.start()
+    seen_inside = False
+    while runner.is_alive() and not seen_inside:
+        seen_inside = any(temp.iterdir()) and runner.is_alive()
+    runner.join()
+    assert done["rows"] == 600001
+    assert seen_inside
+    assert list(temp.iterdir()) == []
