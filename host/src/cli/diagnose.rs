@@ -87,24 +87,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         },
         ..Options::default()
     };
-    if let Some(m) = &a.master {
-        fricsim::master::by_name(m).map_err(|e| format!("--master: {e}"))?;
-    }
-    if !(a.alpha > 0.0 && a.alpha < 1.0) {
-        return Err(format!("--alpha {}: must be between 0 and 1", a.alpha));
-    }
-    if !(2..=32).contains(&a.position_knots) {
-        return Err(format!(
-            "--position-knots {}: must be in 2..=32 (the LuGre table holds 32 points)",
-            a.position_knots
-        ));
-    }
-    if a.blocks < 3 {
-        return Err(format!(
-            "--blocks {}: at least 3 (every third block is held out)",
-            a.blocks
-        ));
-    }
+    options.check()?;
     if !a.candidates.is_empty() {
         options.candidates = a
             .candidates
