@@ -33,6 +33,7 @@ pub mod plot;
 pub mod reference;
 pub mod results;
 pub mod rows;
+pub mod run;
 pub mod signals;
 pub mod ssp;
 pub mod sweep;

@@ -26,7 +26,9 @@
 //!    over the same increments for comparison (theirs: 0.33 s, 29.1 s,
 //!    19.55 s in Matlab).
 //! 4. **Bristle count** 10 … 100 000: a 1000-increment curve with one
-//!    reversal (0 → 3·δmax → −3·δmax), per-increment cost.
+//!    reversal (0 → 3·δmax → −3·δmax), per-increment cost, of the law and,
+//!    in turns with it, through `Bristle.fmu`'s C ABI (the same forces, bit
+//!    for bit).
 //! 5. **`fricsim sweep`** ([`fricsim::sweep::run_all`]) on one thread and
 //!    on every core: runs per second.
 //! 6. **`fricsim diagnose`** on the EMPS data: the command, timed.
@@ -169,7 +171,7 @@ fn run(args: &Args) -> Result<(), String> {
     let laws = law_table(&root, &sizes)?;
     let host = host_table(&root, &python, &sizes)?;
     let curve = appels_herder_curve(sizes.repeats)?;
-    let scaling = bristle_scaling(sizes.repeats)?;
+    let scaling = bristle_scaling(&root, sizes.repeats)?;
     let sweep = sweep_speedup(&root, &sizes)?;
     let diagnose = if sizes.diagnose {
         Some(time_diagnose(&root)?)
@@ -966,9 +968,49 @@ struct ScalingRow {
     placement: f64,
     /// The 1000-increment curve with one reversal, s.
     curve: f64,
+    /// The same curve through `Bristle.fmu`'s C ABI (`fmi2SetReal` x,
+    /// `fmi2DoStep`, `fmi2GetReal` F per increment), s; taken in turns
+    /// with the law's.
+    fmu: f64,
 }
 
-fn bristle_scaling(repeats: usize) -> Result<Vec<ScalingRow>, String> {
+/// The bristle curve through the C ABI of `Bristle.fmu` with `count`
+/// bristles and the law's default parameters: the time of the
+/// [`INCREMENTS`] steps (instantiation and placement apart), s, and the sum
+/// of the forces, which must equal [`bristle_curve`]'s bit for bit.
+fn bristle_curve_through_fmu(fmu: &Fmu, count: usize) -> Result<(f64, f64), String> {
+    let vr = |name: &str| fmu.variable(name).map(|v| v.value_reference);
+    let e = |e: fricsim::FmuError| e.to_string();
+    let (x, f) = (vr("x").map_err(e)?, vr("F").map_err(e)?);
+    let n_bristles = vr("n_bristles").map_err(e)?;
+    let count_from_load = vr("count_from_load").map_err(e)?;
+    let count = i32::try_from(count).map_err(|_| format!("{count} bristles: too many"))?;
+    let mut b = fmu.instantiate("bristle").map_err(e)?;
+    b.setup_experiment(0.0, None).map_err(e)?;
+    b.enter_initialization_mode().map_err(e)?;
+    // the law's defaults are the FMU's (stiffness from the load, seed 1)
+    // but for the count, set here
+    b.set_boolean(&[count_from_load], &[false]).map_err(e)?;
+    b.set_integer(&[n_bristles], &[count]).map_err(e)?;
+    b.exit_initialization_mode().map_err(e)?;
+    let delta_max = BristleParams::default().delta_max;
+    let h = 1e-3;
+    let mut force = [0.0];
+    let mut sum = 0.0;
+    let clock = Instant::now();
+    for k in 1..=INCREMENTS {
+        b.set_real(&[x], &[bristle_curve_point(k, delta_max)])
+            .map_err(e)?;
+        b.do_step((k - 1) as f64 * h, h).map_err(e)?;
+        b.get_real(&[f], &mut force).map_err(e)?;
+        sum += force[0];
+    }
+    Ok((clock.elapsed().as_secs_f64(), sum))
+}
+
+fn bristle_scaling(root: &Path, repeats: usize) -> Result<Vec<ScalingRow>, String> {
+    let fmu = Fmu::open(root.join("dist/Bristle.fmu"))
+        .map_err(|e| format!("Bristle.fmu: {e} (run ./build-fmu.sh)"))?;
     let mut rows = Vec::new();
     for &count in BRISTLE_COUNTS {
         let p = BristleParams {
@@ -980,8 +1022,28 @@ fn bristle_scaling(repeats: usize) -> Result<Vec<ScalingRow>, String> {
         })?;
         let fresh = Bristle::new(p).map_err(|e| e.to_string())?;
         let half = INCREMENTS / 2;
-        // 0 → 3·δmax in 500 increments, then back to −3·δmax in 500
-        let curve = per_call(repeats, || bristle_curve(&mut fresh.clone()))?;
+        // 0 → 3·δmax in 500 increments, then back to −3·δmax in 500; the
+        // law alone (a clone of the placed bristles each time) and through
+        // the FMU, in turns
+        let law_sum = bristle_curve(&mut fresh.clone());
+        let (curve, fmu_curve) = best_of_alternating(
+            repeats,
+            || {
+                let mut b = fresh.clone();
+                Ok(timed(|| {
+                    std::hint::black_box(bristle_curve(&mut b));
+                }))
+            },
+            || {
+                let (time, sum) = bristle_curve_through_fmu(&fmu, count)?;
+                if sum.to_bits() != law_sum.to_bits() {
+                    return Err(format!(
+                        "{count} bristles: the FMU's forces sum to {sum:e}, the law's to {law_sum:e}"
+                    ));
+                }
+                Ok(time)
+            },
+        )?;
         // bristles that change state over the curve (untimed)
         let mut changes = 0;
         let mut b = fresh.clone();
@@ -993,15 +1055,13 @@ fn bristle_scaling(repeats: usize) -> Result<Vec<ScalingRow>, String> {
             changes += reconnect + (connected + reconnect).abs_diff(b.n_connected());
             connected = b.n_connected();
         }
-        // the clone is part of each timed curve: take it out
-        let clone = per_call(repeats, || fresh.clone().force())?;
-        let curve = (curve - clone).max(0.0);
-        eprintln!("{count} bristles: placement {placement:e} s, curve {curve:e} s");
+        eprintln!("{count} bristles: placement {placement:e} s, curve {curve:e} s, through the FMU {fmu_curve:e} s");
         rows.push(ScalingRow {
             count,
             changes,
             placement,
             curve,
+            fmu: fmu_curve,
         });
     }
     Ok(rows)
@@ -1233,11 +1293,11 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
 
     let _ = writeln!(
         s,
-        "\n**Bristle count**: the bristle law (`friction-laws`) over a {INCREMENTS}-increment curve with one reversal (0 → 3·δmax in 500 increments, back to −3·δmax in 500), Appels and Herder's σ_ini and δmax; the placement (`Bristle::new`, once per realisation) apart:\n"
+        "\n**Bristle count**: the bristle law (`friction-laws`) over a {INCREMENTS}-increment curve with one reversal (0 → 3·δmax in 500 increments, back to −3·δmax in 500), Appels and Herder's σ_ini and δmax; the placement (`Bristle::new`, once per realisation) apart. The last two columns run the same curve through `Bristle.fmu` (`fmi2SetReal` x, `fmi2DoStep`, `fmi2GetReal` F per increment, the FMU loaded by `fricsim::fmu`), in turns with the law; its forces equal the law's bit for bit:\n"
     );
     let _ = writeln!(
         s,
-        "| bristles | placement | curve | per increment | bristle state changes in the curve | per state change | growth of the cost per increment against the count (log–log slope from the previous row) |\n|---|---|---|---|---|---|---|"
+        "| bristles | placement | curve | per increment | bristle state changes in the curve | per state change | growth of the cost per increment against the count (log–log slope from the previous row) | curve through `Bristle.fmu`'s C ABI | FMU / law |\n|---|---|---|---|---|---|---|---|---|"
     );
     let mut previous: Option<&ScalingRow> = None;
     for row in &r.scaling {
@@ -1249,13 +1309,15 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
         });
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.0} ns | {} | {:.1} ns | {slope} |",
+            "| {} | {} | {} | {:.0} ns | {} | {:.1} ns | {slope} | {} | {:.2}× |",
             row.count,
             duration(row.placement),
             duration(row.curve),
             row.curve / INCREMENTS as f64 * 1e9,
             row.changes,
-            row.curve / row.changes.max(1) as f64 * 1e9
+            row.curve / row.changes.max(1) as f64 * 1e9,
+            duration(row.fmu),
+            row.fmu / row.curve
         );
         previous = Some(row);
     }
@@ -1332,6 +1394,15 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
             last.count,
             duration(last.curve),
             met(last.curve < 0.01)
+        );
+        let _ = writeln!(
+            s,
+            "- {} bristles, {INCREMENTS}-increment curve through the C ABI within 2× of the law alone: {:.2}× ({} against {}): {}",
+            last.count,
+            last.fmu / last.curve,
+            duration(last.fmu),
+            duration(last.curve),
+            met(last.fmu <= 2.0 * last.curve)
         );
     }
     if let Some(c) = r.curve.first() {

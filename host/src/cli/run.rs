@@ -4,13 +4,11 @@
 //! Settings come from the command line, else from the file
 //! (`DefaultExperiment`, our annotation), else from defaults.
 
-use fricsim::inputs::{ExternalInputs, InputTable};
-use fricsim::master::{by_name, simulate_streaming, step_count, Observer, Streamed};
+use fricsim::inputs::InputTable;
 use fricsim::output_file::OutputFile;
-use fricsim::results::{ColumnStats, ResultWriter};
+use fricsim::results::ResultWriter;
+use fricsim::run::{PreparedRun, RunOptions, RunOutcome};
 use fricsim::ssp::SystemFile;
-use fricsim::system::System;
-use fricsim::FmuError;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -57,32 +55,8 @@ pub struct RunArgs {
     pub step_timeout: Option<f64>,
 }
 
-/// The progress bar and the external inputs, consulted by the run.
-struct Watch {
-    inputs: Option<ExternalInputs>,
-    bar: ProgressBar,
-}
-
-impl Observer for Watch {
-    fn before_step(&mut self, system: &mut System, t: f64, init: bool) -> Result<(), FmuError> {
-        match &mut self.inputs {
-            Some(i) => i.before_step(system, t, init),
-            None => Ok(()),
-        }
-    }
-
-    fn after_step(&mut self, done: usize, total: usize) {
-        // drawing is rate-limited by indicatif; updating every 256 steps
-        // keeps even the bookkeeping out of the step loop's cost
-        if done.is_multiple_of(256) || done == total {
-            self.bar.set_position(done as u64);
-        }
-    }
-}
-
 pub fn run(a: &RunArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let (start, stop, step) = a.grid.resolve(&file)?;
     // the result file is claimed before the FMUs are opened: a run that
     // would overwrite an input or another run's result stops here
     let out = a
@@ -93,25 +67,29 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     inputs.extend(a.input.as_deref().map(|p| ("the --input table", p)));
     inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
     let output = OutputFile::create(&out, &inputs).map_err(|e| e.to_string())?;
-    let mut master = by_name(&super::master_name(&a.master, &file))?;
-
-    let mut system = file.build(start).map_err(|e| e.to_string())?;
-    system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
-    super::print_warnings(system.warnings());
     let plot_signals = if !a.plot_signals.is_empty() {
         a.plot_signals.clone()
     } else {
         file.settings.plot.clone()
     };
-    for s in a.record.iter().chain(&plot_signals) {
-        system.record(s).map_err(|e| e.to_string())?;
-    }
-    let inputs = match &a.input {
-        Some(path) => Some(ExternalInputs::bind(InputTable::read(path)?, &system)?),
-        None => None,
+    let options = RunOptions {
+        start: a.grid.start,
+        stop: a.grid.stop,
+        step: a.grid.step,
+        master: a.master.clone(),
+        record: a.record.iter().chain(&plot_signals).cloned().collect(),
+        inputs: match &a.input {
+            Some(path) => Some(InputTable::read(path)?),
+            None => None,
+        },
+        call_time_limit: super::call_time_limit(a.step_timeout)?,
+        ..RunOptions::default()
     };
+    let prepared = PreparedRun::new(&file, &options)?;
+    super::print_warnings(prepared.warnings());
+    let (n, step) = (prepared.steps(), prepared.time_grid().2);
+    let master = prepared.master_name();
 
-    let n = step_count(start, step, stop);
     let bar = if a.quiet || !std::io::stderr().is_terminal() {
         ProgressBar::hidden()
     } else {
@@ -124,8 +102,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         );
         bar
     };
-    let mut watch = Watch { inputs, bar };
-    let columns = system.columns();
+    let columns = prepared.columns();
     let mut writer = ResultWriter::new(output, &columns);
     let plot_signals = if plot_signals.is_empty() {
         columns.clone()
@@ -137,51 +114,27 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         Some(_) => writer.keep_columns(&columns, &plot_signals).err(),
         None => None,
     };
-    let started = std::time::Instant::now();
-    let run = simulate_streaming(
-        &mut system,
-        master.as_mut(),
-        start,
-        step,
-        stop,
-        &mut watch,
-        &mut writer,
-    )
-    .map_err(|e| format!("initialization failed: {e}"))?;
-    let elapsed = started.elapsed();
-    watch.bar.finish_and_clear();
+    let run = prepared.run(&mut writer, &mut |done, _| bar.set_position(done as u64))?;
+    bar.finish_and_clear();
 
     let kept = writer.kept();
-    let stats = writer.stats.clone();
     writer
         .finish(run.error.as_deref())
         .map_err(|e| e.to_string())?;
     if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
         let title = format!(
-            "{} ({})",
+            "{} ({master})",
             if file.name.is_empty() {
                 "system"
             } else {
                 &file.name
             },
-            master.name()
         );
         plot_error = fricsim::plot::plot_signals(kept, &plot_signals, plot, &title).err();
     }
 
-    print!(
-        "{}",
-        summary(
-            &file,
-            &run,
-            &stats,
-            n,
-            step,
-            master.name(),
-            elapsed.as_secs_f64()
-        )
-    );
-    if let Some(report) = master.report() {
+    print!("{}", summary(&file, &run, n, step, master));
+    if let Some(report) = &run.master_report {
         println!("{report}");
     }
     println!("wrote {}", out.display());
@@ -203,18 +156,10 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
 
 /// The summary: what ran, how long, each column's min/max/final value,
 /// and whether the run completed.
-fn summary(
-    file: &SystemFile,
-    run: &Streamed,
-    stats: &ColumnStats,
-    n: usize,
-    step: f64,
-    master: &str,
-    wall: f64,
-) -> String {
+fn summary(file: &SystemFile, run: &RunOutcome, n: usize, step: f64, master: &str) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let done = run.rows.saturating_sub(1);
+    let (done, stats, wall) = (run.steps, &run.stats, run.wall_time);
     let _ = writeln!(
         s,
         "{}: {} components, {} connections, {} parameter values",

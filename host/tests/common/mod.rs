@@ -70,6 +70,23 @@ pub fn stub_fmu_dir(capabilities: &str, flags: &[&str]) -> TempDir {
     dir
 }
 
+/// The FMU `dist/<name>.fmu` of this repository with `edit` applied to its
+/// model description, zipped into `out`. The edit must change something.
+pub fn repacked(name: &str, out: &Path, edit: impl Fn(&str) -> String) -> PathBuf {
+    let unpacked = fricsim::fmu::archive::unpack(
+        &repository().join("dist").join(format!("{name}.fmu")),
+        &fricsim::fmu::archive::UnpackOptions::default(),
+    )
+    .unwrap();
+    let md = unpacked.path().join("modelDescription.xml");
+    let text = std::fs::read_to_string(&md).unwrap();
+    let edited = edit(&text);
+    assert_ne!(edited, text, "the edit changed nothing");
+    std::fs::write(&md, edited).unwrap();
+    zip_dir(unpacked.path(), out);
+    out.to_path_buf()
+}
+
 /// Zip the files below `dir` into `out`.
 pub fn zip_dir(dir: &Path, out: &Path) {
     fn add(zip: &mut zip::ZipWriter<std::fs::File>, root: &Path, dir: &Path) {
