@@ -128,9 +128,9 @@ impl OutputFile {
         std::fs::rename(&self.partial, &self.path).map_err(io)?;
         self.out = None;
         // the rename is durable once the directory is (fsync(2))
-        if let Some(dir) = self.path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            File::open(dir).and_then(|d| d.sync_all()).map_err(io)?;
-        }
+        // (the temporary file's directory: `.` for a bare file name)
+        let dir = self.partial.parent().unwrap_or(Path::new("."));
+        File::open(dir).and_then(|d| d.sync_all()).map_err(io)?;
         Ok(())
     }
 
