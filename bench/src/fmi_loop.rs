@@ -67,6 +67,15 @@ impl Functions {
 /// The logger's five fixed arguments (see [`print_message`]).
 type FixedArgumentsLogger =
     unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String);
+/// The logger as FMI 2.0 declares it, variadic.
+type VariadicLogger = unsafe extern "C" fn(
+    fmi2ComponentEnvironment,
+    fmi2String,
+    fmi2Status,
+    fmi2String,
+    fmi2String,
+    ...
+);
 
 /// The importer's logger: the message printed on stderr as it comes, its
 /// `%` arguments not expanded. FMI 2.0 declares it variadic (§2.1.5),
@@ -126,7 +135,9 @@ pub fn jacobi_run(
 ) -> Result<(f64, Vec<f64>), String> {
     let callbacks = fmi2CallbackFunctions {
         // SAFETY: see `print_message`
-        logger: Some(unsafe { std::mem::transmute::<FixedArgumentsLogger, _>(print_message) }),
+        logger: Some(unsafe {
+            std::mem::transmute::<FixedArgumentsLogger, VariadicLogger>(print_message)
+        }),
         allocateMemory: Some(libc_calloc),
         freeMemory: Some(libc_free),
         stepFinished: None,
