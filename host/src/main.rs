@@ -59,6 +59,9 @@ enum Command {
     /// seed), in parallel on all cores; writes one CSV row per run with the
     /// parameters, final values, RMS values and wall time.
     Sweep(cli::sweep::SweepArgs),
+    /// The child process of `run --isolate` (started by fricsim itself).
+    #[command(name = "isolated-child", hide = true)]
+    IsolatedChild(cli::isolated::ChildArgs),
 }
 
 fn main() -> ExitCode {
@@ -82,6 +85,7 @@ fn main() -> ExitCode {
         Command::Reference(args) => cli::reference::run(&args),
         Command::Diagnose(args) => cli::diagnose::run(&args),
         Command::Sweep(args) => cli::sweep::run(&args),
+        Command::IsolatedChild(args) => cli::isolated::child(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -54,12 +54,19 @@ pub struct RunArgs {
     /// watchdog reports it on stderr when it passes the limit.
     #[arg(long = "step-timeout", value_name = "SECONDS")]
     pub step_timeout: Option<f64>,
+    /// Run the FMUs in a child process, so that one that crashes (a
+    /// segmentation fault, abort(), exit()) or hangs past --step-timeout
+    /// costs the run its end, not its rows: the result keeps every row
+    /// and is marked incomplete naming the instance, the FMI call, the
+    /// time and the signal or exit status.
+    #[arg(long)]
+    pub isolate: bool,
 }
 
 /// The progress bar and the external inputs, consulted by the run.
-struct Watch {
-    inputs: Option<ExternalInputs>,
-    bar: ProgressBar,
+pub struct Watch {
+    pub inputs: Option<ExternalInputs>,
+    pub bar: ProgressBar,
 }
 
 impl Observer for Watch {
@@ -80,9 +87,70 @@ impl Observer for Watch {
 }
 
 pub fn run(a: &RunArgs) -> Result<(), String> {
+    if a.isolate {
+        return super::isolated::run(a);
+    }
+    let Prepared {
+        plan,
+        mut master,
+        mut system,
+        inputs,
+        start,
+        stop,
+    } = prepare(a)?;
+    let mut watch = Watch {
+        inputs,
+        bar: progress_bar(a, plan.n),
+    };
+    let columns = system.columns();
+    let mut sink = RunSink::new(a, &columns, &plan);
+    let started = std::time::Instant::now();
+    let run = simulate_streaming(
+        &mut system,
+        master.as_mut(),
+        start,
+        plan.step,
+        stop,
+        &mut watch,
+        &mut sink,
+    )
+    .map_err(|e| format!("initialization failed: {e}"))?;
+    let wall = started.elapsed().as_secs_f64();
+    watch.bar.finish_and_clear();
+    let report = master.report();
+    conclude(a, sink, &plan, &run, report, wall)
+}
+
+/// What a run is, as its summary and plot tell it (sent by an isolated
+/// run's child to its parent).
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct Plan {
+    /// The first line of the summary: the system file and its size.
+    pub system: String,
+    /// The plot's title.
+    pub title: String,
+    pub master: String,
+    /// Macro steps and their length.
+    pub n: usize,
+    pub step: f64,
+    pub plot_signals: Vec<String>,
+}
+
+/// A run ready to start: the system built, its master and inputs.
+pub struct Prepared {
+    pub plan: Plan,
+    pub master: Box<dyn fricsim::master::MasterAlgorithm>,
+    pub system: System,
+    pub inputs: Option<ExternalInputs>,
+    pub start: f64,
+    pub stop: f64,
+}
+
+/// Read the system file, build the system, bind the inputs.
+pub fn prepare(a: &RunArgs) -> Result<Prepared, String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
     let (start, stop, step) = a.grid.resolve(&file)?;
-    let mut master = by_name(&super::master_name(&a.master, &file))?;
+    let master = by_name(&super::master_name(&a.master, &file))?;
 
     let mut system = file.build(start).map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
@@ -99,58 +167,20 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         Some(path) => Some(ExternalInputs::bind(InputTable::read(path)?, &system)?),
         None => None,
     };
-
-    let n = step_count(start, step, stop);
-    let bar = if a.quiet || !std::io::stderr().is_terminal() {
-        ProgressBar::hidden()
-    } else {
-        let bar = ProgressBar::with_draw_target(Some(n as u64), ProgressDrawTarget::stderr());
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} steps, {elapsed} elapsed, {eta} left",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        bar
-    };
-    let mut watch = Watch { inputs, bar };
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::default_out(&a.system, ""));
-    let columns = system.columns();
-    let mut writer = ResultWriter::new(&out, &columns);
     let plot_signals = if plot_signals.is_empty() {
-        columns.clone()
+        system.columns()
     } else {
         plot_signals
     };
-    // a plot that cannot be drawn does not hide the run or its summary
-    let mut plot_error = match a.plot {
-        Some(_) => writer.keep_columns(&columns, &plot_signals).err(),
-        None => None,
-    };
-    let started = std::time::Instant::now();
-    let run = simulate_streaming(
-        &mut system,
-        master.as_mut(),
-        start,
-        step,
-        stop,
-        &mut watch,
-        &mut writer,
-    )
-    .map_err(|e| format!("initialization failed: {e}"))?;
-    let elapsed = started.elapsed();
-    watch.bar.finish_and_clear();
-
-    let kept = writer.kept();
-    let stats = writer.stats.clone();
-    writer
-        .finish(run.error.as_deref())
-        .map_err(|e| format!("{}: {e}", out.display()))?;
-    if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
-        let title = format!(
+    let plan = Plan {
+        system: format!(
+            "{}: {} components, {} connections, {} parameter values",
+            file.ssd,
+            file.components.len(),
+            file.connections.len(),
+            file.parameters.len()
+        ),
+        title: format!(
             "{} ({})",
             if file.name.is_empty() {
                 "system"
@@ -158,30 +188,107 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
                 &file.name
             },
             master.name()
-        );
-        plot_error = fricsim::plot::plot_signals(kept, &plot_signals, plot, &title).err();
+        ),
+        master: master.name().to_string(),
+        n: step_count(start, step, stop),
+        step,
+        plot_signals,
+    };
+    Ok(Prepared {
+        plan,
+        master,
+        system,
+        inputs,
+        start,
+        stop,
+    })
+}
+
+/// The progress bar of `n` steps on a terminal, else a hidden one.
+pub fn progress_bar(a: &RunArgs, n: usize) -> ProgressBar {
+    if a.quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(n as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, {eta} left")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// The result file of `--out` [default: out/<file name>.csv].
+pub fn out_path(a: &RunArgs) -> PathBuf {
+    a.out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, ""))
+}
+
+/// Where the rows go: the result file, and the plotted columns kept.
+pub struct RunSink {
+    writer: ResultWriter,
+    out: PathBuf,
+    /// Why the plot cannot be drawn, if it cannot: it does not hide the
+    /// run or its summary.
+    plot_error: Option<String>,
+}
+
+impl RunSink {
+    pub fn new(a: &RunArgs, columns: &[String], plan: &Plan) -> RunSink {
+        let out = out_path(a);
+        let mut writer = ResultWriter::new(&out, columns);
+        let plot_error = match a.plot {
+            Some(_) => writer.keep_columns(columns, &plan.plot_signals).err(),
+            None => None,
+        };
+        RunSink {
+            writer,
+            out,
+            plot_error,
+        }
+    }
+}
+
+impl fricsim::master::RowSink for RunSink {
+    fn write(&mut self, times: &[f64], rows: &fricsim::rows::Rows) -> Result<(), String> {
+        self.writer.write(times, rows)
+    }
+}
+
+/// After the run: the result file ended (marked incomplete if `run`
+/// stopped early), the plot, the summary; an error if the run is
+/// incomplete.
+pub fn conclude(
+    a: &RunArgs,
+    sink: RunSink,
+    plan: &Plan,
+    run: &Streamed,
+    master_report: Option<String>,
+    wall: f64,
+) -> Result<(), String> {
+    let RunSink {
+        writer,
+        out,
+        mut plot_error,
+    } = sink;
+    let kept = writer.kept();
+    let stats = writer.stats.clone();
+    writer
+        .finish(run.error.as_deref())
+        .map_err(|e| format!("{}: {e}", out.display()))?;
+    if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
+        plot_error = fricsim::plot::plot_signals(kept, &plan.plot_signals, plot, &plan.title).err();
     }
 
-    print!(
-        "{}",
-        summary(
-            &file,
-            &run,
-            &stats,
-            n,
-            step,
-            master.name(),
-            elapsed.as_secs_f64()
-        )
-    );
-    if let Some(report) = master.report() {
+    print!("{}", summary(plan, run, &stats, wall));
+    if let Some(report) = master_report {
         println!("{report}");
     }
     println!("wrote {}", out.display());
     if let (Some(p), None) = (&a.plot, &plot_error) {
         println!("wrote {}", p.display());
     }
-    if let Some(e) = run.error {
+    if let Some(e) = &run.error {
         return Err(format!(
             "run INCOMPLETE (the {} rows up to the failure are in {}): {e}",
             run.rows,
@@ -196,26 +303,14 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
 
 /// The summary: what ran, how long, each column's min/max/final value,
 /// and whether the run completed.
-fn summary(
-    file: &SystemFile,
-    run: &Streamed,
-    stats: &ColumnStats,
-    n: usize,
-    step: f64,
-    master: &str,
-    wall: f64,
-) -> String {
+fn summary(plan: &Plan, run: &Streamed, stats: &ColumnStats, wall: f64) -> String {
     use std::fmt::Write;
+    let Plan {
+        n, step, master, ..
+    } = plan;
     let mut s = String::new();
     let done = run.rows.saturating_sub(1);
-    let _ = writeln!(
-        s,
-        "{}: {} components, {} connections, {} parameter values",
-        file.ssd,
-        file.components.len(),
-        file.connections.len(),
-        file.parameters.len()
-    );
+    let _ = writeln!(s, "{}", plan.system);
     let _ = writeln!(
         s,
         "{done} of {n} macro steps of {step} s with {master} ({} to {} s), {wall:.3} s wall time: {}",

@@ -1,0 +1,296 @@
+//! The parent's side of an isolated run: start the child, hand its rows to
+//! a [`RowSink`] as they come, stop a call that lasts too long, and say
+//! how the child ended.
+
+use super::blackbox::{BlackBox, CallRecord};
+use super::ring::RowRing;
+use super::{Message, BLACK_BOX_FILE, CHILD_COMMAND, RING_FILE};
+use crate::master::RowSink;
+use std::ffi::OsString;
+use std::io::BufRead;
+use std::os::unix::process::ExitStatusExt;
+use std::process::{Command, ExitStatus, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+/// How often the parent looks at the ring, the pipe and the child when
+/// nothing came.
+const POLL: Duration = Duration::from_millis(2);
+
+/// How an isolated run went, as the parent saw it.
+pub struct Outcome<S> {
+    /// The sink made when the run started, with every row the child sent.
+    pub sink: Option<S>,
+    /// `Started`'s columns and `extra`.
+    pub columns: Vec<String>,
+    pub started: Option<serde_json::Value>,
+    /// `Finished`'s rows, error and `extra`, if the child got that far.
+    pub finished: Option<(usize, Option<String>, serde_json::Value)>,
+    /// Why the run could not start (`Failed`).
+    pub failed: Option<String>,
+    /// How the child ended before `Finished`: the instance, the call, the
+    /// communication point, the signal or exit status (or the time limit).
+    pub died: Option<String>,
+    /// The rows the sink received.
+    pub rows: usize,
+}
+
+impl<S> Outcome<S> {
+    /// Why the run stopped before its end, if it did: the host's error
+    /// or the child's death.
+    pub fn error(&self) -> Option<String> {
+        match (&self.died, &self.finished) {
+            (Some(d), _) => Some(d.clone()),
+            (None, Some((_, e, _))) => e.clone(),
+            (None, None) => None,
+        }
+    }
+}
+
+/// Run `fricsim isolated-child --run-dir DIR ARGS` and follow it: `ARGS`
+/// are the parent's own arguments (the subcommand and its options), `limit`
+/// the time limit on each FMI call. When the child says the run started,
+/// `make_sink(columns, extra)` makes the sink of its rows (an error there
+/// stops the child).
+pub fn run_isolated<S: RowSink>(
+    args: &[OsString],
+    limit: Option<Duration>,
+    make_sink: impl FnOnce(&[String], &serde_json::Value) -> Result<S, String>,
+) -> Result<Outcome<S>, String> {
+    let dir = tempfile::Builder::new()
+        .prefix("fricsim-isolated-")
+        .tempdir()
+        .map_err(|e| format!("cannot make the isolated run's directory: {e}"))?;
+    let black_box = BlackBox::create(&dir.path().join(BLACK_BOX_FILE))
+        .map_err(|e| format!("cannot make the isolated run's black box: {e}"))?;
+    let exe = std::env::current_exe()
+        .map_err(|e| format!("cannot find fricsim's own binary to start the child: {e}"))?;
+    let mut child = Command::new(&exe)
+        .arg(CHILD_COMMAND)
+        .arg("--run-dir")
+        .arg(dir.path())
+        .args(args)
+        .env("TMPDIR", dir.path())
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .map_err(|e| format!("cannot start {}: {e}", exe.display()))?;
+    let pipe = child.stdout.take().expect("stdout is piped");
+    let (messages, received) = mpsc::channel();
+    let reader = std::thread::spawn(move || {
+        for line in std::io::BufReader::new(pipe).lines() {
+            let Ok(line) = line else { break };
+            let message = serde_json::from_str::<Message>(&line)
+                .map_err(|e| format!("the isolated child sent `{line}`: {e}"));
+            if messages.send(message).is_err() {
+                break;
+            }
+        }
+    });
+
+    let mut outcome = Outcome {
+        sink: None,
+        columns: Vec::new(),
+        started: None,
+        finished: None,
+        failed: None,
+        died: None,
+        rows: 0,
+    };
+    let mut make_sink = Some(make_sink);
+    let mut ring: Option<RowRing> = None;
+    let mut instances: Vec<String> = Vec::new();
+    let mut sink_error = None;
+    let mut hang = Hang::default();
+    let status = loop {
+        let mut busy = take_rows(&ring, &mut outcome, &mut sink_error);
+        while let Ok(message) = received.try_recv() {
+            busy = true;
+            match message {
+                Ok(Message::Started {
+                    columns,
+                    instances: names,
+                    extra,
+                }) => {
+                    instances = names;
+                    let made = make_sink.take().map(|f| f(&columns, &extra));
+                    outcome.started = Some(extra);
+                    outcome.columns = columns;
+                    match made {
+                        Some(Ok(sink)) => outcome.sink = Some(sink),
+                        Some(Err(e)) => sink_error = Some(e),
+                        None => {}
+                    }
+                    match RowRing::open(&dir.path().join(RING_FILE)) {
+                        Ok(r) => ring = Some(r),
+                        Err(e) => sink_error = Some(format!("cannot map the child's rows: {e}")),
+                    }
+                }
+                Ok(Message::Finished { rows, error, extra }) => {
+                    outcome.finished = Some((rows, error, extra))
+                }
+                Ok(Message::Failed { message }) => outcome.failed = Some(message),
+                Err(e) => sink_error = Some(e),
+            }
+        }
+        if let Some(e) = &sink_error {
+            // the parent cannot take the rows: the child is stopped
+            let _ = child.kill();
+            let _ = child.wait();
+            let _ = reader.join();
+            return Err(e.clone());
+        }
+        match child.try_wait() {
+            Ok(Some(status)) => break status,
+            Ok(None) => {}
+            Err(e) => return Err(format!("cannot follow the isolated child: {e}")),
+        }
+        if let Some(limit) = limit {
+            if let Some(call) = hang.over(&black_box.read(), limit) {
+                let _ = child.kill();
+                let _ = child.wait();
+                outcome.died = Some(format!(
+                    "{} for more than the limit of {} s (--step-timeout): the FMU process was killed (SIGKILL)",
+                    where_(&call, &instances, "was in"),
+                    limit.as_secs_f64()
+                ));
+                break ExitStatus::from_raw(libc::SIGKILL);
+            }
+        }
+        if !busy {
+            std::thread::sleep(POLL);
+        }
+    };
+    let _ = reader.join();
+    for message in received.try_iter() {
+        match message {
+            Ok(Message::Finished { rows, error, extra }) => {
+                outcome.finished = Some((rows, error, extra))
+            }
+            Ok(Message::Failed { message }) => outcome.failed = Some(message),
+            Ok(Message::Started { .. }) | Err(_) => {}
+        }
+    }
+    take_rows(&ring, &mut outcome, &mut sink_error);
+    if let Some(e) = sink_error {
+        return Err(e);
+    }
+    if outcome.died.is_none() && outcome.finished.is_none() && outcome.failed.is_none() {
+        outcome.died = Some(death(&black_box.read(), &instances, status));
+    }
+    Ok(outcome)
+}
+
+/// Hand the rows in the ring (if made) to the sink: whether there were any.
+fn take_rows<S: RowSink>(
+    ring: &Option<RowRing>,
+    outcome: &mut Outcome<S>,
+    error: &mut Option<String>,
+) -> bool {
+    let (Some(ring), Some(sink)) = (ring, &mut outcome.sink) else {
+        return false;
+    };
+    let (times, rows) = ring.take();
+    if times.is_empty() {
+        return false;
+    }
+    outcome.rows += times.len();
+    if let Err(e) = sink.write(&times, &rows) {
+        error.get_or_insert(e);
+    }
+    true
+}
+
+/// The call the child is in, and since when the parent has seen it.
+#[derive(Default)]
+struct Hang {
+    seen: Option<(u64, Instant)>,
+}
+
+impl Hang {
+    /// `record` if one call has lasted longer than `limit`.
+    fn over(&mut self, record: &CallRecord, limit: Duration) -> Option<CallRecord> {
+        if record.instance.is_none() {
+            self.seen = None;
+            return None;
+        }
+        match self.seen {
+            Some((calls, since)) if calls == record.calls => {
+                (since.elapsed() > limit).then(|| record.clone())
+            }
+            _ => {
+                self.seen = Some((record.calls, Instant::now()));
+                None
+            }
+        }
+    }
+}
+
+/// `instance "belt" <verb> fmi2DoStep at t = 0.5 s`, from the black box.
+fn where_(call: &CallRecord, instances: &[String], verb: &str) -> String {
+    let at = match call.time {
+        Some(t) if call.function == "fmi2DoStep" => format!(" at t = {t} s"),
+        Some(t) => format!(" (after fmi2DoStep at t = {t} s)"),
+        None => String::new(),
+    };
+    match call.instance {
+        Some(i) => {
+            let name = instances
+                .get(i)
+                .map(|n| format!("\"{n}\""))
+                .unwrap_or_else(|| format!("number {}", i + 1));
+            format!("instance {name} {verb} {}{at}", call.function)
+        }
+        None if call.calls == 0 => "before any FMI call".to_string(),
+        None => format!(
+            "outside any FMI call (the last begun: {}){at}",
+            call.function
+        ),
+    }
+}
+
+/// Why the child ended without finishing, in words.
+fn death(call: &CallRecord, instances: &[String], status: ExitStatus) -> String {
+    if let Some(signal) = status.signal() {
+        let verb = if call.instance.is_some() {
+            "crashed in"
+        } else {
+            ""
+        };
+        let place = if verb.is_empty() {
+            format!("the FMU process crashed {}", where_(call, instances, ""))
+        } else {
+            where_(call, instances, verb)
+        };
+        return format!(
+            "{place}: the FMU process was killed by signal {signal} ({})",
+            signal_name(signal)
+        );
+    }
+    let code = status
+        .code()
+        .map_or_else(|| "unknown".to_string(), |c| c.to_string());
+    format!(
+        "{}: the FMU process exited with status {code} before the run finished",
+        match call.instance {
+            Some(_) => where_(call, instances, "ended the process in"),
+            None => format!("the FMU process ended {}", where_(call, instances, "")),
+        }
+    )
+}
+
+fn signal_name(signal: i32) -> &'static str {
+    match signal {
+        libc::SIGSEGV => "SIGSEGV",
+        libc::SIGABRT => "SIGABRT",
+        libc::SIGBUS => "SIGBUS",
+        libc::SIGFPE => "SIGFPE",
+        libc::SIGILL => "SIGILL",
+        libc::SIGKILL => "SIGKILL",
+        libc::SIGTERM => "SIGTERM",
+        libc::SIGINT => "SIGINT",
+        libc::SIGPIPE => "SIGPIPE",
+        _ => "a signal",
+    }
+}
