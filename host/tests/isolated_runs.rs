@@ -259,3 +259,45 @@ fn an_error_before_the_run_is_reported_once_as_in_process() {
     );
     assert_eq!(messages[0], messages[1]);
 }
+
+#[test]
+fn fricsim_cosim_isolate_survives_a_crash_the_same_way() {
+    let rig = rig();
+    let out = rig.dir.path().join("cosim.csv");
+    let tmp = empty_dir(rig.dir.path(), "tmp_cosim");
+    let run = Command::new(env!("CARGO_BIN_EXE_fricsim"))
+        .arg("cosim")
+        .arg(format!("--fmu=belt={}", rig.belt.display()))
+        .arg(format!("--fmu=friction={}", common::lugre_fmu().display()))
+        .args(["--set", &format!("belt.fault={}", belt::SEGFAULT)])
+        .args(["--set", &format!("belt.fault_step={FAULT_STEP}")])
+        .args(["--set", "belt.v0=0"])
+        .args([
+            "--connect",
+            "belt.v->friction.v",
+            "--connect",
+            "friction.F->belt.F",
+        ])
+        .arg(format!("--step={H}"))
+        .arg(format!("--stop={STOP}"))
+        .arg("--out")
+        .arg(&out)
+        .arg("--isolate")
+        .env("TMPDIR", &tmp)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    // cosim records the same columns: the rows equal run's in-process rows
+    assert_eq!(lines[..=FAULT_STEP], rig.reference[..=FAULT_STEP], "{text}");
+    assert_eq!(
+        lines[FAULT_STEP + 1..],
+        [
+            "# INCOMPLETE: the run stopped early: instance \"belt\" crashed in fmi2DoStep at \
+          t = 0.0087890625 s: the FMU process was killed by signal 11 (SIGSEGV)"
+        ]
+    );
+    assert!(entries(&tmp).is_empty(), "{:?}", entries(&tmp));
+}

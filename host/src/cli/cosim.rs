@@ -1,7 +1,7 @@
 //! `fricsim cosim`: connect FMUs given on the command line, co-simulate
 //! with a fixed macro step, write a CSV and a plot, print a summary.
 
-use fricsim::master::{simulate_streaming, NoObserver};
+use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, RowSink, Streamed};
 use fricsim::results::ResultWriter;
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
@@ -46,9 +46,47 @@ pub struct CosimArgs {
     /// watchdog reports it on stderr when it passes the limit.
     #[arg(long = "step-timeout", value_name = "SECONDS")]
     pub step_timeout: Option<f64>,
+    /// Run the FMUs in a child process (see docs/user-guide.md, "Isolated
+    /// runs"), so that one that crashes (a
+    /// segmentation fault, abort(), exit()) or hangs past --step-timeout
+    /// costs the run its end, not its rows: the result keeps every row
+    /// and is marked incomplete naming the instance, the FMI call, the
+    /// time and the signal or exit status.
+    #[arg(long)]
+    pub isolate: bool,
 }
 
 pub fn run(a: &CosimArgs) -> Result<(), String> {
+    if a.isolate {
+        return super::isolated::run_isolated(a);
+    }
+    let (mut system, mut master, plan) = prepare(a)?;
+    let mut sink = CosimSink::new(a, &system.columns(), &plan);
+    let started = std::time::Instant::now();
+    let run = simulate_streaming(
+        &mut system,
+        master.as_mut(),
+        0.0,
+        a.step,
+        a.stop,
+        &mut NoObserver,
+        &mut sink,
+    )
+    .map_err(|e| e.to_string())?;
+    let wall = started.elapsed().as_secs_f64();
+    conclude(a, sink, &plan, &run, master.report(), wall)
+}
+
+/// What the summary and the plot need to know of a run (sent by an
+/// isolated run's child to its parent).
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct CosimPlan {
+    pub master: String,
+    pub signals: Vec<String>,
+}
+
+/// The system built from the options, its master.
+pub fn prepare(a: &CosimArgs) -> Result<(System, Box<dyn MasterAlgorithm>, CosimPlan), String> {
     if !(a.step.is_finite() && a.step > 0.0) {
         return Err(format!("--step must be > 0, got {}", a.step));
     }
@@ -93,32 +131,54 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     let mut system =
         System::build(&components, &parameters, &connections).map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
-    let mut master = fricsim::master::by_name(&a.master)?;
+    let master = fricsim::master::by_name(&a.master)?;
     super::print_warnings(system.warnings());
-    let columns = system.columns();
-    let mut writer = ResultWriter::new(&a.out, &columns);
     let signals = if a.plot_signals.is_empty() {
-        columns.clone()
+        system.columns()
     } else {
         a.plot_signals.clone()
     };
-    // a signal that cannot be plotted is reported once the CSV is written
-    let plot_error = match a.plot {
-        Some(_) => writer.keep_columns(&columns, &signals).err(),
-        None => None,
+    let plan = CosimPlan {
+        master: master.name().to_string(),
+        signals,
     };
-    let started = std::time::Instant::now();
-    let run = simulate_streaming(
-        &mut system,
-        master.as_mut(),
-        0.0,
-        a.step,
-        a.stop,
-        &mut NoObserver,
-        &mut writer,
-    )
-    .map_err(|e| e.to_string())?;
-    let elapsed = started.elapsed();
+    Ok((system, master, plan))
+}
+
+/// Where the rows go: the result file, and the plotted columns kept.
+pub struct CosimSink {
+    writer: ResultWriter,
+    /// A signal that cannot be plotted, reported once the CSV is written.
+    plot_error: Option<String>,
+}
+
+impl CosimSink {
+    pub fn new(a: &CosimArgs, columns: &[String], plan: &CosimPlan) -> CosimSink {
+        let mut writer = ResultWriter::new(&a.out, columns);
+        let plot_error = match a.plot {
+            Some(_) => writer.keep_columns(columns, &plan.signals).err(),
+            None => None,
+        };
+        CosimSink { writer, plot_error }
+    }
+}
+
+impl RowSink for CosimSink {
+    fn write(&mut self, times: &[f64], rows: &fricsim::rows::Rows) -> Result<(), String> {
+        self.writer.write(times, rows)
+    }
+}
+
+/// After the run: the result file ended, the plot, the summary.
+pub fn conclude(
+    a: &CosimArgs,
+    sink: CosimSink,
+    plan: &CosimPlan,
+    run: &Streamed,
+    master_report: Option<String>,
+    wall: f64,
+) -> Result<(), String> {
+    let CosimSink { writer, plot_error } = sink;
     let kept = writer.kept();
     let stats = writer.stats.clone();
     writer
@@ -130,31 +190,31 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
         fricsim::plot::plot_signals(
             kept,
-            &signals,
+            &plan.signals,
             plot,
-            &format!("fricsim cosim ({})", master.name()),
+            &format!("fricsim cosim ({})", plan.master),
         )?;
     }
     println!(
         "{} macro steps of {} s with {}, {} columns, {:.3} s wall time",
         run.rows.saturating_sub(1),
         a.step,
-        master.name(),
+        plan.master,
         run.columns.len(),
-        elapsed.as_secs_f64()
+        wall
     );
     for (k, c) in run.columns.iter().enumerate() {
         let (lo, hi) = (stats.min[k], stats.max[k]);
         println!("  {c:<24} min {lo:>12.5e}  max {hi:>12.5e}");
     }
-    if let Some(report) = master.report() {
+    if let Some(report) = master_report {
         print!("{report}");
     }
     println!("wrote {}", a.out.display());
     if let Some(p) = &a.plot {
         println!("wrote {}", p.display());
     }
-    match run.error {
+    match &run.error {
         Some(e) => Err(format!(
             "run INCOMPLETE (results up to the failure are in {}): {e}",
             a.out.display()

@@ -54,7 +54,8 @@ pub struct RunArgs {
     /// watchdog reports it on stderr when it passes the limit.
     #[arg(long = "step-timeout", value_name = "SECONDS")]
     pub step_timeout: Option<f64>,
-    /// Run the FMUs in a child process, so that one that crashes (a
+    /// Run the FMUs in a child process (see docs/user-guide.md, "Isolated
+    /// runs"), so that one that crashes (a
     /// segmentation fault, abort(), exit()) or hangs past --step-timeout
     /// costs the run its end, not its rows: the result keeps every row
     /// and is marked incomplete naming the instance, the FMI call, the
@@ -67,6 +68,12 @@ pub struct RunArgs {
 pub struct Watch {
     pub inputs: Option<ExternalInputs>,
     pub bar: ProgressBar,
+}
+
+impl Drop for Watch {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
+    }
 }
 
 impl Observer for Watch {
@@ -88,7 +95,7 @@ impl Observer for Watch {
 
 pub fn run(a: &RunArgs) -> Result<(), String> {
     if a.isolate {
-        return super::isolated::run(a);
+        return super::isolated::run_isolated(a);
     }
     let Prepared {
         plan,

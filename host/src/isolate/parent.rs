@@ -250,34 +250,27 @@ fn where_(call: &CallRecord, instances: &[String], verb: &str) -> String {
     }
 }
 
-/// Why the child ended without finishing, in words.
+/// Why the child ended without finishing, in words: where (from the
+/// black box) and how (the signal or the exit status).
 fn death(call: &CallRecord, instances: &[String], status: ExitStatus) -> String {
-    if let Some(signal) = status.signal() {
-        let verb = if call.instance.is_some() {
-            "crashed in"
-        } else {
-            ""
-        };
-        let place = if verb.is_empty() {
-            format!("the FMU process crashed {}", where_(call, instances, ""))
-        } else {
-            where_(call, instances, verb)
-        };
-        return format!(
-            "{place}: the FMU process was killed by signal {signal} ({})",
-            signal_name(signal)
-        );
-    }
-    let code = status
-        .code()
-        .map_or_else(|| "unknown".to_string(), |c| c.to_string());
-    format!(
-        "{}: the FMU process exited with status {code} before the run finished",
-        match call.instance {
-            Some(_) => where_(call, instances, "ended the process in"),
-            None => format!("the FMU process ended {}", where_(call, instances, "")),
-        }
-    )
+    let (verb, how) = match (status.signal(), status.code()) {
+        (Some(s), _) => (
+            "crashed in",
+            format!(
+                "the FMU process was killed by signal {s} ({})",
+                signal_name(s)
+            ),
+        ),
+        (None, Some(c)) => (
+            "ended the process in",
+            format!("the FMU process exited with status {c} before the run finished"),
+        ),
+        (None, None) => (
+            "ended the process in",
+            "the FMU process ended before the run finished".to_string(),
+        ),
+    };
+    format!("{}: {how}", where_(call, instances, verb))
 }
 
 fn signal_name(signal: i32) -> &'static str {
@@ -292,5 +285,70 @@ fn signal_name(signal: i32) -> &'static str {
         libc::SIGINT => "SIGINT",
         libc::SIGPIPE => "SIGPIPE",
         _ => "a signal",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn in_step(calls: u64) -> CallRecord {
+        CallRecord {
+            calls,
+            instance: Some(1),
+            function: "fmi2DoStep".into(),
+            time: Some(0.5),
+        }
+    }
+
+    #[test]
+    fn a_death_names_the_instance_the_call_the_time_and_the_cause() {
+        let names = ["rig".to_string(), "belt".to_string()];
+        assert_eq!(
+            death(&in_step(3), &names, ExitStatus::from_raw(libc::SIGBUS)),
+            "instance \"belt\" crashed in fmi2DoStep at t = 0.5 s: the FMU process was killed by signal 7 (SIGBUS)"
+        );
+        // exit(3): status 3 << 8
+        assert_eq!(
+            death(&in_step(3), &names, ExitStatus::from_raw(3 << 8)),
+            "instance \"belt\" ended the process in fmi2DoStep at t = 0.5 s: the FMU process exited with status 3 before the run finished"
+        );
+        let between = CallRecord {
+            instance: None,
+            function: "fmi2GetReal".into(),
+            ..in_step(4)
+        };
+        assert_eq!(
+            death(&between, &names, ExitStatus::from_raw(libc::SIGSEGV)),
+            "outside any FMI call (the last begun: fmi2GetReal) (after fmi2DoStep at t = 0.5 s): the FMU process was killed by signal 11 (SIGSEGV)"
+        );
+        let never = CallRecord {
+            calls: 0,
+            instance: None,
+            function: String::new(),
+            time: None,
+        };
+        assert!(death(&never, &[], ExitStatus::from_raw(0)).starts_with("before any FMI call: "));
+    }
+
+    #[test]
+    fn a_hang_is_one_call_lasting_past_the_limit_not_many_short_ones() {
+        let mut hang = Hang::default();
+        let limit = Duration::from_millis(30);
+        // many calls, each seen once: never over the limit
+        for calls in 0..5 {
+            assert_eq!(hang.over(&in_step(calls), limit), None);
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        // the same call seen again after the limit
+        assert_eq!(hang.over(&in_step(9), limit), None);
+        std::thread::sleep(limit * 2);
+        assert_eq!(hang.over(&in_step(9), limit), Some(in_step(9)));
+        // between calls: nothing is running
+        let idle = CallRecord {
+            instance: None,
+            ..in_step(9)
+        };
+        assert_eq!(hang.over(&idle, limit), None);
     }
 }
