@@ -51,7 +51,8 @@ pub struct RunArgs {
     /// Time limit on each FMI call, in seconds: a call that takes longer
     /// stops the run (rows so far kept, marked incomplete) naming the
     /// instance and the call; a running call cannot be interrupted, a
-    /// watchdog reports it on stderr when it passes the limit.
+    /// watchdog reports it on stderr when it passes the limit (with
+    /// --isolate it is stopped: the FMU process is killed).
     #[arg(long = "step-timeout", value_name = "SECONDS")]
     pub step_timeout: Option<f64>,
     /// Run the FMUs in a child process (see docs/user-guide.md, "Isolated

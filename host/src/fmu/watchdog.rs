@@ -13,8 +13,9 @@
 //! and address space; there is no safe way to stop a thread in the middle of
 //! foreign code (killing it would leave the FMU's locks and memory in an
 //! unknown state). A call that never returns keeps fricsim waiting until it
-//! is interrupted (Ctrl-C), and the results of that run are then lost; only
-//! running each FMU in its own process could do better.
+//! is interrupted (Ctrl-C), and the results of that run are then lost.
+//! `--isolate` runs the FMUs in a child process, which the parent kills
+//! when a call passes the limit ([`crate::isolate`]).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock, Weak};
