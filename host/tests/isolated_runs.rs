@@ -148,7 +148,7 @@ fn crashed_run(rig: &Rig, fault: i32, args: &[&str]) -> (String, String) {
     let run = fricsim_run(&system, &out, &tmp, &all);
     let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
     assert_eq!(run.status.code(), Some(1), "{stderr}");
-    let text = std::fs::read_to_string(&out).unwrap();
+    let text = std::fs::read_to_string(&out).unwrap_or_else(|e| panic!("{e}: {stderr}"));
     let lines: Vec<&str> = text.lines().collect();
     // the header and the rows at 0, H, …, 9·H, each bit for bit as in-process
     assert_eq!(lines.len(), 1 + FAULT_STEP + 1, "{text}");
@@ -288,7 +288,7 @@ fn fricsim_cosim_isolate_survives_a_crash_the_same_way() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(1), "{stderr}");
-    let text = std::fs::read_to_string(&out).unwrap();
+    let text = std::fs::read_to_string(&out).unwrap_or_else(|e| panic!("{e}: {stderr}"));
     let lines: Vec<&str> = text.lines().collect();
     // cosim records the same columns: the rows equal run's in-process rows
     assert_eq!(lines[..=FAULT_STEP], rig.reference[..=FAULT_STEP], "{text}");

@@ -9,6 +9,7 @@ use crate::master::RowSink;
 use std::ffi::OsString;
 use std::io::BufRead;
 use std::os::unix::process::ExitStatusExt;
+use std::path::PathBuf;
 use std::process::{Command, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -89,7 +90,7 @@ pub fn run_isolated<S: RowSink>(
         }
     });
 
-    let mut outcome = Outcome {
+    let outcome = Outcome {
         sink: None,
         columns: Vec::new(),
         started: None,
@@ -98,43 +99,22 @@ pub fn run_isolated<S: RowSink>(
         died: None,
         rows: 0,
     };
-    let mut make_sink = Some(make_sink);
-    let mut ring: Option<RowRing> = None;
-    let mut instances: Vec<String> = Vec::new();
-    let mut sink_error = None;
+    let mut follow = Follow {
+        outcome,
+        make_sink: Some(make_sink),
+        ring: None,
+        ring_path: dir.path().join(RING_FILE),
+        instances: Vec::new(),
+        error: None,
+    };
     let mut hang = Hang::default();
     let status = loop {
-        let mut busy = take_rows(&ring, &mut outcome, &mut sink_error);
+        let mut busy = follow.take_rows();
         while let Ok(message) = received.try_recv() {
             busy = true;
-            match message {
-                Ok(Message::Started {
-                    columns,
-                    instances: names,
-                    extra,
-                }) => {
-                    instances = names;
-                    let made = make_sink.take().map(|f| f(&columns, &extra));
-                    outcome.started = Some(extra);
-                    outcome.columns = columns;
-                    match made {
-                        Some(Ok(sink)) => outcome.sink = Some(sink),
-                        Some(Err(e)) => sink_error = Some(e),
-                        None => {}
-                    }
-                    match RowRing::open(&dir.path().join(RING_FILE)) {
-                        Ok(r) => ring = Some(r),
-                        Err(e) => sink_error = Some(format!("cannot map the child's rows: {e}")),
-                    }
-                }
-                Ok(Message::Finished { rows, error, extra }) => {
-                    outcome.finished = Some((rows, error, extra))
-                }
-                Ok(Message::Failed { message }) => outcome.failed = Some(message),
-                Err(e) => sink_error = Some(e),
-            }
+            follow.receive(message);
         }
-        if let Some(e) = &sink_error {
+        if let Some(e) = &follow.error {
             // the parent cannot take the rows: the child is stopped
             let _ = child.kill();
             let _ = child.wait();
@@ -150,9 +130,9 @@ pub fn run_isolated<S: RowSink>(
             if let Some(call) = hang.over(&black_box.read(), limit) {
                 let _ = child.kill();
                 let _ = child.wait();
-                outcome.died = Some(format!(
+                follow.outcome.died = Some(format!(
                     "{} for more than the limit of {} s (--step-timeout): the FMU process was killed (SIGKILL)",
-                    where_(&call, &instances, "was in"),
+                    where_(&call, &follow.instances, "was in"),
                     limit.as_secs_f64()
                 ));
                 break ExitStatus::from_raw(libc::SIGKILL);
@@ -162,44 +142,94 @@ pub fn run_isolated<S: RowSink>(
             std::thread::sleep(POLL);
         }
     };
+    // what the child said and stored before it ended, in order: it may
+    // have started, run and died between two looks
     let _ = reader.join();
     for message in received.try_iter() {
-        match message {
-            Ok(Message::Finished { rows, error, extra }) => {
-                outcome.finished = Some((rows, error, extra))
-            }
-            Ok(Message::Failed { message }) => outcome.failed = Some(message),
-            Ok(Message::Started { .. }) | Err(_) => {}
-        }
+        follow.receive(message);
     }
-    take_rows(&ring, &mut outcome, &mut sink_error);
-    if let Some(e) = sink_error {
+    follow.take_rows();
+    if let Some(e) = follow.error {
         return Err(e);
     }
+    let mut outcome = follow.outcome;
+    if let Some((rows, _, _)) = &outcome.finished {
+        if *rows != outcome.rows {
+            return Err(format!(
+                "the isolated child ran {rows} rows but the parent received {}",
+                outcome.rows
+            ));
+        }
+    }
     if outcome.died.is_none() && outcome.finished.is_none() && outcome.failed.is_none() {
-        outcome.died = Some(death(&black_box.read(), &instances, status));
+        outcome.died = Some(death(&black_box.read(), &follow.instances, status));
     }
     Ok(outcome)
 }
 
-/// Hand the rows in the ring (if made) to the sink: whether there were any.
-fn take_rows<S: RowSink>(
-    ring: &Option<RowRing>,
-    outcome: &mut Outcome<S>,
-    error: &mut Option<String>,
-) -> bool {
-    let (Some(ring), Some(sink)) = (ring, &mut outcome.sink) else {
-        return false;
-    };
-    let (times, rows) = ring.take();
-    if times.is_empty() {
-        return false;
+/// What the parent has from the child so far.
+struct Follow<S, F> {
+    outcome: Outcome<S>,
+    /// Makes the sink when the child says the run started.
+    make_sink: Option<F>,
+    ring: Option<RowRing>,
+    ring_path: PathBuf,
+    instances: Vec<String>,
+    /// Why the parent cannot go on (the sink failed, the child's message
+    /// or ring is unreadable).
+    error: Option<String>,
+}
+
+impl<S, F> Follow<S, F>
+where
+    S: RowSink,
+    F: FnOnce(&[String], &serde_json::Value) -> Result<S, String>,
+{
+    /// Take a message of the child's.
+    fn receive(&mut self, message: Result<Message, String>) {
+        match message {
+            Ok(Message::Started {
+                columns,
+                instances,
+                extra,
+            }) => {
+                self.instances = instances;
+                match self.make_sink.take().map(|f| f(&columns, &extra)) {
+                    Some(Ok(sink)) => self.outcome.sink = Some(sink),
+                    Some(Err(e)) => self.error = Some(e),
+                    None => {}
+                }
+                self.outcome.started = Some(extra);
+                self.outcome.columns = columns;
+                match RowRing::open(&self.ring_path) {
+                    Ok(r) => self.ring = Some(r),
+                    Err(e) => self.error = Some(format!("cannot map the child's rows: {e}")),
+                }
+            }
+            Ok(Message::Finished { rows, error, extra }) => {
+                self.outcome.finished = Some((rows, error, extra))
+            }
+            Ok(Message::Failed { message }) => self.outcome.failed = Some(message),
+            Err(e) => self.error = Some(e),
+        }
     }
-    outcome.rows += times.len();
-    if let Err(e) = sink.write(&times, &rows) {
-        error.get_or_insert(e);
+
+    /// Hand the rows in the ring (once made) to the sink: whether there
+    /// were any.
+    fn take_rows(&mut self) -> bool {
+        let (Some(ring), Some(sink)) = (&self.ring, &mut self.outcome.sink) else {
+            return false;
+        };
+        let (times, rows) = ring.take();
+        if times.is_empty() {
+            return false;
+        }
+        self.outcome.rows += times.len();
+        if let Err(e) = sink.write(&times, &rows) {
+            self.error.get_or_insert(e);
+        }
+        true
     }
-    true
 }
 
 /// The call the child is in, and since when the parent has seen it.
