@@ -4,7 +4,8 @@
 # cross-built and tested under Wine), run the Rust tests, create the pinned
 # Python venv (FMPy, fmutool, libcosimpy), install Chromium (the report
 # tests render report.html in it), build the `fmi` crate's importer
-# (libclang for its bindings) and run the Python tests.
+# (libclang for its bindings), build and install the Python package
+# fricsim (python/, maturin) and run the Python tests.
 set -euo pipefail
 cd "$(dirname "$0")"
 ./build-fmu.sh
@@ -12,4 +13,5 @@ cargo test --workspace --profile release-test
 scripts/setup-venv.sh
 scripts/setup-browser.sh
 scripts/setup-fmi-crate.sh
+scripts/setup-python-package.sh
 .venv/bin/python -m pytest tests -q

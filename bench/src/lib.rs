@@ -14,6 +14,8 @@
 
 use std::path::Path;
 
+pub mod fmi_loop;
+
 /// Replace the text between the markers `begin` and `end` of `path` with
 /// `block` (which holds the markers), keeping the rest; a missing file is
 /// created with a title, a file without the markers is refused. With no

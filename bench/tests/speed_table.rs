@@ -67,6 +67,28 @@ fn quick_mode_writes_every_table_between_its_markers() {
             assert!((finals[0] - finals[1]).abs() < 1e-6, "{cells:?}");
         }
     }
+    // the hand-written FMI loop computes the same force as the host
+    let cells = common::table_row(
+        &text,
+        "**The host against a hand-written FMI loop**",
+        "jacobi",
+    );
+    assert_eq!(cells.len(), 5, "{cells:?}");
+    let finals: Vec<f64> = cells[4].split(", ").map(|x| x.parse().unwrap()).collect();
+    assert_eq!(finals[0], finals[1], "{cells:?}");
+    for format in ["CSV", "MAT v4"] {
+        let cells = common::table_row(&text, "**The whole `fricsim run", format);
+        assert_eq!(cells.len(), 3, "{cells:?}");
+    }
+    for stop in ["0.1 s", "0.2 s", "0.4 s"] {
+        let cells = common::table_row(&text, "**Peak resident memory**", stop);
+        assert_eq!(cells.len(), 6, "{cells:?}");
+        // a resident process holds at least its code: over 1 MB
+        for rss in &cells[2..4] {
+            let mb: f64 = rss.trim_end_matches(" MB").parse().unwrap();
+            assert!(mb > 1.0, "{cells:?}");
+        }
+    }
     for law in ["bristle", "Dahl", "LuGre"] {
         assert_eq!(
             common::table_row(&text, "**Appels and Herder's Experiments 3 curve**", law).len(),
@@ -93,7 +115,7 @@ fn quick_mode_writes_every_table_between_its_markers() {
         .skip_while(|l| !l.starts_with("**Goals**"))
         .filter(|l| l.starts_with("- "))
         .collect();
-    assert_eq!(goals.len(), 8, "{goals:?}");
+    assert_eq!(goals.len(), 12, "{goals:?}");
     for g in goals {
         assert!(
             g.ends_with(": met") || g.ends_with(": NOT MET") || g.ends_with("not measured"),

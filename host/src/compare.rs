@@ -1,7 +1,7 @@
 //! Co-simulation error against a reference: for each signal common to a
-//! result CSV and a reference CSV (both `time` first, `component.variable`
-//! columns, as `fricsim run` and `fricsim reference` write them), the
-//! relative RMS error
+//! result and a reference (CSV, `time` first, `component.variable`
+//! columns, as `fricsim run` and `fricsim reference` write them, or MAT v4
+//! result files, [`crate::matfile`]), the relative RMS error
 //!
 //! `e_rms = √(Σ (y_i − r_i)²) / √(Σ r_i²)`  (RMS of the difference over RMS
 //! of the reference, over the result's time points),
@@ -63,7 +63,7 @@ pub struct ResultFile {
     pub time: Vec<f64>,
     /// `values[k][i]`: column `k` at row `i`.
     pub values: Vec<Vec<f64>>,
-    /// 1-based line of each row.
+    /// 1-based line of each row (of a MAT file: its time point).
     pub lines: Vec<u64>,
     /// The text of a `# INCOMPLETE: …` line (a run that stopped early).
     pub incomplete: Option<String>,
@@ -73,12 +73,60 @@ impl ResultFile {
     /// Reads a CSV with a header `time,<columns…>` and at least one row of
     /// numbers (`NaN` and `inf` parse and are refused when compared);
     /// `#` lines are comments. Time must be finite and strictly increasing.
+    /// A path ending in `.mat` is read as a MAT v4 result file
+    /// ([`crate::matfile::read`]), with the same checks.
     pub fn read(path: &Path) -> Result<ResultFile, CompareError> {
+        if crate::matfile::is_mat(path) {
+            return Self::read_mat(path);
+        }
         let text = std::fs::read_to_string(path).map_err(|e| CompareError::Read {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
         Self::parse(path, &text)
+    }
+
+    /// A MAT v4 result file: the variables of its `data_2`, time strictly
+    /// increasing and finite, at least one time point and one column.
+    fn read_mat(path: &Path) -> Result<ResultFile, CompareError> {
+        let read_error = |message: String| CompareError::Read {
+            path: path.to_path_buf(),
+            message,
+        };
+        let mat = crate::matfile::read(path).map_err(|message| CompareError::Read {
+            path: path.to_path_buf(),
+            // the reader's messages name the file already
+            message: message
+                .strip_prefix(&format!("{}: ", path.display()))
+                .map_or(message.clone(), str::to_string),
+        })?;
+        if mat.columns.is_empty() {
+            return Err(read_error("no variables but time in data_2".into()));
+        }
+        if mat.time.is_empty() {
+            return Err(read_error("no time points in data_2".into()));
+        }
+        for (i, pair) in mat.time.windows(2).enumerate() {
+            if !pair[0].is_finite() || pair[1] <= pair[0] {
+                return Err(read_error(format!(
+                    "time point {}: time {} after {}; time must be finite and strictly increasing",
+                    i + 2,
+                    pair[1],
+                    pair[0]
+                )));
+            }
+        }
+        if let Some(t) = mat.time.iter().find(|t| !t.is_finite()) {
+            return Err(read_error(format!("time {t} is not a finite number")));
+        }
+        Ok(ResultFile {
+            path: path.to_path_buf(),
+            columns: mat.columns,
+            lines: (1..=mat.time.len() as u64).collect(),
+            time: mat.time,
+            values: mat.values,
+            incomplete: mat.incomplete,
+        })
     }
 
     /// As [`ResultFile::read`], from the file's text.
@@ -198,6 +246,13 @@ impl ResultFile {
         let col = self.column(name).unwrap_or(&[]);
         match col.iter().position(|x| !x.is_finite()) {
             None => Ok(()),
+            Some(i) if crate::matfile::is_mat(&self.path) => Err(CompareError::Read {
+                path: self.path.clone(),
+                message: format!(
+                    "time point {}: {name} = {} is not a finite number",
+                    self.lines[i], col[i]
+                ),
+            }),
             Some(i) => Err(CompareError::NotFinite {
                 path: self.path.clone(),
                 line: self.lines[i],

@@ -36,8 +36,13 @@ pub struct InputTable {
 impl InputTable {
     /// Read and check the file: a header with `time` first and distinct
     /// names, at least one row, finite numbers, every row as long as the
-    /// header, non-decreasing time.
+    /// header, non-decreasing time. A path ending in `.mat` is read as a
+    /// MAT v4 result file ([`crate::matfile::read`]), with the same checks
+    /// (its time points counted as lines: the first is 2).
     pub fn read(path: &Path) -> Result<InputTable, String> {
+        if crate::matfile::is_mat(path) {
+            return Self::read_mat(path);
+        }
         let shown = path.display();
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)
@@ -120,6 +125,49 @@ impl InputTable {
             return Err(format!("{shown}: no rows after the header"));
         }
         Ok(table)
+    }
+}
+
+impl InputTable {
+    /// [`InputTable::read`] of a MAT v4 result file.
+    fn read_mat(path: &Path) -> Result<InputTable, String> {
+        let shown = path.display();
+        let mat = crate::matfile::read(path)?;
+        if mat.columns.is_empty() {
+            return Err(format!("{shown}: no input columns after `time` in data_2"));
+        }
+        if mat.time.is_empty() {
+            return Err(format!("{shown}: no time points in data_2"));
+        }
+        for (k, name) in mat.columns.iter().enumerate() {
+            if mat.columns[..k].contains(name) {
+                return Err(format!("{shown}: column `{name}` occurs twice"));
+            }
+        }
+        let columns: Vec<(String, Vec<f64>)> = mat.columns.into_iter().zip(mat.values).collect();
+        for (i, &t) in mat.time.iter().enumerate() {
+            let point = i + 1;
+            let bad = std::iter::once(("time", t))
+                .chain(columns.iter().map(|(n, v)| (n.as_str(), v[i])))
+                .find(|(_, x)| !x.is_finite());
+            if let Some((name, x)) = bad {
+                return Err(format!(
+                    "{shown}: time point {point}: column `{name}`: {x} is not a finite number"
+                ));
+            }
+            if i > 0 && t < mat.time[i - 1] {
+                return Err(format!(
+                    "{shown}: time point {point}: time {t} is before the previous point's {}: time must not decrease",
+                    mat.time[i - 1]
+                ));
+            }
+        }
+        Ok(InputTable {
+            path: path.to_path_buf(),
+            lines: (2..mat.time.len() as u64 + 2).collect(),
+            time: mat.time,
+            columns,
+        })
     }
 }
 

@@ -74,6 +74,18 @@ fn main() -> ExitCode {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let args = Args::parse();
+    // the commands that stream a run to a result file stop between chunks
+    // on SIGINT/SIGTERM and put the rows so far in place (an isolated
+    // run's child too: it stops there and its parent puts them in place)
+    if matches!(
+        args.command,
+        Command::Run(_) | Command::Cosim(_) | Command::IsolatedChild(_)
+    ) {
+        if let Err(e) = fricsim::signals::stop_on_termination() {
+            eprintln!("fricsim: cannot catch SIGINT and SIGTERM: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
     let result = match args.command {
         Command::Info { fmu } => cli::info::run(&fmu).map_err(|e| e.to_string()),
         Command::Cosim(args) => cli::cosim::run(&args),
@@ -91,7 +103,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("fricsim: {e}");
-            ExitCode::FAILURE
+            // stopped by a signal: 128 + its number, as a shell reports it
+            match fricsim::signals::received() {
+                Some((signal, _)) => ExitCode::from((128 + signal) as u8),
+                None => ExitCode::FAILURE,
+            }
         }
     }
 }

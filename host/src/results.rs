@@ -7,56 +7,140 @@
 //! ([`crate::master::simulate_streaming`]) and writes them at once, keeping
 //! only a summary of each column and the columns to be plotted, so that a
 //! run's memory does not grow with its length; [`write_csv`] writes a
-//! [`Run`] held in memory as the same file.
+//! [`Run`] held in memory as the same file. A path ending in `.mat` gets
+//! a MAT v4 file instead ([`crate::matfile`], [`create`]). Both write
+//! through an [`OutputFile`]: a result is put in place whole (or marked
+//! incomplete) or not at all.
 
 use crate::master::{RowSink, Run};
+use crate::matfile::MatFile;
+use crate::output_file::{OutputError, OutputFile};
 use crate::rows::Rows;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use crate::system::RecordedType;
+use std::io::Write;
+use std::path::Path;
 
-/// A CSV result file written row by row: created (with its directory) at
-/// the first rows, so that a run that fails before its first row leaves
-/// no file.
+/// A result file written row by row, whatever its format.
+pub trait RowFile {
+    fn path(&self) -> &Path;
+    /// Write the Integer and Boolean columns as whole numbers, where the
+    /// format distinguishes them (CSV); `types` has one entry per column.
+    fn whole_number_columns(&mut self, _types: &[RecordedType]) {}
+    /// The first `times.len()` rows of `rows`, at `times`.
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()>;
+    /// The end of the file, saying why the run stopped early if `error`
+    /// is given; then the file is put in place ([`OutputFile::commit`]).
+    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError>;
+}
+
+/// The result file written to `out` for the columns `time` and `columns`:
+/// MAT v4 when its path's extension is `.mat` ([`crate::matfile::is_mat`]),
+/// else CSV.
+pub fn create(out: OutputFile, columns: &[String]) -> Box<dyn RowFile> {
+    if crate::matfile::is_mat(out.path()) {
+        Box::new(MatFile::new(out, columns))
+    } else {
+        Box::new(CsvFile::new(out, columns))
+    }
+}
+
+impl RowFile for CsvFile {
+    fn path(&self) -> &Path {
+        CsvFile::path(self)
+    }
+    fn whole_number_columns(&mut self, types: &[RecordedType]) {
+        CsvFile::whole_number_columns(self, types)
+    }
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
+        CsvFile::write_rows(self, times, rows)
+    }
+    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError> {
+        CsvFile::finish(*self, error)
+    }
+}
+
+impl RowFile for MatFile {
+    fn path(&self) -> &Path {
+        MatFile::path(self)
+    }
+    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
+        MatFile::write_rows(self, times, rows)
+    }
+    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError> {
+        MatFile::finish(*self, error)
+    }
+}
+
+/// A CSV result file written row by row to an [`OutputFile`] (so that it
+/// is put in place whole, or marked incomplete, or not at all).
 pub struct CsvFile {
-    path: PathBuf,
     header: String,
-    out: Option<BufWriter<File>>,
+    header_written: bool,
+    out: OutputFile,
+    /// Per column, whether it holds whole numbers (an Integer or a
+    /// Boolean variable), written as such: `3`, not `3.0`; empty: none.
+    whole: Vec<bool>,
 }
 
 impl CsvFile {
-    /// A file at `path` with the columns `time` and `columns`.
-    pub fn new(path: &Path, columns: &[String]) -> CsvFile {
+    /// A CSV file in `out` with the columns `time` and `columns`.
+    pub fn new(out: OutputFile, columns: &[String]) -> CsvFile {
         CsvFile {
-            path: path.to_path_buf(),
             header: header(columns),
-            out: None,
+            header_written: false,
+            out,
+            whole: Vec::new(),
         }
     }
 
-    fn out(&mut self) -> std::io::Result<&mut BufWriter<File>> {
-        if self.out.is_none() {
-            if let Some(dir) = self.path.parent() {
-                std::fs::create_dir_all(dir)?;
-            }
-            let mut out = BufWriter::with_capacity(1 << 16, File::create(&self.path)?);
-            writeln!(out, "{}", self.header)?;
-            self.out = Some(out);
+    /// Write the columns whose `types` are Integer or Boolean as whole
+    /// numbers (`3`, a Boolean `0` or `1`, as FMPy's `write_csv` does),
+    /// not as Reals (`3.0`); `types` has one entry per column
+    /// ([`crate::system::System::column_types`]).
+    pub fn whole_number_columns(&mut self, types: &[RecordedType]) {
+        self.whole = types.iter().map(|t| *t != RecordedType::Real).collect();
+        if !self.whole.contains(&true) {
+            self.whole.clear();
         }
-        Ok(self.out.as_mut().expect("opened above"))
+    }
+
+    /// The path the file is put at.
+    pub fn path(&self) -> &Path {
+        self.out.path()
+    }
+
+    fn out(&mut self) -> std::io::Result<&mut OutputFile> {
+        if !self.header_written {
+            self.header_written = true;
+            writeln!(self.out, "{}", self.header)?;
+        }
+        Ok(&mut self.out)
     }
 
     /// The first `times.len()` rows of `rows`, at `times`.
     pub fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
-        let out = self.out()?;
+        self.out()?;
+        let (out, whole) = (&mut self.out, &self.whole);
         let mut digits = zmij::Buffer::new();
         let mut line = Vec::with_capacity(32 * (rows.width() + 1));
         for (t, row) in times.iter().zip(rows) {
             line.clear();
             push_number(&mut line, &mut digits, *t);
-            for x in row {
-                line.push(b',');
-                push_number(&mut line, &mut digits, *x);
+            if whole.is_empty() {
+                for x in row {
+                    line.push(b',');
+                    push_number(&mut line, &mut digits, *x);
+                }
+            } else {
+                for (x, whole) in row.iter().zip(whole) {
+                    line.push(b',');
+                    if *whole {
+                        // an i32 or a Boolean read into an f64: exact
+                        write!(line, "{}", *x as i64)?;
+                    } else {
+                        push_number(&mut line, &mut digits, *x);
+                    }
+                }
             }
             line.push(b'\n');
             out.write_all(&line)?;
@@ -65,18 +149,20 @@ impl CsvFile {
     }
 
     /// The end of the file: `# INCOMPLETE: the run stopped early: …` if
-    /// `error` says why the run stopped early.
-    pub fn finish(mut self, error: Option<&str>) -> std::io::Result<()> {
-        let out = self.out()?;
-        if let Some(e) = error {
-            let one_line = e.replace(['\n', '\r'], " ");
-            writeln!(out, "# INCOMPLETE: the run stopped early: {one_line}")?;
+    /// `error` says why the run stopped early; then the file is put in
+    /// place ([`OutputFile::commit`]: not after a write error).
+    pub fn finish(mut self, error: Option<&str>) -> Result<(), OutputError> {
+        // a write error is kept by the OutputFile and reported by commit
+        if let Ok(out) = self.out() {
+            if let Some(e) = error {
+                let one_line = e.replace(['\n', '\r'], " ");
+                let _ = writeln!(out, "# INCOMPLETE: the run stopped early: {one_line}");
+            }
         }
-        out.flush()
+        self.out.commit()
     }
 }
 
-/// Write `run` (rows held in memory) as a CSV result file.
 /// The header line: `time`, then the columns, comma-separated (`time`
 /// alone when nothing else is recorded, not `time,`).
 fn header(columns: &[String]) -> String {
@@ -86,9 +172,11 @@ fn header(columns: &[String]) -> String {
         .join(",")
 }
 
-pub fn write_csv(run: &Run, path: &Path) -> std::io::Result<()> {
-    let mut file = CsvFile::new(path, &run.columns);
-    file.write_rows(&run.time, &run.rows)?;
+/// Write `run` (rows held in memory) as a CSV result file to `out`.
+pub fn write_csv(run: &Run, out: OutputFile) -> Result<(), OutputError> {
+    let mut file = CsvFile::new(out, &run.columns);
+    // a write error is reported by finish, with the path
+    let _ = file.write_rows(&run.time, &run.rows);
     file.finish(run.error.as_deref())
 }
 
@@ -133,10 +221,10 @@ impl ColumnStats {
     }
 }
 
-/// The rows of a run as they come: written to a CSV file, summed up in
-/// [`ColumnStats`], and the columns to be plotted kept.
+/// The rows of a run as they come: written to a result file ([`create`]),
+/// summed up in [`ColumnStats`], and the columns to be plotted kept.
 pub struct ResultWriter {
-    file: CsvFile,
+    file: Box<dyn RowFile>,
     pub stats: ColumnStats,
     /// The columns kept (their indices), their names, their times and rows.
     kept: Option<Kept>,
@@ -150,13 +238,19 @@ struct Kept {
 }
 
 impl ResultWriter {
-    /// A writer of the rows of `columns` to the CSV file `path`.
-    pub fn new(path: &Path, columns: &[String]) -> ResultWriter {
+    /// A writer of the rows of `columns` to the result file `out` (CSV,
+    /// or MAT v4 if its path ends in `.mat`: [`create`]).
+    pub fn new(out: OutputFile, columns: &[String]) -> ResultWriter {
         ResultWriter {
-            file: CsvFile::new(path, columns),
+            file: create(out, columns),
             stats: ColumnStats::new(columns.len()),
             kept: None,
         }
+    }
+
+    /// See [`CsvFile::whole_number_columns`].
+    pub fn whole_number_columns(&mut self, types: &[RecordedType]) {
+        self.file.whole_number_columns(types);
     }
 
     /// Keep the columns `names` in memory besides writing them (for a
@@ -193,8 +287,8 @@ impl ResultWriter {
         })
     }
 
-    /// The end of the file (see [`CsvFile::finish`]).
-    pub fn finish(self, error: Option<&str>) -> std::io::Result<()> {
+    /// The end of the file (see [`CsvFile::finish`], [`MatFile::finish`]).
+    pub fn finish(self, error: Option<&str>) -> Result<(), OutputError> {
         self.file.finish(error)
     }
 }
@@ -203,7 +297,7 @@ impl RowSink for ResultWriter {
     fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String> {
         self.file
             .write_rows(times, rows)
-            .map_err(|e| format!("{}: {e}", self.file.path.display()))?;
+            .map_err(|e| format!("{}: {e}", self.file.path().display()))?;
         self.stats.add(times, rows);
         if let Some(k) = &mut self.kept {
             k.time.extend_from_slice(times);
@@ -215,6 +309,11 @@ impl RowSink for ResultWriter {
             }
         }
         Ok(())
+    }
+
+    /// A termination signal stops the run ([`crate::signals`]).
+    fn stop_requested(&self) -> Option<String> {
+        crate::signals::stop_reason()
     }
 }
 

@@ -11,11 +11,11 @@
 //! cores; a run that fails is a row that says so, not the end of the sweep.
 
 use crate::master::{by_name, simulate_with, NoObserver};
+use crate::output_file::{OutputError, OutputFile};
 use crate::ssp::{CheckedSystem, SystemFile};
 use crate::system::ParameterValue;
 use rayon::prelude::*;
 use std::io::Write as _;
-use std::path::Path;
 use std::time::Instant;
 
 /// One swept variable: `component.variable` and its values.
@@ -237,11 +237,15 @@ pub fn run_all(file: &SystemFile, plan: &Plan, threads: usize) -> Result<Vec<Out
 /// The table: `run`, one column per swept variable, `status` (`ok` or the
 /// error), `points`, `wall_s`, then `final:<column>` and `rms:<column>` for
 /// every recorded column (those of the first run that has any).
-pub fn write_csv(outcomes: &[Outcome], path: &Path) -> std::io::Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+/// Written through `out` ([`OutputFile`]): put in place whole or not at
+/// all.
+pub fn write_csv(outcomes: &[Outcome], mut out: OutputFile) -> Result<(), OutputError> {
+    // a write error is kept by the OutputFile and reported by commit
+    let _ = write_table(outcomes, &mut out);
+    out.commit()
+}
+
+fn write_table(outcomes: &[Outcome], out: &mut OutputFile) -> std::io::Result<()> {
     let ports: Vec<&str> = outcomes
         .first()
         .map(|o| o.point.iter().map(|(k, _)| k.as_str()).collect())

@@ -20,11 +20,18 @@ pub struct Component {
     pub name: String,
     pub fmu: Fmu,
     pub instance: Instance,
-    /// Real outputs (name, value reference), recorded every step.
+    /// The recorded variables (name, value reference), one column each in
+    /// this order: the Real ones (the outputs, then those recorded by
+    /// [`System::record`]), then the Integer and Enumeration ones, then
+    /// the Boolean ones.
     pub outputs: Vec<(String, ValueReference)>,
-    /// The value references of `outputs`, in order: [`System::sample`]
-    /// reads them in one `fmi2GetReal` call.
+    /// The value references of the Real ones of `outputs`, in order:
+    /// [`System::sample`] reads them in one `fmi2GetReal` call.
     output_vrs: Vec<ValueReference>,
+    /// The Integer (and Enumeration) ones, read with `fmi2GetInteger`.
+    integer_vrs: Vec<ValueReference>,
+    /// The Boolean ones, read with `fmi2GetBoolean`.
+    boolean_vrs: Vec<ValueReference>,
     /// The component's connected inputs, in connection order:
     /// [`System::propagate`] sets them in one `fmi2SetReal`, from the
     /// next `inputs.len()` values it has read (see [`System::plan`]).
@@ -152,17 +159,111 @@ fn forget_sampled(components: &mut [Component]) {
 
 /// Read every component's recorded outputs into `row`, one `fmi2GetReal`
 /// per component, one after the other (`row` holds as many values as
-/// they have), and note each component's [`Instance::changes`] then.
+/// they have; Integer and Boolean ones after the Real ones, see
+/// [`read_discrete`]), and note each component's [`Instance::changes`]
+/// then.
 #[inline(always)] // into the run's loop
 fn read_outputs(components: &mut [Component], row: &mut [f64]) -> Result<(), FmuError> {
     let mut rest = row;
     for c in components {
-        let (values, after) = rest.split_at_mut(c.output_vrs.len());
-        c.instance.get_real(&c.output_vrs, values)?;
+        let (values, after) = rest.split_at_mut(c.outputs.len());
+        let (reals, discrete) = values.split_at_mut(c.output_vrs.len());
+        c.instance.get_real(&c.output_vrs, reals)?;
+        if !discrete.is_empty() {
+            read_discrete(c, discrete)?;
+        }
         c.sampled = c.instance.changes();
         rest = after;
     }
     Ok(())
+}
+
+/// Values read at a time by [`read_discrete`] (on the stack).
+const DISCRETE_CHUNK: usize = 32;
+
+/// Read a component's recorded Integer and Boolean variables into
+/// `values` (as many as it has), as numbers: each Integer exactly (an
+/// `i32` is an `f64` exactly), a Boolean as 0 or 1.
+#[cold]
+#[inline(never)]
+fn read_discrete(c: &mut Component, values: &mut [f64]) -> Result<(), FmuError> {
+    let (integers, booleans) = values.split_at_mut(c.integer_vrs.len());
+    for (vrs, values) in c
+        .integer_vrs
+        .chunks(DISCRETE_CHUNK)
+        .zip(integers.chunks_mut(DISCRETE_CHUNK))
+    {
+        let mut buffer = [0i32; DISCRETE_CHUNK];
+        c.instance.get_integer(vrs, &mut buffer[..vrs.len()])?;
+        for (x, i) in values.iter_mut().zip(buffer) {
+            *x = f64::from(i);
+        }
+    }
+    for (vrs, values) in c
+        .boolean_vrs
+        .chunks(DISCRETE_CHUNK)
+        .zip(booleans.chunks_mut(DISCRETE_CHUNK))
+    {
+        let mut buffer = [false; DISCRETE_CHUNK];
+        c.instance.get_boolean(vrs, &mut buffer[..vrs.len()])?;
+        for (x, b) in values.iter_mut().zip(buffer) {
+            *x = f64::from(u8::from(b));
+        }
+    }
+    Ok(())
+}
+
+/// Which of the recorded types a variable of kind `kind` is, if it is
+/// one: Real, Integer (Enumeration too) or Boolean; a String is not
+/// recorded.
+fn recorded_type(kind: &VariableKind) -> Option<RecordedType> {
+    match kind {
+        VariableKind::Real { .. } => Some(RecordedType::Real),
+        VariableKind::Integer { .. } | VariableKind::Enumeration { .. } => {
+            Some(RecordedType::Integer)
+        }
+        VariableKind::Boolean { .. } => Some(RecordedType::Boolean),
+        VariableKind::String { .. } => None,
+    }
+}
+
+/// The type of a recorded column: a Real, or a whole number (an Integer,
+/// an Enumeration, or a Boolean as 0 or 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum RecordedType {
+    Real,
+    Integer,
+    Boolean,
+}
+
+impl Component {
+    /// Record `(name, vr)` of type `ty`: in its place among the columns
+    /// (Real, then Integer, then Boolean, see [`Component::outputs`]).
+    fn add_recorded(&mut self, name: &str, vr: ValueReference, ty: RecordedType) {
+        let (at, vrs) = match ty {
+            RecordedType::Real => (self.output_vrs.len(), &mut self.output_vrs),
+            RecordedType::Integer => (
+                self.output_vrs.len() + self.integer_vrs.len(),
+                &mut self.integer_vrs,
+            ),
+            RecordedType::Boolean => (self.outputs.len(), &mut self.boolean_vrs),
+        };
+        vrs.push(vr);
+        self.outputs.insert(at, (name.to_string(), vr));
+    }
+
+    /// The type of each recorded column, in column order.
+    fn column_types(&self) -> impl Iterator<Item = RecordedType> {
+        std::iter::repeat_n(RecordedType::Real, self.output_vrs.len())
+            .chain(std::iter::repeat_n(
+                RecordedType::Integer,
+                self.integer_vrs.len(),
+            ))
+            .chain(std::iter::repeat_n(
+                RecordedType::Boolean,
+                self.boolean_vrs.len(),
+            ))
+    }
 }
 
 /// Read every connected output, one per `sources`, into `values` (as
@@ -289,25 +390,29 @@ impl System {
                 )));
             }
             let instance = fmu.instantiate(&name)?;
-            let outputs: Vec<(String, ValueReference)> = fmu
+            let outputs: Vec<(String, ValueReference, RecordedType)> = fmu
                 .description()
                 .variables
                 .iter()
-                .filter(|v| {
-                    v.causality == Causality::Output && matches!(v.kind, VariableKind::Real { .. })
-                })
-                .map(|v| (v.name.clone(), v.value_reference))
+                .filter(|v| v.causality == Causality::Output)
+                .filter_map(|v| Some((v.name.clone(), v.value_reference, recorded_type(&v.kind)?)))
                 .collect();
-            list.push(Component {
+            let mut component = Component {
                 name,
                 fmu,
                 instance,
-                output_vrs: outputs.iter().map(|(_, vr)| *vr).collect(),
-                outputs,
+                output_vrs: Vec::new(),
+                integer_vrs: Vec::new(),
+                boolean_vrs: Vec::new(),
+                outputs: Vec::new(),
                 inputs: Vec::new(),
                 first_column: 0,
                 sampled: NOT_READ,
-            });
+            };
+            for (name, vr, ty) in outputs {
+                component.add_recorded(&name, vr, ty);
+            }
+            list.push(component);
         }
         let mut system = System {
             components: list,
@@ -515,7 +620,7 @@ impl System {
         let mut width = 0;
         for c in &self.components {
             offsets.push(width);
-            width += c.output_vrs.len();
+            width += c.outputs.len();
         }
         // per component, its connected inputs in connection order; their
         // sources one after the other in the same order
@@ -557,9 +662,11 @@ impl System {
         }
     }
 
-    /// Record the Real variable `component.variable` too (an input, a
-    /// parameter, a local), after the component's outputs; recording one
-    /// that is already recorded changes nothing.
+    /// Record the variable `component.variable` too (an input, a
+    /// parameter, a local): a Real after the component's Real columns, an
+    /// Integer (or Enumeration) or a Boolean after its columns of that type
+    /// ([`Component::outputs`]); recording one that is already recorded
+    /// changes nothing.
     pub fn record(&mut self, port: &str) -> Result<(), SystemError> {
         let (c, v) = split_port(port)?;
         let names: Vec<&str> = self.components.iter().map(|x| x.name.as_str()).collect();
@@ -575,15 +682,15 @@ impl System {
                 "cannot record `{port}`: `{c}` has no variable `{v}`"
             ))
         })?;
-        if !matches!(var.kind, VariableKind::Real { .. }) {
+        let Some(ty) = recorded_type(&var.kind) else {
             return Err(SystemError::Invalid(format!(
-                "cannot record `{port}`: it is a {} variable; only Real variables are recorded",
+                "cannot record `{port}`: it is a {} variable; only Real, Integer, Enumeration and Boolean variables are recorded",
                 var.kind.type_name()
             )));
-        }
+        };
         if !component.outputs.iter().any(|(n, _)| n == v) {
-            component.outputs.push((v.to_string(), var.value_reference));
-            component.output_vrs.push(var.value_reference);
+            let vr = var.value_reference;
+            component.add_recorded(v, vr, ty);
             self.plan();
         }
         Ok(())
@@ -608,6 +715,15 @@ impl System {
             .variable(v)
             .map_err(|_| SystemError::Invalid(format!("`{port}`: `{c}` has no variable `{v}`")))?;
         Ok((i, var))
+    }
+
+    /// The type of each column of [`System::columns`], in order: the
+    /// Integer and Boolean ones hold whole numbers (a Boolean 0 or 1).
+    pub fn column_types(&self) -> Vec<RecordedType> {
+        self.components
+            .iter()
+            .flat_map(Component::column_types)
+            .collect()
     }
 
     /// Column names `component.output`, in recording order.

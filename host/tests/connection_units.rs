@@ -7,30 +7,20 @@
 //! could drive ours from an SSP file), and `cosim` checked no units at all.
 
 mod common;
-use common::{assert_message, zip_dir};
-use fricsim::fmu::UnpackOptions;
+use common::assert_message;
 use fricsim::ssp::SystemFile;
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
 
 /// `dist/Rig1D.fmu` with no unit on its output `v`, as `dir/Unitless.fmu`.
 fn rig_without_velocity_unit(dir: &Path) -> PathBuf {
-    let unpacked = fricsim::fmu::archive::unpack(
-        &common::repository().join("dist/Rig1D.fmu"),
-        &UnpackOptions::default(),
-    )
-    .unwrap();
-    let md = unpacked.path().join("modelDescription.xml");
-    let text = std::fs::read_to_string(&md).unwrap();
-    let at = text
-        .find("<ScalarVariable name=\"v\"")
-        .expect("Rig1D has v");
-    let unit = at + text[at..].find("<Real unit=\"m/s\"/>").unwrap();
-    let edited = format!("{}<Real/>{}", &text[..unit], &text[unit + 18..]);
-    std::fs::write(&md, edited).unwrap();
-    let fmu = dir.join("Unitless.fmu");
-    zip_dir(unpacked.path(), &fmu);
-    fmu
+    common::repacked("Rig1D", &dir.join("Unitless.fmu"), |text| {
+        let at = text
+            .find("<ScalarVariable name=\"v\"")
+            .expect("Rig1D has v");
+        let unit = at + text[at..].find("<Real unit=\"m/s\"/>").unwrap();
+        format!("{}<Real/>{}", &text[..unit], &text[unit + 18..])
+    })
 }
 
 fn ssd(rig: &Path, rig_v_connector: &str) -> String {

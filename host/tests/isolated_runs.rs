@@ -301,3 +301,81 @@ fn fricsim_cosim_isolate_survives_a_crash_the_same_way() {
     );
     assert!(entries(&tmp).is_empty(), "{:?}", entries(&tmp));
 }
+
+#[test]
+fn output_interval_start_values_and_whole_numbers_are_as_in_process_byte_for_byte() {
+    let rig = rig();
+    let system = system_file(rig.dir.path(), &rig.belt, 0);
+    // every 3rd of the 65 points (0, 3·H, …, 63·H) and the last (64·H);
+    // a start value; an Integer column
+    let interval = (3.0 * H).to_string();
+    let args = [
+        "--output-interval",
+        &interval,
+        "--set",
+        "friction.Fs=1.25",
+        "--record",
+        "belt.fault_step",
+    ];
+    for ext in ["csv", "mat"] {
+        let mut files = Vec::new();
+        for isolate in [false, true] {
+            let name = format!("interval_{isolate}.{ext}");
+            let out = rig.dir.path().join(&name);
+            let tmp = empty_dir(rig.dir.path(), &format!("tmp_{name}"));
+            let mut all = args.to_vec();
+            if isolate {
+                all.push("--isolate");
+            }
+            let run = fricsim_run(&system, &out, &tmp, &all);
+            assert!(
+                run.status.success(),
+                "{}",
+                String::from_utf8_lossy(&run.stderr)
+            );
+            let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
+            assert!(stdout.contains("64 of 64 macro steps"), "{stdout}");
+            assert!(entries(&tmp).is_empty(), "{:?}", entries(&tmp));
+            files.push(std::fs::read(&out).unwrap());
+        }
+        if ext == "csv" {
+            let text = String::from_utf8_lossy(&files[0]).into_owned();
+            let lines: Vec<&str> = text.lines().collect();
+            assert_eq!(lines.len(), 1 + 22 + 1, "{text}");
+            let k = lines[0]
+                .split(',')
+                .position(|c| c == "belt.fault_step")
+                .unwrap_or_else(|| panic!("{}", lines[0]));
+            for line in &lines[1..] {
+                assert_eq!(line.split(',').nth(k), Some("10"), "{line}");
+            }
+        }
+        assert!(files[0] == files[1], "the isolated .{ext} differs");
+    }
+
+    // a crash at step 10 with every 4th point: 0, 4·H, 8·H and the last
+    // point the parent received, 9·H, as a failing run in-process
+    let interval = (4.0 * H).to_string();
+    let failing = system_file(rig.dir.path(), &rig.belt, belt::SEGFAULT);
+    let out = rig.dir.path().join("interval_crash.csv");
+    let tmp = empty_dir(rig.dir.path(), "tmp_interval_crash");
+    let run = fricsim_run(
+        &failing,
+        &out,
+        &tmp,
+        &["--isolate", "--output-interval", &interval],
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("run INCOMPLETE (the 4 rows"), "{stderr}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let expected: Vec<&str> = [0, 1, 5, 9, 10]
+        .iter()
+        .map(|&i| rig.reference[i].as_str())
+        .collect();
+    assert_eq!(lines[..5], expected[..], "{text}");
+    assert_eq!(lines.len(), 6, "{text}");
+    assert!(lines[5].starts_with("# INCOMPLETE: "), "{}", lines[5]);
+    assert!(entries(&tmp).is_empty(), "{:?}", entries(&tmp));
+}

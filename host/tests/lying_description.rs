@@ -8,7 +8,7 @@
 //! the host's temporary directory, which is removed when the FMU is dropped.
 
 mod common;
-use common::{assert_message, zip_dir};
+use common::assert_message;
 use fricsim::fmu::{Fmu, UnpackOptions};
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
@@ -17,19 +17,7 @@ use tempfile::TempDir;
 /// `dist/Dahl.fmu` with `edit` applied to its model description, zipped
 /// into `dir/Lying.fmu`.
 fn lying_fmu(dir: &Path, edit: impl Fn(&str) -> String) -> PathBuf {
-    let unpacked = fricsim::fmu::archive::unpack(
-        &common::repository().join("dist/Dahl.fmu"),
-        &UnpackOptions::default(),
-    )
-    .unwrap();
-    let md = unpacked.path().join("modelDescription.xml");
-    let text = std::fs::read_to_string(&md).unwrap();
-    let edited = edit(&text);
-    assert_ne!(edited, text, "the edit changed nothing");
-    std::fs::write(&md, edited).unwrap();
-    let fmu = dir.join("Lying.fmu");
-    zip_dir(unpacked.path(), &fmu);
-    fmu
+    common::repacked("Dahl", &dir.join("Lying.fmu"), edit)
 }
 
 /// Where the host unpacks: must be empty again after each case.

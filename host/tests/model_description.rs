@@ -245,6 +245,44 @@ fn malformed_xml_is_refused_with_a_position() {
     assert!(matches!(e, FmuError::XmlSyntax { line: 21, .. }), "{e}");
 }
 
+/// `--` inside a comment is not well-formed XML (XML 1.0 §2.5); FMPy
+/// (lxml) refuses such a description, so fricsim does too, naming where
+/// the `--` is, in the prolog and inside the document alike.
+#[test]
+fn a_double_hyphen_in_a_comment_is_refused_where_it_is() {
+    let inside = VALID.replacen(
+        "<CoSimulation",
+        "<!-- a - comment -- with a double hyphen -->\n  <CoSimulation",
+        1,
+    );
+    let line = inside
+        .lines()
+        .position(|l| l.contains("double hyphen"))
+        .unwrap()
+        + 1;
+    let e = refused(&inside, &["`--` inside a comment"]);
+    assert!(
+        matches!(e, FmuError::XmlSyntax { line: l, .. } if l == line),
+        "{e}"
+    );
+    let prolog = VALID.replacen("a comment before", "a comment -- before", 1);
+    let e = refused(&prolog, &["`--` inside a comment"]);
+    assert!(
+        matches!(
+            e,
+            FmuError::XmlSyntax {
+                line: 2,
+                column: 16,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // a comment with single hyphens only is fine
+    let fine = VALID.replacen("<CoSimulation", "<!-- a - b -->\n  <CoSimulation", 1);
+    ModelDescription::parse(&fine).expect("single hyphens are allowed");
+}
+
 #[test]
 fn truncated_xml_is_refused() {
     for cut in [10, 100, VALID.len() / 2, VALID.len() - 30] {

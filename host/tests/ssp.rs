@@ -915,3 +915,27 @@ fn a_document_of_many_elements_is_read_in_one_pass_and_located() {
         &[&format!("system.ssd:{line}"), "no component `rigg`"],
     );
 }
+
+/// Elements nested deeper than the XML reader supports (65 535 levels)
+/// are refused at once, naming the line where the limit is passed, not
+/// the start of the file.
+#[test]
+fn a_nesting_too_deep_is_refused_where_it_passes_the_limit() {
+    let depth = 70_000;
+    let nested = format!("{}{}", "<x>\n".repeat(depth), "</x>\n".repeat(depth));
+    let system = valid_system().replacen("</ssd:System>", &format!("{nested}</ssd:System>"), 1);
+    let first = system.lines().position(|l| l == "<x>").unwrap() + 1;
+    let message = refused(&system);
+    let line: usize = message
+        .split("system.ssd:")
+        .nth(1)
+        .and_then(|rest| rest.split(':').next())
+        .and_then(|l| l.parse().ok())
+        .unwrap_or_else(|| panic!("no line in: {message}"));
+    // the root, the system and its elements are open around the <x>s
+    assert!(
+        line > first + 65_000 && line < first + depth,
+        "line {line}: {message}"
+    );
+    assert!(message.contains("65535"), "{message}");
+}

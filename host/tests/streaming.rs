@@ -13,6 +13,7 @@ use fricsim::master::{
     by_name, simulate_streaming, simulate_with, NoObserver, RowSink, Rows, Run, Streamed,
     CHUNK_STEPS,
 };
+use fricsim::output_file::OutputFile;
 use fricsim::results::{write_csv, ResultWriter};
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
@@ -243,12 +244,12 @@ fn the_csv_written_as_the_rows_come_is_the_whole_runs_byte_for_byte() {
     )
     .unwrap();
     let kept_file = dir.path().join("whole.csv");
-    write_csv(&whole, &kept_file).unwrap();
+    write_csv(&whole, OutputFile::create(&kept_file, &[]).unwrap()).unwrap();
 
     let streamed_file = dir.path().join("sub/streamed.csv");
     let mut system = stick_slip();
     let columns = system.columns();
-    let mut writer = ResultWriter::new(&streamed_file, &columns);
+    let mut writer = ResultWriter::new(OutputFile::create(&streamed_file, &[]).unwrap(), &columns);
     let plotted = vec!["friction.F".to_string(), "rig.x".to_string()];
     writer.keep_columns(&columns, &plotted).unwrap();
     let run = simulate_streaming(
@@ -284,11 +285,14 @@ fn the_csv_written_as_the_rows_come_is_the_whole_runs_byte_for_byte() {
         let b: Vec<f64> = kept.rows.column(k).collect();
         assert_eq!(bits(&a), bits(&b), "{name}");
     }
-    assert!(writer_for_unknown_column_is_refused(&columns));
+    assert!(writer_for_unknown_column_is_refused(
+        &dir.path().join("unused.csv"),
+        &columns
+    ));
 }
 
-fn writer_for_unknown_column_is_refused(columns: &[String]) -> bool {
-    let mut w = ResultWriter::new(Path::new("unused.csv"), columns);
+fn writer_for_unknown_column_is_refused(path: &Path, columns: &[String]) -> bool {
+    let mut w = ResultWriter::new(OutputFile::create(path, &[]).unwrap(), columns);
     let e = w
         .keep_columns(columns, &["rig.nothing".to_string()])
         .unwrap_err();

@@ -19,6 +19,14 @@
 //!      ([`StickSlipModel::monolithic_jacobi`],
 //!      [`StickSlipModel::monolithic_newton`]). Only the FMI boundary and
 //!      the master's bookkeeping differ between the two.
+//!    - a hand-written FMI loop ([`fricsim_bench::fmi_loop`]): the same
+//!      FMUs dlopen'd and called through the C ABI with the Jacobi scheme,
+//!      nothing but each call's status checked, every output recorded;
+//!      timed in turns with the host.
+//!    - the whole `fricsim run` command, as a fresh process, writing its
+//!      CSV and its MAT file in turns; and its peak resident memory
+//!      (`wait4`'s `ru_maxrss`) for 20, 200 and 2000 s runs in both
+//!      formats.
 //! 3. **Appels and Herder's Experiments 3 curve**: the force–displacement
 //!    curve of the bristle model with Appels and Herder's parameters
 //!    (0.352 kg, N = 109 bristles), 1000 displacement increments from rest
@@ -26,7 +34,9 @@
 //!    over the same increments for comparison (theirs: 0.33 s, 29.1 s,
 //!    19.55 s in Matlab).
 //! 4. **Bristle count** 10 … 100 000: a 1000-increment curve with one
-//!    reversal (0 → 3·δmax → −3·δmax), per-increment cost.
+//!    reversal (0 → 3·δmax → −3·δmax), per-increment cost, of the law and,
+//!    in turns with it, through `Bristle.fmu`'s C ABI (the same forces, bit
+//!    for bit).
 //! 5. **`fricsim sweep`** ([`fricsim::sweep::run_all`]) on one thread and
 //!    on every core: runs per second.
 //! 6. **`fricsim diagnose`** on the EMPS data: the command, timed.
@@ -90,9 +100,10 @@ struct Args {
     /// Run only one side of the stick-slip benchmark and print its time
     /// (the best of `--repeats` runs in this process, one by default) and
     /// final force, for profilers such as callgrind and for timing one
-    /// build against another: `host` or `monolithic`, with `--master` and
+    /// build against another: `host`, `monolithic` or `fmi-loop` (the
+    /// hand-written FMI loop, Jacobi only), with `--master` and
     /// `--stop`; no table is written.
-    #[arg(long, value_parser = ["host", "monolithic"])]
+    #[arg(long, value_parser = ["host", "monolithic", "fmi-loop"])]
     only: Option<String>,
     /// The master of `--only`: jacobi or newton.
     #[arg(long, default_value = "jacobi", value_parser = ["jacobi", "newton"])]
@@ -102,6 +113,11 @@ struct Args {
     stop: Option<f64>,
     #[command(flatten)]
     file: TableFileArgs,
+    /// Run this command, wait for it and print its wall time (s) and
+    /// peak resident memory (bytes): how the memory figures are taken
+    /// ([`fricsim_process`]).
+    #[arg(long, hide = true, num_args = 1.., allow_hyphen_values = true)]
+    peak_memory_of: Vec<String>,
 }
 
 fn main() -> std::process::ExitCode {
@@ -116,9 +132,16 @@ struct Sizes {
     sweep_runs: usize,
     sweep_stop: f64,
     diagnose: bool,
+    /// Stop times of the peak-memory runs, s.
+    memory_stops: [f64; 3],
 }
 
 fn run(args: &Args) -> Result<(), String> {
+    if let [command, arguments @ ..] = args.peak_memory_of.as_slice() {
+        let (wall, peak) = wait_for(std::process::Command::new(command).args(arguments))?;
+        println!("{wall} {peak}");
+        return Ok(());
+    }
     let root = args.file.root();
     if let Some(side) = &args.only {
         let repeats = args.repeats.unwrap_or(1);
@@ -138,6 +161,7 @@ fn run(args: &Args) -> Result<(), String> {
             sweep_runs: 4,
             sweep_stop: 0.1,
             diagnose: false,
+            memory_stops: [0.1, 0.2, 0.4],
         }
     } else {
         Sizes {
@@ -152,6 +176,7 @@ fn run(args: &Args) -> Result<(), String> {
             // user would run
             sweep_stop: 20.0,
             diagnose: true,
+            memory_stops: [20.0, 200.0, 2000.0],
         }
     };
     if sizes.repeats == 0 {
@@ -168,8 +193,10 @@ fn run(args: &Args) -> Result<(), String> {
     let started = Instant::now();
     let laws = law_table(&root, &sizes)?;
     let host = host_table(&root, &python, &sizes)?;
+    let fmi_loop = fmi_loop_row(&root, &sizes)?;
+    let process = process_table(&root, &sizes)?;
     let curve = appels_herder_curve(sizes.repeats)?;
-    let scaling = bristle_scaling(sizes.repeats)?;
+    let scaling = bristle_scaling(&root, sizes.repeats)?;
     let sweep = sweep_speedup(&root, &sizes)?;
     let diagnose = if sizes.diagnose {
         Some(time_diagnose(&root)?)
@@ -182,6 +209,8 @@ fn run(args: &Args) -> Result<(), String> {
         &Report {
             laws,
             host,
+            fmi_loop,
+            process,
             curve,
             scaling,
             sweep,
@@ -404,21 +433,195 @@ impl RowSink for LastRow {
     }
 }
 
+// ---- 2b. the host against a hand-written FMI loop; the whole process ------
+
+/// The host's Jacobi stepping and the hand-written loop's, s, timed in
+/// turns, with the final friction force of each.
+struct FmiLoopRow {
+    host: f64,
+    hand: f64,
+    finals: [f64; 2],
+}
+
+fn fmi_loop_row(root: &Path, sizes: &Sizes) -> Result<FmiLoopRow, String> {
+    let file = SystemFile::open(root.join(STICK_SLIP)).map_err(|e| e.to_string())?;
+    let open = |name: &str| {
+        Fmu::open(root.join("dist").join(name))
+            .map_err(|e| format!("{name}: {e} (run ./build-fmu.sh)"))
+    };
+    let (rig, lugre) = (open("Rig1D.fmu")?, open("LuGre.fmu")?);
+    let (h, stop) = (STICK_SLIP_STEP, sizes.host_stop);
+    let (mut host_final, mut hand_final) = (f64::NAN, f64::NAN);
+    let (host, hand) = best_of_alternating(
+        sizes.repeats,
+        || {
+            let (wall, force, _) = host_run(&file, "jacobi", h, stop)?;
+            host_final = force;
+            Ok(wall)
+        },
+        || {
+            let (wall, force) = hand_loop_run(&rig, &lugre, h, stop)?;
+            hand_final = force;
+            Ok(wall)
+        },
+    )?;
+    eprintln!("stick-slip jacobi: host {host:.4} s, hand-written FMI loop {hand:.4} s");
+    Ok(FmiLoopRow {
+        host,
+        hand,
+        finals: [host_final, hand_final],
+    })
+}
+
+/// The stick-slip system's FMUs: Rig1D and LuGre.
+fn stick_slip_fmus(root: &Path) -> Result<(Fmu, Fmu), String> {
+    let open = |name: &str| {
+        Fmu::open(root.join("dist").join(name))
+            .map_err(|e| format!("{name}: {e} (run ./build-fmu.sh)"))
+    };
+    Ok((open("Rig1D.fmu")?, open("LuGre.fmu")?))
+}
+
+/// A run of the hand-written FMI loop on the stick-slip system: its wall
+/// time, s, and final friction force. The system's parameters are
+/// Rig1D's and LuGre's defaults (the 1995 values), which the loop keeps.
+fn hand_loop_run(rig: &Fmu, lugre: &Fmu, h: f64, stop: f64) -> Result<(f64, f64), String> {
+    let (wall, last) = fricsim_bench::fmi_loop::jacobi_run(
+        &[("rig", rig), ("friction", lugre)],
+        &[("rig.v", "friction.v"), ("friction.F", "rig.F")],
+        h,
+        stop,
+    )?;
+    // friction's outputs F, z follow rig's ten
+    Ok((wall, last[last.len() - 2]))
+}
+
+/// The whole `fricsim run` command as a user runs it, and its memory.
+struct ProcessTable {
+    /// Best wall time of a fresh process writing CSV and MAT, s.
+    csv: f64,
+    mat: f64,
+    /// Stop time, peak resident memory (bytes) writing CSV and MAT, and
+    /// the two files' sizes.
+    memory: Vec<(f64, u64, u64, u64, u64)>,
+}
+
+/// `fricsim run examples/stick_slip.ssd --stop STOP --out OUT`, a fresh
+/// process: its wall time from spawn to exit, s, and its peak resident
+/// memory, bytes. Linux counts in a child's peak (`ru_maxrss`) the memory
+/// of the process it was forked from, so the command is started by a
+/// fresh `speed-table --peak-memory-of …` (a few MB), not from this
+/// process, whose tables by then hold more than `fricsim run` ever does.
+fn fricsim_process(root: &Path, stop: f64, out: &Path) -> Result<(f64, u64), String> {
+    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let fricsim = exe.with_file_name("fricsim");
+    let output = std::process::Command::new(&exe)
+        .current_dir(root)
+        .arg("--peak-memory-of")
+        .arg(&fricsim)
+        .args([
+            "run",
+            STICK_SLIP,
+            "--quiet",
+            "--stop",
+            &stop.to_string(),
+            "--out",
+        ])
+        .arg(out)
+        .output()
+        .map_err(|e| format!("{}: {e}", exe.display()))?;
+    let text = String::from_utf8_lossy(&output.stdout);
+    let figures: Vec<f64> = text
+        .split_whitespace()
+        .filter_map(|x| x.parse().ok())
+        .collect();
+    match (output.status.success(), figures.as_slice()) {
+        (true, &[wall, peak]) => Ok((wall, peak as u64)),
+        _ => Err(format!(
+            "fricsim run {STICK_SLIP} --stop {stop}: {}",
+            String::from_utf8_lossy(&output.stderr).trim()
+        )),
+    }
+}
+
+/// Run `command` to its end, its output dropped: its wall time from spawn
+/// to exit, s, and its peak resident memory, bytes (`wait4`'s
+/// `ru_maxrss`, in kB on Linux).
+fn wait_for(command: &mut std::process::Command) -> Result<(f64, u64), String> {
+    let clock = Instant::now();
+    let child = command
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::inherit())
+        .spawn()
+        .map_err(|e| e.to_string())?;
+    let mut status = 0;
+    // SAFETY: an all-zero rusage is a valid value; wait4 fills it for
+    // this child, which nothing else waits for
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let pid = child.id() as libc::pid_t;
+    if unsafe { libc::wait4(pid, &mut status, 0, &mut usage) } != pid {
+        return Err(format!("wait4: {}", std::io::Error::last_os_error()));
+    }
+    let wall = clock.elapsed().as_secs_f64();
+    if !libc::WIFEXITED(status) || libc::WEXITSTATUS(status) != 0 {
+        return Err(format!("failed (wait status {status})"));
+    }
+    Ok((wall, usage.ru_maxrss as u64 * 1024))
+}
+
+fn process_table(root: &Path, sizes: &Sizes) -> Result<ProcessTable, String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let (csv_out, mat_out) = (dir.path().join("r.csv"), dir.path().join("r.mat"));
+    let stop = sizes.host_stop;
+    let (csv, mat) = best_of_alternating(
+        sizes.repeats,
+        || Ok(fricsim_process(root, stop, &csv_out)?.0),
+        || Ok(fricsim_process(root, stop, &mat_out)?.0),
+    )?;
+    eprintln!("fricsim run, whole process: CSV {csv:.3} s, MAT {mat:.3} s");
+    let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+    let mut memory = Vec::new();
+    for stop in sizes.memory_stops {
+        let (_, csv_rss) = fricsim_process(root, stop, &csv_out)?;
+        let csv_size = size(&csv_out);
+        let _ = std::fs::remove_file(&csv_out);
+        let (_, mat_rss) = fricsim_process(root, stop, &mat_out)?;
+        let mat_size = size(&mat_out);
+        let _ = std::fs::remove_file(&mat_out);
+        eprintln!("{stop} s: peak RSS {csv_rss} B (CSV), {mat_rss} B (MAT)");
+        memory.push((stop, csv_rss, mat_rss, csv_size, mat_size));
+    }
+    Ok(ProcessTable { csv, mat, memory })
+}
+
 /// `--only`: one side of the stick-slip benchmark, run `repeats` times
 /// (at least once); the best time is printed, with the last run's final
 /// force (every run computes the same).
 fn run_one(root: &Path, side: &str, master: &str, stop: f64, repeats: usize) -> Result<(), String> {
     let file = SystemFile::open(root.join(STICK_SLIP)).map_err(|e| e.to_string())?;
     let h = STICK_SLIP_STEP;
-    let model = if side == "host" {
-        None
-    } else {
+    let model = if side == "monolithic" {
         Some(StickSlipModel::from_file(&file)?)
+    } else {
+        None
+    };
+    let fmus = if side == "fmi-loop" {
+        if master != "jacobi" {
+            return Err("--only fmi-loop runs the Jacobi scheme only".into());
+        }
+        Some(stick_slip_fmus(root)?)
+    } else {
+        None
     };
     let (mut best, mut force) = (f64::INFINITY, f64::NAN);
     for _ in 0..repeats.max(1) {
-        let wall = match &model {
-            None => {
+        let wall = match (&model, &fmus) {
+            (_, Some((rig, lugre))) => {
+                let (wall, f) = hand_loop_run(rig, lugre, h, stop)?;
+                force = f;
+                wall
+            }
+            (None, None) => {
                 let (wall, f, algorithm) = host_run(&file, master, h, stop)?;
                 if let Some(report) = algorithm.report() {
                     eprintln!("{report}");
@@ -426,7 +629,7 @@ fn run_one(root: &Path, side: &str, master: &str, stop: f64, repeats: usize) -> 
                 force = f;
                 wall
             }
-            Some(model) => {
+            (Some(model), None) => {
                 let (wall, f, iterations) = match master {
                     "jacobi" => model.monolithic_jacobi(h, stop),
                     _ => model.monolithic_newton(h, stop)?,
@@ -966,9 +1169,49 @@ struct ScalingRow {
     placement: f64,
     /// The 1000-increment curve with one reversal, s.
     curve: f64,
+    /// The same curve through `Bristle.fmu`'s C ABI (`fmi2SetReal` x,
+    /// `fmi2DoStep`, `fmi2GetReal` F per increment), s; taken in turns
+    /// with the law's.
+    fmu: f64,
 }
 
-fn bristle_scaling(repeats: usize) -> Result<Vec<ScalingRow>, String> {
+/// The bristle curve through the C ABI of `Bristle.fmu` with `count`
+/// bristles and the law's default parameters: the time of the
+/// [`INCREMENTS`] steps (instantiation and placement apart), s, and the sum
+/// of the forces, which must equal [`bristle_curve`]'s bit for bit.
+fn bristle_curve_through_fmu(fmu: &Fmu, count: usize) -> Result<(f64, f64), String> {
+    let vr = |name: &str| fmu.variable(name).map(|v| v.value_reference);
+    let e = |e: fricsim::FmuError| e.to_string();
+    let (x, f) = (vr("x").map_err(e)?, vr("F").map_err(e)?);
+    let n_bristles = vr("n_bristles").map_err(e)?;
+    let count_from_load = vr("count_from_load").map_err(e)?;
+    let count = i32::try_from(count).map_err(|_| format!("{count} bristles: too many"))?;
+    let mut b = fmu.instantiate("bristle").map_err(e)?;
+    b.setup_experiment(0.0, None).map_err(e)?;
+    b.enter_initialization_mode().map_err(e)?;
+    // the law's defaults are the FMU's (stiffness from the load, seed 1)
+    // but for the count, set here
+    b.set_boolean(&[count_from_load], &[false]).map_err(e)?;
+    b.set_integer(&[n_bristles], &[count]).map_err(e)?;
+    b.exit_initialization_mode().map_err(e)?;
+    let delta_max = BristleParams::default().delta_max;
+    let h = 1e-3;
+    let mut force = [0.0];
+    let mut sum = 0.0;
+    let clock = Instant::now();
+    for k in 1..=INCREMENTS {
+        b.set_real(&[x], &[bristle_curve_point(k, delta_max)])
+            .map_err(e)?;
+        b.do_step((k - 1) as f64 * h, h).map_err(e)?;
+        b.get_real(&[f], &mut force).map_err(e)?;
+        sum += force[0];
+    }
+    Ok((clock.elapsed().as_secs_f64(), sum))
+}
+
+fn bristle_scaling(root: &Path, repeats: usize) -> Result<Vec<ScalingRow>, String> {
+    let fmu = Fmu::open(root.join("dist/Bristle.fmu"))
+        .map_err(|e| format!("Bristle.fmu: {e} (run ./build-fmu.sh)"))?;
     let mut rows = Vec::new();
     for &count in BRISTLE_COUNTS {
         let p = BristleParams {
@@ -980,8 +1223,28 @@ fn bristle_scaling(repeats: usize) -> Result<Vec<ScalingRow>, String> {
         })?;
         let fresh = Bristle::new(p).map_err(|e| e.to_string())?;
         let half = INCREMENTS / 2;
-        // 0 → 3·δmax in 500 increments, then back to −3·δmax in 500
-        let curve = per_call(repeats, || bristle_curve(&mut fresh.clone()))?;
+        // 0 → 3·δmax in 500 increments, then back to −3·δmax in 500; the
+        // law alone (a clone of the placed bristles each time) and through
+        // the FMU, in turns
+        let law_sum = bristle_curve(&mut fresh.clone());
+        let (curve, fmu_curve) = best_of_alternating(
+            repeats,
+            || {
+                let mut b = fresh.clone();
+                Ok(timed(|| {
+                    std::hint::black_box(bristle_curve(&mut b));
+                }))
+            },
+            || {
+                let (time, sum) = bristle_curve_through_fmu(&fmu, count)?;
+                if sum.to_bits() != law_sum.to_bits() {
+                    return Err(format!(
+                        "{count} bristles: the FMU's forces sum to {sum:e}, the law's to {law_sum:e}"
+                    ));
+                }
+                Ok(time)
+            },
+        )?;
         // bristles that change state over the curve (untimed)
         let mut changes = 0;
         let mut b = fresh.clone();
@@ -993,15 +1256,13 @@ fn bristle_scaling(repeats: usize) -> Result<Vec<ScalingRow>, String> {
             changes += reconnect + (connected + reconnect).abs_diff(b.n_connected());
             connected = b.n_connected();
         }
-        // the clone is part of each timed curve: take it out
-        let clone = per_call(repeats, || fresh.clone().force())?;
-        let curve = (curve - clone).max(0.0);
-        eprintln!("{count} bristles: placement {placement:e} s, curve {curve:e} s");
+        eprintln!("{count} bristles: placement {placement:e} s, curve {curve:e} s, through the FMU {fmu_curve:e} s");
         rows.push(ScalingRow {
             count,
             changes,
             placement,
             curve,
+            fmu: fmu_curve,
         });
     }
     Ok(rows)
@@ -1122,6 +1383,8 @@ fn time_diagnose(root: &Path) -> Result<f64, String> {
 struct Report {
     laws: Vec<LawRow>,
     host: HostTable,
+    fmi_loop: FmiLoopRow,
+    process: ProcessTable,
     curve: Vec<CurveRow>,
     scaling: Vec<ScalingRow>,
     sweep: SweepRow,
@@ -1211,6 +1474,61 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
         );
     }
 
+    let l = &r.fmi_loop;
+    let _ = writeln!(
+        s,
+        "\n**The host against a hand-written FMI loop** (Jacobi, the same run): the same `Rig1D.fmu` and `LuGre.fmu` opened with `dlopen` and called through the C ABI by the smallest loop one could write (`bench/src/fmi_loop.rs`: set the connected input, step, read every output into a row, status checked; rows handed on in chunks as the host does), timed in turns with the host:\n"
+    );
+    let _ = writeln!(
+        s,
+        "| master | host | hand-written FMI loop | host / loop | final friction.F (host, loop) |\n|---|---|---|---|---|\n| jacobi | {} | {} | {:.2}× | {:.9}, {:.9} |",
+        duration(l.host),
+        duration(l.hand),
+        l.host / l.hand,
+        l.finals[0],
+        l.finals[1]
+    );
+    let p = &r.process;
+    let fmpy_jacobi = h
+        .rows
+        .iter()
+        .find(|row| row.master == "jacobi")
+        .and_then(|row| row.fmpy.as_ref().ok().copied());
+    let against = |t: f64| fmpy_jacobi.map_or("–".to_string(), |f| format!("{:.0}×", f / t));
+    let _ = writeln!(
+        s,
+        "\n**The whole `fricsim run {STICK_SLIP} --out FILE`** ({} s), a fresh process each time (start, unpacking the FMUs, the run, writing the file, exit), CSV and MAT v4 in turns, against FMPy's Jacobi loop above (its own clock, without the interpreter's start):\n",
+        h.stop
+    );
+    let _ = writeln!(
+        s,
+        "| result file | whole process | FMPy / process |\n|---|---|---|\n| CSV | {} | {} |\n| MAT v4 | {} | {} |",
+        duration(p.csv),
+        against(p.csv),
+        duration(p.mat),
+        against(p.mat)
+    );
+    let mb = |b: u64| format!("{:.1} MB", b as f64 / 1e6);
+    let _ = writeln!(
+        s,
+        "\n**Peak resident memory** of the whole `fricsim run {STICK_SLIP} --stop S` (`ru_maxrss`), one run each:\n"
+    );
+    let _ = writeln!(
+        s,
+        "| S | rows | peak RSS, CSV | peak RSS, MAT | CSV file | MAT file |\n|---|---|---|---|---|---|"
+    );
+    for &(stop, csv_rss, mat_rss, csv_size, mat_size) in &p.memory {
+        let _ = writeln!(
+            s,
+            "| {stop} s | {} | {} | {} | {} | {} |",
+            step_count(0.0, STICK_SLIP_STEP, stop) + 1,
+            mb(csv_rss),
+            mb(mat_rss),
+            mb(csv_size),
+            mb(mat_size)
+        );
+    }
+
     let _ = writeln!(
         s,
         "\n**Appels and Herder's Experiments 3 curve**: the force–displacement curve at 0.352 kg (N = {} bristles, their Table 3), {INCREMENTS} increments from rest to 3·δmax (sliding), bristle placement included; Dahl and LuGre with the same stiffness and sliding level over the same increments (one per 10 ms). Their times are Matlab on a 3.16 GHz workstation:\n",
@@ -1233,11 +1551,11 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
 
     let _ = writeln!(
         s,
-        "\n**Bristle count**: the bristle law (`friction-laws`) over a {INCREMENTS}-increment curve with one reversal (0 → 3·δmax in 500 increments, back to −3·δmax in 500), Appels and Herder's σ_ini and δmax; the placement (`Bristle::new`, once per realisation) apart:\n"
+        "\n**Bristle count**: the bristle law (`friction-laws`) over a {INCREMENTS}-increment curve with one reversal (0 → 3·δmax in 500 increments, back to −3·δmax in 500), Appels and Herder's σ_ini and δmax; the placement (`Bristle::new`, once per realisation) apart. The last two columns run the same curve through `Bristle.fmu` (`fmi2SetReal` x, `fmi2DoStep`, `fmi2GetReal` F per increment, the FMU loaded by `fricsim::fmu`), in turns with the law; its forces equal the law's bit for bit:\n"
     );
     let _ = writeln!(
         s,
-        "| bristles | placement | curve | per increment | bristle state changes in the curve | per state change | growth of the cost per increment against the count (log–log slope from the previous row) |\n|---|---|---|---|---|---|---|"
+        "| bristles | placement | curve | per increment | bristle state changes in the curve | per state change | growth of the cost per increment against the count (log–log slope from the previous row) | curve through `Bristle.fmu`'s C ABI | FMU / law |\n|---|---|---|---|---|---|---|---|---|"
     );
     let mut previous: Option<&ScalingRow> = None;
     for row in &r.scaling {
@@ -1249,13 +1567,15 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
         });
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.0} ns | {} | {:.1} ns | {slope} |",
+            "| {} | {} | {} | {:.0} ns | {} | {:.1} ns | {slope} | {} | {:.2}× |",
             row.count,
             duration(row.placement),
             duration(row.curve),
             row.curve / INCREMENTS as f64 * 1e9,
             row.changes,
-            row.curve / row.changes.max(1) as f64 * 1e9
+            row.curve / row.changes.max(1) as f64 * 1e9,
+            duration(row.fmu),
+            row.fmu / row.curve
         );
         previous = Some(row);
     }
@@ -1317,6 +1637,34 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
             met(row.host / row.monolithic <= 2.0)
         );
     }
+    let _ = writeln!(
+        s,
+        "- host at most 2× the hand-written FMI loop (jacobi): {:.2}×: {}",
+        l.host / l.hand,
+        met(l.host / l.hand <= 2.0)
+    );
+    for (format, t) in [("CSV", p.csv), ("MAT v4", p.mat)] {
+        let _ = match fmpy_jacobi {
+            Some(f) => writeln!(
+                s,
+                "- the whole `fricsim run` process, writing {format}, at least 100× faster than FMPy's loop (jacobi): {:.0}×: {}",
+                f / t,
+                met(f / t >= 100.0)
+            ),
+            None => writeln!(s, "- the whole `fricsim run` process, writing {format}: FMPy not measured"),
+        };
+    }
+    let peak = p.memory.iter().map(|m| m.1.max(m.2)).max().unwrap_or(0);
+    let least = p.memory.iter().map(|m| m.1.min(m.2)).min().unwrap_or(0);
+    let _ = writeln!(
+        s,
+        "- peak memory at most 32 MB and flat from {} to {} s: {} to {}: {}",
+        sizes.memory_stops[0],
+        sizes.memory_stops[2],
+        mb(least),
+        mb(peak),
+        met(peak <= 32_000_000 && peak as f64 <= 1.5 * least as f64)
+    );
     if let (Some(first), Some(last)) = (r.scaling.first(), r.scaling.last()) {
         let slope = (last.curve / first.curve).ln() / (last.count as f64 / first.count as f64).ln();
         let _ = writeln!(
@@ -1332,6 +1680,15 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
             last.count,
             duration(last.curve),
             met(last.curve < 0.01)
+        );
+        let _ = writeln!(
+            s,
+            "- {} bristles, {INCREMENTS}-increment curve through the C ABI within 2× of the law alone: {:.2}× ({} against {}): {}",
+            last.count,
+            last.fmu / last.curve,
+            duration(last.fmu),
+            duration(last.curve),
+            met(last.fmu <= 2.0 * last.curve)
         );
     }
     if let Some(c) = r.curve.first() {

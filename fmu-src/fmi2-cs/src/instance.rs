@@ -60,7 +60,8 @@ pub struct Instance {
     #[allow(clippy::vec_box)]
     saved_states: Vec<Box<Snapshot>>,
     /// The model state saved after the last step (checked for finiteness
-    /// there); while [`Instance::step_state_current`] it is also the state
+    /// there), unless the model answers [`Model::state_is_finite`] itself;
+    /// while [`Instance::step_state_current`] it is also the state
     /// the next step starts from, which that step keeps for its replay
     /// without asking the model again.
     step_state: Vec<f64>,
@@ -883,13 +884,25 @@ impl Instance {
             return Err(step_failed(t, h, e));
         }
         // A step that overflowed (finite but extreme parameters or inputs)
-        // is a failed step too: the state is no longer meaningful.
-        save_model_state(&*self.model, self.state_len, &mut self.step_state);
-        if !all_finite(&self.step_state) {
-            self.state = State::Error;
-            return Err(self.state_overflowed(t, h));
+        // is a failed step too: the state is no longer meaningful. A model
+        // that can tell says so without a copy of its state; else the state
+        // is saved and scanned (and kept: the next step's replay starts
+        // from it).
+        match self.model.state_is_finite() {
+            Some(true) => {}
+            Some(false) => {
+                self.state = State::Error;
+                return Err(self.state_overflowed(t, h));
+            }
+            None => {
+                save_model_state(&*self.model, self.state_len, &mut self.step_state);
+                if !all_finite(&self.step_state) {
+                    self.state = State::Error;
+                    return Err(self.state_overflowed(t, h));
+                }
+                self.step_state_current = true;
+            }
         }
-        self.step_state_current = true;
         // Inputs as the FMU saw them at the end of the step (u + du·h); the
         // slopes apply to one step only.
         if self.sloped {
@@ -918,7 +931,9 @@ impl Instance {
     #[cold]
     #[inline(never)]
     fn state_overflowed(&self, t: f64, h: f64) -> String {
-        let x = self.step_state.iter().find(|x| !x.is_finite()).copied();
+        let mut state = Vec::new();
+        save_model_state(&*self.model, self.state_len, &mut state);
+        let x = state.iter().find(|x| !x.is_finite()).copied();
         format!(
             "step from t = {t} over h = {h} failed: the model state became {}: the parameters or inputs are out of the model's range",
             x.unwrap_or(f64::NAN)

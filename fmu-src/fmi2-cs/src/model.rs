@@ -78,6 +78,17 @@ pub trait Model: Send {
         out.copy_from_slice(&state);
     }
 
+    /// Whether the state after a step is finite, if the model can tell
+    /// without its state being copied: `Some(answer)`, which must equal a
+    /// scan of what [`Model::save_state`] writes. `None` (the default)
+    /// makes the layer save the state after every step and scan it, which
+    /// costs a copy of the whole state per step: a model with a large
+    /// state (the bristle model's `2·N` values) answers from what it
+    /// knows. Called after every step.
+    fn state_is_finite(&self) -> Option<bool> {
+        None
+    }
+
     /// Restore a state written by `save_state` of the same model.
     fn restore_state(&mut self, state: &[f64]) -> Result<(), String>;
 

@@ -470,6 +470,27 @@ impl Bristle {
         self.move_to(x.at(h));
     }
 
+    /// Whether every value of the state ([`Bristle::write_state_into`]) is
+    /// finite, in `O(1)`: the answer of a full scan, bit for bit, without
+    /// reading the `2·N` bristle values. They are finite by construction:
+    /// - `x` changes only in [`Bristle::move_to`], and only to a finite
+    ///   position ([`Bristle::classify`] ignores a non-finite one); `x_ref`
+    ///   is only ever set to `x`; `dir`, `lo`, `hi`, `N` and the generator
+    ///   words are small integers;
+    /// - an offset is written only by the placement (`|δi| ≤ δmax`) and by a
+    ///   reversal, as `di + X` for a bristle still connected at the shift
+    ///   `X = x − x_ref` (so `|di + X| < δmax`) or as `±(δmax − |r|)`;
+    /// - a relaxation `|r|` is drawn in `[0, δmax)`.
+    ///
+    /// So the state is finite exactly when the two positions are (always,
+    /// by the first point; checked all the same, as a guard against a
+    /// change breaking the argument). The FMU layer asks this after every
+    /// step instead of copying and scanning the state, which cost 20 times
+    /// the step itself at 100 000 bristles.
+    pub fn state_is_finite(&self) -> bool {
+        self.x.is_finite() && self.x_ref.is_finite()
+    }
+
     /// The number of values of the state: `14 + 2·N`.
     pub fn state_len(&self) -> usize {
         14 + self.d.len() + self.relax.len()
@@ -962,6 +983,39 @@ mod tests {
         let mut bad = saved.clone();
         bad[2] = 0.5;
         assert!(b.state_from_slice(&bad).is_err());
+    }
+
+    #[test]
+    fn state_is_finite_answers_as_a_full_scan() {
+        // random walks around δmax, then the extremes a host may send: huge
+        // positions of either sign (x − x_ref overflows), NaN and infinities
+        // (ignored), each followed by reversals
+        let p = BristleParams {
+            n_bristles: 2000,
+            ..BristleParams::default()
+        };
+        let extremes = [
+            1e300,
+            -1e300,
+            f64::MAX,
+            -f64::MAX,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            0.0,
+            1e-8,
+            -1e-8,
+        ];
+        for seed in 0..3 {
+            let mut b = Bristle::new(BristleParams { seed, ..p }).unwrap();
+            let path = random_path(20 + seed, 400, p.delta_max);
+            for &x in path.iter().chain(&extremes).chain(&path) {
+                b.move_to(x);
+                let scanned = b.state_to_vec().iter().all(|v| v.is_finite());
+                assert!(scanned, "a non-finite state after a move to {x}");
+                assert_eq!(b.state_is_finite(), scanned);
+            }
+        }
     }
 
     #[test]

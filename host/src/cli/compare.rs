@@ -9,7 +9,7 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 pub struct CompareArgs {
     /// The result to check: CSV with `time` first, then component.variable
-    /// columns (as `fricsim run` writes it).
+    /// columns, or a .mat result file (as `fricsim run` writes either).
     pub result: PathBuf,
     /// The reference, in the same format (e.g. from `fricsim reference`);
     /// interpolated linearly onto the result's times if the grids differ.

@@ -1,9 +1,12 @@
 //! `fricsim cosim`: connect FMUs given on the command line, co-simulate
 //! with a fixed macro step, write a CSV and a plot, print a summary.
 
-use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, RowSink, Streamed};
+use super::isolated::{json, Ending};
+use fricsim::isolate::child::Child;
+use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, Streamed};
+use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
-use fricsim::system::System;
+use fricsim::system::{RecordedType, System};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -31,7 +34,8 @@ pub struct CosimArgs {
     /// Stop time in seconds.
     #[arg(long, default_value_t = 1.0)]
     pub stop: f64,
-    /// Result CSV.
+    /// Result file: CSV, or MAT v4 in the Dymola/OpenModelica layout if
+    /// it ends in .mat.
     #[arg(long, default_value = "out/result.csv")]
     pub out: PathBuf,
     /// Plot of the chosen signals (.png or .svg) [default: no plot].
@@ -58,11 +62,14 @@ pub struct CosimArgs {
 }
 
 pub fn run(a: &CosimArgs) -> Result<(), String> {
+    let parsed = parse(a)?;
+    // the result file is claimed before the FMUs are opened
+    let output = claim_output(a, &parsed)?;
     if a.isolate {
-        return super::isolated::run_isolated(a);
+        return run_isolated(a, output);
     }
-    let (mut system, mut master, plan) = prepare(a)?;
-    let mut sink = CosimSink::new(a, &system.columns(), &plan);
+    let (mut system, mut master, plan) = build(a, &parsed)?;
+    let mut sink = CosimSink::new(a, output, &system.columns(), &plan);
     let started = std::time::Instant::now();
     let run = simulate_streaming(
         &mut system,
@@ -78,16 +85,73 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     conclude(a, sink, &plan, &run, master.report(), wall)
 }
 
+/// `--isolate`, the parent: the rows the child computes written to the
+/// result file claimed before it started.
+fn run_isolated(a: &CosimArgs, output: OutputFile) -> Result<(), String> {
+    let isolated = super::isolated::run_isolated(a.step_timeout, |columns, plan: &CosimPlan| {
+        Ok(CosimSink::new(a, output, columns, plan))
+    })?;
+    let ended = isolated.ending.ended();
+    let run = Streamed {
+        columns: isolated.columns,
+        rows: isolated.rows,
+        error: isolated.error,
+        ended,
+    };
+    conclude(
+        a,
+        isolated.sink,
+        &isolated.plan,
+        &run,
+        isolated.ending.master_report,
+        isolated.ending.wall,
+    )
+}
+
+/// `--isolate`, the child: build the system and run it, the rows going
+/// to the parent.
+pub fn child(a: &CosimArgs, link: &mut Child) -> Result<(), String> {
+    let parsed = parse(a)?;
+    let (mut system, mut master, plan) = build(a, &parsed)?;
+    link.started(&mut system, json(&plan)?)?;
+    let started = std::time::Instant::now();
+    let run = link
+        .simulate_streaming(
+            &mut system,
+            master.as_mut(),
+            0.0,
+            a.step,
+            a.stop,
+            &mut NoObserver,
+        )
+        .map_err(|e| e.to_string())?;
+    let ending = Ending {
+        master_report: master.report(),
+        wall: started.elapsed().as_secs_f64(),
+        ended: run.ended.clone().map(|e| (e.instance, e.time)),
+    };
+    link.finished(&run, json(ending)?)
+}
+
 /// What the summary and the plot need to know of a run (sent by an
 /// isolated run's child to its parent).
 #[derive(serde::Serialize, serde::Deserialize)]
 pub struct CosimPlan {
     pub master: String,
     pub signals: Vec<String>,
+    /// The type of each column.
+    pub types: Vec<RecordedType>,
 }
 
-/// The system built from the options, its master.
-pub fn prepare(a: &CosimArgs) -> Result<(System, Box<dyn MasterAlgorithm>, CosimPlan), String> {
+/// The options read: components, parameters, connections.
+pub struct Parsed<'a> {
+    components: Vec<(String, &'a Path)>,
+    parameters: Vec<(String, f64)>,
+    connections: Vec<(String, String)>,
+}
+
+/// Check and read the options.
+fn parse(a: &CosimArgs) -> Result<Parsed<'_>, String> {
     if !(a.step.is_finite() && a.step > 0.0) {
         return Err(format!("--step must be > 0, got {}", a.step));
     }
@@ -127,10 +191,31 @@ pub fn prepare(a: &CosimArgs) -> Result<(System, Box<dyn MasterAlgorithm>, Cosim
                 .ok_or(format!("--connect expects out.port->in.port, got `{s}`"))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let components: Vec<(String, &Path)> =
-        components.iter().map(|(n, p)| (n.clone(), *p)).collect();
-    let mut system =
-        System::build(&components, &parameters, &connections).map_err(|e| e.to_string())?;
+    Ok(Parsed {
+        components,
+        parameters,
+        connections,
+    })
+}
+
+/// The result file `--out`, claimed.
+fn claim_output(a: &CosimArgs, parsed: &Parsed) -> Result<OutputFile, String> {
+    let mut inputs: Vec<(&str, &Path)> = parsed
+        .components
+        .iter()
+        .map(|(_, p)| ("the FMU", *p))
+        .collect();
+    inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
+    OutputFile::create(&a.out, &inputs).map_err(|e| e.to_string())
+}
+
+/// The system built from the options, its master.
+fn build(
+    a: &CosimArgs,
+    parsed: &Parsed,
+) -> Result<(System, Box<dyn MasterAlgorithm>, CosimPlan), String> {
+    let mut system = System::build(&parsed.components, &parsed.parameters, &parsed.connections)
+        .map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
     let master = fricsim::master::by_name(&a.master)?;
     super::print_warnings(system.warnings());
@@ -142,6 +227,7 @@ pub fn prepare(a: &CosimArgs) -> Result<(System, Box<dyn MasterAlgorithm>, Cosim
     let plan = CosimPlan {
         master: master.name().to_string(),
         signals,
+        types: system.column_types(),
     };
     Ok((system, master, plan))
 }
@@ -149,13 +235,15 @@ pub fn prepare(a: &CosimArgs) -> Result<(System, Box<dyn MasterAlgorithm>, Cosim
 /// Where the rows go: the result file, and the plotted columns kept.
 pub struct CosimSink {
     writer: ResultWriter,
-    /// A signal that cannot be plotted, reported once the CSV is written.
+    /// A signal that cannot be plotted, reported once the result is
+    /// written.
     plot_error: Option<String>,
 }
 
 impl CosimSink {
-    pub fn new(a: &CosimArgs, columns: &[String], plan: &CosimPlan) -> CosimSink {
-        let mut writer = ResultWriter::new(&a.out, columns);
+    fn new(a: &CosimArgs, output: OutputFile, columns: &[String], plan: &CosimPlan) -> CosimSink {
+        let mut writer = ResultWriter::new(output, columns);
+        writer.whole_number_columns(&plan.types);
         let plot_error = match a.plot {
             Some(_) => writer.keep_columns(columns, &plan.signals).err(),
             None => None,
@@ -164,9 +252,12 @@ impl CosimSink {
     }
 }
 
-impl RowSink for CosimSink {
+impl fricsim::master::RowSink for CosimSink {
     fn write(&mut self, times: &[f64], rows: &fricsim::rows::Rows) -> Result<(), String> {
         self.writer.write(times, rows)
+    }
+    fn stop_requested(&self) -> Option<String> {
+        self.writer.stop_requested()
     }
 }
 
@@ -184,7 +275,7 @@ pub fn conclude(
     let stats = writer.stats.clone();
     writer
         .finish(run.error.as_deref())
-        .map_err(|e| format!("{}: {e}", a.out.display()))?;
+        .map_err(|e| e.to_string())?;
     if let Some(e) = plot_error {
         return Err(e);
     }
@@ -210,6 +301,9 @@ pub fn conclude(
     }
     if let Some(report) = master_report {
         print!("{report}");
+    }
+    if let Some(ended) = &run.ended {
+        println!("{ended}");
     }
     println!("wrote {}", a.out.display());
     if let Some(p) = &a.plot {

@@ -13,6 +13,7 @@ pub enum CrossValidateArg {
     Always,
     Never,
 }
+use fricsim::output_file::same_file;
 use fricsim::ssp::SystemFile;
 use std::path::PathBuf;
 
@@ -22,7 +23,8 @@ pub struct DiagnoseArgs {
     /// with one LuGre friction component.
     pub system: PathBuf,
     /// Measurements: CSV with `time` first, then `component.variable`
-    /// columns; unconnected inputs drive the system, outputs are compared.
+    /// columns, or a .mat result file; unconnected inputs drive the
+    /// system, outputs are compared.
     pub data: PathBuf,
     /// Held-out measurements (same channels) to score on [default: every
     /// third of 30 equal time blocks of DATA, from the second on, is held
@@ -85,30 +87,36 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         },
         ..Options::default()
     };
-    if let Some(m) = &a.master {
-        fricsim::master::by_name(m).map_err(|e| format!("--master: {e}"))?;
-    }
-    if !(a.alpha > 0.0 && a.alpha < 1.0) {
-        return Err(format!("--alpha {}: must be between 0 and 1", a.alpha));
-    }
-    if !(2..=32).contains(&a.position_knots) {
-        return Err(format!(
-            "--position-knots {}: must be in 2..=32 (the LuGre table holds 32 points)",
-            a.position_knots
-        ));
-    }
-    if a.blocks < 3 {
-        return Err(format!(
-            "--blocks {}: at least 3 (every third block is held out)",
-            a.blocks
-        ));
-    }
+    options.check()?;
     if !a.candidates.is_empty() {
         options.candidates = a
             .candidates
             .iter()
             .map(|c| Effect::from_name(c))
             .collect::<Result<_, _>>()?;
+    }
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, "-diagnosis").with_extension(""));
+    // the report directory is written whole (diagnose::report), but never
+    // over one of the inputs
+    let inputs = [
+        Some(("the system file", &a.system)),
+        Some(("the measured data", &a.data)),
+        a.heldout.as_ref().map(|p| ("the held-out data", p)),
+        a.lugre.as_ref().map(|p| ("the LuGre FMU", p)),
+    ];
+    if let Some((what, input)) = inputs
+        .into_iter()
+        .flatten()
+        .find(|(_, p)| same_file(&out, p))
+    {
+        return Err(format!(
+            "the report directory {} is {what} {}, an input of the run: choose another --out",
+            out.display(),
+            input.display()
+        ));
     }
     let mut file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
     let moved = fricsim::diagnose::dahl::move_to_lugre(&mut file, a.lugre.as_deref())?;
@@ -117,10 +125,6 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         println!("note: {note}");
         d.notes.push(note);
     }
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::default_out(&a.system, "-diagnosis").with_extension(""));
     report::write(&d, &file, &d.friction_component, &out)?;
     let names: Vec<&str> = d.effects.iter().map(|e| e.name.name()).collect();
     println!(

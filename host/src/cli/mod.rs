@@ -13,7 +13,7 @@ use fricsim::ssp::SystemFile;
 use std::path::{Path, PathBuf};
 
 /// `--start`, `--stop`, `--step` of the commands that co-simulate a
-/// system file (`run`, `sweep`), resolved by [`time_grid`]. (`reference`
+/// system file (`run`, `sweep`), resolved by [`fricsim::run::time_grid`]. (`reference`
 /// has its own, since there `--step` is only the output interval.)
 #[derive(clap::Args)]
 pub struct GridArgs {
@@ -35,7 +35,7 @@ pub struct GridArgs {
 impl GridArgs {
     /// `(start, stop, step)` from these options, else from `file`.
     pub fn resolve(&self, file: &SystemFile) -> Result<(f64, f64, f64), String> {
-        time_grid(file, self.start, self.stop, self.step)
+        fricsim::run::time_grid(file, self.start, self.stop, self.step)
     }
 }
 
@@ -45,44 +45,6 @@ pub fn master_name(option: &Option<String>, file: &SystemFile) -> String {
     option
         .clone()
         .unwrap_or_else(|| file.settings.master_or_default())
-}
-
-/// The time grid of a run of `file`: `--start`, `--stop` and `--step` where
-/// given, else the file's `DefaultExperiment` and stepSize annotation
-/// (start defaults to 0). Shared by `fricsim run` and `fricsim reference`,
-/// so that both produce the same times.
-pub fn time_grid(
-    file: &SystemFile,
-    start: Option<f64>,
-    stop: Option<f64>,
-    step: Option<f64>,
-) -> Result<(f64, f64, f64), String> {
-    let start = match start {
-        Some(s) if !s.is_finite() => return Err(format!("--start must be finite, got {s}")),
-        Some(s) => s,
-        None => file.start_time.unwrap_or(0.0),
-    };
-    let stop = stop.or(file.stop_time).ok_or_else(|| {
-        format!(
-            "{}: no stop time: give --stop or <ssd:DefaultExperiment stopTime=\"…\">",
-            file.ssd
-        )
-    })?;
-    if !(stop.is_finite() && stop > start) {
-        return Err(format!(
-            "the stop time {stop} must be after the start time {start}"
-        ));
-    }
-    let step = step.or(file.settings.step_size).ok_or_else(|| {
-        format!(
-            "{}: no step size: give --step or the stepSize of the fricsim annotation (see docs/user-guide.md, \"Our annotation\")",
-            file.ssd
-        )
-    })?;
-    if !(step.is_finite() && step > 0.0) {
-        return Err(format!("--step must be a positive number, got {step}"));
-    }
-    Ok((start, stop, step))
 }
 
 /// `out/<system file stem><suffix>.csv`, the default result file.

@@ -51,7 +51,7 @@ pub struct ReferenceArgs {
 
 pub fn run(a: &ReferenceArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let (start, stop, step) = super::time_grid(&file, a.start, a.stop, a.step)?;
+    let (start, stop, step) = fricsim::run::time_grid(&file, a.start, a.stop, a.step)?;
     if !(a.rtol.is_finite() && a.rtol > 0.0 && a.rtol < 1.0) {
         return Err(format!("--rtol must be in (0, 1), got {}", a.rtol));
     }
@@ -84,7 +84,9 @@ pub fn run(a: &ReferenceArgs) -> Result<(), String> {
         error: None,
     };
     // The writer of `fricsim run`: the same format to the digit.
-    fricsim::results::write_csv(&run, &out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let output = fricsim::output_file::OutputFile::create(&out, &file.files_read())
+        .map_err(|e| e.to_string())?;
+    fricsim::results::write_csv(&run, output).map_err(|e| e.to_string())?;
 
     println!("{}: {}", file.ssd, model.description());
     print!(

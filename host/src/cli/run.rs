@@ -4,12 +4,14 @@
 //! Settings come from the command line, else from the file
 //! (`DefaultExperiment`, our annotation), else from defaults.
 
-use fricsim::inputs::{ExternalInputs, InputTable};
-use fricsim::master::{by_name, simulate_streaming, step_count, Observer, Streamed};
-use fricsim::results::{ColumnStats, ResultWriter};
+use super::isolated::{json, Ending};
+use fricsim::inputs::InputTable;
+use fricsim::isolate::child::Child;
+use fricsim::output_file::OutputFile;
+use fricsim::results::ResultWriter;
+use fricsim::run::{PreparedRun, Recorder, RunOptions, RunOutcome, StartValue};
 use fricsim::ssp::SystemFile;
-use fricsim::system::System;
-use fricsim::FmuError;
+use fricsim::system::RecordedType;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -25,7 +27,8 @@ pub struct RunArgs {
     /// file's annotation, else jacobi].
     #[arg(long)]
     pub master: Option<String>,
-    /// Result CSV [default: out/<file name>.csv].
+    /// Result file: CSV, or MAT v4 in the Dymola/OpenModelica layout if
+    /// it ends in .mat [default: out/<file name>.csv].
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Plot of the chosen signals (.png or .svg) [default: no plot; the
@@ -36,10 +39,23 @@ pub struct RunArgs {
     /// Plot annotation, else every recorded column].
     #[arg(long = "plot-signal")]
     pub plot_signals: Vec<String>,
-    /// Record a Real variable besides the outputs, component.variable
-    /// (repeat): e.g. a connected input.
+    /// Record a variable besides the outputs, component.variable (repeat):
+    /// e.g. a connected input. Real, Integer and Boolean variables.
     #[arg(long = "record")]
     pub record: Vec<String>,
+    /// A start value, component.variable=value (repeat), read as the
+    /// variable's type (Boolean: true/false/1/0); set after the system
+    /// file's parameter values and --start-values, the last one winning.
+    #[arg(long = "set", value_name = "COMPONENT.VARIABLE=VALUE")]
+    pub set: Vec<String>,
+    /// Start values from an SSP parameter-value file (.ssv) naming
+    /// component.variable, set after the system file's own.
+    #[arg(long = "start-values", value_name = "FILE.ssv")]
+    pub start_values: Option<PathBuf>,
+    /// Record every SECONDS instead of at every step: a whole multiple of
+    /// the step; the last point is always recorded.
+    #[arg(long = "output-interval", value_name = "SECONDS")]
+    pub output_interval: Option<f64>,
     /// External inputs: CSV with `time` first, then component.variable
     /// columns for unconnected inputs (bare names for a one-component
     /// system), interpolated linearly in time as FMPy does.
@@ -65,155 +81,107 @@ pub struct RunArgs {
     pub isolate: bool,
 }
 
-/// The progress bar and the external inputs, consulted by the run.
-pub struct Watch {
-    pub inputs: Option<ExternalInputs>,
-    pub bar: ProgressBar,
-}
-
-impl Drop for Watch {
-    fn drop(&mut self) {
-        self.bar.finish_and_clear();
-    }
-}
-
-impl Observer for Watch {
-    fn before_step(&mut self, system: &mut System, t: f64, init: bool) -> Result<(), FmuError> {
-        match &mut self.inputs {
-            Some(i) => i.before_step(system, t, init),
-            None => Ok(()),
-        }
-    }
-
-    fn after_step(&mut self, done: usize, total: usize) {
-        // drawing is rate-limited by indicatif; updating every 256 steps
-        // keeps even the bookkeeping out of the step loop's cost
-        if done.is_multiple_of(256) || done == total {
-            self.bar.set_position(done as u64);
-        }
-    }
-}
-
 pub fn run(a: &RunArgs) -> Result<(), String> {
-    if a.isolate {
-        return super::isolated::run_isolated(a);
-    }
-    let Prepared {
-        plan,
-        mut master,
-        mut system,
-        inputs,
-        start,
-        stop,
-    } = prepare(a)?;
-    let mut watch = Watch {
-        inputs,
-        bar: progress_bar(a, plan.n),
-    };
-    let columns = system.columns();
-    let mut sink = RunSink::new(a, &columns, &plan);
-    let started = std::time::Instant::now();
-    let run = simulate_streaming(
-        &mut system,
-        master.as_mut(),
-        start,
-        plan.step,
-        stop,
-        &mut watch,
-        &mut sink,
-    )
-    .map_err(|e| format!("initialization failed: {e}"))?;
-    let wall = started.elapsed().as_secs_f64();
-    watch.bar.finish_and_clear();
-    let report = master.report();
-    conclude(a, sink, &plan, &run, report, wall)
-}
-
-/// What a run is, as its summary and plot tell it (sent by an isolated
-/// run's child to its parent).
-#[derive(serde::Serialize, serde::Deserialize)]
-pub struct Plan {
-    /// The first line of the summary: the system file and its size.
-    pub system: String,
-    /// The plot's title.
-    pub title: String,
-    pub master: String,
-    /// Macro steps and their length.
-    pub n: usize,
-    pub step: f64,
-    pub plot_signals: Vec<String>,
-}
-
-/// A run ready to start: the system built, its master and inputs.
-pub struct Prepared {
-    pub plan: Plan,
-    pub master: Box<dyn fricsim::master::MasterAlgorithm>,
-    pub system: System,
-    pub inputs: Option<ExternalInputs>,
-    pub start: f64,
-    pub stop: f64,
-}
-
-/// Read the system file, build the system, bind the inputs.
-pub fn prepare(a: &RunArgs) -> Result<Prepared, String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
-    let (start, stop, step) = a.grid.resolve(&file)?;
-    let master = by_name(&super::master_name(&a.master, &file))?;
-
-    let mut system = file.build(start).map_err(|e| e.to_string())?;
-    system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
-    super::print_warnings(system.warnings());
-    let plot_signals = if !a.plot_signals.is_empty() {
-        a.plot_signals.clone()
-    } else {
-        file.settings.plot.clone()
-    };
-    for s in a.record.iter().chain(&plot_signals) {
-        system.record(s).map_err(|e| e.to_string())?;
+    // the result file is claimed before the FMUs are opened: a run that
+    // would overwrite an input or another run's result stops here
+    let (out, output) = claim_output(a, &file)?;
+    if a.isolate {
+        return run_isolated(a, &file, out, output);
     }
-    let inputs = match &a.input {
-        Some(path) => Some(ExternalInputs::bind(InputTable::read(path)?, &system)?),
-        None => None,
-    };
+    let plot_signals = plot_signals(a, &file);
+    let prepared = PreparedRun::new(&file, &options(a, &file)?)?;
+    super::print_warnings(prepared.warnings());
+    let (n, step) = (prepared.steps(), prepared.time_grid().2);
+    let master = prepared.master_name();
+
+    let bar = progress_bar(a, n);
+    let columns = prepared.columns();
+    let mut writer = ResultWriter::new(output, &columns);
+    writer.whole_number_columns(&prepared.column_types());
     let plot_signals = if plot_signals.is_empty() {
-        system.columns()
+        columns.clone()
     } else {
         plot_signals
     };
-    let plan = Plan {
-        system: format!(
-            "{}: {} components, {} connections, {} parameter values",
-            file.ssd,
-            file.components.len(),
-            file.connections.len(),
-            file.parameters.len()
-        ),
-        title: format!(
-            "{} ({})",
-            if file.name.is_empty() {
-                "system"
-            } else {
-                &file.name
-            },
-            master.name()
-        ),
-        master: master.name().to_string(),
-        n: step_count(start, step, stop),
-        step,
-        plot_signals,
+    // a plot that cannot be drawn does not hide the run or its summary
+    let plot_error = match a.plot {
+        Some(_) => writer.keep_columns(&columns, &plot_signals).err(),
+        None => None,
     };
-    Ok(Prepared {
-        plan,
-        master,
-        system,
-        inputs,
-        start,
-        stop,
+    // a hidden bar (--quiet, stderr not a terminal) needs no progress
+    let mut progress = |done: usize, _| bar.set_position(done as u64);
+    let progress: Option<&mut dyn FnMut(usize, usize)> = if bar.is_hidden() {
+        None
+    } else {
+        Some(&mut progress)
+    };
+    let run = prepared.run(&mut writer, progress)?;
+    bar.finish_and_clear();
+    let ran = Ran {
+        out,
+        plot_signals,
+        plot_error,
+        n,
+        step,
+        master: master.to_string(),
+    };
+    conclude(a, &file, writer, run, ran)
+}
+
+/// The result file of `--out` [default: out/<file name>.csv], claimed.
+fn claim_output(a: &RunArgs, file: &SystemFile) -> Result<(PathBuf, OutputFile), String> {
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, ""));
+    let mut inputs = file.files_read();
+    inputs.extend(a.input.as_deref().map(|p| ("the --input table", p)));
+    inputs.extend(
+        a.start_values
+            .as_deref()
+            .map(|p| ("the --start-values file", p)),
+    );
+    inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
+    let output = OutputFile::create(&out, &inputs).map_err(|e| e.to_string())?;
+    Ok((out, output))
+}
+
+/// The signals to plot: `--plot-signal`, else the file's Plot annotation
+/// (none: every column).
+fn plot_signals(a: &RunArgs, file: &SystemFile) -> Vec<String> {
+    if !a.plot_signals.is_empty() {
+        a.plot_signals.clone()
+    } else {
+        file.settings.plot.clone()
+    }
+}
+
+/// The run's options from the command line.
+fn options(a: &RunArgs, file: &SystemFile) -> Result<RunOptions, String> {
+    Ok(RunOptions {
+        start: a.grid.start,
+        stop: a.grid.stop,
+        step: a.grid.step,
+        master: a.master.clone(),
+        record: a
+            .record
+            .iter()
+            .chain(&plot_signals(a, file))
+            .cloned()
+            .collect(),
+        start_values: start_values(file, a)?,
+        output_interval: a.output_interval,
+        inputs: match &a.input {
+            Some(path) => Some(InputTable::read(path)?),
+            None => None,
+        },
+        call_time_limit: super::call_time_limit(a.step_timeout)?,
     })
 }
 
 /// The progress bar of `n` steps on a terminal, else a hidden one.
-pub fn progress_bar(a: &RunArgs, n: usize) -> ProgressBar {
+fn progress_bar(a: &RunArgs, n: usize) -> ProgressBar {
     if a.quiet || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
@@ -225,78 +193,159 @@ pub fn progress_bar(a: &RunArgs, n: usize) -> ProgressBar {
     bar
 }
 
-/// The result file of `--out` [default: out/<file name>.csv].
-pub fn out_path(a: &RunArgs) -> PathBuf {
-    a.out
-        .clone()
-        .unwrap_or_else(|| super::default_out(&a.system, ""))
+/// What an isolated run's child tells its parent when the run starts.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Plan {
+    /// Macro steps and their length.
+    n: usize,
+    step: f64,
+    master: String,
+    /// Communication points per recorded row ([`PreparedRun::output_every`]).
+    every: usize,
+    /// The type of each column.
+    types: Vec<RecordedType>,
 }
 
-/// Where the rows go: the result file, and the plotted columns kept.
-pub struct RunSink {
-    writer: ResultWriter,
+/// `--isolate`, the parent: the child computes every communication point,
+/// the parent records them as [`PreparedRun::run`] does (the output
+/// interval) into the result file claimed before the child started.
+fn run_isolated(
+    a: &RunArgs,
+    file: &SystemFile,
     out: PathBuf,
+    output: OutputFile,
+) -> Result<(), String> {
+    let plot_signals = plot_signals(a, file);
+    let mut kept_signals = plot_signals.clone();
+    let mut plot_error = None;
+    let isolated = super::isolated::run_isolated(a.step_timeout, |columns, plan: &Plan| {
+        let mut writer = ResultWriter::new(output, columns);
+        writer.whole_number_columns(&plan.types);
+        if kept_signals.is_empty() {
+            kept_signals = columns.to_vec();
+        }
+        plot_error = match a.plot {
+            Some(_) => writer.keep_columns(columns, &kept_signals).err(),
+            None => None,
+        };
+        Ok(Recorder::new(writer, plan.every, columns.len()))
+    })?;
+    let mut recorder = isolated.sink;
+    let mut error = isolated.error;
+    if let Err(e) = recorder.finish() {
+        error.get_or_insert(e);
+    }
+    let stats = recorder.stats.clone();
+    let writer = recorder.into_inner();
+    let run = RunOutcome {
+        columns: isolated.columns,
+        rows: stats.rows,
+        steps: isolated.rows.saturating_sub(1),
+        error,
+        ended: isolated.ending.ended(),
+        stats,
+        master_report: isolated.ending.master_report,
+        wall_time: isolated.ending.wall,
+    };
+    let plan = isolated.plan;
+    let ran = Ran {
+        out,
+        plot_signals: kept_signals,
+        plot_error,
+        n: plan.n,
+        step: plan.step,
+        master: plan.master,
+    };
+    conclude(a, file, writer, run, ran)
+}
+
+/// `--isolate`, the child: the run of [`PreparedRun`], every
+/// communication point sent to the parent.
+pub fn child(a: &RunArgs, link: &mut Child) -> Result<(), String> {
+    let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
+    let mut prepared = PreparedRun::new(&file, &options(a, &file)?)?;
+    super::print_warnings(prepared.warnings());
+    let n = prepared.steps();
+    let plan = Plan {
+        n,
+        step: prepared.time_grid().2,
+        master: prepared.master_name().to_string(),
+        every: prepared.output_every(),
+        types: prepared.column_types(),
+    };
+    link.started(prepared.system_mut(), json(plan)?)?;
+    let bar = progress_bar(a, n);
+    let mut progress = |done: usize, _| bar.set_position(done as u64);
+    let progress: Option<&mut dyn FnMut(usize, usize)> = if bar.is_hidden() {
+        None
+    } else {
+        Some(&mut progress)
+    };
+    let run = link.run_prepared(prepared, progress)?;
+    bar.finish_and_clear();
+    let ending = Ending {
+        master_report: run.master_report,
+        wall: run.wall_time,
+        ended: run.ended.map(|e| (e.instance, e.time)),
+    };
+    link.finished_with(run.rows, run.error, json(ending)?)
+}
+
+/// What the summary and the plot need besides the run.
+struct Ran {
+    out: PathBuf,
+    plot_signals: Vec<String>,
     /// Why the plot cannot be drawn, if it cannot: it does not hide the
     /// run or its summary.
     plot_error: Option<String>,
+    n: usize,
+    step: f64,
+    master: String,
 }
 
-impl RunSink {
-    pub fn new(a: &RunArgs, columns: &[String], plan: &Plan) -> RunSink {
-        let out = out_path(a);
-        let mut writer = ResultWriter::new(&out, columns);
-        let plot_error = match a.plot {
-            Some(_) => writer.keep_columns(columns, &plan.plot_signals).err(),
-            None => None,
-        };
-        RunSink {
-            writer,
-            out,
-            plot_error,
-        }
-    }
-}
-
-impl fricsim::master::RowSink for RunSink {
-    fn write(&mut self, times: &[f64], rows: &fricsim::rows::Rows) -> Result<(), String> {
-        self.writer.write(times, rows)
-    }
-}
-
-/// After the run: the result file ended (marked incomplete if `run`
+/// After the run: the result file ended (marked incomplete if the run
 /// stopped early), the plot, the summary; an error if the run is
 /// incomplete.
-pub fn conclude(
+fn conclude(
     a: &RunArgs,
-    sink: RunSink,
-    plan: &Plan,
-    run: &Streamed,
-    master_report: Option<String>,
-    wall: f64,
+    file: &SystemFile,
+    writer: ResultWriter,
+    run: RunOutcome,
+    ran: Ran,
 ) -> Result<(), String> {
-    let RunSink {
-        writer,
+    let Ran {
         out,
+        plot_signals,
         mut plot_error,
-    } = sink;
+        n,
+        step,
+        master,
+    } = ran;
     let kept = writer.kept();
-    let stats = writer.stats.clone();
     writer
         .finish(run.error.as_deref())
-        .map_err(|e| format!("{}: {e}", out.display()))?;
+        .map_err(|e| e.to_string())?;
     if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
-        plot_error = fricsim::plot::plot_signals(kept, &plan.plot_signals, plot, &plan.title).err();
+        let title = format!(
+            "{} ({master})",
+            if file.name.is_empty() {
+                "system"
+            } else {
+                &file.name
+            },
+        );
+        plot_error = fricsim::plot::plot_signals(kept, &plot_signals, plot, &title).err();
     }
 
-    print!("{}", summary(plan, run, &stats, wall));
-    if let Some(report) = master_report {
+    print!("{}", summary(file, &run, n, step, &master));
+    if let Some(report) = &run.master_report {
         println!("{report}");
     }
     println!("wrote {}", out.display());
     if let (Some(p), None) = (&a.plot, &plot_error) {
         println!("wrote {}", p.display());
     }
-    if let Some(e) = &run.error {
+    if let Some(e) = run.error {
         return Err(format!(
             "run INCOMPLETE (the {} rows up to the failure are in {}): {e}",
             run.rows,
@@ -309,22 +358,45 @@ pub fn conclude(
     }
 }
 
+/// `--start-values`, then `--set`, in the order they apply.
+fn start_values(file: &SystemFile, a: &RunArgs) -> Result<Vec<(String, StartValue)>, String> {
+    let mut values = match &a.start_values {
+        Some(path) => fricsim::run::start_values_file(file, path)?,
+        None => Vec::new(),
+    };
+    for s in &a.set {
+        let (port, value) = s
+            .split_once('=')
+            .ok_or(format!("--set expects component.variable=value, got `{s}`"))?;
+        values.push((port.trim().to_string(), StartValue::Text(value.to_string())));
+    }
+    Ok(values)
+}
+
 /// The summary: what ran, how long, each column's min/max/final value,
 /// and whether the run completed.
-fn summary(plan: &Plan, run: &Streamed, stats: &ColumnStats, wall: f64) -> String {
+fn summary(file: &SystemFile, run: &RunOutcome, n: usize, step: f64, master: &str) -> String {
     use std::fmt::Write;
-    let Plan {
-        n, step, master, ..
-    } = plan;
     let mut s = String::new();
-    let done = run.rows.saturating_sub(1);
-    let _ = writeln!(s, "{}", plan.system);
+    let (done, stats, wall) = (run.steps, &run.stats, run.wall_time);
+    let _ = writeln!(
+        s,
+        "{}: {} components, {} connections, {} parameter values",
+        file.ssd,
+        file.components.len(),
+        file.connections.len(),
+        file.parameters.len()
+    );
     let _ = writeln!(
         s,
         "{done} of {n} macro steps of {step} s with {master} ({} to {} s), {wall:.3} s wall time: {}",
         stats.first_time.unwrap_or(0.0),
         stats.last_time.unwrap_or(0.0),
-        if run.error.is_none() { "completed" } else { "INCOMPLETE" }
+        match (&run.error, &run.ended) {
+            (Some(_), _) => "INCOMPLETE".to_string(),
+            (None, Some(ended)) => ended.to_string(),
+            (None, None) => "completed".to_string(),
+        }
     );
     let width = run
         .columns

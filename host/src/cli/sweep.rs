@@ -3,6 +3,7 @@
 //! in parallel on all cores, summarised one row per run in a CSV
 //! ([`fricsim::sweep`]).
 
+use fricsim::output_file::OutputFile;
 use fricsim::ssp::SystemFile;
 use fricsim::sweep::{check_axes, grid, run_all, seed_ports, write_csv, Axis, Plan};
 use std::path::PathBuf;
@@ -42,6 +43,11 @@ pub fn run(a: &SweepArgs) -> Result<(), String> {
     let (start, stop, step) = a.grid.resolve(&file)?;
     let master = super::master_name(&a.master, &file);
     fricsim::master::by_name(&master)?; // refused before anything runs
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::default_out(&a.system, "-sweep"));
+    let output = OutputFile::create(&out, &file.files_read()).map_err(|e| e.to_string())?;
     let mut axes = a
         .params
         .iter()
@@ -87,11 +93,7 @@ pub fn run(a: &SweepArgs) -> Result<(), String> {
     let started = std::time::Instant::now();
     let outcomes = run_all(&file, &plan, threads)?;
     let wall = started.elapsed().as_secs_f64();
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::default_out(&a.system, "-sweep"));
-    write_csv(&outcomes, &out).map_err(|e| format!("{}: {e}", out.display()))?;
+    write_csv(&outcomes, output).map_err(|e| e.to_string())?;
     let failed = outcomes.iter().filter(|o| o.error.is_some()).count();
     println!(
         "{}: {} runs ({} failed) of {} s with {} on {threads} threads in {wall:.3} s wall time ({:.2} runs/s)",

@@ -105,6 +105,32 @@ pub enum CrossValidate {
 /// 1 kHz: tens of thousands).
 pub const CROSS_VALIDATE_MAX_SAMPLES: usize = 5_000;
 
+impl Options {
+    /// Refuse settings the workflow cannot use, naming the setting and its
+    /// value (`fricsim diagnose` and the Python package call this first).
+    pub fn check(&self) -> Result<(), String> {
+        if let Some(m) = &self.master {
+            crate::master::by_name(m).map_err(|e| format!("master: {e}"))?;
+        }
+        if !(self.alpha > 0.0 && self.alpha < 1.0) {
+            return Err(format!("alpha {}: must be between 0 and 1", self.alpha));
+        }
+        if !(2..=32).contains(&self.position_knots) {
+            return Err(format!(
+                "position_knots {}: must be in 2..=32 (the LuGre table holds 32 points)",
+                self.position_knots
+            ));
+        }
+        if self.blocks < 3 {
+            return Err(format!(
+                "blocks {}: at least 3 (every third block is held out)",
+                self.blocks
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Default for Options {
     fn default() -> Self {
         Options {

@@ -14,7 +14,7 @@
 //! names, units declared in `UnitDefinitions`, `ModelStructure` indices).
 
 use crate::error::FmuError;
-use crate::ssp::xml::line_column;
+use crate::ssp::xml::{double_hyphen_offset, line_column};
 use quick_xml::events::Event;
 use serde::Deserialize;
 use std::collections::HashMap;
@@ -297,9 +297,12 @@ impl ModelDescription {
 }
 
 /// First pass: the root element must be `fmiModelDescription` with
-/// `fmiVersion="2.0"`.
+/// `fmiVersion="2.0"`, and no comment may hold `--` (XML 1.0 §2.5: FMPy's
+/// parser, lxml, refuses such a file, so it is refused here too, with the
+/// line).
 fn check_fmi_version(xml: &str) -> Result<(), FmuError> {
     let mut reader = quick_xml::Reader::from_str(xml);
+    reader.config_mut().check_comments = true;
     let syntax = |reader: &quick_xml::Reader<&[u8]>, message: String| {
         let (line, column) = line_column(xml.as_bytes(), reader.error_position() as usize);
         FmuError::XmlSyntax {
@@ -309,7 +312,11 @@ fn check_fmi_version(xml: &str) -> Result<(), FmuError> {
         }
     };
     loop {
+        let position = reader.buffer_position() as usize;
         match reader.read_event() {
+            Err(quick_xml::Error::IllFormed(
+                quick_xml::errors::IllFormedError::DoubleHyphenInComment,
+            )) => return Err(double_hyphen(xml, position)),
             Err(e) => return Err(syntax(&reader, e.to_string())),
             Ok(Event::Eof) => return Err(syntax(&reader, "no root element".into())),
             Ok(Event::Start(e) | Event::Empty(e)) => {
@@ -337,10 +344,40 @@ fn check_fmi_version(xml: &str) -> Result<(), FmuError> {
                         found: version.into_owned(),
                     });
                 }
-                return Ok(());
+                return check_comments(xml, reader);
             }
             Ok(_) => {}
         }
+    }
+}
+
+/// The rest of the first pass: only a comment holding `--` is reported
+/// here; any other error is left to the deserializer, whose messages say
+/// more (a truncated file names the element left open).
+fn check_comments(xml: &str, mut reader: quick_xml::Reader<&[u8]>) -> Result<(), FmuError> {
+    loop {
+        let position = reader.buffer_position() as usize;
+        match reader.read_event() {
+            Err(quick_xml::Error::IllFormed(
+                quick_xml::errors::IllFormedError::DoubleHyphenInComment,
+            )) => return Err(double_hyphen(xml, position)),
+            Err(_) | Ok(Event::Eof) => return Ok(()),
+            Ok(_) => {}
+        }
+    }
+}
+
+/// The error for a comment holding `--`, in the event starting at byte
+/// `event_start`.
+fn double_hyphen(xml: &str, event_start: usize) -> FmuError {
+    let offset = double_hyphen_offset(xml, event_start);
+    let (line, column) = line_column(xml.as_bytes(), offset);
+    FmuError::XmlSyntax {
+        line,
+        column,
+        message: "`--` inside a comment, which XML does not allow (XML 1.0 §2.5): \
+                  FMPy and other importers refuse the file"
+            .to_string(),
     }
 }
 

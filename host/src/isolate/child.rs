@@ -5,7 +5,10 @@
 use super::blackbox::BlackBox;
 use super::ring::RowRing;
 use super::{Message, BLACK_BOX_FILE, RING_FILE};
-use crate::master::{simulate_streaming, MasterAlgorithm, Observer, RowSink, Rows, Streamed};
+use crate::master::{
+    simulate_streaming, MasterAlgorithm, NoObserver, Observer, RowSink, Rows, Streamed,
+};
+use crate::run::{PreparedRun, RunOutcome};
 use crate::system::System;
 use crate::FmuError;
 use std::cell::Cell;
@@ -112,6 +115,46 @@ impl Child {
         simulate_streaming(system, master, start, h, stop, &mut observer, &mut sink)
     }
 
+    /// [`PreparedRun::run_observed`], each row going to the parent as
+    /// [`Child::simulate_streaming`] sends them: every communication
+    /// point, whatever the output interval (the parent records them with
+    /// a [`crate::run::Recorder`]). The system must have been
+    /// [`Child::started`] ([`PreparedRun::system_mut`]).
+    pub fn run_prepared(
+        &mut self,
+        prepared: PreparedRun,
+        progress: Option<&mut dyn FnMut(usize, usize)>,
+    ) -> Result<RunOutcome, String> {
+        let ring = self
+            .ring
+            .as_ref()
+            .expect("Child::started makes the ring before the run");
+        let sent = Sent {
+            ring,
+            rows: Cell::new(0),
+        };
+        let mut observer = SendingObserver {
+            inner: &mut NoObserver,
+            sent: &sent,
+        };
+        let mut sink = SendingSink {
+            sent: &sent,
+            handed: 0,
+        };
+        prepared.run_observed(&mut sink, progress, &mut observer)
+    }
+
+    /// The run ended after `rows` rows, stopped early by `error` if it
+    /// was: tell the parent.
+    pub fn finished_with(
+        &mut self,
+        rows: usize,
+        error: Option<String>,
+        extra: serde_json::Value,
+    ) -> Result<(), String> {
+        self.send(&Message::Finished { rows, error, extra })
+    }
+
     /// The run ended: tell the parent.
     pub fn finished(&mut self, run: &Streamed, extra: serde_json::Value) -> Result<(), String> {
         self.send(&Message::Finished {
@@ -182,5 +225,11 @@ impl RowSink for SendingSink<'_> {
         }
         self.handed += times.len();
         Ok(())
+    }
+
+    /// A termination signal stops the run, as in-process
+    /// ([`crate::signals`]); the parent writes what came.
+    fn stop_requested(&self) -> Option<String> {
+        crate::signals::stop_reason()
     }
 }

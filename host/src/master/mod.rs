@@ -278,11 +278,14 @@ pub fn simulate_with(
     let n = step_count(start, h, stop);
     system.start_recording(n + 1);
     system.sample()?;
-    let error = step_range(system, master, observer, start, h, 0..n, n);
+    let (error, ended) = Stop::split(step_range(system, master, observer, start, h, 0..n, n));
     // the times of the rows kept follow from their number: nothing is
     // stored for them as the run steps
     let rows = system.take_recording();
-    let time = communication_times(start, h, rows.rows_folded()..rows.rows_pushed());
+    let mut time = communication_times(start, h, rows.rows_folded()..rows.rows_pushed());
+    if let (Some(ended), Some(last)) = (ended, time.last_mut()) {
+        *last = ended.time;
+    }
     Ok(Run {
         columns,
         time,
@@ -313,6 +316,15 @@ pub trait RowSink {
     }
 }
 
+impl<T: RowSink + ?Sized> RowSink for &mut T {
+    fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String> {
+        (**self).write(times, rows)
+    }
+    fn stop_requested(&self) -> Option<String> {
+        (**self).stop_requested()
+    }
+}
+
 /// What a [`simulate_streaming`] run leaves once its rows are handed on.
 pub struct Streamed {
     pub columns: Vec<String>,
@@ -321,6 +333,54 @@ pub struct Streamed {
     /// Why the run stopped early, if it did: an FMU's failure, the sink's
     /// error or its request to stop.
     pub error: Option<String>,
+    /// The component that ended the run, if one did ([`Ended`]): a normal
+    /// end, its last row recorded.
+    pub ended: Option<Ended>,
+}
+
+/// A component that ended the simulation before the stop time, as FMI 2.0
+/// lets a co-simulation FMU do (§4.2.3): its `fmi2DoStep` returned
+/// `fmi2Discard` and `fmi2GetBooleanStatus(fmi2Terminated)` says true.
+/// FMPy, like the FMI reference importer, takes that for the normal end
+/// of the run and records the outputs at `fmi2LastSuccessfulTime`; so does
+/// fricsim: the run's last row is there, and it is no failure. (The other
+/// components keep the state they had when that FMU stopped: with the
+/// Jacobi master, those after it in the system have not taken the step.)
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ended {
+    /// The instance that ended the simulation.
+    pub instance: String,
+    /// Its `fmi2LastSuccessfulTime`: the time of the run's last row.
+    pub time: f64,
+}
+
+impl std::fmt::Display for Ended {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} ended the simulation at t = {}",
+            self.instance, self.time
+        )
+    }
+}
+
+/// Why [`step_all`] stopped before the end of its steps.
+enum Stop {
+    /// A failure, in words.
+    Failed(String),
+    /// A component ended the simulation; its last row is recorded.
+    Ended(Ended),
+}
+
+impl Stop {
+    /// `(error, ended)` of a run that stopped as `stop` says.
+    fn split(stop: Option<Stop>) -> (Option<String>, Option<Ended>) {
+        match stop {
+            None => (None, None),
+            Some(Stop::Failed(e)) => (Some(e), None),
+            Some(Stop::Ended(e)) => (None, Some(e)),
+        }
+    }
 }
 
 /// [`simulate_with`], handing the rows to `sink` as the run goes instead
@@ -348,6 +408,7 @@ pub fn simulate_streaming(
     let mut written = 0;
     let mut done = 0;
     let mut error = None;
+    let mut ended = None;
     loop {
         if error.is_none() && done < n {
             error = sink.stop_requested();
@@ -358,15 +419,19 @@ pub fn simulate_streaming(
             done
         };
         if end > done {
-            error = step_range(system, master, observer, start, h, done..end, n);
+            (error, ended) =
+                Stop::split(step_range(system, master, observer, start, h, done..end, n));
             done = end;
         }
-        let last_chunk = error.is_some() || done == n;
+        let last_chunk = error.is_some() || ended.is_some() || done == n;
         let held = system.recorded().len();
         // the last row stays until the run ends: the next step reads the
         // connected inputs from it
         let handing = if last_chunk { held } else { held - 1 };
-        let times = communication_times(start, h, written..written + handing);
+        let mut times = communication_times(start, h, written..written + handing);
+        if let (Some(ended), Some(last)) = (&ended, times.last_mut()) {
+            *last = ended.time;
+        }
         if let Err(e) = sink.write(&times, system.recorded()) {
             error.get_or_insert(e);
             break;
@@ -382,6 +447,7 @@ pub fn simulate_streaming(
         columns,
         rows: written,
         error,
+        ended,
     })
 }
 
@@ -396,7 +462,7 @@ fn step_range(
     h: f64,
     steps: std::ops::Range<usize>,
     n: usize,
-) -> Option<String> {
+) -> Option<Stop> {
     match (master.as_jacobi(), observer.between_steps()) {
         (Some(jacobi), false) => step_all::<_, false>(system, jacobi, observer, start, h, steps, n),
         (Some(jacobi), true) => step_all::<_, true>(system, jacobi, observer, start, h, steps, n),
@@ -467,7 +533,9 @@ impl Advance for jacobi::Jacobi {
 
 /// The steps `steps` of the `n` of [`simulate_with`] from `start`, after
 /// the row of the point where they start: a row per communication point
-/// completed; why the run stopped early, if it did. One copy for the Jacobi master, its step inlined, one
+/// completed; why the run stopped early, if it did (a component that ends
+/// the simulation, [`Ended`], leaves the row of its last successful time
+/// as the last). One copy for the Jacobi master, its step inlined, one
 /// for any other, called through the trait object; each in two, with and
 /// without the observer's calls between the steps
 /// ([`Observer::between_steps`], `BETWEEN_STEPS`).
@@ -480,7 +548,7 @@ fn step_all<M: Advance + ?Sized, const BETWEEN_STEPS: bool>(
     h: f64,
     steps: std::ops::Range<usize>,
     n: usize,
-) -> Option<String> {
+) -> Option<Stop> {
     // t = start + i·h, each counted from the start; the step's end is the
     // next step's start, so each is computed once
     let mut t_next = counted(start, h, steps.start);
@@ -496,26 +564,63 @@ fn step_all<M: Advance + ?Sized, const BETWEEN_STEPS: bool>(
         // end of the last step (or by `simulate_with` before the first)
         // and this step
         .and_then(|()| master.advance(system, t, t_next - t, !BETWEEN_STEPS));
-        if let Err(e) = stepped {
-            return Some(format!("at t = {t}: {e}"));
-        }
+        let ended = match stepped {
+            Ok(()) => None,
+            Err(e) => match ended_by(system, &e) {
+                Some(ended) => Some(ended),
+                None => return Some(Stop::Failed(format!("at t = {t}: {e}"))),
+            },
+        };
         let finite = match system.sample_with(row_is_finite) {
             Ok(finite) => finite,
-            Err(e) => return Some(format!("at t = {t_next}: {e}")),
+            Err(e) => return Some(Stop::Failed(format!("at t = {t_next}: {e}"))),
         };
         // the usual case first: a row of numbers
         if !finite {
             let row = system.recorded().last().unwrap_or_default();
             if let Some(e) = non_finite(system, row) {
                 system.discard_last_sample();
-                return Some(format!("at t = {t}: {e} after fmi2DoStep to t = {t_next}"));
+                return Some(Stop::Failed(format!(
+                    "at t = {t}: {e} after fmi2DoStep to t = {t_next}"
+                )));
             }
+        }
+        if let Some(ended) = ended {
+            return Some(Stop::Ended(ended));
         }
         if BETWEEN_STEPS {
             observer.after_step(i + 1, n);
         }
     }
     None
+}
+
+/// If `error` is a component's `fmi2DoStep` that returned `fmi2Discard`
+/// while the component asks to end the simulation
+/// (`fmi2GetBooleanStatus(fmi2Terminated)` = true): that component and
+/// its `fmi2LastSuccessfulTime` ([`Ended`]). Either status call failing
+/// leaves the discard a failure.
+#[cold]
+#[inline(never)]
+fn ended_by(system: &mut System, error: &FmuError) -> Option<Ended> {
+    let FmuError::Call {
+        function: "fmi2DoStep",
+        instance,
+        status: crate::fmu::Status::Discard,
+        ..
+    } = error
+    else {
+        return None;
+    };
+    let c = system.components.iter_mut().find(|c| &c.name == instance)?;
+    if !c.instance.terminated().ok()? {
+        return None;
+    }
+    let time = c.instance.last_successful_time().ok()?;
+    Some(Ended {
+        instance: instance.clone(),
+        time,
+    })
 }
 
 #[cfg(test)]

@@ -217,6 +217,8 @@ pub struct SystemFile {
     /// Whether sources must stay inside the base directory (an archive).
     in_archive: bool,
     base: PathBuf,
+    /// The `.ssv` files of the parameter bindings (outside an archive).
+    parameter_files: Vec<PathBuf>,
     _unpacked: Option<TempDir>,
 }
 
@@ -313,6 +315,26 @@ fn parse_number(text: &str) -> Option<f64> {
 }
 
 impl SystemFile {
+    /// The files a run of this system reads, each with what it is: the
+    /// system file, and outside an archive the FMUs and `.ssv` files it
+    /// points at (an archive's are unpacked copies).
+    pub fn files_read(&self) -> Vec<(&'static str, &Path)> {
+        let mut files = vec![("the system file", self.path.as_path())];
+        if !self.in_archive {
+            files.extend(
+                self.components
+                    .iter()
+                    .map(|c| ("the FMU", c.source.as_path())),
+            );
+            files.extend(
+                self.parameter_files
+                    .iter()
+                    .map(|p| ("the parameter file", p.as_path())),
+            );
+        }
+        files
+    }
+
     /// Read a `.ssd` file or an `.ssp` archive (by its extension).
     pub fn open(path: impl AsRef<Path>) -> Result<SystemFile, SspError> {
         let path = path.as_ref();
@@ -361,6 +383,7 @@ impl SystemFile {
             settings: Settings::default(),
             in_archive,
             base,
+            parameter_files: Vec::new(),
             _unpacked: None,
         };
         file.parse(&text)?;
@@ -584,6 +607,11 @@ impl SystemFile {
                 None => String::new(),
             };
             let location = at("ParameterBinding", k, format!("{owner_text}{shown}"));
+            if let (Some(source), false) = (&b.source, self.in_archive) {
+                if let Ok(path) = self.resolve(source) {
+                    self.parameter_files.push(path);
+                }
+            }
             let params = self.binding(owner.as_deref(), b, &location, &lines, first_parameter)?;
             applied.push((owner, params));
         }
@@ -800,15 +828,48 @@ impl SystemFile {
                         format!("source=\"{source}\": {shown} does not exist"),
                     ));
                 }
-                let text = read_text(&path, &shown)?;
-                let text = text.strip_prefix('\u{feff}').unwrap_or(&text).to_string();
-                let syntax =
-                    |e: SyntaxError| error(format!("{shown}:{}:{}", e.line, e.column), e.message);
-                let (_, lines) = xml::first_pass(&text, "ParameterSet", NS_SSV).map_err(syntax)?;
-                let set: RawParameterSet = xml::deserialize(&text).map_err(syntax)?;
+                let (set, lines) = read_parameter_set(&path, &shown)?;
                 (set, Some(lines), Some(shown))
             }
         };
+        self.parameter_set(owner, set, &prefix, |k, shown| {
+            match (&file_lines, &file_shown) {
+                (Some(l), Some(f)) => match l.of("Parameter", k) {
+                    Some(line) => format!("{f}:{line}: {shown}"),
+                    None => format!("{f}: {shown}"),
+                },
+                _ => match lines.of("Parameter", first_parameter + k) {
+                    Some(line) => format!("{}:{line}: {shown}", self.ssd),
+                    None => format!("{}: {shown}", self.ssd),
+                },
+            }
+        })
+    }
+
+    /// The parameter values of an SSP parameter-value file (`.ssv`, an
+    /// `ssv:ParameterSet`) at `path`, named `component.variable` as in a
+    /// binding of the system: start values for a run of this system
+    /// (`fricsim run --start-values`). The values are not checked against
+    /// the FMUs here (see [`crate::run::check_start_value`]).
+    pub fn parameter_values_file(&self, path: &Path) -> Result<Vec<ParameterDef>, SspError> {
+        let shown = path.display().to_string();
+        let (set, lines) = read_parameter_set(path, &shown)?;
+        self.parameter_set(None, set, "", |k, what| match lines.of("Parameter", k) {
+            Some(line) => format!("{shown}:{line}: {what}"),
+            None => format!("{shown}: {what}"),
+        })
+    }
+
+    /// The parameters of `set` for the component `owner` (`None`: of the
+    /// system, named `component.variable`), their names after `prefix`;
+    /// `locate(k, element)` says where parameter `k` is, for messages.
+    fn parameter_set(
+        &self,
+        owner: Option<&str>,
+        set: RawParameterSet,
+        prefix: &str,
+        locate: impl Fn(usize, &str) -> String,
+    ) -> Result<Vec<ParameterDef>, SspError> {
         let mut out = Vec::new();
         for (k, p) in set
             .parameters
@@ -818,16 +879,7 @@ impl SystemFile {
             .enumerate()
         {
             let shown = element("Parameter", &[("name", &p.name)]);
-            let here = match (&file_lines, &file_shown) {
-                (Some(l), Some(f)) => match l.of("Parameter", k) {
-                    Some(line) => format!("{f}:{line}: {shown}"),
-                    None => format!("{f}: {shown}"),
-                },
-                _ => match lines.of("Parameter", first_parameter + k) {
-                    Some(line) => format!("{}:{line}: {shown}", self.ssd),
-                    None => format!("{}: {shown}", self.ssd),
-                },
-            };
+            let here = locate(k, &shown);
             let name = p
                 .name
                 .clone()
@@ -1180,7 +1232,7 @@ fn system_error(e: SystemError) -> String {
 }
 
 /// A `component.variable` of the annotation: the component exists and has
-/// a Real variable of that name.
+/// a variable of that name that can be recorded (not a String).
 fn check_signal(signal: &str, fmus: &[(String, Fmu)], names: &[String]) -> Result<(), String> {
     let (c, v) = signal
         .split_once('.')
@@ -1198,10 +1250,9 @@ fn check_signal(signal: &str, fmus: &[(String, Fmu)], names: &[String]) -> Resul
             names_with(fmu, Causality::Input)
         )
     })?;
-    if !matches!(var.kind, VariableKind::Real { .. }) {
+    if matches!(var.kind, VariableKind::String { .. }) {
         return Err(format!(
-            "signal `{signal}` is a {} variable; only Real variables are recorded and plotted",
-            var.kind.type_name()
+            "signal `{signal}` is a String variable; only Real, Integer, Enumeration and Boolean variables are recorded and plotted"
         ));
     }
     Ok(())
@@ -1324,6 +1375,17 @@ fn check_parameter(p: &ParameterDef, c: &ComponentDef, fmu: &Fmu) -> Result<(), 
         }
     }
     Ok(())
+}
+
+/// Read and parse the `ssv:ParameterSet` file at `path` (`shown` in
+/// messages), with the lines of its elements.
+fn read_parameter_set(path: &Path, shown: &str) -> Result<(RawParameterSet, Lines), SspError> {
+    let text = read_text(path, shown)?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text).to_string();
+    let syntax = |e: SyntaxError| error(format!("{shown}:{}:{}", e.line, e.column), e.message);
+    let (_, lines) = xml::first_pass(&text, "ParameterSet", NS_SSV).map_err(syntax)?;
+    let set: RawParameterSet = xml::deserialize(&text).map_err(syntax)?;
+    Ok((set, lines))
 }
 
 fn read_text(path: &Path, shown: &str) -> Result<String, SspError> {

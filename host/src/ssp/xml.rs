@@ -59,6 +59,18 @@ pub fn line_column(text: &[u8], offset: usize) -> (usize, usize) {
     (line, column)
 }
 
+/// The byte offset of the `--` inside the first comment at or after byte
+/// `event_start` (where the event quick-xml refused with
+/// `DoubleHyphenInComment` starts): located here, as quick-xml's own
+/// offset for this error can be off within a comment that holds a single
+/// `-` before.
+pub fn double_hyphen_offset(xml: &str, event_start: usize) -> usize {
+    let opened = xml[event_start..]
+        .find("<!--")
+        .map_or(event_start, |p| event_start + p + 4);
+    xml[opened..].find("--").map_or(opened, |p| opened + p)
+}
+
 /// The line of byte offsets met in increasing order, counted as the
 /// parser goes: each byte of the document is looked at once, so a pass
 /// over a document with many elements stays linear in its size (asking
@@ -122,13 +134,8 @@ pub fn first_pass(xml: &str, root: &str, namespace: &str) -> Result<(String, Lin
             Err(quick_xml::Error::IllFormed(
                 quick_xml::errors::IllFormedError::DoubleHyphenInComment,
             )) => {
-                // located here: quick-xml's offset for this error can be
-                // off within a comment that holds a single `-` before
-                let from = position as usize;
-                let opened = xml[from..].find("<!--").map_or(from, |p| from + p + 4);
-                let offset = xml[opened..].find("--").map_or(opened, |p| opened + p);
                 return Err(at(
-                    offset as u64,
+                    double_hyphen_offset(xml, position as usize) as u64,
                     "`--` inside a comment, which XML does not allow (XML 1.0 §2.5): \
                      other SSP tools refuse the file"
                         .to_string(),
@@ -152,7 +159,11 @@ pub fn first_pass(xml: &str, root: &str, namespace: &str) -> Result<(String, Lin
                         None => format!("{message}; the file is truncated"),
                     };
                 }
-                return Err(at(reader.error_position(), message));
+                // (quick-xml leaves the error position at 0 for some
+                // errors, such as a nesting deeper than its namespace
+                // resolver's limit: the event that failed starts at
+                // `position`)
+                return Err(at(reader.error_position().max(position), message));
             }
         };
         let is_empty = matches!(event, Event::Empty(_));

@@ -3,7 +3,7 @@
 //! into a `.fmu` at test time, and the counters it exports for the tests.
 #![allow(dead_code)]
 
-use crate::common::{compile_shared, zip_dir};
+use crate::common::c_fmu;
 use fricsim::fmu::Fmu;
 use std::path::{Path, PathBuf};
 
@@ -30,22 +30,12 @@ pub const HANG: i32 = 9;
 /// Compile the C source and zip it with its model description into
 /// `dir/BeltOscillator.fmu` (binaries/linux64/BeltOscillator.so).
 pub fn build_fmu(dir: &Path) -> PathBuf {
-    let root = dir.join("BeltOscillator");
-    let binaries = root.join("binaries/linux64");
-    std::fs::create_dir_all(&binaries).unwrap();
-    std::fs::copy(
-        Path::new(SOURCE_DIR).join("modelDescription.xml"),
-        root.join("modelDescription.xml"),
+    c_fmu(
+        Path::new(SOURCE_DIR),
+        "belt_oscillator.c",
+        "BeltOscillator",
+        dir,
     )
-    .unwrap();
-    compile_shared(
-        &Path::new(SOURCE_DIR).join("belt_oscillator.c"),
-        &binaries.join("BeltOscillator.so"),
-        &[],
-    );
-    let fmu = dir.join("BeltOscillator.fmu");
-    zip_dir(&root, &fmu);
-    fmu
 }
 
 /// The FMU's own bookkeeping, read from its loaded binary. Holding this

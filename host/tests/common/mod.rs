@@ -70,6 +70,45 @@ pub fn stub_fmu_dir(capabilities: &str, flags: &[&str]) -> TempDir {
     dir
 }
 
+/// The FMU `dist/<name>.fmu` of this repository with `edit` applied to its
+/// model description, zipped into `out`. The edit must change something.
+pub fn repacked(name: &str, out: &Path, edit: impl Fn(&str) -> String) -> PathBuf {
+    let unpacked = fricsim::fmu::archive::unpack(
+        &repository().join("dist").join(format!("{name}.fmu")),
+        &fricsim::fmu::archive::UnpackOptions::default(),
+    )
+    .unwrap();
+    let md = unpacked.path().join("modelDescription.xml");
+    let text = std::fs::read_to_string(&md).unwrap();
+    let edited = edit(&text);
+    assert_ne!(edited, text, "the edit changed nothing");
+    std::fs::write(&md, edited).unwrap();
+    zip_dir(unpacked.path(), out);
+    out.to_path_buf()
+}
+
+/// An FMU written by hand in C: compile `source_dir/c_file` into
+/// `binaries/linux64/<identifier>.so`, zip it with
+/// `source_dir/modelDescription.xml` into `dir/<identifier>.fmu`.
+pub fn c_fmu(source_dir: &Path, c_file: &str, identifier: &str, dir: &Path) -> PathBuf {
+    let root = dir.join(identifier);
+    let binaries = root.join("binaries/linux64");
+    std::fs::create_dir_all(&binaries).unwrap();
+    std::fs::copy(
+        source_dir.join("modelDescription.xml"),
+        root.join("modelDescription.xml"),
+    )
+    .unwrap();
+    compile_shared(
+        &source_dir.join(c_file),
+        &binaries.join(format!("{identifier}.so")),
+        &[],
+    );
+    let fmu = dir.join(format!("{identifier}.fmu"));
+    zip_dir(&root, &fmu);
+    fmu
+}
+
 /// Zip the files below `dir` into `out`.
 pub fn zip_dir(dir: &Path, out: &Path) {
     fn add(zip: &mut zip::ZipWriter<std::fs::File>, root: &Path, dir: &Path) {

@@ -1,0 +1,277 @@
+//! The smallest Jacobi co-simulation of two FMUs one could write by hand:
+//! the FMUs' libraries opened with `dlopen` (`libloading`), their FMI 2.0
+//! functions called straight through the C ABI, no checks but each call's
+//! status, every output recorded at every step. It is what the host's
+//! stepping is measured against in BENCHMARKS.md: the same FMUs, the same
+//! scheme and calls, without the host's bookkeeping.
+//!
+//! Every Real output is recorded, as the host records them.
+//!
+//! The scheme is the host's Jacobi (`fricsim::master::jacobi`): at each
+//! communication point every component gets its connected inputs from the
+//! row recorded there, then steps; the row at the next point is read from
+//! every output. Rows go into a buffer of [`fricsim::master::CHUNK_STEPS`]
+//! rows used again once full, as `fricsim run` hands its rows on.
+
+use fmi2_types::*;
+use fricsim::fmu::model_description::{Causality, VariableKind};
+use fricsim::fmu::Fmu;
+use fricsim::master::{step_count, CHUNK_STEPS};
+use std::ffi::CString;
+use std::time::Instant;
+
+/// The FMI functions the loop calls, from one library.
+struct Functions {
+    _library: libloading::Library,
+    instantiate: fmi2InstantiateTYPE,
+    setup_experiment: fmi2SetupExperimentTYPE,
+    enter_initialization_mode: fmi2ComponentTYPE,
+    exit_initialization_mode: fmi2ComponentTYPE,
+    free_instance: fmi2FreeInstanceTYPE,
+    get_real: fmi2GetRealTYPE,
+    set_real: fmi2SetRealTYPE,
+    do_step: fmi2DoStepTYPE,
+}
+
+impl Functions {
+    fn open(fmu: &Fmu) -> Result<Functions, String> {
+        let path = fmu.library().path();
+        let shown = path.display();
+        // SAFETY: the FMU's own library, already loaded by `fmu` (this
+        // takes a second reference to it); its exports have the FMI 2.0
+        // signatures of fmi2-types.
+        unsafe {
+            let library = libloading::Library::new(path).map_err(|e| format!("{shown}: {e}"))?;
+            macro_rules! get {
+                ($name:literal) => {
+                    *library
+                        .get(concat!($name, "\0").as_bytes())
+                        .map_err(|e| format!("{shown}: {}: {e}", $name))?
+                };
+            }
+            Ok(Functions {
+                instantiate: get!("fmi2Instantiate"),
+                setup_experiment: get!("fmi2SetupExperiment"),
+                enter_initialization_mode: get!("fmi2EnterInitializationMode"),
+                exit_initialization_mode: get!("fmi2ExitInitializationMode"),
+                free_instance: get!("fmi2FreeInstance"),
+                get_real: get!("fmi2GetReal"),
+                set_real: get!("fmi2SetReal"),
+                do_step: get!("fmi2DoStep"),
+                _library: library,
+            })
+        }
+    }
+}
+
+/// The logger's five fixed arguments (see [`print_message`]).
+type FixedArgumentsLogger =
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String);
+
+/// The importer's logger: the message printed on stderr as it comes, its
+/// `%` arguments not expanded. FMI 2.0 declares it variadic (§2.1.5),
+/// which stable Rust cannot define; a function of the five fixed
+/// arguments is called alike on x86-64 (the caller sets up the variadic
+/// part, which this one does not read).
+unsafe extern "C" fn print_message(
+    _: fmi2ComponentEnvironment,
+    instance: fmi2String,
+    status: fmi2Status,
+    _: fmi2String,
+    message: fmi2String,
+) {
+    let text = |s: fmi2String| match s.is_null() {
+        true => String::new(),
+        // SAFETY: a C string from the FMU, valid during the call
+        false => unsafe { std::ffi::CStr::from_ptr(s) }
+            .to_string_lossy()
+            .into_owned(),
+    };
+    eprintln!("{} (status {status}): {}", text(instance), text(message));
+}
+
+/// One instance: its functions, its pointer, where its outputs go in a
+/// row, and its connected input with the row column it comes from.
+struct Unit {
+    f: Functions,
+    c: fmi2Component,
+    outputs: Vec<fmi2ValueReference>,
+    first_column: usize,
+    input: Option<(fmi2ValueReference, usize)>,
+}
+
+impl Drop for Unit {
+    fn drop(&mut self) {
+        // SAFETY: `c` came from this library's fmi2Instantiate
+        unsafe { (self.f.free_instance)(self.c) }
+    }
+}
+
+fn ok(status: fmi2Status, call: &str) -> Result<(), String> {
+    match status {
+        0 => Ok(()),
+        s => Err(format!("{call} returned status {s}")),
+    }
+}
+
+/// A Jacobi run of `components` (name, FMU) from 0 to `stop` in steps of
+/// `h`, each `(from, to)` of `connections` an output `component.variable`
+/// driving an input: the wall time of initialization and stepping, s, and
+/// the last row (every output of every component, in order).
+pub fn jacobi_run(
+    components: &[(&str, &Fmu)],
+    connections: &[(&str, &str)],
+    h: f64,
+    stop: f64,
+) -> Result<(f64, Vec<f64>), String> {
+    let callbacks = fmi2CallbackFunctions {
+        // SAFETY: see `print_message`
+        logger: Some(unsafe { std::mem::transmute::<FixedArgumentsLogger, _>(print_message) }),
+        allocateMemory: Some(libc_calloc),
+        freeMemory: Some(libc_free),
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    };
+    let mut units = Vec::new();
+    let mut width = 0;
+    let mut columns = Vec::new();
+    for (name, fmu) in components {
+        let d = fmu.description();
+        let outputs: Vec<_> = d
+            .variables
+            .iter()
+            .filter(|v| {
+                v.causality == Causality::Output && matches!(v.kind, VariableKind::Real { .. })
+            })
+            .collect();
+        columns.extend(outputs.iter().map(|v| format!("{name}.{}", v.name)));
+        let c_name = CString::new(*name).map_err(|e| e.to_string())?;
+        let guid = CString::new(d.guid.as_str()).map_err(|e| e.to_string())?;
+        let resources = CString::new(format!("file://{}/resources", fmu.dir().display()))
+            .map_err(|e| e.to_string())?;
+        let f = Functions::open(fmu)?;
+        // SAFETY: valid C strings and callbacks that outlive the instance
+        let c = unsafe {
+            (f.instantiate)(
+                c_name.as_ptr(),
+                1, // fmi2CoSimulation
+                guid.as_ptr(),
+                resources.as_ptr(),
+                &callbacks,
+                0,
+                0,
+            )
+        };
+        if c.is_null() {
+            return Err(format!("fmi2Instantiate of {name} failed"));
+        }
+        units.push(Unit {
+            f,
+            c,
+            outputs: outputs.iter().map(|v| v.value_reference).collect(),
+            first_column: width,
+            input: None,
+        });
+        width += outputs.len();
+    }
+    for (from, to) in connections {
+        let column = columns
+            .iter()
+            .position(|c| c == from)
+            .ok_or_else(|| format!("no output {from}"))?;
+        let (name, variable) = to.split_once('.').ok_or("component.variable")?;
+        let k = components
+            .iter()
+            .position(|(n, _)| *n == name)
+            .ok_or_else(|| format!("no component {name}"))?;
+        let vr = components[k]
+            .1
+            .variable(variable)
+            .map_err(|e| e.to_string())?
+            .value_reference;
+        units[k].input = Some((vr, column));
+    }
+    // SAFETY (every call below): live instances of their own libraries,
+    // arrays as long as the counts given
+    unsafe {
+        for u in &units {
+            ok(
+                (u.f.setup_experiment)(u.c, 0, 0.0, 0.0, 1, stop),
+                "fmi2SetupExperiment",
+            )?;
+            ok(
+                (u.f.enter_initialization_mode)(u.c),
+                "fmi2EnterInitializationMode",
+            )?;
+        }
+    }
+    let clock = Instant::now();
+    let n = step_count(0.0, h, stop);
+    let chunk = CHUNK_STEPS.min(n) + 1;
+    let mut rows = vec![0.0; chunk * width];
+    let mut times = vec![0.0; chunk];
+    let sample = |units: &[Unit], row: &mut [f64]| -> Result<(), String> {
+        for u in units {
+            let out = &mut row[u.first_column..u.first_column + u.outputs.len()];
+            unsafe {
+                ok(
+                    (u.f.get_real)(u.c, u.outputs.as_ptr(), u.outputs.len(), out.as_mut_ptr()),
+                    "fmi2GetReal",
+                )?;
+            }
+        }
+        Ok(())
+    };
+    let set_inputs = |units: &[Unit], row: &[f64]| -> Result<(), String> {
+        for u in units {
+            if let Some((vr, column)) = u.input {
+                unsafe { ok((u.f.set_real)(u.c, &vr, 1, &row[column]), "fmi2SetReal")? };
+            }
+        }
+        Ok(())
+    };
+    // initialization as the host's: inputs set before and after leaving it
+    sample(&units, &mut rows[..width])?;
+    set_inputs(&units, &rows[..width])?;
+    for u in &units {
+        unsafe {
+            ok(
+                (u.f.exit_initialization_mode)(u.c),
+                "fmi2ExitInitializationMode",
+            )?
+        };
+    }
+    sample(&units, &mut rows[..width])?;
+    let mut held = 1; // rows in the buffer
+    for i in 0..n {
+        let t = i as f64 * h;
+        let (done, next) = rows.split_at_mut(held * width);
+        let row = &done[(held - 1) * width..];
+        for u in &units {
+            if let Some((vr, column)) = u.input {
+                unsafe { ok((u.f.set_real)(u.c, &vr, 1, &row[column]), "fmi2SetReal")? };
+            }
+            // noSetFMUStatePriorToCurrentPoint false, as the host calls it
+            unsafe { ok((u.f.do_step)(u.c, t, h, 0), "fmi2DoStep")? };
+        }
+        sample(&units, &mut next[..width])?;
+        times[held] = (i + 1) as f64 * h;
+        held += 1;
+        if held == chunk {
+            // the rows handed on; the last stays for the next step
+            rows.copy_within((held - 1) * width..held * width, 0);
+            held = 1;
+        }
+    }
+    let wall = clock.elapsed().as_secs_f64();
+    std::hint::black_box(&times);
+    Ok((wall, rows[(held - 1) * width..held * width].to_vec()))
+}
+
+unsafe extern "C" fn libc_calloc(count: usize, size: usize) -> *mut std::ffi::c_void {
+    libc::calloc(count, size)
+}
+
+unsafe extern "C" fn libc_free(p: *mut std::ffi::c_void) {
+    libc::free(p)
+}

@@ -1,0 +1,261 @@
+"""fricsim from Python: the co-simulation host of friction-fmu as a library.
+
+The work is done by the host's Rust library (``fricsim._native``, built by
+maturin from ``python/src/lib.rs``) with the GIL released; this package
+gives it Python's types:
+
+- :func:`info` — an FMU's model description as a :class:`ModelInfo`;
+- :func:`run` — a system file co-simulated, as a numpy structured array
+  with ``time`` first (FMPy's convention; ``pandas.DataFrame(result)``
+  works), the same numbers as ``fricsim run``'s CSV bit for bit;
+- :func:`sweep` — a parameter grid, one DataFrame row per run, on the
+  cores of this machine or as tasks of a Dask cluster (``client=``);
+- :func:`diagnose` and :func:`diagnose_many` — ``fricsim diagnose`` on
+  one dataset, or on many as Dask tasks.
+
+Every error of the host raises :class:`FricsimError` (a ``RuntimeError``)
+with the host's message: the file and line, the instance, the FMI call.
+Ctrl-C stops a run cleanly and raises ``KeyboardInterrupt``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _native
+from ._native import FricsimError
+from ._tables import write_table_csv
+
+__all__ = [
+    "FricsimError",
+    "ModelInfo",
+    "Variable",
+    "Diagnosis",
+    "info",
+    "run",
+    "sweep",
+    "diagnose",
+    "diagnose_many",
+]
+
+PathLike = Union[str, os.PathLike]
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One ScalarVariable of a model description (FMI 2.0.4 §2.2.7)."""
+
+    name: str
+    value_reference: int
+    causality: str
+    variability: str
+    type: str
+    start: Optional[str]
+    unit: Optional[str]
+    description: Optional[str]
+
+
+@dataclass(frozen=True)
+class ModelInfo:
+    """What ``fricsim info`` shows: the model, its Co-Simulation
+    capabilities (FMI 2.0.4 §4.3.1), the default experiment (§2.2.5) and
+    the variables."""
+
+    fmi_version: str
+    model_name: str
+    guid: str
+    description: Optional[str]
+    generation_tool: Optional[str]
+    generation_date_and_time: Optional[str]
+    model_identifier: str
+    model_exchange: Optional[str]
+    platforms: list
+    capabilities: dict
+    default_experiment: Optional[dict]
+    variables: list = field(repr=False)
+
+    def variable(self, name: str) -> Variable:
+        """The variable called ``name``."""
+        for v in self.variables:
+            if v.name == name:
+                return v
+        raise KeyError(f"{self.model_name} has no variable `{name}`")
+
+
+def info(fmu: PathLike) -> ModelInfo:
+    """The model description of ``fmu`` (the archive is read, its binary
+    not loaded, so FMUs for other platforms can be inspected too)."""
+    d = json.loads(_native.info(os.fspath(fmu)))
+    d["variables"] = [Variable(**v) for v in d["variables"]]
+    return ModelInfo(**d)
+
+
+def run(
+    system: PathLike,
+    start_values: Optional[Mapping[str, Any]] = None,
+    start: Optional[float] = None,
+    stop: Optional[float] = None,
+    step: Optional[float] = None,
+    master: Optional[str] = None,
+    output_interval: Optional[float] = None,
+    input: Any = None,
+    record: Sequence[str] = (),
+    step_timeout: Optional[float] = None,
+) -> np.ndarray:
+    """Co-simulate the system file ``system`` (``.ssd`` or ``.ssp``) as
+    ``fricsim run`` does, and return its rows as a numpy structured array:
+    ``time``, then one field per recorded ``component.variable``.
+
+    ``start_values`` maps ``component.variable`` to a value set after the
+    file's own parameter values (numbers; text for String variables).
+    ``start``, ``stop``, ``step`` and ``master`` default to the file's
+    ``DefaultExperiment`` and annotation; ``output_interval`` (a whole
+    multiple of the step) records every k-th communication point only. ``input`` is a CSV path, a
+    structured array or a DataFrame with ``time`` first and a column per
+    unconnected input, interpolated linearly in time as FMPy does.
+    ``record`` names further Real variables to record. ``step_timeout``
+    limits each FMI call, in seconds.
+
+    A run that stops early raises :class:`FricsimError`; the rows up to the
+    failure are its ``result`` attribute.
+    """
+    values = list((start_values or {}).items())
+    with tempfile.TemporaryDirectory(prefix="fricsim-input-") as tmp:
+        input_path = None
+        if input is not None:
+            input_path = _as_csv(input, Path(tmp) / "input.csv")
+        columns, data, error = _native.run(
+            os.fspath(system),
+            start=start,
+            stop=stop,
+            step=step,
+            master=master,
+            start_values=values,
+            output_interval=output_interval,
+            record=list(record),
+            input=input_path,
+            step_timeout=step_timeout,
+        )
+    dtype = np.dtype([(c, np.float64) for c in columns])
+    result = np.frombuffer(data, dtype=dtype).copy()
+    if error is not None:
+        failure = FricsimError(
+            f"run INCOMPLETE (the {len(result)} rows up to the failure are in "
+            f"the exception's result): {error}"
+        )
+        failure.result = result
+        raise failure
+    return result
+
+
+def _as_csv(table: Any, path: Path) -> str:
+    """A CSV path as given, else ``table`` (DataFrame, structured array)
+    written to ``path`` with every number exactly."""
+    if isinstance(table, (str, os.PathLike)):
+        return os.fspath(table)
+    write_table_csv(table, path)
+    return os.fspath(path)
+
+
+class Diagnosis:
+    """The result of :func:`diagnose`: the fields of ``report.json`` as
+    attributes (``effects``, ``nominal_rms``, ``final_rms``,
+    ``floor_rms``, ``unexplained``, …, and the whole of it as ``report``),
+    and the paths of what was written: ``out``, ``report_html``,
+    ``report_json``, ``report_md``, ``refitted_system``. In Jupyter it
+    shows as ``report.md``."""
+
+    def __init__(self, report: dict, out: Path):
+        self.report = report
+        self.out = out
+        self.report_html = out / "report.html"
+        self.report_json = out / "report.json"
+        self.report_md = out / "report.md"
+        self.refitted_system = out / "refitted.ssp"
+
+    def __getattr__(self, name: str) -> Any:
+        report = self.__dict__.get("report", {})
+        if name in report:
+            return report[name]
+        raise AttributeError(f"the diagnosis has no field `{name}`")
+
+    @property
+    def effect_names(self) -> list:
+        """The effects found, in the order they were added."""
+        return [e["name"] for e in self.report["effects"]]
+
+    def __repr__(self) -> str:
+        found = ", then ".join(self.effect_names) or "no missing effect"
+        return (
+            f"<Diagnosis of {self.report['system']}: {found}; held-out RMS "
+            f"{self.report['nominal_rms']:.5f} -> {self.report['final_rms']:.5f}; "
+            f"{self.report_html}>"
+        )
+
+    def _repr_markdown_(self) -> str:
+        return self.report_md.read_text()
+
+
+def diagnose(
+    system: PathLike,
+    data: Any,
+    heldout: Any = None,
+    out: Optional[PathLike] = None,
+    **options: Any,
+) -> Diagnosis:
+    """``fricsim diagnose``: which friction effect the system misses
+    against the measurements ``data`` (a CSV path or a DataFrame with
+    ``time`` first and ``component.variable`` columns), scored on
+    ``heldout`` (same kinds) or on held-out blocks of ``data``.
+
+    ``out`` is the output directory (default
+    ``out/<system name>-diagnosis``); ``options`` are those of the command
+    with underscores: ``candidates`` (list of effect names),
+    ``position_knots``, ``alpha``, ``smooth``, ``blocks``,
+    ``cross_validate`` ("auto", "always", "never"), ``polish``,
+    ``master``, ``lugre``."""
+    system = Path(system)
+    if out is None:
+        out = Path("out") / f"{system.stem}-diagnosis"
+    known = {
+        "candidates",
+        "position_knots",
+        "alpha",
+        "smooth",
+        "blocks",
+        "cross_validate",
+        "polish",
+        "master",
+        "lugre",
+    }
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise TypeError(
+            f"diagnose: unknown option(s) {', '.join(unknown)} "
+            f"(known: {', '.join(sorted(known))})"
+        )
+    if "lugre" in options and options["lugre"] is not None:
+        options["lugre"] = os.fspath(options["lugre"])
+    with tempfile.TemporaryDirectory(prefix="fricsim-data-") as tmp:
+        data_path = _as_csv(data, Path(tmp) / "data.csv")
+        heldout_path = None
+        if heldout is not None:
+            heldout_path = _as_csv(heldout, Path(tmp) / "heldout.csv")
+        report = _native.diagnose(
+            os.fspath(system),
+            data_path,
+            os.fspath(out),
+            heldout=heldout_path,
+            **options,
+        )
+    return Diagnosis(json.loads(report), Path(out))
+
+
+from ._distributed import diagnose_many, sweep  # noqa: E402  (uses the above)

@@ -1,0 +1,290 @@
+"""The Python package `fricsim` (python/, installed into .venv by
+scripts/setup-python-package.sh): the same numbers as the `fricsim`
+command bit for bit, the host's messages in its exceptions, DataFrames
+where the command takes CSV files, and Ctrl-C that stops a run cleanly."""
+
+import csv
+import re
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import fricsim
+
+ROOT = __import__("pathlib").Path(__file__).resolve().parent.parent
+FRICSIM = ROOT / "target" / "release" / "fricsim"
+STICK_SLIP = ROOT / "examples" / "stick_slip.ssd"
+PLANAR = ROOT / "examples" / "planar_stick_slip.ssd"
+EMPS = ROOT / "examples" / "emps_nominal.ssd"
+EMPS_TRAIN = ROOT / "examples" / "data" / "emps_train.csv"
+EMPS_TEST = ROOT / "examples" / "data" / "emps_test_pulses.csv"
+
+
+def cli(*args, cwd=ROOT):
+    assert FRICSIM.exists(), f"{FRICSIM} is missing: cargo build --release -p fricsim"
+    return subprocess.run([str(FRICSIM), *map(str, args)], cwd=cwd, capture_output=True, text=True)
+
+
+def read_exact_csv(path):
+    """A result CSV as column name -> float64 array, every number parsed
+    by Python's float (exact for the shortest round-trip digits)."""
+    with open(path) as f:
+        rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+    header, body = rows[0], rows[1:]
+    return {name: np.array([float(r[k]) for r in body]) for k, name in enumerate(header)}
+
+
+def same_bits(a, b):
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    return a.shape == b.shape and np.array_equal(a.view(np.uint64), b.view(np.uint64))
+
+
+@pytest.mark.parametrize(
+    "system, options",
+    [
+        (STICK_SLIP, {"stop": 12.0}),
+        (PLANAR, {"stop": 2.0, "master": "gauss-seidel"}),
+    ],
+    ids=["stick_slip", "planar_stick_slip"],
+)
+def test_run_equals_the_command_csv_bit_for_bit(tmp_path, system, options):
+    result = fricsim.run(system, **options)
+    out = tmp_path / "run.csv"
+    args = ["run", system, "--out", out, "--quiet", "--stop", options["stop"]]
+    if "master" in options:
+        args += ["--master", options["master"]]
+    done = cli(*args)
+    assert done.returncode == 0, done.stderr
+    expected = read_exact_csv(out)
+    assert list(result.dtype.names) == list(expected)
+    assert result.dtype.names[0] == "time"
+    assert len(result) == len(expected["time"]) > 1000
+    for name in expected:
+        assert same_bits(result[name], expected[name]), name
+    frame = pd.DataFrame(result)
+    assert list(frame.columns) == list(expected)
+    assert same_bits(frame["time"].to_numpy(), expected["time"])
+
+
+ALONE = """<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription version="1.0" name="alone"
+    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
+    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon">
+  <ssd:System name="alone">
+    <ssd:Elements>
+      <ssd:Component name="friction" source="{fmu}">
+        <ssd:Connectors>
+          <ssd:Connector name="v" kind="input"><ssc:Real unit="m/s"/></ssd:Connector>
+          <ssd:Connector name="F" kind="output"><ssc:Real unit="N"/></ssd:Connector>
+        </ssd:Connectors>
+      </ssd:Component>
+    </ssd:Elements>
+  </ssd:System>
+</ssd:SystemStructureDescription>
+"""
+
+
+def test_start_values_and_output_interval():
+    base = fricsim.run(STICK_SLIP, stop=10.0)
+    stickier = fricsim.run(STICK_SLIP, stop=10.0, start_values={"friction.Fs": 2.0})
+    assert base["friction.F"].max() < 1.5 < stickier["friction.F"].max() <= 2.0
+    # every 100th communication point of the same run (10 s at 1e-4 s)
+    sparse = fricsim.run(STICK_SLIP, stop=10.0, output_interval=1e-2)
+    assert len(sparse) == 1001
+    for name in base.dtype.names:
+        assert same_bits(sparse[name], base[name][::100]), name
+
+
+def test_a_dataframe_input_equals_the_command_with_the_csv(tmp_path):
+    system = tmp_path / "alone.ssd"
+    system.write_text(ALONE.format(fmu=ROOT / "dist" / "LuGre.fmu"))
+    t = np.linspace(0.0, 1.0, 101)
+    v = 2e-3 * np.sin(2 * np.pi * t)
+    table = pd.DataFrame({"time": t, "friction.v": v})
+    inputs = tmp_path / "inputs.csv"
+    inputs.write_text("time,friction.v\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), v.tolist())))
+    out = tmp_path / "alone.csv"
+    done = cli("run", system, "--stop", 1.0, "--step", 1e-3, "--input", inputs, "--out", out, "--quiet")
+    assert done.returncode == 0, done.stderr
+    expected = read_exact_csv(out)
+    for given in (table, inputs, table.to_records(index=False)):
+        result = fricsim.run(system, stop=1.0, step=1e-3, input=given)
+        assert np.ptp(result["friction.F"]) > 0
+        for name in expected:
+            assert same_bits(result[name], expected[name]), name
+
+
+def test_info_is_the_model_description():
+    lugre = fricsim.info(ROOT / "dist" / "LuGre.fmu")
+    assert lugre.model_name == "LuGre"
+    assert lugre.fmi_version == "2.0"
+    assert "linux64" in lugre.platforms
+    assert lugre.capabilities["can_get_and_set_fmu_state"] is True
+    force = lugre.variable("F")
+    assert (force.causality, force.type, force.unit) == ("output", "Real", "N")
+    assert lugre.variable("sigma0").causality == "parameter"
+    with pytest.raises(KeyError, match="no variable `nosuch`"):
+        lugre.variable("nosuch")
+    with pytest.raises(fricsim.FricsimError, match="nosuch.fmu"):
+        fricsim.info(ROOT / "dist" / "nosuch.fmu")
+
+
+def test_errors_carry_the_host_messages(tmp_path):
+    broken = tmp_path / "broken.ssd"
+    text = STICK_SLIP.read_text().replace("<ssd:Connections>", "<ssd:Connections><oops>", 1)
+    broken.write_text(text)
+    with pytest.raises(fricsim.FricsimError) as e:
+        fricsim.run(broken)
+    assert isinstance(e.value, RuntimeError)
+    # file:line:column, then what is wrong there
+    assert re.search(r"broken\.ssd:\d+:\d+: ill-formed document", str(e.value)), str(e.value)
+
+    with pytest.raises(fricsim.FricsimError, match="nosuch"):
+        fricsim.run(STICK_SLIP, stop=1.0, start_values={"friction.nosuch": 1.0})
+
+    # the host refuses a value outside the declared range
+    with pytest.raises(fricsim.FricsimError, match="friction.sigma0. to -1: below the declared min = 0"):
+        fricsim.run(STICK_SLIP, stop=1.0, start_values={"friction.sigma0": -1.0})
+    # the FMU refuses the value: the instance, the call and the reason
+    with pytest.raises(fricsim.FricsimError) as e:
+        fricsim.run(STICK_SLIP, stop=1.0, start_values={"friction.sigma0": 0.0})
+    message = str(e.value)
+    assert 'instance "friction"' in message and "fmi2GetReal" in message, message
+    assert "invalid parameter sigma0 = 0" in message, message
+
+    with pytest.raises(fricsim.FricsimError, match="unknown master algorithm `nosuch`"):
+        fricsim.run(STICK_SLIP, stop=1.0, master="nosuch")
+
+    with pytest.raises(fricsim.FricsimError, match="alpha 2: must be between 0 and 1"):
+        fricsim.diagnose(EMPS, EMPS_TRAIN, out=tmp_path / "d", alpha=2.0)
+    with pytest.raises(fricsim.FricsimError, match="unknown effect|nosuch"):
+        fricsim.diagnose(EMPS, EMPS_TRAIN, out=tmp_path / "d", candidates=["nosuch"])
+    with pytest.raises(TypeError, match="unknown option.*alhpa"):
+        fricsim.diagnose(EMPS, EMPS_TRAIN, out=tmp_path / "d", alhpa=0.1)
+
+
+def test_sweep_equals_the_command_sweep_bit_for_bit(tmp_path):
+    grid = {"friction.Fs": [1.5, 2.0], "rig.k": [2.0, 3.0]}
+    frame = fricsim.sweep(STICK_SLIP, grid, stop=3.0)
+    out = tmp_path / "sweep.csv"
+    done = cli("sweep", STICK_SLIP, "--param", "friction.Fs=1.5,2.0", "--param", "rig.k=2.0,3.0",
+               "--stop", 3.0, "--out", out)
+    assert done.returncode == 0, done.stderr
+    expected = read_exact_csv_mixed(out)
+    assert len(frame) == len(expected) == 4
+    value_columns = [c for c in expected[0] if c.startswith(("final:", "rms:"))]
+    assert value_columns and value_columns == [c for c in frame.columns if c.startswith(("final:", "rms:"))]
+    for i, row in enumerate(expected):
+        assert frame["friction.Fs"][i] == float(row["friction.Fs"])
+        assert frame["points"][i] == int(row["points"])
+        assert frame["error"][i] is None and row["status"] == "ok"
+        for c in value_columns:
+            assert same_bits(frame[c][i], float(row[c])), c
+
+
+def read_exact_csv_mixed(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def test_a_point_the_fmu_refuses_is_an_error_row():
+    frame = fricsim.sweep(STICK_SLIP, {"friction.sigma0": [-1.0, 1e5]}, stop=0.5)
+    assert "below its declared min" in frame["error"][0]
+    assert frame["error"][1] is None
+    assert np.isnan(frame["final:friction.F"][0]) and np.isfinite(frame["final:friction.F"][1])
+    with pytest.raises(fricsim.FricsimError, match="no variable `nosuch`"):
+        fricsim.sweep(STICK_SLIP, {"friction.nosuch": [1.0]}, stop=0.5)
+
+
+DIAGNOSE_OPTIONS = {"candidates": ["direction_dependent", "viscous"], "polish": False}
+
+
+def test_a_dataframe_to_diagnose_equals_the_csv_path(tmp_path):
+    by_path = fricsim.diagnose(EMPS, EMPS_TRAIN, EMPS_TEST, out=tmp_path / "a", **DIAGNOSE_OPTIONS)
+    frame = pd.read_csv(EMPS_TRAIN, comment="#")
+    heldout = pd.read_csv(EMPS_TEST, comment="#")
+    by_frame = fricsim.diagnose(EMPS, frame, heldout, out=tmp_path / "b", **DIAGNOSE_OPTIONS)
+    assert by_path.effect_names == by_frame.effect_names == ["direction_dependent"]
+    assert by_path.report_html.exists() and by_path.refitted_system.exists()
+    ignore = {"data", "heldout", "wall_seconds", "polish_seconds"}
+    a = {k: v for k, v in by_path.report.items() if k not in ignore}
+    b = {k: v for k, v in by_frame.report.items() if k not in ignore}
+    assert a == b
+    assert by_path.final_rms < by_path.nominal_rms
+    # the refitted system runs
+    assert len(fricsim.run(by_path.refitted_system, stop=0.5)) > 10
+
+
+CHILD = textwrap.dedent(
+    """
+    import sys, fricsim
+    print("running", flush=True)
+    try:
+        fricsim.run(sys.argv[1], stop=1e6)
+    except KeyboardInterrupt:
+        print("KeyboardInterrupt", flush=True)
+        sys.exit(3)
+    print("finished", flush=True)
+    """
+)
+
+
+def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt(tmp_path):
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    child = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(ROOT / "dist" / "stick_slip.ssp")],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env={**os.environ, "TMPDIR": str(temp)},
+    )
+    assert child.stdout.readline().strip() == "running"
+    # wait until the run has unpacked its FMUs, i.e. is inside Rust
+    while not any(temp.iterdir()):
+        assert child.poll() is None, child.stderr.read()
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=120)
+    assert child.returncode == 3, err
+    assert out.strip() == "KeyboardInterrupt"
+    assert list(temp.iterdir()) == []
+
+
+def test_seeds_equal_the_command_sweep_with_seeds(tmp_path):
+    piezo = ROOT / "examples" / "piezo_push.ssd"
+    frame = fricsim.sweep(piezo, {}, stop=2.0, seeds=3)
+    out = tmp_path / "seeds.csv"
+    done = cli("sweep", piezo, "--seeds", 3, "--stop", 2.0, "--out", out)
+    assert done.returncode == 0, done.stderr
+    expected = read_exact_csv_mixed(out)
+    assert list(frame["friction.seed"]) == [1.0, 2.0, 3.0]
+    assert len(set(frame["rms:friction.F"])) == 3  # three realisations
+    for i, row in enumerate(expected):
+        assert same_bits(frame["rms:friction.F"][i], float(row["rms:friction.F"]))
+        assert same_bits(frame["final:friction.F"][i], float(row["final:friction.F"]))
+
+
+def test_the_gil_is_released_while_a_run_goes_on(tmp_path, monkeypatch):
+    """Python code in another thread runs while Rust runs: this thread sees
+    the run's unpacked FMUs (which exist only inside the Rust call) while
+    the run's thread is still in it. With the GIL held, this thread could
+    only look after the call had returned and removed them."""
+    import threading
+
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    monkeypatch.setenv("TMPDIR", str(temp))
+    done = {}
+    runner = threading.Thread(target=lambda: done.setdefault("rows", len(fricsim.run(STICK_SLIP, stop=60.0))))
+    runner.start()
+    seen_inside = False
+    while runner.is_alive() and not seen_inside:
+        seen_inside = any(temp.iterdir()) and runner.is_alive()
+    runner.join()
+    assert done["rows"] == 600001
+    assert seen_inside
+    assert list(temp.iterdir()) == []
