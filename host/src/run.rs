@@ -8,6 +8,7 @@
 //! [`RowSink`] as they are computed, and returns the [`RunOutcome`].
 //!
 //! ```no_run
+//! use fricsim::output_file::OutputFile;
 //! use fricsim::results::ResultWriter;
 //! use fricsim::run::{PreparedRun, RunOptions, StartValue};
 //! use fricsim::ssp::SystemFile;
@@ -18,9 +19,11 @@
 //!     output_interval: Some(1e-2),
 //!     ..RunOptions::default()
 //! };
+//! let out = OutputFile::create("out/stick_slip.csv".as_ref(), &file.files_read())
+//!     .map_err(|e| e.to_string())?;
 //! let prepared = PreparedRun::new(&file, &options)?;
-//! let mut csv = ResultWriter::new("out/stick_slip.csv".as_ref(), &prepared.columns());
-//! let outcome = prepared.run(&mut csv, &mut |_, _| {})?;
+//! let mut csv = ResultWriter::new(out, &prepared.columns());
+//! let outcome = prepared.run(&mut csv, None)?;
 //! csv.finish(outcome.error.as_deref()).map_err(|e| e.to_string())?;
 //! println!("{} rows, {:?}", outcome.rows, outcome.error);
 //! # Ok::<(), String>(())
