@@ -27,6 +27,7 @@ pub mod compare;
 pub mod error;
 pub mod fmu;
 pub mod inputs;
+pub mod isolate;
 pub mod master;
 pub mod matfile;
 pub mod output_file;

@@ -59,6 +59,9 @@ enum Command {
     /// seed), in parallel on all cores; writes one CSV row per run with the
     /// parameters, final values, RMS values and wall time.
     Sweep(cli::sweep::SweepArgs),
+    /// The child process of `run --isolate` (started by fricsim itself).
+    #[command(name = "isolated-child", hide = true)]
+    IsolatedChild(cli::isolated::ChildArgs),
 }
 
 fn main() -> ExitCode {
@@ -72,8 +75,12 @@ fn main() -> ExitCode {
     }
     let args = Args::parse();
     // the commands that stream a run to a result file stop between chunks
-    // on SIGINT/SIGTERM and put the rows so far in place
-    if matches!(args.command, Command::Run(_) | Command::Cosim(_)) {
+    // on SIGINT/SIGTERM and put the rows so far in place (an isolated
+    // run's child too: it stops there and its parent puts them in place)
+    if matches!(
+        args.command,
+        Command::Run(_) | Command::Cosim(_) | Command::IsolatedChild(_)
+    ) {
         if let Err(e) = fricsim::signals::stop_on_termination() {
             eprintln!("fricsim: cannot catch SIGINT and SIGTERM: {e}");
             return ExitCode::FAILURE;
@@ -90,6 +97,7 @@ fn main() -> ExitCode {
         Command::Reference(args) => cli::reference::run(&args),
         Command::Diagnose(args) => cli::diagnose::run(&args),
         Command::Sweep(args) => cli::sweep::run(&args),
+        Command::IsolatedChild(args) => cli::isolated::child(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -19,13 +19,11 @@
 //!     output_interval: Some(1e-2),
 //!     ..RunOptions::default()
 //! };
-//! let prepared = PreparedRun::new(&file, &options)?;
-//! // the result file: refused if it is one of the inputs, locked, put in
-//! // place whole (fricsim::output_file)
 //! let out = OutputFile::create("out/stick_slip.csv".as_ref(), &file.files_read())
 //!     .map_err(|e| e.to_string())?;
+//! let prepared = PreparedRun::new(&file, &options)?;
 //! let mut csv = ResultWriter::new(out, &prepared.columns());
-//! let outcome = prepared.run(&mut csv, &mut |_, _| {})?;
+//! let outcome = prepared.run(&mut csv, None)?;
 //! csv.finish(outcome.error.as_deref()).map_err(|e| e.to_string())?;
 //! println!("{} rows, {:?}", outcome.rows, outcome.error);
 //! # Ok::<(), String>(())
@@ -250,16 +248,49 @@ impl PreparedRun {
     /// in initialization is an `Err`; a failure after it is the outcome's
     /// [`RunOutcome::error`], with the rows up to it handed on.
     pub fn run(
+        self,
+        sink: &mut dyn RowSink,
+        progress: Option<&mut dyn FnMut(usize, usize)>,
+    ) -> Result<RunOutcome, String> {
+        let every = self.every;
+        self.run_recording(sink, progress, None, every)
+    }
+
+    /// The communication points per recorded row: 1, or the output
+    /// interval over the step.
+    pub fn output_every(&self) -> usize {
+        self.every
+    }
+
+    /// Run as [`PreparedRun::run`] does, with `observer` told of each
+    /// step before the run's own (external inputs, progress), and every
+    /// communication point handed to `sink` whatever the output interval:
+    /// for a caller that picks the rows itself, later, with a
+    /// [`Recorder`] of [`PreparedRun::output_every`] (an isolated run's
+    /// child sends every row to its parent, which records them).
+    pub fn run_observed(
+        self,
+        sink: &mut dyn RowSink,
+        progress: Option<&mut dyn FnMut(usize, usize)>,
+        observer: &mut dyn Observer,
+    ) -> Result<RunOutcome, String> {
+        self.run_recording(sink, progress, Some(observer), 1)
+    }
+
+    fn run_recording(
         mut self,
         sink: &mut dyn RowSink,
         progress: Option<&mut dyn FnMut(usize, usize)>,
+        observer: Option<&mut dyn Observer>,
+        every: usize,
     ) -> Result<RunOutcome, String> {
         let started = std::time::Instant::now();
         let mut watch = Watch {
             inputs: self.inputs.take(),
             progress,
+            observer,
         };
-        let mut recorder = Recorder::new(sink, self.every, self.system.columns().len());
+        let mut recorder = Recorder::new(sink, every, self.system.columns().len());
         let streamed = simulate_streaming(
             &mut self.system,
             self.master.as_mut(),
@@ -321,19 +352,27 @@ pub struct RunOutcome {
     pub wall_time: f64,
 }
 
-/// The external inputs and the progress callback, consulted by the run.
-struct Watch<'p> {
+/// The external inputs, the progress callback and the caller's observer
+/// ([`PreparedRun::run_observed`]), consulted by the run.
+struct Watch<'p, 'o> {
     inputs: Option<ExternalInputs>,
     progress: Option<&'p mut dyn FnMut(usize, usize)>,
+    observer: Option<&'o mut dyn Observer>,
 }
 
-impl Observer for Watch<'_> {
-    /// Nothing to do between steps without external inputs or progress.
+impl Observer for Watch<'_, '_> {
+    /// Nothing to do between steps without external inputs, progress or
+    /// an observer that has something to do.
     fn between_steps(&self) -> bool {
-        self.inputs.is_some() || self.progress.is_some()
+        self.inputs.is_some()
+            || self.progress.is_some()
+            || self.observer.as_ref().is_some_and(|o| o.between_steps())
     }
 
     fn before_step(&mut self, system: &mut System, t: f64, init: bool) -> Result<(), FmuError> {
+        if let Some(o) = &mut self.observer {
+            o.before_step(system, t, init)?;
+        }
         match &mut self.inputs {
             Some(i) => i.before_step(system, t, init),
             None => Ok(()),
@@ -341,6 +380,9 @@ impl Observer for Watch<'_> {
     }
 
     fn after_step(&mut self, done: usize, total: usize) {
+        if let Some(o) = &mut self.observer {
+            o.after_step(done, total);
+        }
         // every 256 steps keeps even the callback out of the step loop's cost
         if let Some(progress) = &mut self.progress {
             if done.is_multiple_of(256) || done == total {
@@ -372,15 +414,19 @@ pub fn output_every(interval: Option<f64>, step: f64) -> Result<usize, String> {
     Ok(k as usize)
 }
 
-/// A sink between the run and the caller's: passes on the start, every
-/// `every`-th communication point and the last one, and sums up what it
-/// passes on in [`ColumnStats`].
-struct Recorder<'s> {
-    sink: &'s mut dyn RowSink,
+/// A sink between a run and the caller's `sink`: passes on the start,
+/// every `every`-th communication point and the last one (see
+/// [`RunOptions::output_interval`]), and sums up what it passes on in
+/// [`ColumnStats`]. [`PreparedRun::run`] records through one; a caller of
+/// [`PreparedRun::run_observed`] may record the rows it is handed with
+/// one of its own, with the same result.
+pub struct Recorder<S: RowSink> {
+    sink: S,
     every: usize,
     /// Communication points seen so far.
     seen: usize,
-    stats: ColumnStats,
+    /// What was passed on.
+    pub stats: ColumnStats,
     /// The last point seen, if it was not passed on: passed on by
     /// [`Recorder::finish`], the run having ended there.
     pending: Option<(f64, Rows)>,
@@ -389,11 +435,13 @@ struct Recorder<'s> {
     picked_times: Vec<f64>,
 }
 
-impl<'s> Recorder<'s> {
-    fn new(sink: &'s mut dyn RowSink, every: usize, width: usize) -> Recorder<'s> {
+impl<S: RowSink> Recorder<S> {
+    /// A recorder of rows `width` wide into `sink`, of every `every`-th
+    /// communication point ([`PreparedRun::output_every`]).
+    pub fn new(sink: S, every: usize, width: usize) -> Recorder<S> {
         Recorder {
             sink,
-            every,
+            every: every.max(1),
             seen: 0,
             stats: ColumnStats::new(width),
             pending: None,
@@ -402,17 +450,23 @@ impl<'s> Recorder<'s> {
         }
     }
 
-    /// Pass on the last point of the run if it was not.
-    fn finish(&mut self) -> Result<(), String> {
+    /// Pass on the last point of the run if it was not: call it once the
+    /// run has ended, completed or not.
+    pub fn finish(&mut self) -> Result<(), String> {
         if let Some((t, row)) = self.pending.take() {
             self.sink.write(&[t], &row)?;
             self.stats.add(&[t], &row);
         }
         Ok(())
     }
+
+    /// The caller's sink.
+    pub fn into_inner(self) -> S {
+        self.sink
+    }
 }
 
-impl RowSink for Recorder<'_> {
+impl<S: RowSink> RowSink for Recorder<S> {
     fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String> {
         let first = self.seen;
         self.seen += times.len();

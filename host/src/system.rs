@@ -229,7 +229,7 @@ fn recorded_type(kind: &VariableKind) -> Option<RecordedType> {
 
 /// The type of a recorded column: a Real, or a whole number (an Integer,
 /// an Enumeration, or a Boolean as 0 or 1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum RecordedType {
     Real,
     Integer,

@@ -107,6 +107,23 @@ fn fricsim_run_writes_integer_and_boolean_columns_exactly_and_exits_0() {
     assert_eq!(lines[2], "1.0,2.0,2,1");
     assert_eq!(*lines.last().unwrap(), "9.0,10.0,10,1");
     assert_eq!(lines.len(), 11);
+
+    // isolated (--isolate): the same file, the same end
+    let isolated = dir.path().join("stair_isolated.csv");
+    let (code, stdout, stderr) = fricsim(&[
+        "run",
+        ssd.to_str().unwrap(),
+        "--out",
+        isolated.to_str().unwrap(),
+        "--isolate",
+    ]);
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("9 of 10 macro steps")
+            && stdout.contains("stair ended the simulation at t = 9"),
+        "{stdout}"
+    );
+    assert_eq!(std::fs::read_to_string(&isolated).unwrap(), csv);
 }
 
 #[test]

@@ -1,10 +1,12 @@
 //! `fricsim cosim`: connect FMUs given on the command line, co-simulate
 //! with a fixed macro step, write a CSV and a plot, print a summary.
 
-use fricsim::master::{simulate_streaming, NoObserver};
+use super::isolated::{json, Ending};
+use fricsim::isolate::child::Child;
+use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, Streamed};
 use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
-use fricsim::system::System;
+use fricsim::system::{RecordedType, System};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -45,12 +47,111 @@ pub struct CosimArgs {
     /// Time limit on each FMI call, in seconds: a call that takes longer
     /// stops the run (rows so far kept, marked incomplete) naming the
     /// instance and the call; a running call cannot be interrupted, a
-    /// watchdog reports it on stderr when it passes the limit.
+    /// watchdog reports it on stderr when it passes the limit (with
+    /// --isolate it is stopped: the FMU process is killed).
     #[arg(long = "step-timeout", value_name = "SECONDS")]
     pub step_timeout: Option<f64>,
+    /// Run the FMUs in a child process (see docs/user-guide.md, "Isolated
+    /// runs"), so that one that crashes (a
+    /// segmentation fault, abort(), exit()) or hangs past --step-timeout
+    /// costs the run its end, not its rows: the result keeps every row
+    /// and is marked incomplete naming the instance, the FMI call, the
+    /// time and the signal or exit status.
+    #[arg(long)]
+    pub isolate: bool,
 }
 
 pub fn run(a: &CosimArgs) -> Result<(), String> {
+    let parsed = parse(a)?;
+    // the result file is claimed before the FMUs are opened
+    let output = claim_output(a, &parsed)?;
+    if a.isolate {
+        return run_isolated(a, output);
+    }
+    let (mut system, mut master, plan) = build(a, &parsed)?;
+    let mut sink = CosimSink::new(a, output, &system.columns(), &plan);
+    let started = std::time::Instant::now();
+    let run = simulate_streaming(
+        &mut system,
+        master.as_mut(),
+        0.0,
+        a.step,
+        a.stop,
+        &mut NoObserver,
+        &mut sink,
+    )
+    .map_err(|e| e.to_string())?;
+    let wall = started.elapsed().as_secs_f64();
+    conclude(a, sink, &plan, &run, master.report(), wall)
+}
+
+/// `--isolate`, the parent: the rows the child computes written to the
+/// result file claimed before it started.
+fn run_isolated(a: &CosimArgs, output: OutputFile) -> Result<(), String> {
+    let isolated = super::isolated::run_isolated(a.step_timeout, |columns, plan: &CosimPlan| {
+        Ok(CosimSink::new(a, output, columns, plan))
+    })?;
+    let ended = isolated.ending.ended();
+    let run = Streamed {
+        columns: isolated.columns,
+        rows: isolated.rows,
+        error: isolated.error,
+        ended,
+    };
+    conclude(
+        a,
+        isolated.sink,
+        &isolated.plan,
+        &run,
+        isolated.ending.master_report,
+        isolated.ending.wall,
+    )
+}
+
+/// `--isolate`, the child: build the system and run it, the rows going
+/// to the parent.
+pub fn child(a: &CosimArgs, link: &mut Child) -> Result<(), String> {
+    let parsed = parse(a)?;
+    let (mut system, mut master, plan) = build(a, &parsed)?;
+    link.started(&mut system, json(&plan)?)?;
+    let started = std::time::Instant::now();
+    let run = link
+        .simulate_streaming(
+            &mut system,
+            master.as_mut(),
+            0.0,
+            a.step,
+            a.stop,
+            &mut NoObserver,
+        )
+        .map_err(|e| e.to_string())?;
+    let ending = Ending {
+        master_report: master.report(),
+        wall: started.elapsed().as_secs_f64(),
+        ended: run.ended.clone().map(|e| (e.instance, e.time)),
+    };
+    link.finished(&run, json(ending)?)
+}
+
+/// What the summary and the plot need to know of a run (sent by an
+/// isolated run's child to its parent).
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct CosimPlan {
+    pub master: String,
+    pub signals: Vec<String>,
+    /// The type of each column.
+    pub types: Vec<RecordedType>,
+}
+
+/// The options read: components, parameters, connections.
+pub struct Parsed<'a> {
+    components: Vec<(String, &'a Path)>,
+    parameters: Vec<(String, f64)>,
+    connections: Vec<(String, String)>,
+}
+
+/// Check and read the options.
+fn parse(a: &CosimArgs) -> Result<Parsed<'_>, String> {
     if !(a.step.is_finite() && a.step > 0.0) {
         return Err(format!("--step must be > 0, got {}", a.step));
     }
@@ -90,41 +191,86 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
                 .ok_or(format!("--connect expects out.port->in.port, got `{s}`"))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let components: Vec<(String, &Path)> =
-        components.iter().map(|(n, p)| (n.clone(), *p)).collect();
-    let mut inputs: Vec<(&str, &Path)> = components.iter().map(|(_, p)| ("the FMU", *p)).collect();
+    Ok(Parsed {
+        components,
+        parameters,
+        connections,
+    })
+}
+
+/// The result file `--out`, claimed.
+fn claim_output(a: &CosimArgs, parsed: &Parsed) -> Result<OutputFile, String> {
+    let mut inputs: Vec<(&str, &Path)> = parsed
+        .components
+        .iter()
+        .map(|(_, p)| ("the FMU", *p))
+        .collect();
     inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
-    let output = OutputFile::create(&a.out, &inputs).map_err(|e| e.to_string())?;
-    let mut system =
-        System::build(&components, &parameters, &connections).map_err(|e| e.to_string())?;
+    OutputFile::create(&a.out, &inputs).map_err(|e| e.to_string())
+}
+
+/// The system built from the options, its master.
+fn build(
+    a: &CosimArgs,
+    parsed: &Parsed,
+) -> Result<(System, Box<dyn MasterAlgorithm>, CosimPlan), String> {
+    let mut system = System::build(&parsed.components, &parsed.parameters, &parsed.connections)
+        .map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
-    let mut master = fricsim::master::by_name(&a.master)?;
+    let master = fricsim::master::by_name(&a.master)?;
     super::print_warnings(system.warnings());
-    let columns = system.columns();
-    let mut writer = ResultWriter::new(output, &columns);
-    writer.whole_number_columns(&system.column_types());
     let signals = if a.plot_signals.is_empty() {
-        columns.clone()
+        system.columns()
     } else {
         a.plot_signals.clone()
     };
-    // a signal that cannot be plotted is reported once the CSV is written
-    let plot_error = match a.plot {
-        Some(_) => writer.keep_columns(&columns, &signals).err(),
-        None => None,
+    let plan = CosimPlan {
+        master: master.name().to_string(),
+        signals,
+        types: system.column_types(),
     };
-    let started = std::time::Instant::now();
-    let run = simulate_streaming(
-        &mut system,
-        master.as_mut(),
-        0.0,
-        a.step,
-        a.stop,
-        &mut NoObserver,
-        &mut writer,
-    )
-    .map_err(|e| e.to_string())?;
-    let elapsed = started.elapsed();
+    Ok((system, master, plan))
+}
+
+/// Where the rows go: the result file, and the plotted columns kept.
+pub struct CosimSink {
+    writer: ResultWriter,
+    /// A signal that cannot be plotted, reported once the result is
+    /// written.
+    plot_error: Option<String>,
+}
+
+impl CosimSink {
+    fn new(a: &CosimArgs, output: OutputFile, columns: &[String], plan: &CosimPlan) -> CosimSink {
+        let mut writer = ResultWriter::new(output, columns);
+        writer.whole_number_columns(&plan.types);
+        let plot_error = match a.plot {
+            Some(_) => writer.keep_columns(columns, &plan.signals).err(),
+            None => None,
+        };
+        CosimSink { writer, plot_error }
+    }
+}
+
+impl fricsim::master::RowSink for CosimSink {
+    fn write(&mut self, times: &[f64], rows: &fricsim::rows::Rows) -> Result<(), String> {
+        self.writer.write(times, rows)
+    }
+    fn stop_requested(&self) -> Option<String> {
+        self.writer.stop_requested()
+    }
+}
+
+/// After the run: the result file ended, the plot, the summary.
+pub fn conclude(
+    a: &CosimArgs,
+    sink: CosimSink,
+    plan: &CosimPlan,
+    run: &Streamed,
+    master_report: Option<String>,
+    wall: f64,
+) -> Result<(), String> {
+    let CosimSink { writer, plot_error } = sink;
     let kept = writer.kept();
     let stats = writer.stats.clone();
     writer
@@ -136,24 +282,24 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     if let (Some(plot), Some(kept)) = (&a.plot, &kept) {
         fricsim::plot::plot_signals(
             kept,
-            &signals,
+            &plan.signals,
             plot,
-            &format!("fricsim cosim ({})", master.name()),
+            &format!("fricsim cosim ({})", plan.master),
         )?;
     }
     println!(
         "{} macro steps of {} s with {}, {} columns, {:.3} s wall time",
         run.rows.saturating_sub(1),
         a.step,
-        master.name(),
+        plan.master,
         run.columns.len(),
-        elapsed.as_secs_f64()
+        wall
     );
     for (k, c) in run.columns.iter().enumerate() {
         let (lo, hi) = (stats.min[k], stats.max[k]);
         println!("  {c:<24} min {lo:>12.5e}  max {hi:>12.5e}");
     }
-    if let Some(report) = master.report() {
+    if let Some(report) = master_report {
         print!("{report}");
     }
     if let Some(ended) = &run.ended {
@@ -163,7 +309,7 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
     if let Some(p) = &a.plot {
         println!("wrote {}", p.display());
     }
-    match run.error {
+    match &run.error {
         Some(e) => Err(format!(
             "run INCOMPLETE (results up to the failure are in {}): {e}",
             a.out.display()

@@ -4,6 +4,7 @@ pub mod compare;
 pub mod cosim;
 pub mod diagnose;
 pub mod info;
+pub mod isolated;
 pub mod reference;
 pub mod run;
 pub mod sweep;

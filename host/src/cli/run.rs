@@ -4,11 +4,14 @@
 //! Settings come from the command line, else from the file
 //! (`DefaultExperiment`, our annotation), else from defaults.
 
+use super::isolated::{json, Ending};
 use fricsim::inputs::InputTable;
+use fricsim::isolate::child::Child;
 use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
-use fricsim::run::{PreparedRun, RunOptions, RunOutcome, StartValue};
+use fricsim::run::{PreparedRun, Recorder, RunOptions, RunOutcome, StartValue};
 use fricsim::ssp::SystemFile;
+use fricsim::system::RecordedType;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -64,15 +67,70 @@ pub struct RunArgs {
     /// Time limit on each FMI call, in seconds: a call that takes longer
     /// stops the run (rows so far kept, marked incomplete) naming the
     /// instance and the call; a running call cannot be interrupted, a
-    /// watchdog reports it on stderr when it passes the limit.
+    /// watchdog reports it on stderr when it passes the limit (with
+    /// --isolate it is stopped: the FMU process is killed).
     #[arg(long = "step-timeout", value_name = "SECONDS")]
     pub step_timeout: Option<f64>,
+    /// Run the FMUs in a child process (see docs/user-guide.md, "Isolated
+    /// runs"), so that one that crashes (a
+    /// segmentation fault, abort(), exit()) or hangs past --step-timeout
+    /// costs the run its end, not its rows: the result keeps every row
+    /// and is marked incomplete naming the instance, the FMI call, the
+    /// time and the signal or exit status.
+    #[arg(long)]
+    pub isolate: bool,
 }
 
 pub fn run(a: &RunArgs) -> Result<(), String> {
     let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
     // the result file is claimed before the FMUs are opened: a run that
     // would overwrite an input or another run's result stops here
+    let (out, output) = claim_output(a, &file)?;
+    if a.isolate {
+        return run_isolated(a, &file, out, output);
+    }
+    let plot_signals = plot_signals(a, &file);
+    let prepared = PreparedRun::new(&file, &options(a, &file)?)?;
+    super::print_warnings(prepared.warnings());
+    let (n, step) = (prepared.steps(), prepared.time_grid().2);
+    let master = prepared.master_name();
+
+    let bar = progress_bar(a, n);
+    let columns = prepared.columns();
+    let mut writer = ResultWriter::new(output, &columns);
+    writer.whole_number_columns(&prepared.column_types());
+    let plot_signals = if plot_signals.is_empty() {
+        columns.clone()
+    } else {
+        plot_signals
+    };
+    // a plot that cannot be drawn does not hide the run or its summary
+    let plot_error = match a.plot {
+        Some(_) => writer.keep_columns(&columns, &plot_signals).err(),
+        None => None,
+    };
+    // a hidden bar (--quiet, stderr not a terminal) needs no progress
+    let mut progress = |done: usize, _| bar.set_position(done as u64);
+    let progress: Option<&mut dyn FnMut(usize, usize)> = if bar.is_hidden() {
+        None
+    } else {
+        Some(&mut progress)
+    };
+    let run = prepared.run(&mut writer, progress)?;
+    bar.finish_and_clear();
+    let ran = Ran {
+        out,
+        plot_signals,
+        plot_error,
+        n,
+        step,
+        master: master.to_string(),
+    };
+    conclude(a, &file, writer, run, ran)
+}
+
+/// The result file of `--out` [default: out/<file name>.csv], claimed.
+fn claim_output(a: &RunArgs, file: &SystemFile) -> Result<(PathBuf, OutputFile), String> {
     let out = a
         .out
         .clone()
@@ -86,65 +144,183 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     );
     inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
     let output = OutputFile::create(&out, &inputs).map_err(|e| e.to_string())?;
-    let plot_signals = if !a.plot_signals.is_empty() {
+    Ok((out, output))
+}
+
+/// The signals to plot: `--plot-signal`, else the file's Plot annotation
+/// (none: every column).
+fn plot_signals(a: &RunArgs, file: &SystemFile) -> Vec<String> {
+    if !a.plot_signals.is_empty() {
         a.plot_signals.clone()
     } else {
         file.settings.plot.clone()
-    };
-    let options = RunOptions {
+    }
+}
+
+/// The run's options from the command line.
+fn options(a: &RunArgs, file: &SystemFile) -> Result<RunOptions, String> {
+    Ok(RunOptions {
         start: a.grid.start,
         stop: a.grid.stop,
         step: a.grid.step,
         master: a.master.clone(),
-        record: a.record.iter().chain(&plot_signals).cloned().collect(),
-        start_values: start_values(&file, a)?,
+        record: a
+            .record
+            .iter()
+            .chain(&plot_signals(a, file))
+            .cloned()
+            .collect(),
+        start_values: start_values(file, a)?,
         output_interval: a.output_interval,
         inputs: match &a.input {
             Some(path) => Some(InputTable::read(path)?),
             None => None,
         },
         call_time_limit: super::call_time_limit(a.step_timeout)?,
-    };
-    let prepared = PreparedRun::new(&file, &options)?;
-    super::print_warnings(prepared.warnings());
-    let (n, step) = (prepared.steps(), prepared.time_grid().2);
-    let master = prepared.master_name();
+    })
+}
 
-    let bar = if a.quiet || !std::io::stderr().is_terminal() {
-        ProgressBar::hidden()
-    } else {
-        let bar = ProgressBar::with_draw_target(Some(n as u64), ProgressDrawTarget::stderr());
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} steps, {elapsed} elapsed, {eta} left",
-            )
+/// The progress bar of `n` steps on a terminal, else a hidden one.
+fn progress_bar(a: &RunArgs, n: usize) -> ProgressBar {
+    if a.quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(n as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, {eta} left")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        bar
+    );
+    bar
+}
+
+/// What an isolated run's child tells its parent when the run starts.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Plan {
+    /// Macro steps and their length.
+    n: usize,
+    step: f64,
+    master: String,
+    /// Communication points per recorded row ([`PreparedRun::output_every`]).
+    every: usize,
+    /// The type of each column.
+    types: Vec<RecordedType>,
+}
+
+/// `--isolate`, the parent: the child computes every communication point,
+/// the parent records them as [`PreparedRun::run`] does (the output
+/// interval) into the result file claimed before the child started.
+fn run_isolated(
+    a: &RunArgs,
+    file: &SystemFile,
+    out: PathBuf,
+    output: OutputFile,
+) -> Result<(), String> {
+    let plot_signals = plot_signals(a, file);
+    let mut kept_signals = plot_signals.clone();
+    let mut plot_error = None;
+    let isolated = super::isolated::run_isolated(a.step_timeout, |columns, plan: &Plan| {
+        let mut writer = ResultWriter::new(output, columns);
+        writer.whole_number_columns(&plan.types);
+        if kept_signals.is_empty() {
+            kept_signals = columns.to_vec();
+        }
+        plot_error = match a.plot {
+            Some(_) => writer.keep_columns(columns, &kept_signals).err(),
+            None => None,
+        };
+        Ok(Recorder::new(writer, plan.every, columns.len()))
+    })?;
+    let mut recorder = isolated.sink;
+    let mut error = isolated.error;
+    if let Err(e) = recorder.finish() {
+        error.get_or_insert(e);
+    }
+    let stats = recorder.stats.clone();
+    let writer = recorder.into_inner();
+    let run = RunOutcome {
+        columns: isolated.columns,
+        rows: stats.rows,
+        steps: isolated.rows.saturating_sub(1),
+        error,
+        ended: isolated.ending.ended(),
+        stats,
+        master_report: isolated.ending.master_report,
+        wall_time: isolated.ending.wall,
     };
-    let columns = prepared.columns();
-    let mut writer = ResultWriter::new(output, &columns);
-    writer.whole_number_columns(&prepared.column_types());
-    let plot_signals = if plot_signals.is_empty() {
-        columns.clone()
-    } else {
-        plot_signals
+    let plan = isolated.plan;
+    let ran = Ran {
+        out,
+        plot_signals: kept_signals,
+        plot_error,
+        n: plan.n,
+        step: plan.step,
+        master: plan.master,
     };
-    // a plot that cannot be drawn does not hide the run or its summary
-    let mut plot_error = match a.plot {
-        Some(_) => writer.keep_columns(&columns, &plot_signals).err(),
-        None => None,
+    conclude(a, file, writer, run, ran)
+}
+
+/// `--isolate`, the child: the run of [`PreparedRun`], every
+/// communication point sent to the parent.
+pub fn child(a: &RunArgs, link: &mut Child) -> Result<(), String> {
+    let file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
+    let mut prepared = PreparedRun::new(&file, &options(a, &file)?)?;
+    super::print_warnings(prepared.warnings());
+    let n = prepared.steps();
+    let plan = Plan {
+        n,
+        step: prepared.time_grid().2,
+        master: prepared.master_name().to_string(),
+        every: prepared.output_every(),
+        types: prepared.column_types(),
     };
-    // a hidden bar (--quiet, stderr not a terminal) needs no progress
+    link.started(prepared.system_mut(), json(plan)?)?;
+    let bar = progress_bar(a, n);
     let mut progress = |done: usize, _| bar.set_position(done as u64);
     let progress: Option<&mut dyn FnMut(usize, usize)> = if bar.is_hidden() {
         None
     } else {
         Some(&mut progress)
     };
-    let run = prepared.run(&mut writer, progress)?;
+    let run = link.run_prepared(prepared, progress)?;
     bar.finish_and_clear();
+    let ending = Ending {
+        master_report: run.master_report,
+        wall: run.wall_time,
+        ended: run.ended.map(|e| (e.instance, e.time)),
+    };
+    link.finished_with(run.rows, run.error, json(ending)?)
+}
 
+/// What the summary and the plot need besides the run.
+struct Ran {
+    out: PathBuf,
+    plot_signals: Vec<String>,
+    /// Why the plot cannot be drawn, if it cannot: it does not hide the
+    /// run or its summary.
+    plot_error: Option<String>,
+    n: usize,
+    step: f64,
+    master: String,
+}
+
+/// After the run: the result file ended (marked incomplete if the run
+/// stopped early), the plot, the summary; an error if the run is
+/// incomplete.
+fn conclude(
+    a: &RunArgs,
+    file: &SystemFile,
+    writer: ResultWriter,
+    run: RunOutcome,
+    ran: Ran,
+) -> Result<(), String> {
+    let Ran {
+        out,
+        plot_signals,
+        mut plot_error,
+        n,
+        step,
+        master,
+    } = ran;
     let kept = writer.kept();
     writer
         .finish(run.error.as_deref())
@@ -161,7 +337,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         plot_error = fricsim::plot::plot_signals(kept, &plot_signals, plot, &title).err();
     }
 
-    print!("{}", summary(&file, &run, n, step, master));
+    print!("{}", summary(file, &run, n, step, &master));
     if let Some(report) = &run.master_report {
         println!("{report}");
     }

@@ -16,6 +16,7 @@ use super::model_description::{ModelDescription, ScalarVariable, ValueReference}
 use super::watchdog::Watched;
 use super::Status;
 use crate::error::FmuError;
+use crate::isolate::blackbox::CallRecorder;
 use fmi2_types::*;
 use std::ffi::CString;
 use std::mem::ManuallyDrop;
@@ -174,11 +175,13 @@ pub struct Instance {
     callbacks: ManuallyDrop<Box<fmi2CallbackFunctions>>,
     states: Vec<fmi2FMUstate>,
     fatal: bool,
-    /// `fatal` or a time limit set: every call goes through
-    /// [`Instance::begin_guarded`], the rest skip both checks with one test.
+    /// `fatal`, a time limit or a black box set: every call goes through
+    /// [`Instance::begin_guarded`], the rest skip these checks with one test.
     guarded: bool,
     /// The time limit on each call, if one is set ([`Instance::set_call_time_limit`]).
     limit: Option<Arc<Watched>>,
+    /// Where each call is recorded, in an isolated run ([`Instance::set_black_box`]).
+    black_box: Option<CallRecorder>,
     /// Calls made so far that may have changed a value of the instance
     /// (every call but `fmi2Get…`), see [`Instance::changes`].
     changes: u64,
@@ -296,6 +299,7 @@ impl Instance {
             fatal: false,
             guarded: false,
             limit: None,
+            black_box: None,
             changes: 0,
         })
     }
@@ -323,7 +327,15 @@ impl Instance {
     /// [`super::watchdog`]).
     pub fn set_call_time_limit(&mut self, limit: Option<Duration>) {
         self.limit = limit.map(|l| Watched::new(&self.name, l));
-        self.guarded = self.fatal || self.limit.is_some();
+        self.guarded = self.fatal || self.limit.is_some() || self.black_box.is_some();
+    }
+
+    /// Record every later FMI call of this instance in an isolated run's
+    /// black box (`None`: no longer), so that the parent process can name
+    /// the call the FMU crashed or hung in ([`crate::isolate::blackbox`]).
+    pub fn set_black_box(&mut self, recorder: Option<CallRecorder>) {
+        self.black_box = recorder;
+        self.guarded = self.fatal || self.limit.is_some() || self.black_box.is_some();
     }
 
     /// Refuse any call after `fmi2Fatal`; otherwise the log mark before the
@@ -359,6 +371,9 @@ impl Instance {
         }
         if let Some(w) = &self.limit {
             w.start(function);
+        }
+        if let Some(b) = &self.black_box {
+            b.enter(function);
         }
         Ok(self.sink.mark())
     }
@@ -413,6 +428,9 @@ impl Instance {
         mark: u64,
         raw: fmi2Status,
     ) -> Result<Status, FmuError> {
+        if let Some(b) = &self.black_box {
+            b.leave();
+        }
         let overtime = self.limit.as_ref().and_then(|w| w.stop());
         let status = Status::from_raw(raw);
         if let (Some((elapsed, limit)), Status::Ok | Status::Warning) = (overtime, status) {
@@ -721,6 +739,9 @@ impl Instance {
     /// or why the FMU could not say.
     #[inline] // the hot path is a few instructions; the rest is in `step_failed`
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Status, FmuError> {
+        if self.guarded {
+            self.record_step_time(t);
+        }
         let f = self.functions.do_step;
         match self.call(DO_STEP, |component| {
             // SAFETY: plain values.
@@ -728,6 +749,15 @@ impl Instance {
         }) {
             Err(e) => self.step_failed(e),
             ok => ok,
+        }
+    }
+
+    /// The communication point of the step that begins, in the black box.
+    #[cold]
+    #[inline(never)]
+    fn record_step_time(&self, t: f64) {
+        if let Some(b) = &self.black_box {
+            b.at_time(t);
         }
     }
 

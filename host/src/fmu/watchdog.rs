@@ -13,14 +13,27 @@
 //! and address space; there is no safe way to stop a thread in the middle of
 //! foreign code (killing it would leave the FMU's locks and memory in an
 //! unknown state). A call that never returns keeps fricsim waiting until it
-//! is interrupted (Ctrl-C), and the results of that run are then lost; only
-//! running each FMU in its own process could do better.
+//! is interrupted (Ctrl-C), and the results of that run are then lost.
+//! `--isolate` runs the FMUs in a child process, which the parent kills
+//! when a call passes the limit ([`crate::isolate`]).
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock, Weak};
 use std::time::{Duration, Instant};
 
 /// How often the watchdog looks at the running calls.
 const POLL: Duration = Duration::from_millis(20);
+
+/// Whether a call past its limit is reported on stderr (see
+/// [`report_on_stderr`]).
+static REPORT: AtomicBool = AtomicBool::new(true);
+
+/// Report a call still running past its limit on stderr (the default), or
+/// not: in an isolated run the parent process stops such a call and says
+/// so itself ([`crate::isolate`]).
+pub fn report_on_stderr(on: bool) {
+    REPORT.store(on, Ordering::Relaxed);
+}
 
 /// The call an instance is in, if any.
 struct Running {
@@ -58,6 +71,9 @@ fn watch() {
             if let Some(r) = running.as_mut() {
                 if !r.reported && r.started.elapsed() > w.limit {
                     r.reported = true;
+                    if !REPORT.load(Ordering::Relaxed) {
+                        continue;
+                    }
                     eprintln!(
                         "fricsim: instance \"{}\" has been in {} for more than the limit of {} s \
                          (--step-timeout); the run stops when the call returns (a running call \

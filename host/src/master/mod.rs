@@ -316,6 +316,15 @@ pub trait RowSink {
     }
 }
 
+impl<T: RowSink + ?Sized> RowSink for &mut T {
+    fn write(&mut self, times: &[f64], rows: &Rows) -> Result<(), String> {
+        (**self).write(times, rows)
+    }
+    fn stop_requested(&self) -> Option<String> {
+        (**self).stop_requested()
+    }
+}
+
 /// What a [`simulate_streaming`] run leaves once its rows are handed on.
 pub struct Streamed {
     pub columns: Vec<String>,

@@ -21,6 +21,11 @@ pub const DISCARD: i32 = 2;
 pub const ERROR: i32 = 3;
 pub const FATAL: i32 = 4;
 pub const SLOW: i32 = 5;
+/// Faults that end or block the process (for isolated runs).
+pub const SEGFAULT: i32 = 6;
+pub const ABORT: i32 = 7;
+pub const EXIT_0: i32 = 8;
+pub const HANG: i32 = 9;
 
 /// Compile the C source and zip it with its model description into
 /// `dir/BeltOscillator.fmu` (binaries/linux64/BeltOscillator.so).

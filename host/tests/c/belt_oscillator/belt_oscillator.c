@@ -27,11 +27,17 @@
  *              (belt_calls_after_fatal()) and reported on stderr.
  *   fault = 5  the step takes 0.6 s longer (it sleeps), then completes
  *              normally: an FMU that is too slow, for the host's time limit.
+ * and faults that end or block the whole process, for isolated runs:
+ *   fault = 6  a write through a null pointer (SIGSEGV)
+ *   fault = 7  abort() (SIGABRT)
+ *   fault = 8  exit(0): the process ends "successfully" mid-run
+ *   fault = 9  the step hangs (sleeps 600 s)
  * belt_live_instances() counts the instances not yet freed. */
 
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -345,9 +351,9 @@ EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
         logf_(b, fmi2Error, "logStatusError", "fmi2ExitInitializationMode: parameter %s = %g is out of range", bad, value);
         return fmi2Error;
     }
-    if (b->fault < 0 || b->fault > 5 || b->fault_step < 0) {
+    if (b->fault < 0 || b->fault > 9 || b->fault_step < 0) {
         logf_(b, fmi2Error, "logStatusError",
-              "fmi2ExitInitializationMode: fault = %d must be 0..5 and fault_step = %d must be >= 0",
+              "fmi2ExitInitializationMode: fault = %d must be 0..9 and fault_step = %d must be >= 0",
               b->fault, b->fault_step);
         return fmi2Error;
     }
@@ -624,6 +630,16 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
     }
     if (fault == 5) {
         struct timespec pause = {0, 600000000L};
+        nanosleep(&pause, NULL);
+    }
+    if (fault == 6) {
+        volatile double *nowhere = NULL;
+        *nowhere = t;
+    }
+    if (fault == 7) abort();
+    if (fault == 8) exit(0);
+    if (fault == 9) {
+        struct timespec pause = {600, 0};
         nanosleep(&pause, NULL);
     }
     integrate(b, h, n);
