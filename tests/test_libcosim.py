@@ -128,8 +128,11 @@ def run_fricsim(ssp, step, n, tmp_path):
 
 
 def relative_differences(ours, theirs):
-    assert set(ours) == set(theirs)
-    return {c: float(np.max(np.abs(ours[c] - theirs[c])) / max(np.max(np.abs(ours[c])), 1e-300)) for c in ours}
+    # fricsim run records the Boolean outputs too (the laws' `sliding`);
+    # the libcosim runs here record the Real ones
+    extra = set(ours) - set(theirs)
+    assert set(theirs) <= set(ours) and all(c.endswith(".sliding") for c in extra), extra
+    return {c: float(np.max(np.abs(ours[c] - theirs[c])) / max(np.max(np.abs(ours[c])), 1e-300)) for c in theirs}
 
 
 def test_the_lists_cover_every_example():
