@@ -57,6 +57,7 @@ def fmpy_jacobi_from_ssp(ssp, step, stop, tmp_path):
         z.extractall(unzipped)
     components = {}
     order = []
+    types = {}
     for c in ssd.system.elements:
         path = unzipped / c.source
         md = read_model_description(str(path))
@@ -78,7 +79,11 @@ def fmpy_jacobi_from_ssp(ssp, step, stop, tmp_path):
                         fmu.setBoolean(vr, [p.value in ("true", "1")])
                     else:
                         raise AssertionError(f"unexpected parameter type {p.type}")
-        outputs = [v.name for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+        # fricsim's columns: per component the Real outputs, then the
+        # Integer and the Boolean ones
+        outputs = [v.name for kind in ("Real", "Integer", "Boolean")
+                   for v in md.modelVariables if v.causality == "output" and v.type == kind]
+        types[c.name] = {v.name: v.type for v in md.modelVariables}
         components[c.name] = (fmu, {n: v.valueReference for n, v in variables.items()}, outputs)
         order.append(c.name)
     kinds = {(c.name, k.name): k.kind for c in ssd.system.elements for k in c.connectors}
@@ -92,8 +97,13 @@ def fmpy_jacobi_from_ssp(ssp, step, stop, tmp_path):
         for (_, (c, v)), x in zip(links, values):
             components[c][0].setReal([components[c][1][v]], [x])
 
+    def value(c, o):
+        fmu, vr = components[c][0], [components[c][1][o]]
+        get = {"Real": fmu.getReal, "Integer": fmu.getInteger, "Boolean": fmu.getBoolean}[types[c][o]]
+        return float(get(vr)[0])
+
     def sample():
-        return [components[c][0].getReal([components[c][1][o]])[0] for c in order for o in components[c][2]]
+        return [value(c, o) for c in order for o in components[c][2]]
 
     propagate()
     for fmu, _, _ in components.values():

@@ -184,6 +184,7 @@ impl PreparedRun {
             .instantiate(&checked, start, &start_values)
             .map_err(|e| e.to_string())?;
         system.set_call_time_limit(options.call_time_limit);
+        system.record_discrete_outputs();
         for s in &options.record {
             system.record(s).map_err(|e| e.to_string())?;
         }

@@ -396,6 +396,7 @@ impl System {
                 .iter()
                 .filter(|v| v.causality == Causality::Output)
                 .filter_map(|v| Some((v.name.clone(), v.value_reference, recorded_type(&v.kind)?)))
+                .filter(|(_, _, ty)| *ty == RecordedType::Real)
                 .collect();
             let mut component = Component {
                 name,
@@ -715,6 +716,29 @@ impl System {
             .variable(v)
             .map_err(|_| SystemError::Invalid(format!("`{port}`: `{c}` has no variable `{v}`")))?;
         Ok((i, var))
+    }
+
+    /// Record every component's Integer, Enumeration and Boolean outputs
+    /// too (a system records its Real outputs from the start), as FMPy
+    /// records every output: `fricsim run` and [`crate::run`] do.
+    pub fn record_discrete_outputs(&mut self) {
+        for c in &mut self.components {
+            let discrete: Vec<(String, ValueReference, RecordedType)> = c
+                .fmu
+                .description()
+                .variables
+                .iter()
+                .filter(|v| v.causality == Causality::Output)
+                .filter_map(|v| Some((v.name.clone(), v.value_reference, recorded_type(&v.kind)?)))
+                .filter(|(name, _, ty)| {
+                    *ty != RecordedType::Real && !c.outputs.iter().any(|(n, _)| n == name)
+                })
+                .collect();
+            for (name, vr, ty) in discrete {
+                c.add_recorded(&name, vr, ty);
+            }
+        }
+        self.plan();
     }
 
     /// The type of each column of [`System::columns`], in order: the
