@@ -322,7 +322,11 @@ fn fricsim_cosim_exits_nonzero_names_the_failure_and_keeps_the_rows_so_far() {
         // header, the rows so far, and a comment that marks the file
         let csv = std::fs::read_to_string(&out).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(lines[0], "time,rig.x,rig.v,rig.a,friction.F,friction.z");
+        // every output, the Boolean friction.sliding too, as run records them
+        assert_eq!(
+            lines[0],
+            "time,rig.x,rig.v,rig.a,friction.F,friction.z,friction.sliding"
+        );
         assert_eq!(lines.len(), 1 + FAULT_STEP + 1, "{csv}");
         let marker = lines[FAULT_STEP + 1];
         assert!(

@@ -217,6 +217,8 @@ fn build(
     let mut system = System::build(&parsed.components, &parsed.parameters, &parsed.connections)
         .map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
+    // every output, Integer and Boolean ones too, as `run` records them
+    system.record_discrete_outputs();
     let master = fricsim::master::by_name(&a.master)?;
     super::print_warnings(system.warnings());
     let signals = if a.plot_signals.is_empty() {
