@@ -188,6 +188,29 @@ def test_sweep_equals_the_command_sweep_bit_for_bit(tmp_path):
             assert same_bits(frame[c][i], float(row[c])), c
 
 
+def test_a_dataframe_of_sample_points_equals_the_grid(tmp_path):
+    """`grid` as a DataFrame of points (here the grid's product, in
+    another order, plus a point off the grid) runs exactly those points:
+    each row equals the mapping grid's row of the same point bit for bit."""
+    grid = {"friction.Fs": [1.5, 2.0], "rig.k": [2.0, 3.0]}
+    by_grid = fricsim.sweep(STICK_SLIP, grid, stop=1.0)
+    points = pd.DataFrame({"friction.Fs": [2.0, 1.5, 1.5, 2.0, 1.75],
+                           "rig.k": [3.0, 2.0, 3.0, 2.0, 2.5]})
+    by_points = fricsim.sweep(STICK_SLIP, points, stop=1.0)
+    assert len(by_points) == 5
+    assert list(by_points["friction.Fs"]) == list(points["friction.Fs"])
+    assert list(by_points["rig.k"]) == list(points["rig.k"])
+    values = [c for c in by_grid.columns if c.startswith(("final:", "rms:"))]
+    for i in range(4):
+        fs, k = points["friction.Fs"][i], points["rig.k"][i]
+        j = by_grid.index[(by_grid["friction.Fs"] == fs) & (by_grid["rig.k"] == k)][0]
+        for c in values:
+            assert same_bits(by_points[c][i], by_grid[c][j]), (c, fs, k)
+    # the point off the grid ran too, and differs from its neighbours
+    assert by_points["error"][4] is None
+    assert not same_bits(by_points["final:friction.F"][4], by_points["final:friction.F"][2])
+
+
 def read_exact_csv_mixed(path):
     with open(path) as f:
         return list(csv.DictReader(f))
