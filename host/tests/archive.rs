@@ -121,6 +121,63 @@ fn a_valid_archive_is_unpacked_and_removed_on_drop() {
 }
 
 #[test]
+fn skip_unused_writes_only_what_a_running_fmu_reads() {
+    let scratch = Scratch::new();
+    // a documentation entry that would inflate past the limit: checked by
+    // its declared size like any entry, never inflated
+    let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+    for (name, contents) in [
+        ("modelDescription.xml", DESCRIPTION),
+        ("binaries/linux64/M.so", b"the library" as &[u8]),
+        ("binaries/linux64/libdep.so", b"what it needs"),
+        ("binaries/win64/M.dll", b"another platform"),
+        ("resources/table.txt", b"1 2 3"),
+        ("model.png", b"png"),
+        ("sources/m.c", b"int x;"),
+        ("documentation/index.html", b"<html/>"),
+    ] {
+        zip.start_file(name, stored()).unwrap();
+        zip.write_all(contents).unwrap();
+    }
+    let path = scratch.write(&zip.finish().unwrap().into_inner());
+    let options = UnpackOptions {
+        skip_unused: true,
+        ..scratch.options()
+    };
+    let dir = unpack(&path, &options).unwrap();
+    let written = |name: &str| dir.path().join(name).is_file();
+    for name in [
+        "modelDescription.xml",
+        "binaries/linux64/M.so",
+        "binaries/linux64/libdep.so",
+        "resources/table.txt",
+        "model.png",
+    ] {
+        assert!(written(name), "{name} must be unpacked");
+    }
+    for name in [
+        "binaries/win64/M.dll",
+        "sources/m.c",
+        "documentation/index.html",
+    ] {
+        assert!(!written(name), "{name} must not be unpacked");
+    }
+    // the platforms an FMU has are still there to be listed
+    assert_eq!(
+        fricsim::fmu::library::platforms(dir.path()),
+        ["linux64", "win64"]
+    );
+    // every entry is checked all the same: a traversal among the skipped
+    // entries refuses the archive
+    drop(dir);
+    let bad = zip_of(&[
+        ("modelDescription.xml", DESCRIPTION),
+        ("documentation/../../evil", b"x"),
+    ]);
+    scratch.refuse(&bad, &options);
+}
+
+#[test]
 fn defaults_are_as_documented() {
     let o = UnpackOptions::default();
     assert_eq!(
@@ -129,6 +186,7 @@ fn defaults_are_as_documented() {
     );
     assert_eq!(DEFAULT_MAX_BYTES, 512 * 1024 * 1024);
     assert_eq!(DEFAULT_MAX_ENTRIES, 10_000);
+    assert!(!o.skip_unused, "unpack writes every entry unless told");
 }
 
 #[test]

@@ -11,6 +11,7 @@
 //! link is ever created, so no write can leave it.
 
 use crate::error::{ArchiveProblem, FmuError};
+use crate::fmu::library::PLATFORM;
 use std::collections::HashSet;
 use std::fs::{self, File};
 use std::io::{self, BufReader, Read, Seek, SeekFrom, Write};
@@ -36,6 +37,17 @@ pub struct UnpackOptions {
     /// Directory in which the temporary directory is created (default: the
     /// system's temporary directory).
     pub temp_parent: Option<PathBuf>,
+    /// Write only what an FMU running here can read: the model
+    /// description, `binaries/linux64/`, `resources/` and the other files
+    /// outside `binaries/`, `documentation/` and `sources/`. The binaries
+    /// of other platforms, the documentation and the sources are checked
+    /// like every entry but not inflated (their folders are made, so the
+    /// platforms an FMU has can still be listed). [`Fmu::open`] sets it:
+    /// our FMUs carry a Windows DLL beside the Linux library, and inflating
+    /// it was half the time spent opening one.
+    ///
+    /// [`Fmu::open`]: crate::fmu::Fmu::open
+    pub skip_unused: bool,
 }
 
 impl Default for UnpackOptions {
@@ -44,6 +56,7 @@ impl Default for UnpackOptions {
             max_bytes: DEFAULT_MAX_BYTES,
             max_entries: DEFAULT_MAX_ENTRIES,
             temp_parent: None,
+            skip_unused: false,
         }
     }
 }
@@ -169,6 +182,9 @@ pub fn unpack_requiring(
         if let Some(parent) = target.parent() {
             fs::create_dir_all(parent).map_err(write_err)?;
         }
+        if options.skip_unused && !used_when_running(&relative) {
+            continue;
+        }
         let mut entry = archive
             .by_index(index)
             .map_err(|e| refuse(Some(&name), ArchiveProblem::Corrupt(e.to_string())))?;
@@ -192,6 +208,18 @@ pub fn unpack_requiring(
         budget -= written;
     }
     Ok(dir)
+}
+
+/// Whether a running FMU may read the file at `relative` (see
+/// [`UnpackOptions::skip_unused`]): anything but the binaries of other
+/// platforms, the documentation and the sources (FMI 2.0.4 §2.4).
+fn used_when_running(relative: &Path) -> bool {
+    let mut parts = relative.components().map(|c| c.as_os_str());
+    match parts.next().and_then(|first| first.to_str()) {
+        Some("documentation" | "sources") => false,
+        Some("binaries") => parts.next() == Some(std::ffi::OsStr::new(PLATFORM)),
+        _ => true,
+    }
 }
 
 /// The entry name as a relative path, or why it is refused. Both `/` and

@@ -84,10 +84,15 @@ impl FmuDir {
 }
 
 impl Fmu {
-    /// Unpack the `.fmu` at `path` with the default limits, parse its model
+    /// Unpack the `.fmu` at `path` with the default limits (only what
+    /// running it reads: [`UnpackOptions::skip_unused`]), parse its model
     /// description and load its binary.
     pub fn open(path: impl AsRef<Path>) -> Result<Fmu, FmuError> {
-        Fmu::open_with(path, &UnpackOptions::default())
+        let options = UnpackOptions {
+            skip_unused: true,
+            ..UnpackOptions::default()
+        };
+        Fmu::open_with(path, &options)
     }
 
     /// [`Fmu::open`] with explicit unpacking limits. A refused model

@@ -38,6 +38,7 @@ use crate::fmu::archive::{unpack_requiring, UnpackOptions};
 use crate::fmu::model_description::{Causality, ScalarVariable, Variability, VariableKind};
 use crate::fmu::Fmu;
 use crate::system::{ParameterValue, System, SystemError};
+use crate::FmuError;
 use std::path::{Component as PathPart, Path, PathBuf};
 use tempfile::TempDir;
 use xml::{Lines, RawParameterBinding, RawParameterSet, SyntaxError};
@@ -1013,8 +1014,12 @@ impl SystemFile {
     /// Open each component's FMU and check the system against the model
     /// descriptions: connectors, connections, parameters, settings.
     pub fn check(&self) -> Result<CheckedSystem, SspError> {
+        // unpacked and loaded at the same time, each on a thread of its
+        // own (inflating a binary is most of an FMU's opening); the
+        // errors are then taken in the components' order, as one by one
+        let opened = open_all(self.components.iter().map(|c| &c.source));
         let mut fmus: Vec<(String, Fmu)> = Vec::new();
-        for c in &self.components {
+        for (c, opened) in self.components.iter().zip(opened) {
             if !c.source.is_file() {
                 let shown = if self.in_archive {
                     format!("{}!/{}", self.path.display(), c.source_text)
@@ -1026,7 +1031,7 @@ impl SystemFile {
                     format!("component `{}`: FMU file {shown} does not exist", c.name),
                 ));
             }
-            let fmu = Fmu::open(&c.source).map_err(|e| {
+            let fmu = opened.map_err(|e| {
                 error(
                     &c.location,
                     format!(
@@ -1413,6 +1418,39 @@ fn percent_decode(s: &str) -> Option<String> {
         }
     }
     String::from_utf8(out).ok()
+}
+
+/// [`Fmu::open`] of each path that is a file, all at once, one thread
+/// each; in the paths' order.
+fn open_all<'a>(paths: impl Iterator<Item = &'a PathBuf>) -> Vec<Result<Fmu, FmuError>> {
+    let open = |path: &PathBuf| {
+        if path.is_file() {
+            Fmu::open(path)
+        } else {
+            Err(FmuError::Io {
+                path: path.clone(),
+                source: std::io::ErrorKind::NotFound.into(),
+            })
+        }
+    };
+    let paths: Vec<&PathBuf> = paths.collect();
+    if paths.len() < 2 {
+        return paths.into_iter().map(open).collect();
+    }
+    std::thread::scope(|scope| {
+        let opening: Vec<_> = paths
+            .iter()
+            .map(|path| scope.spawn(move || open(path)))
+            .collect();
+        opening
+            .into_iter()
+            .map(|thread| {
+                thread
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
+            .collect()
+    })
 }
 
 #[cfg(test)]
