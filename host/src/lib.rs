@@ -40,6 +40,7 @@ pub mod signals;
 pub mod ssp;
 pub mod sweep;
 pub mod system;
+pub mod writer_thread;
 
 pub use error::{ArchiveProblem, FmuError};
 pub mod diagnose;

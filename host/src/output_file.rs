@@ -13,7 +13,8 @@
 //!   SIGKILL blocks no one; the lock file is removed at the end of a run
 //!   that runs its code to the end (one left by a killed run is reused);
 //! * writes to the temporary file `.<name>.fricsim-partial-<pid>` in the
-//!   same directory and, once complete, flushes it to the disk
+//!   same directory (starting the disk writing every few MB as it goes,
+//!   [`Writeback`]) and, once complete, flushes it to the disk
 //!   (`fsync`), renames it over the path (atomic on POSIX: a reader sees
 //!   the previous file or the new one, never a mix) and flushes the
 //!   directory, so that the rename itself survives a power loss;
@@ -52,7 +53,7 @@ pub struct OutputFile {
     partial: PathBuf,
     /// Opened at the first write, so that a run that writes nothing
     /// leaves nothing.
-    out: Option<BufWriter<File>>,
+    out: Option<BufWriter<Writeback>>,
     /// The first write error: the file is then never put in place.
     failed: Option<(std::io::ErrorKind, String)>,
     _lock: Lock,
@@ -97,7 +98,7 @@ impl OutputFile {
     }
 
     /// The temporary file, created at the first call.
-    fn out(&mut self) -> std::io::Result<&mut BufWriter<File>> {
+    fn out(&mut self) -> std::io::Result<&mut BufWriter<Writeback>> {
         if self.out.is_none() {
             let file = OpenOptions::new()
                 .write(true)
@@ -105,7 +106,7 @@ impl OutputFile {
                 .create(true)
                 .truncate(true)
                 .open(&self.partial)?;
-            self.out = Some(BufWriter::with_capacity(1 << 16, file));
+            self.out = Some(BufWriter::with_capacity(1 << 16, Writeback::new(file)));
         }
         Ok(self.out.as_mut().expect("opened above"))
     }
@@ -124,7 +125,7 @@ impl OutputFile {
         }
         let out = self.out().map_err(io)?;
         out.flush().map_err(io)?;
-        out.get_ref().sync_all().map_err(io)?;
+        out.get_ref().file.sync_all().map_err(io)?;
         std::fs::rename(&self.partial, &self.path).map_err(io)?;
         self.out = None;
         // the rename is durable once the directory is (fsync(2))
@@ -173,10 +174,81 @@ impl Drop for OutputFile {
     fn drop(&mut self) {
         if let Some(out) = self.out.take() {
             // not flushed: its bytes go nowhere
-            let (file, _) = out.into_parts();
-            drop(file);
+            let (writeback, _) = out.into_parts();
+            drop(writeback);
             let _ = std::fs::remove_file(&self.partial);
         }
+    }
+}
+
+/// The temporary file, which starts the disk writing each
+/// [`Writeback::EVERY`] bytes as they are written (Linux's
+/// `sync_file_range(2)` with `SYNC_FILE_RANGE_WRITE`, which does not
+/// wait), so that the `fsync` that puts the result in place finds most of
+/// it on the disk already instead of writing it all then. Elsewhere a
+/// plain file.
+struct Writeback {
+    file: File,
+    /// Where the next byte goes, and where the bytes not yet sent to the
+    /// disk start.
+    position: u64,
+    unsent: u64,
+}
+
+impl Writeback {
+    const EVERY: u64 = 4 << 20;
+
+    fn new(file: File) -> Writeback {
+        Writeback {
+            file,
+            position: 0,
+            unsent: 0,
+        }
+    }
+
+    fn start_writing(&mut self) {
+        if self.position < self.unsent + Self::EVERY {
+            return;
+        }
+        #[cfg(target_os = "linux")]
+        {
+            use std::os::fd::AsRawFd;
+            // SAFETY: a valid descriptor and range; the call only starts
+            // the writing of pages already written, and a failure here
+            // is found again by the fsync at the end
+            unsafe {
+                libc::sync_file_range(
+                    self.file.as_raw_fd(),
+                    self.unsent as libc::off64_t,
+                    (self.position - self.unsent) as libc::off64_t,
+                    libc::SYNC_FILE_RANGE_WRITE,
+                );
+            }
+        }
+        self.unsent = self.position;
+    }
+}
+
+impl Write for Writeback {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let n = self.file.write(bytes)?;
+        self.position += n as u64;
+        self.start_writing();
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.flush()
+    }
+}
+
+impl Seek for Writeback {
+    /// A writer going back to fill in a header: the bytes from there on
+    /// are sent again with the next ones.
+    fn seek(&mut self, to: SeekFrom) -> std::io::Result<u64> {
+        self.position = self.file.seek(to)?;
+        self.unsent = self.unsent.min(self.position);
+        Ok(self.position)
     }
 }
 

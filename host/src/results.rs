@@ -36,7 +36,7 @@ pub trait RowFile {
 /// The result file written to `out` for the columns `time` and `columns`:
 /// MAT v4 when its path's extension is `.mat` ([`crate::matfile::is_mat`]),
 /// else CSV.
-pub fn create(out: OutputFile, columns: &[String]) -> Box<dyn RowFile> {
+pub fn create(out: OutputFile, columns: &[String]) -> Box<dyn RowFile + Send> {
     if crate::matfile::is_mat(out.path()) {
         Box::new(MatFile::new(out, columns))
     } else {
@@ -224,7 +224,7 @@ impl ColumnStats {
 /// The rows of a run as they come: written to a result file ([`create`]),
 /// summed up in [`ColumnStats`], and the columns to be plotted kept.
 pub struct ResultWriter {
-    file: Box<dyn RowFile>,
+    file: Box<dyn RowFile + Send>,
     pub stats: ColumnStats,
     /// The columns kept (their indices), their names, their times and rows.
     kept: Option<Kept>,

@@ -266,6 +266,18 @@ impl Rows {
         self.len = 1;
     }
 
+    /// Drop every row (their numbers become zeros made ready again), so
+    /// that the table can record again without allocating.
+    pub fn clear(&mut self) {
+        self.values[..self.len * self.width].fill(0.0);
+        self.len = 0;
+    }
+
+    /// Rows that fit before the table allocates again.
+    pub fn capacity(&self) -> usize {
+        self.values.len().checked_div(self.width).unwrap_or(0)
+    }
+
     /// Remove the last row, if any (its numbers become zeros made ready
     /// for the next row).
     pub fn pop(&mut self) {

@@ -257,6 +257,24 @@ impl PreparedRun {
         self.run_recording(sink, progress, None, every)
     }
 
+    /// [`PreparedRun::run`] with the rows written on a thread of their own
+    /// ([`crate::writer_thread`]): the sink (and the output interval's
+    /// picking, and the summary) works on one chunk while the run computes
+    /// the next, on a second core. The same rows reach the sink in the
+    /// same order; an error of the sink or its request to stop reaches the
+    /// run a chunk or two later than on one thread.
+    pub fn run_with_writer_thread(
+        self,
+        sink: &mut (dyn RowSink + Send),
+        progress: Option<&mut dyn FnMut(usize, usize)>,
+    ) -> Result<RunOutcome, String> {
+        let recorder = Recorder::new(sink, self.every, self.system.columns().len());
+        let (outcome, mut recorder) = crate::writer_thread::on_writer_thread(recorder, |front| {
+            self.run_streaming(front, progress, None)
+        });
+        Ok(outcome?.recorded_by(&mut recorder))
+    }
+
     /// The communication points per recorded row: 1, or the output
     /// interval over the step.
     pub fn output_every(&self) -> usize {
@@ -279,11 +297,25 @@ impl PreparedRun {
     }
 
     fn run_recording(
-        mut self,
+        self,
         sink: &mut dyn RowSink,
         progress: Option<&mut dyn FnMut(usize, usize)>,
         observer: Option<&mut dyn Observer>,
         every: usize,
+    ) -> Result<RunOutcome, String> {
+        let mut recorder = Recorder::new(sink, every, self.system.columns().len());
+        let outcome = self.run_streaming(&mut recorder, progress, observer)?;
+        Ok(outcome.recorded_by(&mut recorder))
+    }
+
+    /// The run, every communication point handed to `sink`; the outcome's
+    /// rows and summary are left to the [`Recorder`] that picks the rows
+    /// ([`RunOutcome::recorded_by`]).
+    fn run_streaming(
+        mut self,
+        sink: &mut dyn RowSink,
+        progress: Option<&mut dyn FnMut(usize, usize)>,
+        observer: Option<&mut dyn Observer>,
     ) -> Result<RunOutcome, String> {
         let started = std::time::Instant::now();
         let mut watch = Watch {
@@ -291,7 +323,6 @@ impl PreparedRun {
             progress,
             observer,
         };
-        let mut recorder = Recorder::new(sink, every, self.system.columns().len());
         let streamed = simulate_streaming(
             &mut self.system,
             self.master.as_mut(),
@@ -299,20 +330,16 @@ impl PreparedRun {
             self.step,
             self.stop,
             &mut watch,
-            &mut recorder,
+            sink,
         )
         .map_err(|e| format!("initialization failed: {e}"))?;
-        let mut error = streamed.error;
-        if let Err(e) = recorder.finish() {
-            error.get_or_insert(e);
-        }
         Ok(RunOutcome {
+            stats: ColumnStats::new(streamed.columns.len()),
             columns: streamed.columns,
-            rows: recorder.stats.rows,
+            rows: 0,
             steps: streamed.rows.saturating_sub(1),
-            error,
+            error: streamed.error,
             ended: streamed.ended,
-            stats: recorder.stats,
             master_report: self.master.report(),
             wall_time: started.elapsed().as_secs_f64(),
         })
@@ -351,6 +378,20 @@ pub struct RunOutcome {
     pub master_report: Option<String>,
     /// Wall-clock time of the run, in seconds.
     pub wall_time: f64,
+}
+
+impl RunOutcome {
+    /// The outcome with the rows `recorder` passed on and their summary,
+    /// once the run has ended: the last point passed on if it was not
+    /// ([`Recorder::finish`]), whose error, if any, becomes the run's.
+    fn recorded_by<S: RowSink>(mut self, recorder: &mut Recorder<S>) -> RunOutcome {
+        if let Err(e) = recorder.finish() {
+            self.error.get_or_insert(e);
+        }
+        self.rows = recorder.stats.rows;
+        self.stats = recorder.stats.clone();
+        self
+    }
 }
 
 /// The external inputs, the progress callback and the caller's observer

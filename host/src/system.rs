@@ -784,10 +784,17 @@ impl System {
         forget_sampled(&mut self.components);
     }
 
-    /// Drop every row read but the last, which stays the row the inputs
-    /// are read from ([`Rows::keep_last`]).
-    pub(crate) fn keep_last_sample(&mut self) {
-        self.recording.rows.keep_last();
+    /// Hand over the rows read so far and record on into `next` (an
+    /// empty table of the same width), starting from a copy of the last
+    /// row, which the next step reads its inputs from: what
+    /// [`Rows::keep_last`] does, but the other rows are given to
+    /// the caller instead of dropped (to be written on another thread).
+    pub(crate) fn swap_recording(&mut self, mut next: Rows) -> Rows {
+        debug_assert!(next.is_empty() && next.width() == self.recording.rows.width());
+        if let Some(last) = self.recording.rows.last() {
+            next.push_row(last);
+        }
+        std::mem::replace(&mut self.recording.rows, next)
     }
 
     /// Let the recordings started from now on keep only their last

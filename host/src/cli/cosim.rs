@@ -7,6 +7,7 @@ use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, Streamed}
 use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
 use fricsim::system::{RecordedType, System};
+use fricsim::writer_thread::on_writer_thread;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -69,18 +70,21 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
         return run_isolated(a, output);
     }
     let (mut system, mut master, plan) = build(a, &parsed)?;
-    let mut sink = CosimSink::new(a, output, &system.columns(), &plan);
+    let sink = CosimSink::new(a, output, &system.columns(), &plan);
     let started = std::time::Instant::now();
-    let run = simulate_streaming(
-        &mut system,
-        master.as_mut(),
-        0.0,
-        a.step,
-        a.stop,
-        &mut NoObserver,
-        &mut sink,
-    )
-    .map_err(|e| e.to_string())?;
+    // the result written on a thread of its own while the run steps on
+    let (run, sink) = on_writer_thread(sink, |front| {
+        simulate_streaming(
+            &mut system,
+            master.as_mut(),
+            0.0,
+            a.step,
+            a.stop,
+            &mut NoObserver,
+            front,
+        )
+    });
+    let run = run.map_err(|e| e.to_string())?;
     let wall = started.elapsed().as_secs_f64();
     conclude(a, sink, &plan, &run, master.report(), wall)
 }

@@ -116,7 +116,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     } else {
         Some(&mut progress)
     };
-    let run = prepared.run(&mut writer, progress)?;
+    let run = prepared.run_with_writer_thread(&mut writer, progress)?;
     bar.finish_and_clear();
     let ran = Ran {
         out,

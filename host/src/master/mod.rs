@@ -314,6 +314,16 @@ pub trait RowSink {
     fn stop_requested(&self) -> Option<String> {
         None
     }
+    /// [`RowSink::write`] of a chunk given by value, and an empty table of
+    /// the same width and room (see [`Rows::capacity`]) back, into which
+    /// the run records its next rows. By default `rows` itself, emptied
+    /// once written; a sink that writes on another thread
+    /// ([`crate::writer_thread`]) keeps `rows` and gives back another.
+    fn write_chunk(&mut self, times: Vec<f64>, mut rows: Rows) -> Result<Rows, String> {
+        self.write(&times, &rows)?;
+        rows.clear();
+        Ok(rows)
+    }
 }
 
 impl<T: RowSink + ?Sized> RowSink for &mut T {
@@ -322,6 +332,9 @@ impl<T: RowSink + ?Sized> RowSink for &mut T {
     }
     fn stop_requested(&self) -> Option<String> {
         (**self).stop_requested()
+    }
+    fn write_chunk(&mut self, times: Vec<f64>, rows: Rows) -> Result<Rows, String> {
+        (**self).write_chunk(times, rows)
     }
 }
 
@@ -432,15 +445,29 @@ pub fn simulate_streaming(
         if let (Some(ended), Some(last)) = (&ended, times.last_mut()) {
             *last = ended.time;
         }
-        if let Err(e) = sink.write(&times, system.recorded()) {
-            error.get_or_insert(e);
+        if last_chunk {
+            match sink.write(&times, system.recorded()) {
+                Ok(()) => written += handing,
+                Err(e) => {
+                    error.get_or_insert(e);
+                }
+            }
             break;
+        }
+        // the chunk goes to the sink whole; the run records on from a
+        // copy of its last row in the table the sink gives back
+        let chunk = system.swap_recording(Rows::new(system.recorded().width()));
+        match sink.write_chunk(times, chunk) {
+            Ok(next) => {
+                let placeholder = system.swap_recording(next);
+                debug_assert_eq!(placeholder.len(), 1);
+            }
+            Err(e) => {
+                error.get_or_insert(e);
+                break;
+            }
         }
         written += handing;
-        if last_chunk {
-            break;
-        }
-        system.keep_last_sample();
     }
     system.take_recording();
     Ok(Streamed {
