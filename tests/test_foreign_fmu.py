@@ -123,8 +123,9 @@ def cosim(components, parameters, connections, step, stop, out, env=None):
 def fmpy_jacobi(components, parameters, connections, step, stop, tmp_path):
     """FMPy's FMU2Slave driving `components` with fricsim's Jacobi scheme:
     parameters set in initialization mode, outputs copied to inputs before
-    exitInitializationMode, after it, and before every step; every Real
-    output recorded at every communication point."""
+    exitInitializationMode, after it, and before every step; every
+    output recorded at every communication point (Integer and Boolean
+    ones as numbers, after the Real ones of their component)."""
     fmus = {}
     for name, path in components:
         md = read_model_description(str(path))
@@ -134,7 +135,10 @@ def fmpy_jacobi(components, parameters, connections, step, stop, tmp_path):
         fmu.setupExperiment(startTime=0.0)
         fmu.enterInitializationMode()
         variables = {v.name: v for v in md.modelVariables}
-        outputs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+        # the Real outputs, then the Integer and Boolean ones, as fricsim
+        # records them
+        outputs = [v for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+        outputs += [v for v in md.modelVariables if v.causality == "output" and v.type in ("Integer", "Boolean")]
         fmus[name] = (fmu, variables, outputs)
     for port, value in parameters.items():
         name, variable = port.split(".", 1)
@@ -148,8 +152,12 @@ def fmpy_jacobi(components, parameters, connections, step, stop, tmp_path):
         for (_, _, b, i), x in zip(connections, values):
             fmus[b][0].setReal([fmus[b][1][i].valueReference], [x])
 
+    def read(fmu, v):
+        getter = {"Real": fmu.getReal, "Integer": fmu.getInteger, "Boolean": fmu.getBoolean}[v.type]
+        return float(getter([v.valueReference])[0])
+
     def sample():
-        return [x for fmu, _, outputs in fmus.values() for x in fmu.getReal(outputs)]
+        return [read(fmu, v) for fmu, _, outputs in fmus.values() for v in outputs]
 
     propagate()
     for fmu, _, _ in fmus.values():
@@ -258,7 +266,7 @@ def test_belt_oscillator_with_lugre_equals_fmpy_jacobi(belt, tmp_path):
     step, stop = 1e-4, 3.0
     process, header, ours = cosim(components, parameters, connections, step, stop, tmp_path / "c.csv")
     assert process.returncode == 0, process.stderr
-    assert header == ["time", "rig.x", "rig.v", "rig.a", "friction.F", "friction.z"]
+    assert header == ["time", "rig.x", "rig.v", "rig.a", "friction.F", "friction.z", "friction.sliding"]
     theirs = fmpy_jacobi(components, parameters, connections, step, stop, tmp_path)
     assert_equal_to_1e9(header, ours, theirs)
     # the comparison covers stick and slip
@@ -331,7 +339,7 @@ def test_pythonfmu_drive_with_dahl_equals_fmpy_jacobi(drive, python_runtime, tmp
     process, header, ours = cosim(components, parameters, connections, step, stop, tmp_path / "c.csv",
                                   env=python_runtime)
     assert process.returncode == 0, process.stderr
-    assert header == ["time", "drive.v", "drive.v_cmd", "friction.F", "friction.z"]
+    assert header == ["time", "drive.v", "drive.v_cmd", "friction.F", "friction.z", "friction.sliding"]
     theirs = fmpy_jacobi(components, parameters, connections, step, stop, tmp_path)
     assert_equal_to_1e9(header, ours, theirs)
     # the drive sweeps the contact both ways: Dahl's force reaches both levels
