@@ -28,12 +28,27 @@ def fmu_path(name):
     return path
 
 
+#: Every callback structure handed to FMPy's process-wide logger proxy.
+_PROXIED_CALLBACKS = []
+
+
+def add_logger_proxy(callbacks):
+    """FMPy's addLoggerProxy, with `callbacks` kept alive for the whole
+    process: the proxy is one for the process and keeps pointing at them
+    after their instance is gone, so that a later FMU2Slave's messages
+    (FMPy's default logger goes through the proxy) would call freed
+    memory."""
+    from fmpy.logging import addLoggerProxy
+
+    addLoggerProxy(byref(callbacks))
+    _PROXIED_CALLBACKS.append(callbacks)
+
+
 class CapturedInstance:
     """An FMU2Slave whose log messages are collected in `messages`."""
 
     def __init__(self, name, tmp_path, logging_on=False):
         from fmpy.fmi2 import calloc, free
-        from fmpy.logging import addLoggerProxy
 
         self.path = fmu_path(name)
         self.md = read_model_description(str(self.path))
@@ -48,7 +63,7 @@ class CapturedInstance:
         self.callbacks.logger = fmi2CallbackLoggerTYPE(logger)
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        addLoggerProxy(byref(self.callbacks))
+        add_logger_proxy(self.callbacks)
         self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName="probe")
         self.fmu.instantiate(callbacks=self.callbacks, loggingOn=logging_on)

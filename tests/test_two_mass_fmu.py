@@ -7,16 +7,15 @@ fricsim's Newton master takes its Jacobian from them."""
 
 from __future__ import annotations
 
-import ctypes
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from conftest import add_logger_proxy
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, calloc, free
-from fmpy.logging import addLoggerProxy
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "independent"))
 import cases  # noqa: E402
@@ -40,7 +39,7 @@ def drive(tmp_path):
     callbacks.logger = fmi2CallbackLoggerTYPE(logger)
     callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
     callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-    addLoggerProxy(ctypes.byref(callbacks))
+    add_logger_proxy(callbacks)
     slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=str(tmp_path / "unzipped")),
                       modelIdentifier="TwoMassDrive", instanceName="drive")
     slave.instantiate(callbacks=callbacks)
