@@ -5,7 +5,8 @@
 # Python venv (FMPy, fmutool, libcosimpy), install Chromium (the report
 # tests render report.html in it), build the `fmi` crate's importer
 # (libclang for its bindings), build and install the Python package
-# fricsim (python/, maturin) and run the Python tests.
+# fricsim (python/, maturin) and run the Python tests (pytest-xdist, two
+# workers).
 set -euo pipefail
 cd "$(dirname "$0")"
 ./build-fmu.sh
@@ -14,4 +15,7 @@ scripts/setup-venv.sh
 scripts/setup-browser.sh
 scripts/setup-fmi-crate.sh
 scripts/setup-python-package.sh
-.venv/bin/python -m pytest tests -q
+# on two workers, each test file whole on one of them (--dist loadfile:
+# a file's module fixtures, such as its Dask cluster or the Wine prefix
+# of test_windows_dll.py, stay in one process)
+.venv/bin/python -m pytest tests -q -n 2 --dist loadfile
