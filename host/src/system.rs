@@ -184,9 +184,16 @@ const DISCRETE_CHUNK: usize = 32;
 /// Read a component's recorded Integer and Boolean variables into
 /// `values` (as many as it has), as numbers: each Integer exactly (an
 /// `i32` is an `f64` exactly), a Boolean as 0 or 1.
-#[cold]
 #[inline(never)]
 fn read_discrete(c: &mut Component, values: &mut [f64]) -> Result<(), FmuError> {
+    if let ([], [vr], [x]) = (&c.integer_vrs[..], &c.boolean_vrs[..], &mut *values) {
+        // one Boolean (a friction law's `sliding`): no buffer to clear
+        let mut b = [0];
+        c.instance
+            .get_boolean_raw(std::slice::from_ref(vr), &mut b)?;
+        *x = f64::from(u8::from(b[0] != 0));
+        return Ok(());
+    }
     let (integers, booleans) = values.split_at_mut(c.integer_vrs.len());
     for (vrs, values) in c
         .integer_vrs
@@ -204,10 +211,10 @@ fn read_discrete(c: &mut Component, values: &mut [f64]) -> Result<(), FmuError> 
         .chunks(DISCRETE_CHUNK)
         .zip(booleans.chunks_mut(DISCRETE_CHUNK))
     {
-        let mut buffer = [false; DISCRETE_CHUNK];
-        c.instance.get_boolean(vrs, &mut buffer[..vrs.len()])?;
+        let mut buffer = [0; DISCRETE_CHUNK];
+        c.instance.get_boolean_raw(vrs, &mut buffer[..vrs.len()])?;
         for (x, b) in values.iter_mut().zip(buffer) {
-            *x = f64::from(u8::from(b));
+            *x = f64::from(u8::from(b != 0));
         }
     }
     Ok(())

@@ -663,9 +663,18 @@ pub unsafe fn get_integer(
     value: *mut fmi2Integer,
 ) -> fmi2Status {
     unsafe {
-        get_converted(c, "fmi2GetInteger", VarType::Integer, vr, n, value, |x| {
-            x as fmi2Integer
-        })
+        get_converted(
+            c,
+            (
+                "fmi2GetInteger",
+                const { crate::state_machine::allowed_mask("fmi2GetInteger") },
+            ),
+            VarType::Integer,
+            vr,
+            n,
+            value,
+            |x| x as fmi2Integer,
+        )
     }
 }
 
@@ -678,33 +687,66 @@ pub unsafe fn get_boolean(
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
     unsafe {
-        get_converted(c, "fmi2GetBoolean", VarType::Boolean, vr, n, value, |x| {
-            (x != 0.0) as fmi2Boolean
-        })
+        get_converted(
+            c,
+            (
+                "fmi2GetBoolean",
+                const { crate::state_machine::allowed_mask("fmi2GetBoolean") },
+            ),
+            VarType::Boolean,
+            vr,
+            n,
+            value,
+            |x| (x != 0.0) as fmi2Boolean,
+        )
     }
 }
 
+/// `fmi2GetInteger` and `fmi2GetBoolean`: the values as Reals (how the
+/// instance keeps every variable), converted. A master that records an
+/// Integer or Boolean output calls this at every step, so it takes the
+/// state mask computed at compile time (as [`call!`]) and converts
+/// through a stack buffer: no allocation per call.
+///
+/// # Safety
+/// See [`call_allowed`] and [`in_slice`].
+#[inline(always)]
 unsafe fn get_converted<T>(
     c: fmi2Component,
-    function: &'static str,
+    (function, allowed): (&'static str, u32),
     t: VarType,
     vr: *const fmi2ValueReference,
     n: usize,
     value: *mut T,
     convert: fn(f64) -> T,
 ) -> fmi2Status {
+    const CHUNK: usize = 32;
     unsafe {
-        // rare calls: the mask is looked up by name
-        call_allowed(c, function, allowed_mask(function), |inst| {
-            let vrs = in_slice(vr, n, "vr[]")?;
-            let out = out_slice(value, n, "value[]")?;
-            let mut tmp = vec![0.0; n];
-            inst.get(t, vrs, &mut tmp)?;
-            for (o, x) in out.iter_mut().zip(tmp) {
-                *o = convert(x);
-            }
-            Ok(fmi2Status::fmi2OK)
-        })
+        call_named(
+            c,
+            move || function,
+            allowed,
+            |inst| {
+                let vrs = in_slice(vr, n, "vr[]")?;
+                let out = out_slice(value, n, "value[]")?;
+                if let ([_], [o]) = (vrs, &mut *out) {
+                    // one value (a recorded flag such as LuGre's `sliding`)
+                    let mut x = [0.0];
+                    inst.get(t, vrs, &mut x)?;
+                    *o = convert(x[0]);
+                    return Ok(fmi2Status::fmi2OK);
+                }
+                let mut buffer = [0.0; CHUNK];
+                for (vrs, out) in vrs.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+                    let reals = &mut buffer[..vrs.len()];
+                    inst.get(t, vrs, reals)?;
+                    for (o, &x) in out.iter_mut().zip(reals.iter()) {
+                        *o = convert(x);
+                    }
+                }
+                Ok(fmi2Status::fmi2OK)
+            },
+        )
     }
 }
 

@@ -594,25 +594,39 @@ impl Instance {
         })
     }
 
-    /// `fmi2GetInteger`. Does not allocate.
+    /// `fmi2GetInteger`. Does not allocate (a recorded Integer output is
+    /// read at every step: the path of [`Instance::get_real`]).
+    #[inline]
     pub fn get_integer(
         &mut self,
         vrs: &[ValueReference],
         values: &mut [i32],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetInteger";
-        let mark = self.begin(F)?;
-        same_length(F, "values", vrs.len(), values.len())?;
-        // SAFETY: both arrays hold `vrs.len()` elements.
-        let raw = unsafe {
-            (self.functions.get_integer)(
-                self.component,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_mut_ptr(),
-            )
-        };
-        self.finish(F, mark, raw)
+        let f = self.functions.get_integer;
+        self.call(F, |component| {
+            same_length(F, "values", vrs.len(), values.len())?;
+            // SAFETY: both arrays hold `vrs.len()` elements.
+            Ok(unsafe { f(component, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()) })
+        })
+    }
+
+    /// `fmi2GetBoolean` into `fmi2Boolean`s as the FMU writes them (0 is
+    /// false, anything else true). Does not allocate (a recorded Boolean
+    /// output is read at every step: the path of [`Instance::get_real`]).
+    #[inline]
+    pub fn get_boolean_raw(
+        &mut self,
+        vrs: &[ValueReference],
+        values: &mut [fmi2Boolean],
+    ) -> Result<Status, FmuError> {
+        const F: &str = "fmi2GetBoolean";
+        let f = self.functions.get_boolean;
+        self.call(F, |component| {
+            same_length(F, "values", vrs.len(), values.len())?;
+            // SAFETY: both arrays hold `vrs.len()` elements.
+            Ok(unsafe { f(component, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()) })
+        })
     }
 
     /// `fmi2SetInteger`. Does not allocate.
@@ -637,26 +651,16 @@ impl Instance {
         vrs: &[ValueReference],
         values: &mut [bool],
     ) -> Result<Status, FmuError> {
-        const F: &str = "fmi2GetBoolean";
-        let mark = self.begin(F)?;
-        same_length(F, "values", vrs.len(), values.len())?;
+        same_length("fmi2GetBoolean", "values", vrs.len(), values.len())?;
         let mut status = Status::Ok;
         for (vrs, values) in vrs
             .chunks(BOOLEAN_CHUNK)
             .zip(values.chunks_mut(BOOLEAN_CHUNK))
         {
             let mut buffer = [fmi2False; BOOLEAN_CHUNK];
-            // SAFETY: `vrs` and `buffer` hold at least `vrs.len()` elements.
-            let raw = unsafe {
-                (self.functions.get_boolean)(
-                    self.component,
-                    vrs.as_ptr(),
-                    vrs.len(),
-                    buffer.as_mut_ptr(),
-                )
-            };
-            status = worst(status, self.finish(F, mark, raw)?);
-            for (value, b) in values.iter_mut().zip(buffer) {
+            let buffer = &mut buffer[..vrs.len()];
+            status = worst(status, self.get_boolean_raw(vrs, buffer)?);
+            for (value, &b) in values.iter_mut().zip(buffer.iter()) {
                 *value = b != fmi2False;
             }
         }
