@@ -11,8 +11,10 @@ bench/src/bin/speed_table.rs, from the same system file it runs itself):
      "step": 1e-4, "stop": 20.0, "master": "jacobi" | "newton",
      "rtol": 1e-8, "atol": [1e-13, 1e-10]}   (newton: atol per connection)
 
-Every component's Real outputs are recorded at every communication point,
-as the host does. Prints one JSON object: the wall time of initialization
+Every component's outputs are recorded at every communication point, as
+the host does: its Real outputs in one fmi2GetReal, then its Integer
+outputs in one fmi2GetInteger and its Boolean outputs in one
+fmi2GetBoolean (where it has any), as whole numbers. Prints one JSON object: the wall time of initialization
 and stepping (s; the instances are made and their parameters set before
 the clock starts, as the host builds its system before its own), the
 number of steps, the final value of every recorded output, and, for
@@ -71,6 +73,21 @@ class Component:
                         if v.causality == "output" and v.type == "Real"]
         self.output_names = [v.name for v in md.modelVariables
                              if v.causality == "output" and v.type == "Real"]
+        # Integer (and Enumeration) and Boolean outputs, read after the
+        # Real ones as the host reads them
+        self.integers = [v.valueReference for v in md.modelVariables
+                         if v.causality == "output" and v.type in ("Integer", "Enumeration")]
+        self.booleans = [v.valueReference for v in md.modelVariables
+                         if v.causality == "output" and v.type == "Boolean"]
+
+    def record(self):
+        """This component's part of a recorded row."""
+        row = self.fmu.getReal(self.outputs)
+        if self.integers:
+            row += [float(i) for i in self.fmu.getInteger(self.integers)]
+        if self.booleans:
+            row += [float(b) for b in self.fmu.getBoolean(self.booleans)]
+        return row
 
     def vr(self, name):
         return self.variables[name].valueReference
@@ -125,12 +142,12 @@ def run(spec):
         for c in components:
             c.fmu.exitInitializationMode()
         propagate()
-        rows = [[x for c in components for x in c.fmu.getReal(c.outputs)]]
+        rows = [[x for c in components for x in c.record()]]
         # where each link's output is in a recorded row
         first, k = {}, 0
         for c in components:
             first[c.name] = k
-            k += len(c.outputs)
+            k += len(c.outputs) + len(c.integers) + len(c.booleans)
         columns = [first[src.name] + src.outputs.index(out) for src, out, _, _ in links]
         # per component: its inputs and the recorded columns they take
         steps = [(c, inputs, [columns[k] for k in ks]) for c, inputs, ks in feeds]
@@ -150,7 +167,7 @@ def run(spec):
                     c.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
             else:
                 newton.step(t, h)
-            rows.append([x for c in components for x in c.fmu.getReal(c.outputs)])
+            rows.append([x for c in components for x in c.record()])
         wall = time.perf_counter() - started
         if newton is not None:
             newton.free()

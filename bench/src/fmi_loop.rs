@@ -5,7 +5,10 @@
 //! stepping is measured against in BENCHMARKS.md: the same FMUs, the same
 //! scheme and calls, without the host's bookkeeping.
 //!
-//! Every Real output is recorded, as the host records them.
+//! Every output is recorded, as the host records them: a component's Real
+//! outputs in one `fmi2GetReal`, then its Integer outputs in one
+//! `fmi2GetInteger` and its Boolean ones in one `fmi2GetBoolean` (where it
+//! has any), as whole numbers.
 //!
 //! The scheme is the host's Jacobi (`fricsim::master::jacobi`): at each
 //! communication point every component gets its connected inputs from the
@@ -29,6 +32,8 @@ struct Functions {
     exit_initialization_mode: fmi2ComponentTYPE,
     free_instance: fmi2FreeInstanceTYPE,
     get_real: fmi2GetRealTYPE,
+    get_integer: fmi2GetIntegerTYPE,
+    get_boolean: fmi2GetBooleanTYPE,
     set_real: fmi2SetRealTYPE,
     do_step: fmi2DoStepTYPE,
 }
@@ -56,6 +61,8 @@ impl Functions {
                 exit_initialization_mode: get!("fmi2ExitInitializationMode"),
                 free_instance: get!("fmi2FreeInstance"),
                 get_real: get!("fmi2GetReal"),
+                get_integer: get!("fmi2GetInteger"),
+                get_boolean: get!("fmi2GetBoolean"),
                 set_real: get!("fmi2SetReal"),
                 do_step: get!("fmi2DoStep"),
                 _library: library,
@@ -105,6 +112,8 @@ struct Unit {
     f: Functions,
     c: fmi2Component,
     outputs: Vec<fmi2ValueReference>,
+    integers: Vec<fmi2ValueReference>,
+    booleans: Vec<fmi2ValueReference>,
     first_column: usize,
     input: Option<(fmi2ValueReference, usize)>,
 }
@@ -123,16 +132,21 @@ fn ok(status: fmi2Status, call: &str) -> Result<(), String> {
     }
 }
 
+/// The most Integer or Boolean outputs a component may have here (read
+/// through a stack buffer).
+const DISCRETE_MAX: usize = 16;
+
 /// A Jacobi run of `components` (name, FMU) from 0 to `stop` in steps of
 /// `h`, each `(from, to)` of `connections` an output `component.variable`
 /// driving an input: the wall time of initialization and stepping, s, and
-/// the last row (every output of every component, in order).
+/// the last row: every output of every component, in order, by name
+/// (`component.variable`).
 pub fn jacobi_run(
     components: &[(&str, &Fmu)],
     connections: &[(&str, &str)],
     h: f64,
     stop: f64,
-) -> Result<(f64, Vec<f64>), String> {
+) -> Result<(f64, Vec<(String, f64)>), String> {
     let callbacks = fmi2CallbackFunctions {
         // SAFETY: see `print_message`
         logger: Some(unsafe {
@@ -155,7 +169,25 @@ pub fn jacobi_run(
                 v.causality == Causality::Output && matches!(v.kind, VariableKind::Real { .. })
             })
             .collect();
-        columns.extend(outputs.iter().map(|v| format!("{name}.{}", v.name)));
+        let of_kind = |integer: bool| -> Vec<_> {
+            d.variables
+                .iter()
+                .filter(|v| {
+                    v.causality == Causality::Output
+                        && match v.kind {
+                            VariableKind::Integer { .. } | VariableKind::Enumeration { .. } => {
+                                integer
+                            }
+                            VariableKind::Boolean { .. } => !integer,
+                            _ => false,
+                        }
+                })
+                .collect()
+        };
+        let (integers, booleans) = (of_kind(true), of_kind(false));
+        for v in outputs.iter().chain(&integers).chain(&booleans) {
+            columns.push(format!("{name}.{}", v.name));
+        }
         let c_name = CString::new(*name).map_err(|e| e.to_string())?;
         let guid = CString::new(d.guid.as_str()).map_err(|e| e.to_string())?;
         let resources = CString::new(format!("file://{}/resources", fmu.dir().display()))
@@ -180,10 +212,17 @@ pub fn jacobi_run(
             f,
             c,
             outputs: outputs.iter().map(|v| v.value_reference).collect(),
+            integers: integers.iter().map(|v| v.value_reference).collect(),
+            booleans: booleans.iter().map(|v| v.value_reference).collect(),
             first_column: width,
             input: None,
         });
-        width += outputs.len();
+        if integers.len().max(booleans.len()) > DISCRETE_MAX {
+            return Err(format!(
+                "{name} has more than {DISCRETE_MAX} Integer or Boolean outputs"
+            ));
+        }
+        width += outputs.len() + integers.len() + booleans.len();
     }
     for (from, to) in connections {
         let column = columns
@@ -223,12 +262,33 @@ pub fn jacobi_run(
     let mut times = vec![0.0; chunk];
     let sample = |units: &[Unit], row: &mut [f64]| -> Result<(), String> {
         for u in units {
-            let out = &mut row[u.first_column..u.first_column + u.outputs.len()];
+            let (n, ni, nb) = (u.outputs.len(), u.integers.len(), u.booleans.len());
+            let out = &mut row[u.first_column..u.first_column + n + ni + nb];
+            let (reals, discrete) = out.split_at_mut(n);
+            let mut buffer = [0; DISCRETE_MAX];
             unsafe {
                 ok(
-                    (u.f.get_real)(u.c, u.outputs.as_ptr(), u.outputs.len(), out.as_mut_ptr()),
+                    (u.f.get_real)(u.c, u.outputs.as_ptr(), n, reals.as_mut_ptr()),
                     "fmi2GetReal",
                 )?;
+                if ni > 0 {
+                    ok(
+                        (u.f.get_integer)(u.c, u.integers.as_ptr(), ni, buffer.as_mut_ptr()),
+                        "fmi2GetInteger",
+                    )?;
+                    for (x, i) in discrete[..ni].iter_mut().zip(buffer) {
+                        *x = f64::from(i);
+                    }
+                }
+                if nb > 0 {
+                    ok(
+                        (u.f.get_boolean)(u.c, u.booleans.as_ptr(), nb, buffer.as_mut_ptr()),
+                        "fmi2GetBoolean",
+                    )?;
+                    for (x, b) in discrete[ni..].iter_mut().zip(buffer) {
+                        *x = f64::from(b);
+                    }
+                }
             }
         }
         Ok(())
@@ -276,7 +336,11 @@ pub fn jacobi_run(
     }
     let wall = clock.elapsed().as_secs_f64();
     std::hint::black_box(&times);
-    Ok((wall, rows[(held - 1) * width..held * width].to_vec()))
+    let last = &rows[(held - 1) * width..held * width];
+    Ok((
+        wall,
+        columns.into_iter().zip(last.iter().copied()).collect(),
+    ))
 }
 
 unsafe extern "C" fn libc_calloc(count: usize, size: usize) -> *mut std::ffi::c_void {

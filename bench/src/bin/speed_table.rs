@@ -398,6 +398,9 @@ fn host_run(
 ) -> Result<(f64, f64, Box<dyn fricsim::master::MasterAlgorithm>), String> {
     let mut algorithm = by_name(master)?;
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
+    // every output, as `fricsim run` records them (LuGre's Boolean
+    // `sliding` too), and as FMPy's loop and the hand-written one read them
+    system.record_discrete_outputs();
     let clock = Instant::now();
     let mut last = LastRow::default();
     let run = simulate_streaming(
@@ -492,8 +495,12 @@ fn hand_loop_run(rig: &Fmu, lugre: &Fmu, h: f64, stop: f64) -> Result<(f64, f64)
         h,
         stop,
     )?;
-    // friction's outputs F, z follow rig's ten
-    Ok((wall, last[last.len() - 2]))
+    let force = last
+        .iter()
+        .find(|(name, _)| name == "friction.F")
+        .ok_or("the hand-written loop recorded no friction.F")?
+        .1;
+    Ok((wall, force))
 }
 
 /// The whole `fricsim run` command as a user runs it, and its memory.
@@ -796,8 +803,9 @@ fn input_nominal(fmus: &[(String, Fmu)], name: &str, variable: &str) -> f64 {
 /// The stick-slip system as plain Rust: Rig1D (`rig`) and LuGre
 /// (`friction`) with the file's parameter values, `rig.v → friction.v`,
 /// `friction.F → rig.F`.
-/// Columns the monolithic loops record: Rig1D's ten outputs, LuGre's two.
-const RECORDED: usize = 12;
+/// Columns the monolithic loops record: Rig1D's ten outputs, LuGre's three
+/// (F, z and the Boolean `sliding`, as 0 or 1).
+const RECORDED: usize = 13;
 
 /// What a run of a monolithic loop records, as a host run does
 /// ([`fricsim::master::Run`]): the time of each communication point and a
@@ -878,21 +886,21 @@ impl StickSlipModel {
         )
     }
 
-    /// The outputs the FMUs record (Rig1D's ten, LuGre's F and z) at time
+    /// The outputs the FMUs record (Rig1D's ten, LuGre's F, z and sliding) at time
     /// `t`, one row per communication point in the host's format
     /// ([`fricsim::master::Run`]: the time, and a [`Rows`] of [`RECORDED`]
     /// columns written in place), so that only the FMI boundary differs
     /// between the two loops.
     /// `friction_force` is LuGre's output F at its input, computed once by
     /// the caller for the row and the exchange alike (as the host passes
-    /// on the values it recorded).
+    /// on the values it recorded), and `sliding` its flag there.
     fn record(
         recording: &mut Recording,
         t: f64,
         rig: &Rig1D,
         lugre: &LuGre,
         force_in: f64,
-        friction_force: f64,
+        (friction_force, sliding): (f64, bool),
     ) {
         let u = Rig1DInputs {
             friction: force_in,
@@ -914,6 +922,7 @@ impl StickSlipModel {
             y.control_force,
             friction_force,
             lugre.z(),
+            f64::from(u8::from(sliding)),
         ]);
     }
 
@@ -938,8 +947,10 @@ impl StickSlipModel {
             }
             // LuGre's F at the communication point: recorded, then passed
             // on at the next exchange
-            let mut force = lugre.force(v_in, 0.0, 0.0);
-            Self::record(&mut recording, 0.0, &rig, &lugre, force_in, force);
+            // (force and flag computed together, as the FMU's outputs are)
+            let mut output = lugre.force_and_sliding(v_in, 0.0, 0.0);
+            let mut force = output.0;
+            Self::record(&mut recording, 0.0, &rig, &lugre, force_in, output);
             for i in 0..n {
                 v_in = rig.slip_velocity();
                 force_in = force;
@@ -953,9 +964,10 @@ impl StickSlipModel {
                     ..Default::default()
                 };
                 lugre.step(&held, h);
-                force = lugre.force(v_in, 0.0, 0.0);
+                output = lugre.force_and_sliding(v_in, 0.0, 0.0);
+                force = output.0;
                 let t = (i + 1) as f64 * h;
-                Self::record(&mut recording, t, &rig, &lugre, force_in, force);
+                Self::record(&mut recording, t, &rig, &lugre, force_in, output);
             }
         });
         std::hint::black_box(&recording);
@@ -997,7 +1009,8 @@ impl StickSlipModel {
             recording = Recording::with_capacity(n + 1);
             let mut u = [rig.slip_velocity(), lugre.force(0.0, 0.0, 0.0)];
             u[1] = lugre.force(u[0], 0.0, 0.0);
-            Self::record(&mut recording, 0.0, &rig, &lugre, u[1], u[1]);
+            let sliding = lugre.sliding(u[0], 0.0, 0.0);
+            Self::record(&mut recording, 0.0, &rig, &lugre, u[1], (u[1], sliding));
             'steps: for i in 0..n {
                 let (rig0, lugre0) = (rig.clone(), lugre.clone());
                 for iteration in 1..=50 {
@@ -1014,7 +1027,8 @@ impl StickSlipModel {
                     if converged {
                         iterations += iteration;
                         let t = (i + 1) as f64 * h;
-                        Self::record(&mut recording, t, &rig, &lugre, u[1], y[1]);
+                        let sliding = lugre.sliding(u[0], 0.0, 0.0);
+                        Self::record(&mut recording, t, &rig, &lugre, u[1], (y[1], sliding));
                         continue 'steps;
                     }
                     // ∂(rig.v)/∂F and ∂(friction.F)/∂v of the step just
