@@ -147,18 +147,25 @@ pub fn package(
     let file = std::fs::File::create(&path)
         .map_err(|e| format!("cannot create {}: {e}", path.display()))?;
     let mut zip = zip::ZipWriter::new(file);
-    let options = zip::write::SimpleFileOptions::default()
+    // The text is deflated (a tenth of its size). The binaries are stored
+    // as they are: an importer unpacks the binary of its platform every
+    // time it loads the FMU (FMPy, fricsim and most tools unpack into a
+    // fresh directory), and inflating it costs more than the
+    // few hundred kilobytes saved are worth (BENCHMARKS.md, "What
+    // starting a run costs").
+    let deflated = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
         .unix_permissions(0o644);
-    let mut add = |name: &str, data: &[u8]| -> Result<(), String> {
+    let stored = deflated.compression_method(zip::CompressionMethod::Stored);
+    let mut add = |name: &str, data: &[u8], options| -> Result<(), String> {
         zip.start_file(name, options)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         zip.write_all(data)
             .map_err(|e| format!("{}: {e}", path.display()))
     };
-    add("modelDescription.xml", xml.as_bytes())?;
+    add("modelDescription.xml", xml.as_bytes(), deflated)?;
     for (entry, binary) in &binaries {
-        add(entry, binary)?;
+        add(entry, binary, stored)?;
     }
     zip.finish()
         .map_err(|e| format!("{}: {e}", path.display()))?;
