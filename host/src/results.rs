@@ -136,7 +136,11 @@ impl CsvFile {
                     line.push(b',');
                     if *whole {
                         // an i32 or a Boolean read into an f64: exact
-                        write!(line, "{}", *x as i64)?;
+                        let n = *x as i64;
+                        if n < 0 {
+                            line.push(b'-');
+                        }
+                        push_whole(&mut line, n.unsigned_abs());
                     } else {
                         push_number(&mut line, &mut digits, *x);
                     }
@@ -208,14 +212,21 @@ impl ColumnStats {
 
     /// The first `times.len()` rows of `rows`, at `times`.
     pub fn add(&mut self, times: &[f64], rows: &Rows) {
-        for (t, row) in times.iter().zip(rows) {
-            self.first_time.get_or_insert(*t);
-            self.last_time = Some(*t);
-            self.rows += 1;
+        let n = times.len().min(rows.len());
+        let (Some(first), Some(last)) = (times.first(), times.get(n.wrapping_sub(1))) else {
+            return;
+        };
+        self.first_time.get_or_insert(*first);
+        self.last_time = Some(*last);
+        self.rows += n;
+        for row in rows.into_iter().take(n) {
             for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(row) {
                 *lo = lo.min(*x);
                 *hi = hi.max(*x);
             }
+        }
+        // the last row, copied once per chunk rather than once per row
+        if let Some(row) = rows.get(n - 1) {
             self.last.copy_from_slice(row);
         }
     }
@@ -324,7 +335,7 @@ impl RowSink for ResultWriter {
 /// several times faster: the digits come
 /// from the `zmij` crate, whose own layout differs from Rust's only for
 /// values below 1e-4 (`0.00001`) and above (`1e+16`), which are laid out
-/// again here.
+/// again here (without allocating: friction states of 1e-5 are common).
 pub fn push_number(line: &mut Vec<u8>, digits: &mut zmij::Buffer, x: f64) {
     let magnitude = x.abs();
     if !x.is_finite() {
@@ -336,46 +347,43 @@ pub fn push_number(line: &mut Vec<u8>, digits: &mut zmij::Buffer, x: f64) {
         line.extend_from_slice(text);
         return;
     }
-    // d.ddd·10^e from zmij's `d.ddde±x` or `0.000ddd`
     let (negative, text) = match text {
         [b'-', rest @ ..] => (true, rest),
         _ => (false, text),
     };
-    let mut mantissa = [0u8; 24];
-    let mut n = 0;
-    let exponent = match text.iter().position(|&b| b == b'e') {
-        Some(e) => {
-            for &b in text[..e].iter().filter(|b| b.is_ascii_digit()) {
-                mantissa[n] = b;
-                n += 1;
-            }
-            let exp = std::str::from_utf8(&text[e + 1..]).unwrap_or("0");
-            exp.trim_start_matches('+').parse::<i32>().unwrap_or(0)
-        }
-        None => {
-            // below 1e-4: `0.` then zeros then the digits
-            let fraction = &text[2.min(text.len())..];
-            let zeros = fraction.iter().take_while(|&&b| b == b'0').count();
-            for &b in &fraction[zeros..] {
-                mantissa[n] = b;
-                n += 1;
-            }
-            -(zeros as i32) - 1
-        }
-    };
-    while n > 1 && mantissa[n - 1] == b'0' {
-        n -= 1;
-    }
     if negative {
         line.push(b'-');
     }
-    line.push(mantissa[0]);
-    if n > 1 {
-        line.push(b'.');
-        line.extend_from_slice(&mantissa[1..n]);
+    match text.iter().position(|&b| b == b'e') {
+        // zmij's `d.ddde-x` is Rust's; its `d.ddde+x` is Rust's `d.ddddex`
+        Some(e) => {
+            line.extend_from_slice(&text[..=e]);
+            let exponent = &text[e + 1..];
+            line.extend_from_slice(exponent.strip_prefix(b"+").unwrap_or(exponent));
+        }
+        // `0.0000ddd` (from 1e-5 to below 1e-4): Rust's `d.ddde-5`, the
+        // exponent one more than the zeros after the point (shortest
+        // digits: no zero ends them)
+        None => {
+            let fraction = &text[2.min(text.len())..];
+            let zeros = fraction.iter().take_while(|&&b| b == b'0').count();
+            let digits = &fraction[zeros..];
+            if let Some((first, rest)) = digits.split_first() {
+                line.push(*first);
+                if !rest.is_empty() {
+                    line.push(b'.');
+                    line.extend_from_slice(rest);
+                }
+            }
+            line.extend_from_slice(b"e-");
+            push_whole(line, zeros as u64 + 1);
+        }
     }
-    line.push(b'e');
-    line.extend_from_slice(exponent.to_string().as_bytes());
+}
+
+/// Append the digits of `n`.
+fn push_whole(line: &mut Vec<u8>, n: u64) {
+    line.extend_from_slice(itoa::Buffer::new().format(n).as_bytes());
 }
 
 #[cfg(test)]
