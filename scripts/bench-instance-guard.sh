@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # What the instance guard costs a single-threaded importer: the FMUs as
-# shipped (each call admitted by one atomic exchange and released by one
-# store, so that a call from a second thread is refused instead of
-# corrupting the instance) against the same FMUs built with the guard
+# shipped (a call from a second thread is refused instead of corrupting
+# the instance; from the thread the guard is biased to, a call enters and
+# leaves by plain stores: fmu-src/fmi2-cs/src/guard.rs) against the same
+# FMUs built with the guard
 # compiled out (fmi2-cs feature `unguarded-instances`, for this script
 # only), on the LuGre stick-slip benchmark (examples/stick_slip.ssd, 20 s
 # at 1e-4 s, Jacobi), measured in turns A B A B in one run:

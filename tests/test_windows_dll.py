@@ -138,7 +138,7 @@ def tools():
     WORK.mkdir(parents=True, exist_ok=True)
     native, windows = WORK / "fmi_driver", WORK / "fmi_driver.exe"
     flags = ["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror"]
-    subprocess.run(["gcc", *flags, "-o", str(native), str(DRIVER_SOURCE), "-ldl"], check=True)
+    subprocess.run(["gcc", *flags, "-o", str(native), str(DRIVER_SOURCE), "-ldl", "-pthread"], check=True)
     subprocess.run(["x86_64-w64-mingw32-gcc", *flags, "-o", str(windows), str(DRIVER_SOURCE)], check=True)
     if not (PREFIX / "system.reg").exists():
         status, out, err = run_to_files(["wine", "wineboot", "--init"], "wineboot", wine_env())

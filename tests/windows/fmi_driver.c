@@ -29,7 +29,12 @@
  * step, each log message as `log STATUS CATEGORY MESSAGE`, each misuse as
  * `check NAME GOT EXPECTED ok|FAILED`. A few calls are made wrongly on
  * purpose (wrong state, NULL component, unknown value reference, NaN
- * input, wrong GUID); each must be refused. The exit status is 0 when
+ * input, wrong GUID); each must be refused. Mid-run, a second thread
+ * reads the first output 40 times and ends before the run goes on: the
+ * instance changes threads twice (its guard's bias, earned by the calls
+ * of one thread, is taken away with a process-wide barrier:
+ * FlushProcessWriteBuffers on Windows, membarrier on Linux), and every
+ * call must be admitted and read the same value. The exit status is 0 when
  * every call returned what it must, 1 otherwise, 2 for a usage error. */
 #define __USE_MINGW_ANSI_STDIO 1 /* C99 printf and strtoull under MinGW */
 #include <math.h>
@@ -49,8 +54,41 @@ static void *symbol(Library lib, const char *name) {
 static void print_load_error(const char *path) {
     fprintf(stderr, "LoadLibrary %s failed: error %lu\n", path, (unsigned long)GetLastError());
 }
+/* one function run on a thread of its own, waited for */
+typedef struct {
+    void (*run)(void *);
+    void *arg;
+} ThreadJob;
+static DWORD WINAPI thread_start(LPVOID job) {
+    ((ThreadJob *)job)->run(((ThreadJob *)job)->arg);
+    return 0;
+}
+static int on_another_thread(void (*run)(void *), void *arg) {
+    ThreadJob job = {run, arg};
+    HANDLE t = CreateThread(NULL, 0, thread_start, &job, 0, NULL);
+    if (!t) return 0;
+    WaitForSingleObject(t, INFINITE);
+    CloseHandle(t);
+    return 1;
+}
 #else
 #include <dlfcn.h>
+#include <pthread.h>
+typedef struct {
+    void (*run)(void *);
+    void *arg;
+} ThreadJob;
+static void *thread_start(void *job) {
+    ((ThreadJob *)job)->run(((ThreadJob *)job)->arg);
+    return NULL;
+}
+static int on_another_thread(void (*run)(void *), void *arg) {
+    ThreadJob job = {run, arg};
+    pthread_t t;
+    if (pthread_create(&t, NULL, thread_start, &job)) return 0;
+    pthread_join(t, NULL);
+    return 1;
+}
 typedef void *Library;
 static Library open_library(const char *path) { return dlopen(path, RTLD_NOW | RTLD_LOCAL); }
 static void *symbol(Library lib, const char *name) { return dlsym(lib, name); }
@@ -173,6 +211,33 @@ static void misuse_mid_run(fmi2Component c) {
     }
 }
 
+/* The calls of `calls_from_another_thread`'s second thread. */
+typedef struct {
+    fmi2Component c;
+    double y;
+    int refused;
+} Hop;
+static void hop_calls(void *arg) {
+    Hop *hop = arg;
+    for (int k = 0; k < 40; k++) {
+        double y = NAN;
+        if (fmi.get_real(hop->c, &outputs[0], 1, &y) == fmi2OK)
+            hop->y = y;
+        else
+            hop->refused++;
+    }
+}
+
+/* The instance used from a second thread, one thread at a time. */
+static void calls_from_another_thread(fmi2Component c) {
+    Hop hop = {c, NAN, 0};
+    double y = NAN;
+    check("thread_started", on_another_thread(hop_calls, &hop), 1);
+    check("calls_from_another_thread_refused", hop.refused, 0);
+    check("get_real_back_on_the_first_thread", fmi.get_real(c, &outputs[0], 1, &y), fmi2OK);
+    check("both_threads_read_the_same", bits_of(hop.y) == bits_of(y), 1);
+}
+
 int main(int argc, char **argv) {
     if (argc < 4) {
         fprintf(stderr, "usage: %s LIBRARY PLAN RESOURCE_URI [URI...]\n", argv[0]);
@@ -274,6 +339,7 @@ int main(int argc, char **argv) {
                 check("set_inputs", 1, 0);
             if (steps == mid_run) {
                 misuse_mid_run(c);
+                if (n_outputs && output_types[0] == 'r') calls_from_another_thread(c);
                 checked_mid_run = 1;
             }
             if (fmi.do_step(c, t, h, 1) != fmi2OK) {

@@ -4,6 +4,7 @@
 //! [`Instance`] inside `catch_unwind`.
 
 use crate::ffi::*;
+use crate::guard::{Admission, Guard};
 use crate::instance::Instance;
 use crate::logger::{Logger, Reporter};
 use crate::model::ModelFactory;
@@ -16,53 +17,53 @@ use std::collections::BTreeSet;
 use std::ffi::CStr;
 use std::os::raw::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-/// What an `fmi2Component` points to: the instance, and the flag that
+/// What an `fmi2Component` points to: the instance, and the guard that
 /// admits one call into it at a time. The FMI standard leaves calls into
 /// one instance from two threads at once undefined (FMI 2.0.4 §2.1.5); a
 /// friction block must not take its importer down for it, so the second
 /// call is refused with `fmi2Error` and a message instead of running on a
-/// state the first is changing. Uncontended, the flag costs one atomic
-/// exchange and one store per call (BENCHMARKS.md, "The instance guard").
+/// state the first is changing. From the thread the guard is biased to,
+/// a call costs two plain stores and a load ([`crate::guard`]).
 pub struct Slot {
-    /// Set while a call runs on `instance`.
-    busy: AtomicBool,
+    /// Admits the calls on `instance`, one at a time.
+    guard: Guard,
     /// The importer's logger for a refused call, which must not touch the
     /// instance (another thread is changing it).
     refusals: Reporter,
     instance: UnsafeCell<Instance>,
 }
 
-// SAFETY: `instance` is reached only by the thread that set `busy`
+// SAFETY: `instance` is reached only by the call the guard admitted
 // (`Slot::admit`), one at a time; `refusals` is only read.
 unsafe impl Sync for Slot {}
 
 impl Slot {
     fn new(instance: Instance) -> Slot {
         Slot {
-            busy: AtomicBool::new(false),
+            guard: Guard::default(),
             refusals: instance.logger.reporter(),
             instance: UnsafeCell::new(instance),
         }
     }
 
     /// The instance, if no other call is running on it: the caller owns it
-    /// until [`Slot::release`]. `None`: another thread is inside a call.
+    /// until [`Slot::release`] of the admission. `None`: another thread is
+    /// inside a call.
     #[inline(always)]
-    fn admit(&self) -> Option<*mut Instance> {
+    fn admit(&self) -> Option<(*mut Instance, Admission)> {
         if cfg!(feature = "unguarded-instances") {
-            return Some(self.instance.get());
+            return Some((self.instance.get(), Admission::Owner));
         }
-        // (`swap`: one locked exchange, no compare loop)
-        (!self.busy.swap(true, Ordering::Acquire)).then(|| self.instance.get())
+        self.guard.admit().map(|a| (self.instance.get(), a))
     }
 
     #[inline(always)]
-    fn release(&self) {
+    fn release(&self, admission: Admission) {
         if !cfg!(feature = "unguarded-instances") {
-            self.busy.store(false, Ordering::Release);
+            self.guard.release(admission);
         }
     }
 }
@@ -118,12 +119,12 @@ fn recently_live(c: usize) -> bool {
 }
 
 /// A call admitted into a slot ([`Slot::admit`]): released when dropped.
-struct Admitted<'a>(&'a Slot);
+struct Admitted<'a>(&'a Slot, Admission);
 
 impl Drop for Admitted<'_> {
     #[inline(always)]
     fn drop(&mut self) {
-        self.0.release();
+        self.0.release(self.1);
     }
 }
 
@@ -148,8 +149,8 @@ unsafe fn recent_instance<'a>(
     // SAFETY: a recently live address is a live slot, created by
     // `instantiate` and not freed.
     let slot = unsafe { &*(c as *const Slot) };
-    let instance = slot.admit()?;
-    let admitted = Admitted(slot);
+    let (instance, admission) = slot.admit()?;
+    let admitted = Admitted(slot, admission);
     // SAFETY: admitted: this thread alone reaches the instance until
     // `admitted` is dropped.
     let instance = unsafe { &mut *instance };
@@ -230,7 +231,7 @@ unsafe fn call_named(
     }
     // SAFETY: live, so a slot created by `instantiate` and not freed.
     let slot = unsafe { &*(c as *const Slot) };
-    let Some(instance) = slot.admit() else {
+    let Some((instance, admission)) = slot.admit() else {
         return concurrent_call(slot, function());
     };
     // (a `move` closure: `function` and the pointer are captured by value,
@@ -258,7 +259,7 @@ unsafe fn call_named(
         let instance = unsafe { &mut *instance };
         panicked(instance, function(), payload)
     });
-    slot.release();
+    slot.release(admission);
     status
 }
 
@@ -510,6 +511,7 @@ pub unsafe fn instantiate(
                 return std::ptr::null_mut();
             }
         }
+        crate::guard::prepare_barrier();
         let address = Box::into_raw(Box::new(Slot::new(instance)));
         live().insert(address as usize);
         address as fmi2Component
