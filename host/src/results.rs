@@ -332,43 +332,40 @@ impl RowSink for ResultWriter {
 /// that parse back to the same `f64`; plain decimal from 1e-4 to below
 /// 1e16, else `1.5e-7`, `2e16`; of two shortest digit strings equally
 /// near `x` the even one, where std may take the other, both exact),
-/// several times faster: the digits come
-/// from the `zmij` crate, whose own layout differs from Rust's only for
-/// values below 1e-4 (`0.00001`) and above (`1e+16`), which are laid out
-/// again here (without allocating: friction states of 1e-5 are common).
+/// several times faster: the digits come from the `zmij` crate, whose
+/// own layout is Rust's except from 1e-5 to below 1e-4 (`0.00001`, Rust's
+/// `1e-5`) and from 1e16 up (`1e+16`, Rust's `1e16`), which are laid out
+/// again here ([`relaid`]).
+#[inline]
 pub fn push_number(line: &mut Vec<u8>, digits: &mut zmij::Buffer, x: f64) {
-    let magnitude = x.abs();
     if !x.is_finite() {
         line.extend_from_slice(format!("{x:?}").as_bytes());
         return;
     }
     let text = digits.format_finite(x).as_bytes();
-    if (1e-4..1e16).contains(&magnitude) || magnitude == 0.0 {
+    let magnitude = x.abs();
+    if (1e-4..1e16).contains(&magnitude) || magnitude < 1e-5 {
         line.extend_from_slice(text);
-        return;
+    } else {
+        relaid(line, text);
     }
-    let (negative, text) = match text {
-        [b'-', rest @ ..] => (true, rest),
-        _ => (false, text),
+}
+
+/// [`push_number`] for zmij's `[-]0.0000ddd` (Rust's `[-]d.ddde-5`: the
+/// exponent one more than the zeros after the point) and `[-]d.ddde+x`
+/// (Rust's `[-]d.dddex`). Common: LuGre's bristle deflection z, about
+/// 1e-5 m, is in every row of a friction run.
+fn relaid(line: &mut Vec<u8>, text: &[u8]) {
+    let (sign, body) = match text {
+        [b'-', rest @ ..] => (&b"-"[..], rest),
+        _ => (&b""[..], text),
     };
-    if negative {
-        line.push(b'-');
-    }
-    match text.iter().position(|&b| b == b'e') {
-        // zmij's `d.ddde-x` is Rust's; its `d.ddde+x` is Rust's `d.ddddex`
-        Some(e) => {
-            line.extend_from_slice(&text[..=e]);
-            let exponent = &text[e + 1..];
-            line.extend_from_slice(exponent.strip_prefix(b"+").unwrap_or(exponent));
-        }
-        // `0.0000ddd` (from 1e-5 to below 1e-4): Rust's `d.ddde-5`, the
-        // exponent one more than the zeros after the point (shortest
-        // digits: no zero ends them)
-        None => {
-            let fraction = &text[2.min(text.len())..];
+    line.extend_from_slice(sign);
+    match body.strip_prefix(b"0.") {
+        Some(fraction) => {
             let zeros = fraction.iter().take_while(|&&b| b == b'0').count();
-            let digits = &fraction[zeros..];
-            if let Some((first, rest)) = digits.split_first() {
+            // the shortest digits: no zero ends them
+            if let Some((first, rest)) = fraction[zeros..].split_first() {
                 line.push(*first);
                 if !rest.is_empty() {
                     line.push(b'.');
@@ -378,6 +375,13 @@ pub fn push_number(line: &mut Vec<u8>, digits: &mut zmij::Buffer, x: f64) {
             line.extend_from_slice(b"e-");
             push_whole(line, zeros as u64 + 1);
         }
+        None => match body.iter().position(|&b| b == b'+') {
+            Some(plus) => {
+                line.extend_from_slice(&body[..plus]);
+                line.extend_from_slice(&body[plus + 1..]);
+            }
+            None => line.extend_from_slice(body),
+        },
     }
 }
 
