@@ -92,6 +92,18 @@ fn one_fmu_holds_every_platform_given() {
         String::from_utf8(names[0].1.clone()).unwrap(),
         fmu_packager::render(lugre).unwrap()
     );
+    // the model description deflated, every binary stored as it is (an
+    // importer unpacks it at every load: nothing to inflate)
+    let mut zip = zip::ZipArchive::new(std::fs::File::open(&fmu).unwrap()).unwrap();
+    for i in 0..zip.len() {
+        let entry = zip.by_index(i).unwrap();
+        let expected = if i == 0 {
+            zip::CompressionMethod::Deflated
+        } else {
+            zip::CompressionMethod::Stored
+        };
+        assert_eq!(entry.compression(), expected, "{}", entry.name().unwrap());
+    }
 }
 
 #[test]
