@@ -325,7 +325,13 @@ fn register_barrier() -> bool {
 
 #[cfg(target_os = "linux")]
 fn heavy_barrier() -> bool {
-    membarrier::call(membarrier::PRIVATE_EXPEDITED) == 0
+    use membarrier::*;
+    // Refused if the process is not registered: a child made by fork()
+    // keeps the registration on the kernels tried here, but should one
+    // not, the child (whose BARRIER was copied from the parent) registers
+    // then, slowly but once.
+    call(PRIVATE_EXPEDITED) == 0
+        || (call(REGISTER_PRIVATE_EXPEDITED) == 0 && call(PRIVATE_EXPEDITED) == 0)
 }
 
 #[cfg(windows)]
