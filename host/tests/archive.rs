@@ -178,6 +178,49 @@ fn skip_unused_writes_only_what_a_running_fmu_reads() {
 }
 
 #[test]
+fn description_only_writes_the_model_description_alone() {
+    let scratch = Scratch::new();
+    let bytes = zip_of(&[
+        ("modelDescription.xml", DESCRIPTION),
+        ("binaries/linux64/M.so", b"the library"),
+        ("binaries/win64/M.dll", b"another platform"),
+        ("resources/table.txt", b"1 2 3"),
+    ]);
+    let path = scratch.write(&bytes);
+    let options = UnpackOptions {
+        description_only: true,
+        ..scratch.options()
+    };
+    let dir = unpack(&path, &options).unwrap();
+    assert_eq!(
+        std::fs::read(dir.path().join("modelDescription.xml")).unwrap(),
+        DESCRIPTION
+    );
+    for name in [
+        "binaries/linux64/M.so",
+        "binaries/win64/M.dll",
+        "resources/table.txt",
+    ] {
+        assert!(
+            !dir.path().join(name).exists(),
+            "{name} must not be unpacked"
+        );
+    }
+    // `fricsim info` still lists the platforms
+    assert_eq!(
+        fricsim::fmu::library::platforms(dir.path()),
+        ["linux64", "win64"]
+    );
+    // and every entry is still checked
+    drop(dir);
+    let bad = zip_of(&[
+        ("modelDescription.xml", DESCRIPTION),
+        ("binaries/../../evil", b"x"),
+    ]);
+    scratch.refuse(&bad, &options);
+}
+
+#[test]
 fn defaults_are_as_documented() {
     let o = UnpackOptions::default();
     assert_eq!(
@@ -187,6 +230,7 @@ fn defaults_are_as_documented() {
     assert_eq!(DEFAULT_MAX_BYTES, 512 * 1024 * 1024);
     assert_eq!(DEFAULT_MAX_ENTRIES, 10_000);
     assert!(!o.skip_unused, "unpack writes every entry unless told");
+    assert!(!o.description_only, "unpack writes every entry unless told");
 }
 
 #[test]

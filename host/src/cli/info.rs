@@ -1,7 +1,8 @@
 //! `fricsim info FMU`: what `fmpy info` shows — the model, its
-//! capabilities, the default experiment and a table of all variables. Reads
-//! the archive and the model description only; the binary is not loaded, so
-//! FMUs for other platforms can be inspected too.
+//! capabilities, the default experiment and a table of all variables. Only
+//! the model description is unpacked (every entry of the archive is
+//! checked, no other written, no binary loaded), so FMUs for other
+//! platforms can be inspected too.
 
 use fricsim::fmu::archive::{unpack, UnpackOptions};
 use fricsim::fmu::library::platforms;
@@ -11,7 +12,11 @@ use std::fmt::Write;
 use std::path::Path;
 
 pub fn run(path: &Path) -> Result<(), FmuError> {
-    let dir = unpack(path, &UnpackOptions::default())?;
+    let options = UnpackOptions {
+        description_only: true,
+        ..UnpackOptions::default()
+    };
+    let dir = unpack(path, &options)?;
     let description = ModelDescription::from_file(&dir.path().join("modelDescription.xml"))?;
     print!("{}", render(&description, &platforms(dir.path())));
     Ok(())

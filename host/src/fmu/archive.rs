@@ -48,6 +48,10 @@ pub struct UnpackOptions {
     ///
     /// [`Fmu::open`]: crate::fmu::Fmu::open
     pub skip_unused: bool,
+    /// Write the model description only, every other entry checked but
+    /// not written (their folders are made, as with `skip_unused`):
+    /// `fricsim info`, which loads no binary.
+    pub description_only: bool,
 }
 
 impl Default for UnpackOptions {
@@ -57,6 +61,7 @@ impl Default for UnpackOptions {
             max_entries: DEFAULT_MAX_ENTRIES,
             temp_parent: None,
             skip_unused: false,
+            description_only: false,
         }
     }
 }
@@ -182,7 +187,9 @@ pub fn unpack_requiring(
         if let Some(parent) = target.parent() {
             fs::create_dir_all(parent).map_err(write_err)?;
         }
-        if options.skip_unused && !used_when_running(&relative) {
+        if options.skip_unused && !used_when_running(&relative)
+            || options.description_only && relative != Path::new("modelDescription.xml")
+        {
             continue;
         }
         let mut entry = archive
