@@ -602,13 +602,8 @@ impl Instance {
         vrs: &[ValueReference],
         values: &mut [i32],
     ) -> Result<Status, FmuError> {
-        const F: &str = "fmi2GetInteger";
         let f = self.functions.get_integer;
-        self.call(F, |component| {
-            same_length(F, "values", vrs.len(), values.len())?;
-            // SAFETY: both arrays hold `vrs.len()` elements.
-            Ok(unsafe { f(component, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()) })
-        })
+        self.get_c_ints("fmi2GetInteger", f, vrs, values)
     }
 
     /// `fmi2GetBoolean` into `fmi2Boolean`s as the FMU writes them (0 is
@@ -620,10 +615,22 @@ impl Instance {
         vrs: &[ValueReference],
         values: &mut [fmi2Boolean],
     ) -> Result<Status, FmuError> {
-        const F: &str = "fmi2GetBoolean";
         let f = self.functions.get_boolean;
-        self.call(F, |component| {
-            same_length(F, "values", vrs.len(), values.len())?;
+        self.get_c_ints("fmi2GetBoolean", f, vrs, values)
+    }
+
+    /// `fmi2GetInteger` or `fmi2GetBoolean` (`function`, `f`): both write
+    /// C ints, and have one signature.
+    #[inline(always)]
+    fn get_c_ints(
+        &mut self,
+        function: &'static str,
+        f: fmi2GetIntegerTYPE,
+        vrs: &[ValueReference],
+        values: &mut [i32],
+    ) -> Result<Status, FmuError> {
+        self.call(function, |component| {
+            same_length(function, "values", vrs.len(), values.len())?;
             // SAFETY: both arrays hold `vrs.len()` elements.
             Ok(unsafe { f(component, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()) })
         })
