@@ -241,8 +241,10 @@ pub struct ModelFactory {
 }
 
 /// The `Model` methods of the state for a law with `state_len` /
-/// `write_state_into` / `state_from_slice` held in field `$law` of a
-/// `Clone` model (`save_state` appends what `write_state_into` writes):
+/// `write_state_into` / `state_is_finite` / `state_from_slice` held in
+/// field `$law` of a `Clone` model (`save_state` appends what
+/// `write_state_into` writes; `state_is_finite` answers after every step
+/// without a copy of the state):
 /// write `fmi2_cs::delegate_state!(law);` inside the `impl Model`.
 #[macro_export]
 macro_rules! delegate_state {
@@ -259,6 +261,10 @@ macro_rules! delegate_state {
 
         fn write_state_into(&self, out: &mut [f64]) {
             self.$law.write_state_into(out);
+        }
+
+        fn state_is_finite(&self) -> Option<bool> {
+            Some(self.$law.state_is_finite())
         }
 
         fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {

@@ -166,12 +166,6 @@ impl Model for BristleFmu {
         false
     }
 
-    /// In `O(1)` (the law's invariants), instead of a scan of the `14 + 2·N`
-    /// state values after every step.
-    fn state_is_finite(&self) -> Option<bool> {
-        Some(self.law.state_is_finite())
-    }
-
     /// dF/dt = (tangent stiffness)·dx/dt.
     fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {
         (output == vr::F)

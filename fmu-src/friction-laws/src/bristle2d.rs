@@ -454,6 +454,13 @@ impl Bristle2D {
         out.copy_from_slice(&[self.z[0], self.z[1]]);
     }
 
+    /// Whether the state is finite (a scan of
+    /// [`Bristle2D::write_state_into`], without the copy).
+    #[inline]
+    pub fn state_is_finite(&self) -> bool {
+        self.z.iter().all(|z| z.is_finite())
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = vec![0.0; self.state_len()];

@@ -3,8 +3,8 @@
 //! restores it with, written once.
 
 /// The state methods of a law whose state is the one value in field
-/// `$field`: `state_len` (1), `write_state_into`, `state_to_vec` and
-/// `state_from_slice` (any finite value), inside the law's `impl`. `$law`
+/// `$field`: `state_len` (1), `write_state_into`, `state_is_finite`,
+/// `state_to_vec` and `state_from_slice` (any finite value), inside the law's `impl`. `$law`
 /// and `$name` are the law and the variable as the messages name them:
 /// `one_value_state!("Dahl", "F", f)` refuses with
 /// "Dahl state F = inf is not finite" or "Dahl state has 1 value, got 2".
@@ -20,6 +20,12 @@ macro_rules! one_value_state {
         #[inline]
         pub fn write_state_into(&self, out: &mut [f64]) {
             out.copy_from_slice(&[self.$field]);
+        }
+
+        #[doc = concat!("Whether `", $name, "` is finite (a scan of [`Self::write_state_into`]).")]
+        #[inline]
+        pub fn state_is_finite(&self) -> bool {
+            self.$field.is_finite()
         }
 
         /// The same state as a new vector.

@@ -1000,6 +1000,15 @@ impl Rig1D {
         out.copy_from_slice(&[self.t, self.x, self.xd, self.xi]);
     }
 
+    /// Whether the state is finite (a scan of [`Rig1D::write_state_into`],
+    /// without the copy).
+    #[inline]
+    pub fn state_is_finite(&self) -> bool {
+        [self.t, self.x, self.xd, self.xi]
+            .iter()
+            .all(|v| v.is_finite())
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = vec![0.0; self.state_len()];

@@ -159,6 +159,13 @@ impl Rig2D {
         self.axes[1].write_state_into(second);
     }
 
+    /// Whether the state of both axes is finite (a scan of
+    /// [`Rig2D::write_state_into`], without the copy).
+    #[inline]
+    pub fn state_is_finite(&self) -> bool {
+        self.axes.iter().all(|axis| axis.state_is_finite())
+    }
+
     /// The same state as a new vector.
     pub fn state_to_vec(&self) -> Vec<f64> {
         let mut v = vec![0.0; self.state_len()];

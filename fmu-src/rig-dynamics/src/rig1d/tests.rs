@@ -1201,3 +1201,24 @@ fn all_outputs_at_once_are_the_single_outputs_bit_for_bit() {
         }
     }
 }
+
+/// `state_is_finite` answers as a scan of the saved state would: each of
+/// the four values made NaN or infinite in turn.
+#[test]
+fn state_is_finite_answers_as_a_scan_of_the_state() {
+    let rig = Rig1D::new(Rig1DParams::default()).unwrap();
+    assert!(rig.state_is_finite());
+    for k in 0..4 {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut r = rig.clone();
+            match k {
+                0 => r.t = bad,
+                1 => r.x = bad,
+                2 => r.xd = bad,
+                _ => r.xi = bad,
+            }
+            assert!(!r.state_to_vec().iter().all(|v| v.is_finite()));
+            assert!(!r.state_is_finite(), "state value {k} = {bad}");
+        }
+    }
+}
