@@ -723,6 +723,26 @@ unsafe fn get_converted<T>(
     convert: fn(f64) -> T,
 ) -> fmi2Status {
     const CHUNK: usize = 32;
+    // The step loop's case, one value whose reading runs none of the
+    // model's code (`Instance::get_plain`: a master recording a flag after
+    // its fmi2GetReal has brought the outputs up to date), before the
+    // general path: it cannot fail or panic, so it needs neither
+    // `catch_unwind` nor the general path's frame. Anything else takes
+    // the general path, nothing changed.
+    if n == 1 && both_usable(vr, value) {
+        // SAFETY: non-null and aligned, one element (FMI contract)
+        let vr = unsafe { *vr };
+        // SAFETY: as `call_allowed`
+        if let Some((admitted, inst)) = unsafe { recent_instance(c, allowed) } {
+            let x = inst.get_plain(t, vr);
+            drop(admitted);
+            if let Some(x) = x {
+                // SAFETY: non-null and aligned, one element (FMI contract)
+                unsafe { *value = convert(x) };
+                return fmi2Status::fmi2OK;
+            }
+        }
+    }
     unsafe {
         call_named(
             c,

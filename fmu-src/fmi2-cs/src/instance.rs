@@ -468,6 +468,24 @@ impl Instance {
         }
     }
 
+    /// [`Instance::get`] of one value in the case that runs none of the
+    /// model's code: a known variable of type `t`, not an output or with
+    /// the outputs up to date. Its value then; else `None`, nothing
+    /// changed, and the caller takes `get`, which checks, computes and
+    /// reports. Calls nothing and cannot panic (the index is checked), so
+    /// that `fmi2GetBoolean` and `fmi2GetInteger` can take it before their
+    /// `catch_unwind`.
+    #[inline(always)]
+    pub fn get_plain(&self, t: VarType, vr: u32) -> Option<f64> {
+        let f = self.flags.get(vr as usize).copied().unwrap_or(0);
+        if f & type_flag(t) == 0 || (f & flag::OUTPUT != 0 && self.outputs_dirty) {
+            return None;
+        }
+        // (`values` has one entry per variable, as `flags`)
+        let x = self.values.as_slice().get(vr as usize).copied()?;
+        x.is_finite().then_some(x)
+    }
+
     /// Lists at least this long that [`Instance::get`] found valid are
     /// remembered: comparing is cheaper than checking again.
     const REMEMBERED: usize = 2;

@@ -1,9 +1,10 @@
 //! `fmi2SetReal` of one value (a master's connection, taken on a fast path
 //! before the general one) refuses everything the general path refuses,
 //! with the same messages, changing nothing; an accepted value has the
-//! same effects as a set through a list; calls are still logged. And the
-//! FMU states and replayed steps follow a bristle count changed by a
-//! reset (the model's state length changes with it).
+//! same effects as a set through a list; calls are still logged. The same
+//! of `fmi2GetBoolean` and `fmi2GetInteger` of one value. And the FMU
+//! states and replayed steps follow a bristle count changed by a reset
+//! (the model's state length changes with it).
 
 mod common;
 use common::*;
@@ -176,4 +177,67 @@ fn states_and_replays_follow_a_bristle_count_changed_by_a_reset() {
     let mut s = saved;
     assert_eq!(unsafe { fmi2FreeFMUstate(a.c, &mut s) }, OK);
     assert_eq!(s, null_mut());
+}
+
+/// `fmi2GetBoolean` and `fmi2GetInteger` of one value (a master recording
+/// a flag, taken on a fast path when no model code has to run) give what
+/// a read through a list gives, before and after the outputs are brought
+/// up to date by `fmi2GetReal`; what the general path refuses is refused
+/// alike.
+#[test]
+fn one_flag_read_is_the_value_a_list_read_gives() {
+    let mut first = Fmu::new("LuGre", &[]);
+    let mut second = Fmu::new("LuGre", &[]);
+    let sliding = first.var("sliding").vr;
+    let n_table = first.var("n_table").vr;
+    let read_one = |fmu: &Fmu| {
+        let mut b = -1;
+        assert_eq!(unsafe { fmi2GetBoolean(fmu.c, &sliding, 1, &mut b) }, OK);
+        b
+    };
+    let read_list = |fmu: &Fmu| {
+        let (vrs, mut b) = ([sliding, sliding], [-1; 2]);
+        assert_eq!(
+            unsafe { fmi2GetBoolean(fmu.c, vrs.as_ptr(), 2, b.as_mut_ptr()) },
+            OK
+        );
+        assert_eq!(b[0], b[1]);
+        b[0]
+    };
+    let mut seen = [false; 2];
+    for k in 0..400 {
+        // sticking, then sliding, then back
+        let v = if (100..300).contains(&k) { 0.5 } else { 1e-6 };
+        for fmu in [&mut first, &mut second] {
+            fmu.set("v", v);
+            fmu.step(1e-3);
+        }
+        // outputs not yet computed (the general path computes them) on
+        // one, computed by fmi2GetReal first on the other
+        let before = read_one(&first);
+        first.get("F");
+        second.get("F");
+        let after = read_one(&second);
+        assert_eq!(before, after, "step {k}");
+        assert_eq!(after, read_list(&second), "step {k}");
+        seen[after as usize] = true;
+        let mut n = -1;
+        assert_eq!(unsafe { fmi2GetInteger(second.c, &n_table, 1, &mut n) }, OK);
+        assert_eq!(n as f64, second.get_any("n_table"));
+    }
+    assert_eq!(seen, [true, true], "both sticking and sliding were read");
+    // a Real variable, an unknown value reference, NULL: refused
+    let (f, unknown, mut b) = (first.var("F").vr, 1_000_000, 0);
+    assert_eq!(unsafe { fmi2GetBoolean(first.c, &f, 1, &mut b) }, ERR);
+    assert!(last_error().contains("not Boolean"), "{}", last_error());
+    assert_eq!(unsafe { fmi2GetBoolean(first.c, &unknown, 1, &mut b) }, ERR);
+    assert!(
+        last_error().contains("unknown value reference"),
+        "{}",
+        last_error()
+    );
+    assert_eq!(
+        unsafe { fmi2GetBoolean(first.c, &sliding, 1, null_mut()) },
+        ERR
+    );
 }
