@@ -97,7 +97,8 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
 
     let bar = progress_bar(a, n);
     let columns = prepared.columns();
-    let mut writer = ResultWriter::new(output, &columns);
+    // (the run's Recorder sums the rows up)
+    let mut writer = ResultWriter::new(output, &columns).summarized_elsewhere();
     writer.whole_number_columns(&prepared.column_types());
     let plot_signals = if plot_signals.is_empty() {
         columns.clone()
@@ -219,7 +220,7 @@ fn run_isolated(
     let mut kept_signals = plot_signals.clone();
     let mut plot_error = None;
     let isolated = super::isolated::run_isolated(a.step_timeout, |columns, plan: &Plan| {
-        let mut writer = ResultWriter::new(output, columns);
+        let mut writer = ResultWriter::new(output, columns).summarized_elsewhere();
         writer.whole_number_columns(&plan.types);
         if kept_signals.is_empty() {
             kept_signals = columns.to_vec();
