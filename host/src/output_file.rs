@@ -8,8 +8,9 @@
 //!   when neither does;
 //! * locks the path for the run: an advisory lock (`flock`, through
 //!   [`File::try_lock`]) on the lock file `.<name>.fricsim-lock` beside
-//!   it, which holds the writer's pid; a second writer is refused at once,
-//!   naming that pid. The lock dies with its process, so a run killed with
+//!   it; a second writer is refused at once, naming the writer's pid
+//!   (Linux: from `/proc/locks`, the lock file left empty; elsewhere the
+//!   lock file holds it). The lock dies with its process, so a run killed with
 //!   SIGKILL blocks no one; the lock file is removed at the end of a run
 //!   that runs its code to the end (one left by a killed run is reused);
 //! * writes to the temporary file `.<name>.fricsim-partial-<pid>` in the
@@ -24,7 +25,7 @@
 //!   removed by the next run that locks the same path.
 
 use std::fs::{File, OpenOptions};
-use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
+use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 
@@ -306,12 +307,9 @@ impl Lock {
             match file.try_lock() {
                 Ok(()) => {}
                 Err(std::fs::TryLockError::WouldBlock) => {
-                    let mut pid = String::new();
-                    let _ = file.read_to_string(&mut pid);
-                    let pid = pid.trim();
                     return Err(OutputError::Locked {
                         path: out.to_path_buf(),
-                        pid: if pid.is_empty() { "unknown" } else { pid }.to_string(),
+                        pid: lock_holder(&mut file).unwrap_or_else(|| "unknown".to_string()),
                     });
                 }
                 Err(std::fs::TryLockError::Error(e)) => return Err(io(e)),
@@ -322,8 +320,17 @@ impl Lock {
             let locked = file.metadata().map_err(io)?;
             match std::fs::metadata(lock_path) {
                 Ok(now) if now.dev() == locked.dev() && now.ino() == locked.ino() => {
-                    file.set_len(0).map_err(io)?;
-                    write!(file, "{}", std::process::id()).map_err(io)?;
+                    // Linux tells the holder's pid (/proc/locks): the file
+                    // stays empty, without a data block, which the file
+                    // system would write out with the result's `fsync`
+                    // and then wait on, and free, when the file is
+                    // removed (1.3 to 1.7 ms on an ext4 mounted with
+                    // `discard`). Elsewhere the file holds the pid.
+                    #[cfg(not(target_os = "linux"))]
+                    {
+                        file.set_len(0).map_err(io)?;
+                        write!(file, "{}", std::process::id()).map_err(io)?;
+                    }
                     return Ok(Lock {
                         path: lock_path.to_path_buf(),
                         _file: file,
@@ -332,6 +339,44 @@ impl Lock {
                 _ => continue,
             }
         }
+    }
+}
+
+/// The pid of the process that holds the lock on the lock file `file`, if
+/// it can be told: on Linux the `FLOCK` entry of its device and inode in
+/// `/proc/locks` (`1: FLOCK  ADVISORY  WRITE 6964 fe:00:11338430 0 EOF`,
+/// the device as hexadecimal major and minor numbers); elsewhere what the
+/// holder wrote into the file.
+#[cold]
+fn lock_holder(file: &mut File) -> Option<String> {
+    #[cfg(target_os = "linux")]
+    {
+        let m = file.metadata().ok()?;
+        let id = format!(
+            "{:02x}:{:02x}:{}",
+            libc::major(m.dev()),
+            libc::minor(m.dev()),
+            m.ino()
+        );
+        let locks = std::fs::read_to_string("/proc/locks").ok()?;
+        locks.lines().find_map(|line| {
+            // (a waiting lock's line has `->` after the number)
+            let fields: Vec<&str> = line.split_whitespace().filter(|f| *f != "->").collect();
+            match fields[..] {
+                [_, "FLOCK", _, _, pid, device_inode, ..] if device_inode == id => {
+                    Some(pid.to_string())
+                }
+                _ => None,
+            }
+        })
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        use std::io::Read;
+        let mut pid = String::new();
+        file.read_to_string(&mut pid).ok()?;
+        let pid = pid.trim();
+        (!pid.is_empty()).then(|| pid.to_string())
     }
 }
 

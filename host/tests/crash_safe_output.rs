@@ -326,11 +326,17 @@ fn a_second_writer_of_the_same_path_is_refused_and_the_first_result_is_whole() {
         .spawn()
         .unwrap();
     let pid = first.id();
-    // the lock file holds the pid once the path is locked
+    // the lock on the lock file, taken by that pid (/proc/locks); the
+    // file itself stays empty (no data block to write out and free)
     let lock = setup.path("out/.r.csv.fricsim-lock");
     wait_for("the lock", || {
-        std::fs::read_to_string(&lock).is_ok_and(|s| s == pid.to_string())
+        std::fs::read_to_string("/proc/locks").is_ok_and(|locks| {
+            locks
+                .lines()
+                .any(|l| l.contains("FLOCK") && l.split_whitespace().any(|f| f == pid.to_string()))
+        })
     });
+    assert_eq!(std::fs::metadata(&lock).unwrap().len(), 0);
     let second = setup
         .run(&["--stop", "0.05", "--out", out.to_str().unwrap()])
         .output()
