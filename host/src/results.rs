@@ -363,24 +363,11 @@ const NUMBER_MAX: usize = 24;
 // zmij lays a number out in a buffer of this size, from its start
 const _: () = assert!(std::mem::size_of::<zmij::Buffer>() >= NUMBER_MAX);
 
-/// Append `x` to `line` as Rust's `{x:?}` writes it (the shortest digits
+/// Write `x` at `dst` as Rust's `{x:?}` writes it (the shortest digits
 /// that parse back to the same `f64`; plain decimal from 1e-4 to below
 /// 1e16, else `1.5e-7`, `2e16`; of two shortest digit strings equally
 /// near `x` the even one, where std may take the other, both exact),
-/// several times faster: see [`put_number`].
-pub fn push_number(line: &mut Vec<u8>, digits: &mut zmij::Buffer, x: f64) {
-    line.reserve(NUMBER_MAX);
-    // SAFETY: NUMBER_MAX bytes reserved after the end; those written are
-    // initialized
-    unsafe {
-        let start = line.as_mut_ptr().add(line.len());
-        let end = put_number(start, digits, x);
-        line.set_len(line.len() + end.offset_from(start) as usize);
-    }
-}
-
-/// Write `x` at `dst` as [`push_number`] appends it; returns the end.
-/// The digits come from the `zmij` crate, whose own layout is Rust's
+/// several times faster; returns the end. The digits come from the `zmij` crate, whose own layout is Rust's
 /// except from 1e-5 to below 1e-4 (`0.00001`, Rust's `1e-5`) and from
 /// 1e16 up (`1e+16`, Rust's `1e16`), which are laid out again here
 /// ([`relaid`]). zmij's buffer is copied whole, a fixed 24 bytes that
@@ -507,7 +494,7 @@ unsafe fn put_whole(dst: *mut u8, x: f64) -> *mut u8 {
 
 #[cfg(test)]
 mod tests {
-    use super::{header, push_number, ColumnStats, CsvFile};
+    use super::{header, put_number, ColumnStats, CsvFile, NUMBER_MAX};
     use crate::output_file::OutputFile;
     use crate::rows::Rows;
     use crate::system::RecordedType;
@@ -602,9 +589,11 @@ mod tests {
     }
 
     fn written(x: f64) -> String {
-        let mut line = Vec::new();
-        push_number(&mut line, &mut zmij::Buffer::new(), x);
-        String::from_utf8(line).unwrap()
+        let mut line = [0u8; NUMBER_MAX];
+        let start = line.as_mut_ptr();
+        // SAFETY: NUMBER_MAX bytes of room; those up to the end written
+        let len = unsafe { put_number(start, &mut zmij::Buffer::new(), x).offset_from(start) };
+        String::from_utf8(line[..len as usize].to_vec()).unwrap()
     }
 
     /// Every value is written as `{:?}` writes it, and parses back to the
