@@ -450,3 +450,93 @@ fn invalid_utf8_is_refused() {
     assert!(matches!(e, FmuError::XmlSyntax { line: 4, .. }), "{e}");
     assert!(e.to_string().contains("UTF-8"), "{e}");
 }
+
+/// What the single-pass reader refuses beyond well-formedness: a missing
+/// required attribute, an attribute of the wrong type, an element that
+/// may appear once appearing twice, a second root, and a file cut short
+/// (named as truncated, with the element left open).
+#[test]
+fn structural_errors_are_refused_with_the_element() {
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            r#" guid="{1234-abcd}""#,
+            "",
+            &["<fmiModelDescription>", "no guid"],
+        ),
+        (
+            r#" modelName="Spring &amp; damper""#,
+            "",
+            &["<fmiModelDescription>", "no modelName"],
+        ),
+        (
+            r#"<CoSimulation modelIdentifier="Spring_1""#,
+            "<CoSimulation",
+            &["<CoSimulation>", "no modelIdentifier"],
+        ),
+        (
+            r#"canInterpolateInputs="1""#,
+            r#"canInterpolateInputs="yes""#,
+            &["canInterpolateInputs=\"yes\"", "not a boolean"],
+        ),
+        (
+            r#"maxOutputDerivativeOrder="2""#,
+            r#"maxOutputDerivativeOrder="-2""#,
+            &["maxOutputDerivativeOrder=\"-2\"", "not a valid integer"],
+        ),
+        (
+            r#"<Boolean start="true"/>"#,
+            r#"<Boolean start="on"/>"#,
+            &["<Boolean> start=\"on\""],
+        ),
+        (
+            r#"<Real start="0.5""#,
+            r#"<Real start="half""#,
+            &["<Real> start=\"half\"", "not a valid number"],
+        ),
+        (
+            r#"<Unknown index="2" "#,
+            r#"<Unknown "#,
+            &["<Unknown>", "no index"],
+        ),
+        (
+            r#"<Category name="logCalls"/>"#,
+            r#"<Category/>"#,
+            &["<Category>", "no name"],
+        ),
+        (
+            "<DefaultExperiment ",
+            "<DefaultExperiment/><DefaultExperiment ",
+            &["a second <DefaultExperiment>"],
+        ),
+        (
+            "</fmiModelDescription>",
+            "</fmiModelDescription><fmiModelDescription/>",
+            &["second root element"],
+        ),
+        (
+            r#"<Real unit="N"/>"#,
+            r#"<Real unit="N" unit="m"/>"#,
+            &["<Real>", "duplicated attribute"],
+        ),
+    ];
+    for (from, to, parts) in cases {
+        assert!(VALID.contains(from), "test case does not apply: {from}");
+        let e = refused(&VALID.replacen(from, to, 1), parts);
+        assert!(
+            matches!(e, FmuError::XmlSyntax { .. }),
+            "{from} -> {to}: {e}"
+        );
+    }
+    // Cut inside <ModelVariables>, between elements and inside a tag: the
+    // message names the element left open.
+    let end = VALID.find("</ModelVariables>").unwrap();
+    let opened = VALID[..VALID.find("<ModelVariables>").unwrap()]
+        .lines()
+        .count();
+    refused(
+        &VALID[..end],
+        &["truncated", "<ModelVariables>", &format!("line {opened}")],
+    );
+    let end = VALID.find("<ScalarVariable name=\"k\"").unwrap() + 10;
+    refused(&VALID[..end], &["truncated", "<ModelVariables>"]);
+}

@@ -5,18 +5,18 @@
 //! Co-Simulation interface, which is the one fricsim uses; the other is
 //! only noted ([`ModelDescription::model_exchange`]).
 //!
-//! Parsing has two passes: the root element's `fmiVersion` is read first
-//! (an FMI 1.0 or 3.0 file has another schema, and saying "version 3.0" is
-//! more useful than a missing-attribute error), then the whole document is
-//! deserialized with quick-xml + serde into `Raw…` structs that mirror the
-//! XML, and converted into the public types with the checks of §2.2.7
+//! Parsing is one pass of quick-xml's pull reader over the document,
+//! which checks well-formedness and fills `Raw…` structs that mirror the
+//! XML (the root's `fmiVersion` is checked first: an FMI 1.0 or 3.0 file
+//! has another schema, and saying "version 3.0" is more useful than a
+//! missing-attribute error); they are then converted into the public types
+//! with the checks of §2.2.7
 //! (legal causality/variability/initial values and combinations, unique
 //! names, units declared in `UnitDefinitions`, `ModelStructure` indices).
 
 use crate::error::FmuError;
 use crate::ssp::xml::{double_hyphen_offset, line_column};
 use quick_xml::events::Event;
-use serde::Deserialize;
 use std::collections::HashMap;
 use std::fmt;
 use std::path::Path;
@@ -262,26 +262,7 @@ impl ModelDescription {
     /// Parse the text of a `modelDescription.xml`.
     pub fn parse(xml: &str) -> Result<ModelDescription, FmuError> {
         let xml = xml.strip_prefix('\u{feff}').unwrap_or(xml);
-        check_fmi_version(xml)?;
-        let mut de = quick_xml::de::Deserializer::from_str(xml);
-        let raw = RawModelDescription::deserialize(&mut de).map_err(|e| {
-            let reader = de.get_ref().get_ref();
-            // Syntax errors point at the offending markup; errors found at
-            // the end of input (truncation) or by serde at the last event.
-            let position = match e {
-                quick_xml::DeError::InvalidXml(_) if reader.error_position() > 0 => {
-                    reader.error_position()
-                }
-                _ => reader.buffer_position(),
-            };
-            let (line, column) = line_column(xml.as_bytes(), position as usize);
-            FmuError::XmlSyntax {
-                line,
-                column,
-                message: e.to_string(),
-            }
-        })?;
-        raw.validate()
+        DescriptionReader::new(xml).read()?.validate()
     }
 
     /// The variable called `name`.
@@ -296,89 +277,552 @@ impl ModelDescription {
     }
 }
 
-/// First pass: the root element must be `fmiModelDescription` with
-/// `fmiVersion="2.0"`, and no comment may hold `--` (XML 1.0 §2.5: FMPy's
-/// parser, lxml, refuses such a file, so it is refused here too, with the
-/// line).
-fn check_fmi_version(xml: &str) -> Result<(), FmuError> {
-    let mut reader = quick_xml::Reader::from_str(xml);
-    reader.config_mut().check_comments = true;
-    let syntax = |reader: &quick_xml::Reader<&[u8]>, message: String| {
-        let (line, column) = line_column(xml.as_bytes(), reader.error_position() as usize);
-        FmuError::XmlSyntax {
-            line,
-            column,
-            message,
-        }
-    };
-    loop {
-        let position = reader.buffer_position() as usize;
-        match reader.read_event() {
-            Err(quick_xml::Error::IllFormed(
-                quick_xml::errors::IllFormedError::DoubleHyphenInComment,
-            )) => return Err(double_hyphen(xml, position)),
-            Err(e) => return Err(syntax(&reader, e.to_string())),
-            Ok(Event::Eof) => return Err(syntax(&reader, "no root element".into())),
-            Ok(Event::Start(e) | Event::Empty(e)) => {
-                if e.name().0 != "fmiModelDescription" {
-                    let found = e.name().0.to_string();
-                    return Err(syntax(
-                        &reader,
-                        format!("root element is <{found}>, expected <fmiModelDescription>"),
-                    ));
-                }
-                let version = e
-                    .try_get_attribute("fmiVersion")
-                    .map_err(|err| syntax(&reader, err.to_string()))?
-                    .ok_or_else(|| {
-                        syntax(
-                            &reader,
-                            "<fmiModelDescription> has no fmiVersion attribute".into(),
-                        )
-                    })?;
-                let version = version
-                    .normalized_value(quick_xml::XmlVersion::Implicit1_0)
-                    .map_err(|err| syntax(&reader, err.to_string()))?;
-                if version.trim() != "2.0" {
-                    return Err(FmuError::UnsupportedFmiVersion {
-                        found: version.into_owned(),
-                    });
-                }
-                return check_comments(xml, reader);
-            }
-            Ok(_) => {}
-        }
-    }
-}
-
-/// The rest of the first pass: only a comment holding `--` is reported
-/// here; any other error is left to the deserializer, whose messages say
-/// more (a truncated file names the element left open).
-fn check_comments(xml: &str, mut reader: quick_xml::Reader<&[u8]>) -> Result<(), FmuError> {
-    loop {
-        let position = reader.buffer_position() as usize;
-        match reader.read_event() {
-            Err(quick_xml::Error::IllFormed(
-                quick_xml::errors::IllFormedError::DoubleHyphenInComment,
-            )) => return Err(double_hyphen(xml, position)),
-            Err(_) | Ok(Event::Eof) => return Ok(()),
-            Ok(_) => {}
-        }
-    }
-}
-
 /// The error for a comment holding `--`, in the event starting at byte
 /// `event_start`.
 fn double_hyphen(xml: &str, event_start: usize) -> FmuError {
     let offset = double_hyphen_offset(xml, event_start);
+    syntax(
+        xml,
+        offset,
+        "`--` inside a comment, which XML does not allow (XML 1.0 §2.5): \
+         FMPy and other importers refuse the file"
+            .to_string(),
+    )
+}
+
+/// A syntax error at byte `offset` of `xml`.
+fn syntax(xml: &str, offset: usize, message: String) -> FmuError {
     let (line, column) = line_column(xml.as_bytes(), offset);
     FmuError::XmlSyntax {
         line,
         column,
-        message: "`--` inside a comment, which XML does not allow (XML 1.0 §2.5): \
-                  FMPy and other importers refuse the file"
-            .to_string(),
+        message,
     }
+}
+
+/// What the children of an open element are read as.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Scope {
+    Root,
+    UnitDefinitions,
+    LogCategories,
+    ModelVariables,
+    ScalarVariable,
+    ModelStructure,
+    Outputs,
+    /// An element fricsim does not read (`TypeDefinitions`, annotations,
+    /// `BaseUnit`, …) or one without children of interest: what is inside
+    /// is only checked for well-formedness.
+    Skip,
+}
+
+/// One pass over the document with quick-xml's reader, which checks
+/// well-formedness (matching end tags, attribute syntax, `--` in comments)
+/// as it goes, filling in the `Raw…` structs.
+struct DescriptionReader<'x> {
+    xml: &'x str,
+    reader: quick_xml::Reader<&'x [u8]>,
+    raw: Option<RawModelDescription>,
+    /// The open elements: what their children are read as, and the byte
+    /// offset of their `<`, for the message of a truncated file.
+    open: Vec<(Scope, usize)>,
+    root_closed: bool,
+}
+
+/// The element whose attributes are being read, for error messages.
+struct ElementAt<'x> {
+    xml: &'x str,
+    /// Byte offset of its `<`.
+    position: usize,
+    name: &'x str,
+}
+
+/// XML white space, which XML Schema allows around a number or boolean.
+const XML_SPACE: [char; 4] = [' ', '\t', '\n', '\r'];
+
+impl ElementAt<'_> {
+    fn error(&self, message: String) -> FmuError {
+        syntax(self.xml, self.position, message)
+    }
+
+    fn missing(&self, attribute: &str) -> FmuError {
+        self.error(format!("<{}> has no {attribute} attribute", self.name))
+    }
+
+    /// An `xs:double`, `xs:int` or `xs:unsignedInt` attribute (`INF`,
+    /// `-INF` and `NaN` included).
+    fn number<T: std::str::FromStr>(&self, key: &str, value: &str) -> Result<T, FmuError> {
+        value.trim_matches(XML_SPACE).parse().map_err(|_| {
+            self.error(format!(
+                "<{}> {}=\"{value}\" is not a valid {}",
+                self.name,
+                key,
+                if std::any::type_name::<T>() == "f64" {
+                    "number"
+                } else {
+                    "integer"
+                }
+            ))
+        })
+    }
+
+    /// An `xs:boolean` attribute: `true`, `false`, `1` or `0`.
+    fn boolean(&self, key: &str, value: &str) -> Result<bool, FmuError> {
+        match value.trim_matches(XML_SPACE) {
+            "true" | "1" => Ok(true),
+            "false" | "0" => Ok(false),
+            _ => Err(self.error(format!(
+                "<{}> {}=\"{value}\" is not a boolean (true, false, 1 or 0)",
+                self.name, key
+            ))),
+        }
+    }
+
+    /// Call `f` with the name and the normalized value of each attribute
+    /// of `element` (quick-xml refuses a duplicated attribute).
+    fn attributes(
+        &self,
+        element: &quick_xml::events::BytesStart<'_>,
+        mut f: impl FnMut(&str, std::borrow::Cow<'_, str>) -> Result<(), FmuError>,
+    ) -> Result<(), FmuError> {
+        for attribute in element.attributes() {
+            let attribute = attribute.map_err(|e| self.error(format!("<{}>: {e}", self.name)))?;
+            let value = attribute
+                .normalized_value(quick_xml::XmlVersion::Implicit1_0)
+                .map_err(|e| self.error(format!("<{}>: {e}", self.name)))?;
+            f(attribute.key.as_ref(), value)?;
+        }
+        Ok(())
+    }
+}
+
+impl<'x> DescriptionReader<'x> {
+    fn new(xml: &'x str) -> Self {
+        let mut reader = quick_xml::Reader::from_str(xml);
+        // `--` inside a comment is not well-formed XML (XML 1.0 §2.5):
+        // FMPy's parser, lxml, refuses such a file, so it is refused here
+        // too, with the line.
+        reader.config_mut().check_comments = true;
+        DescriptionReader {
+            xml,
+            reader,
+            raw: None,
+            open: Vec::new(),
+            root_closed: false,
+        }
+    }
+
+    fn read(mut self) -> Result<RawModelDescription, FmuError> {
+        let xml = self.xml;
+        loop {
+            let position = self.reader.buffer_position() as usize;
+            let event = match self.reader.read_event() {
+                Ok(event) => event,
+                Err(quick_xml::Error::IllFormed(
+                    quick_xml::errors::IllFormedError::DoubleHyphenInComment,
+                )) => return Err(double_hyphen(xml, position)),
+                Err(e) => {
+                    let mut message = e.to_string();
+                    if let (quick_xml::Error::Syntax(_), Some(&(_, at))) = (&e, self.open.last()) {
+                        message = format!("{message}; {}", self.truncated(at));
+                    }
+                    // (quick-xml leaves the error position at 0 for some
+                    // errors: the event that failed starts at `position`)
+                    let at = (self.reader.error_position() as usize).max(position);
+                    return Err(syntax(xml, at, message));
+                }
+            };
+            match event {
+                Event::Start(e) => {
+                    let scope = self.element(&e, position)?;
+                    self.open.push((scope, position));
+                }
+                Event::Empty(e) => {
+                    self.element(&e, position)?;
+                }
+                Event::End(_) => {
+                    self.open.pop();
+                    self.root_closed = self.open.is_empty();
+                }
+                Event::Eof => {
+                    if let Some(&(_, at)) = self.open.last() {
+                        return Err(syntax(xml, xml.len(), self.truncated(at)));
+                    }
+                    return self
+                        .raw
+                        .ok_or_else(|| syntax(xml, xml.len(), "no root element".into()));
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// "The document ends inside <X> (line N)" for the element opened at
+    /// byte `at`.
+    fn truncated(&self, at: usize) -> String {
+        let name: String = self.xml[at + 1..]
+            .chars()
+            .take_while(|c| !c.is_whitespace() && !matches!(c, '>' | '/'))
+            .collect();
+        let (line, _) = line_column(self.xml.as_bytes(), at);
+        format!("the document ends inside <{name}> (opened at line {line}): the file is truncated")
+    }
+
+    /// Read the element starting at byte `position`; returns what its
+    /// children are read as.
+    fn element(
+        &mut self,
+        e: &quick_xml::events::BytesStart<'_>,
+        position: usize,
+    ) -> Result<Scope, FmuError> {
+        let xml = self.xml;
+        let name = e.name().into_inner();
+        let at = ElementAt {
+            xml,
+            position,
+            name,
+        };
+        let Some(&(scope, _)) = self.open.last() else {
+            return self.root(e, &at);
+        };
+        let raw = self.raw.as_mut().expect("the root was read");
+        let once = |seen: bool| {
+            if seen {
+                Err(at.error(format!(
+                    "a second <{name}> in <fmiModelDescription>, which allows one"
+                )))
+            } else {
+                Ok(())
+            }
+        };
+        Ok(match (scope, name) {
+            (Scope::Root, "ModelExchange") => {
+                once(raw.model_exchange.is_some())?;
+                let mut me = RawModelExchange::default();
+                at.attributes(e, |key, value| {
+                    if key == "modelIdentifier" {
+                        me.model_identifier = value.into_owned();
+                    }
+                    Ok(())
+                })?;
+                raw.model_exchange = Some(me);
+                Scope::Skip
+            }
+            (Scope::Root, "CoSimulation") => {
+                once(raw.co_simulation.is_some())?;
+                raw.co_simulation = Some(co_simulation(e, &at)?);
+                Scope::Skip
+            }
+            (Scope::Root, "UnitDefinitions") => {
+                once(raw.unit_definitions.is_some())?;
+                raw.unit_definitions = Some(RawUnitDefinitions::default());
+                Scope::UnitDefinitions
+            }
+            (Scope::Root, "LogCategories") => {
+                once(raw.log_categories.is_some())?;
+                raw.log_categories = Some(RawLogCategories::default());
+                Scope::LogCategories
+            }
+            (Scope::Root, "DefaultExperiment") => {
+                once(raw.default_experiment.is_some())?;
+                let mut d = RawDefaultExperiment::default();
+                at.attributes(e, |key, value| {
+                    let field = match key {
+                        "startTime" => &mut d.start_time,
+                        "stopTime" => &mut d.stop_time,
+                        "tolerance" => &mut d.tolerance,
+                        "stepSize" => &mut d.step_size,
+                        _ => return Ok(()),
+                    };
+                    *field = Some(at.number(key, &value)?);
+                    Ok(())
+                })?;
+                raw.default_experiment = Some(d);
+                Scope::Skip
+            }
+            (Scope::Root, "ModelVariables") => {
+                once(raw.model_variables.is_some())?;
+                raw.model_variables = Some(RawModelVariables::default());
+                Scope::ModelVariables
+            }
+            (Scope::Root, "ModelStructure") => {
+                once(raw.model_structure.is_some())?;
+                raw.model_structure = Some(RawModelStructure::default());
+                Scope::ModelStructure
+            }
+            (Scope::UnitDefinitions, "Unit") => {
+                let mut unit = None;
+                at.attributes(e, |key, value| {
+                    if key == "name" {
+                        unit = Some(value.into_owned());
+                    }
+                    Ok(())
+                })?;
+                let name = unit.ok_or_else(|| at.missing("name"))?;
+                let units = raw.unit_definitions.as_mut().expect("open");
+                units.units.push(RawUnit { name });
+                Scope::Skip
+            }
+            (Scope::LogCategories, "Category") => {
+                let mut category = RawCategory::default();
+                let mut named = false;
+                at.attributes(e, |key, value| {
+                    match key {
+                        "name" => {
+                            category.name = value.into_owned();
+                            named = true;
+                        }
+                        "description" => category.description = Some(value.into_owned()),
+                        _ => {}
+                    }
+                    Ok(())
+                })?;
+                if !named {
+                    return Err(at.missing("name"));
+                }
+                let categories = raw.log_categories.as_mut().expect("open");
+                categories.categories.push(category);
+                Scope::Skip
+            }
+            (Scope::ModelVariables, "ScalarVariable") => {
+                let variable = scalar_variable(e, &at)?;
+                let variables = raw.model_variables.as_mut().expect("open");
+                variables.variables.push(variable);
+                Scope::ScalarVariable
+            }
+            (Scope::ScalarVariable, "Real" | "Integer" | "Boolean" | "String" | "Enumeration") => {
+                let variables = raw.model_variables.as_mut().expect("open");
+                let variable = variables.variables.last_mut().expect("open");
+                type_element(e, &at, variable)?;
+                Scope::Skip
+            }
+            (Scope::ModelStructure, "Outputs") => {
+                let structure = raw.model_structure.as_mut().expect("open");
+                if structure.outputs.is_some() {
+                    return Err(at.error("a second <Outputs> in <ModelStructure>".into()));
+                }
+                structure.outputs = Some(RawUnknowns::default());
+                Scope::Outputs
+            }
+            (Scope::Outputs, "Unknown") => {
+                let mut index = None;
+                let mut dependencies = None;
+                at.attributes(e, |key, value| {
+                    match key {
+                        "index" => index = Some(at.number(key, &value)?),
+                        "dependencies" => dependencies = Some(value.into_owned()),
+                        _ => {}
+                    }
+                    Ok(())
+                })?;
+                let index = index.ok_or_else(|| at.missing("index"))?;
+                let structure = raw.model_structure.as_mut().expect("open");
+                let outputs = structure.outputs.as_mut().expect("open");
+                outputs.unknowns.push(RawUnknown {
+                    index,
+                    dependencies,
+                });
+                Scope::Skip
+            }
+            _ => Scope::Skip,
+        })
+    }
+}
+
+impl DescriptionReader<'_> {
+    /// The root element: `fmiModelDescription` with `fmiVersion="2.0"`
+    /// (an FMI 1.0 or 3.0 file has another schema, and saying "version
+    /// 3.0" is more useful than a missing-attribute error).
+    fn root(
+        &mut self,
+        e: &quick_xml::events::BytesStart<'_>,
+        at: &ElementAt<'_>,
+    ) -> Result<Scope, FmuError> {
+        if self.root_closed {
+            return Err(at.error(format!(
+                "a second root element <{}> after </fmiModelDescription>",
+                at.name
+            )));
+        }
+        if at.name != "fmiModelDescription" {
+            return Err(at.error(format!(
+                "root element is <{}>, expected <fmiModelDescription>",
+                at.name
+            )));
+        }
+        let mut raw = RawModelDescription::default();
+        let (mut version, mut model_name, mut guid, mut indicators) = (None, None, None, None);
+        at.attributes(e, |key, value| {
+            let value = Some(value.into_owned());
+            match key {
+                "fmiVersion" => version = value,
+                "modelName" => model_name = value,
+                "guid" => guid = value,
+                "description" => raw.description = value,
+                "author" => raw.author = value,
+                "version" => raw.version = value,
+                "generationTool" => raw.generation_tool = value,
+                "generationDateAndTime" => raw.generation_date_and_time = value,
+                "numberOfEventIndicators" => indicators = value,
+                _ => {}
+            }
+            Ok(())
+        })?;
+        let version = version.ok_or_else(|| at.missing("fmiVersion"))?;
+        if version.trim_matches(XML_SPACE) != "2.0" {
+            return Err(FmuError::UnsupportedFmiVersion { found: version });
+        }
+        raw.fmi_version = version;
+        raw.model_name = model_name.ok_or_else(|| at.missing("modelName"))?;
+        raw.guid = guid.ok_or_else(|| at.missing("guid"))?;
+        if let Some(text) = indicators {
+            raw.number_of_event_indicators = Some(at.number("numberOfEventIndicators", &text)?);
+        }
+        self.raw = Some(raw);
+        Ok(Scope::Root)
+    }
+}
+
+/// The `CoSimulation` element (FMI 2.0 §4.3.1).
+fn co_simulation(
+    e: &quick_xml::events::BytesStart<'_>,
+    at: &ElementAt<'_>,
+) -> Result<RawCoSimulation, FmuError> {
+    let mut cs = RawCoSimulation::default();
+    let mut identified = false;
+    at.attributes(e, |key, value| {
+        let flag = match key {
+            "modelIdentifier" => {
+                cs.model_identifier = value.into_owned();
+                identified = true;
+                return Ok(());
+            }
+            "maxOutputDerivativeOrder" => {
+                cs.max_output_derivative_order = Some(at.number(key, &value)?);
+                return Ok(());
+            }
+            "needsExecutionTool" => &mut cs.needs_execution_tool,
+            "canHandleVariableCommunicationStepSize" => {
+                &mut cs.can_handle_variable_communication_step_size
+            }
+            "canInterpolateInputs" => &mut cs.can_interpolate_inputs,
+            "canRunAsynchronuously" => &mut cs.can_run_asynchronuously,
+            "canBeInstantiatedOnlyOncePerProcess" => {
+                &mut cs.can_be_instantiated_only_once_per_process
+            }
+            "canGetAndSetFMUstate" => &mut cs.can_get_and_set_fmu_state,
+            "canSerializeFMUstate" => &mut cs.can_serialize_fmu_state,
+            "providesDirectionalDerivative" => &mut cs.provides_directional_derivative,
+            _ => return Ok(()),
+        };
+        *flag = Some(at.boolean(key, &value)?);
+        Ok(())
+    })?;
+    if !identified {
+        return Err(at.missing("modelIdentifier"));
+    }
+    Ok(cs)
+}
+
+/// The attributes of a `ScalarVariable` (FMI 2.0 §2.2.7); whether they are
+/// present and legal is checked by [`RawScalarVariable::validate`], which
+/// names the variable.
+fn scalar_variable(
+    e: &quick_xml::events::BytesStart<'_>,
+    at: &ElementAt<'_>,
+) -> Result<RawScalarVariable, FmuError> {
+    let mut v = RawScalarVariable::default();
+    at.attributes(e, |key, value| {
+        match key {
+            "name" => v.name = Some(value.into_owned()),
+            "valueReference" => v.value_reference = Some(at.number(key, &value)?),
+            "description" => v.description = Some(value.into_owned()),
+            "causality" => v.causality = Some(value.into_owned()),
+            "variability" => v.variability = Some(value.into_owned()),
+            "initial" => v.initial = Some(value.into_owned()),
+            _ => {}
+        }
+        Ok(())
+    })?;
+    Ok(v)
+}
+
+/// A type element inside a `ScalarVariable` (`Real`, `Integer`, …), into
+/// `variable`; more than one is counted and refused by validation.
+fn type_element(
+    e: &quick_xml::events::BytesStart<'_>,
+    at: &ElementAt<'_>,
+    variable: &mut RawScalarVariable,
+) -> Result<(), FmuError> {
+    variable.type_elements += 1;
+    match at.name {
+        "Real" => {
+            let mut r = RawReal::default();
+            at.attributes(e, |key, value| {
+                let field = match key {
+                    "unit" => {
+                        r.unit = Some(value.into_owned());
+                        return Ok(());
+                    }
+                    "derivative" => {
+                        r.derivative = Some(at.number(key, &value)?);
+                        return Ok(());
+                    }
+                    "start" => &mut r.start,
+                    "nominal" => &mut r.nominal,
+                    "min" => &mut r.min,
+                    "max" => &mut r.max,
+                    _ => return Ok(()),
+                };
+                *field = Some(at.number(key, &value)?);
+                Ok(())
+            })?;
+            variable.real = Some(r);
+        }
+        "Integer" | "Enumeration" => {
+            let mut i = RawInteger::default();
+            at.attributes(e, |key, value| {
+                let field = match key {
+                    "declaredType" => {
+                        i.declared_type = Some(value.into_owned());
+                        return Ok(());
+                    }
+                    "start" => &mut i.start,
+                    "min" => &mut i.min,
+                    "max" => &mut i.max,
+                    _ => return Ok(()),
+                };
+                *field = Some(at.number(key, &value)?);
+                Ok(())
+            })?;
+            if at.name == "Integer" {
+                variable.integer = Some(i);
+            } else {
+                variable.enumeration = Some(i);
+            }
+        }
+        "Boolean" => {
+            let mut b = RawBoolean::default();
+            at.attributes(e, |key, value| {
+                if key == "start" {
+                    b.start = Some(at.boolean(key, &value)?);
+                }
+                Ok(())
+            })?;
+            variable.boolean = Some(b);
+        }
+        _ => {
+            let mut s = RawString::default();
+            at.attributes(e, |key, value| {
+                if key == "start" {
+                    s.start = Some(value.into_owned());
+                }
+                Ok(())
+            })?;
+            variable.string = Some(s);
+        }
+    }
+    Ok(())
 }
 
 fn invalid(location: impl Into<String>, message: impl Into<String>) -> FmuError {
@@ -396,215 +840,149 @@ fn is_c_identifier(s: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
-// The XML as it is, before validation. quick-xml maps attributes to `@name`
-// fields and child elements to fields named like the element; elements not
-// listed here (TypeDefinitions, annotations, …) are skipped.
+// The XML as it is, before validation: the attributes and child elements
+// fricsim reads, filled in by `DescriptionReader`; elements not listed
+// here (TypeDefinitions, annotations, …) are skipped.
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawModelDescription {
-    #[serde(rename = "@fmiVersion")]
     fmi_version: String,
-    #[serde(rename = "@modelName")]
     model_name: String,
-    #[serde(rename = "@guid")]
     guid: String,
-    #[serde(rename = "@description")]
     description: Option<String>,
-    #[serde(rename = "@author")]
     author: Option<String>,
-    #[serde(rename = "@version")]
     version: Option<String>,
-    #[serde(rename = "@generationTool")]
     generation_tool: Option<String>,
-    #[serde(rename = "@generationDateAndTime")]
     generation_date_and_time: Option<String>,
-    #[serde(rename = "@numberOfEventIndicators")]
     number_of_event_indicators: Option<u32>,
-    #[serde(rename = "ModelExchange")]
     model_exchange: Option<RawModelExchange>,
-    #[serde(rename = "CoSimulation")]
     co_simulation: Option<RawCoSimulation>,
-    #[serde(rename = "UnitDefinitions")]
     unit_definitions: Option<RawUnitDefinitions>,
-    #[serde(rename = "LogCategories")]
     log_categories: Option<RawLogCategories>,
-    #[serde(rename = "DefaultExperiment")]
     default_experiment: Option<RawDefaultExperiment>,
-    #[serde(rename = "ModelVariables")]
     model_variables: Option<RawModelVariables>,
-    #[serde(rename = "ModelStructure")]
     model_structure: Option<RawModelStructure>,
 }
 
 /// The one attribute of `ModelExchange` fricsim reports.
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawModelExchange {
-    #[serde(rename = "@modelIdentifier")]
     model_identifier: String,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawCoSimulation {
-    #[serde(rename = "@modelIdentifier")]
     model_identifier: String,
-    #[serde(rename = "@needsExecutionTool")]
     needs_execution_tool: Option<bool>,
-    #[serde(rename = "@canHandleVariableCommunicationStepSize")]
     can_handle_variable_communication_step_size: Option<bool>,
-    #[serde(rename = "@canInterpolateInputs")]
     can_interpolate_inputs: Option<bool>,
-    #[serde(rename = "@maxOutputDerivativeOrder")]
     max_output_derivative_order: Option<u32>,
-    #[serde(rename = "@canRunAsynchronuously")]
     can_run_asynchronuously: Option<bool>,
-    #[serde(rename = "@canBeInstantiatedOnlyOncePerProcess")]
     can_be_instantiated_only_once_per_process: Option<bool>,
-    #[serde(rename = "@canGetAndSetFMUstate")]
     can_get_and_set_fmu_state: Option<bool>,
-    #[serde(rename = "@canSerializeFMUstate")]
     can_serialize_fmu_state: Option<bool>,
-    #[serde(rename = "@providesDirectionalDerivative")]
     provides_directional_derivative: Option<bool>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawUnitDefinitions {
-    #[serde(rename = "Unit", default)]
     units: Vec<RawUnit>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawUnit {
-    #[serde(rename = "@name")]
     name: String,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawLogCategories {
-    #[serde(rename = "Category", default)]
     categories: Vec<RawCategory>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawCategory {
-    #[serde(rename = "@name")]
     name: String,
-    #[serde(rename = "@description")]
     description: Option<String>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawDefaultExperiment {
-    #[serde(rename = "@startTime")]
     start_time: Option<f64>,
-    #[serde(rename = "@stopTime")]
     stop_time: Option<f64>,
-    #[serde(rename = "@tolerance")]
     tolerance: Option<f64>,
-    #[serde(rename = "@stepSize")]
     step_size: Option<f64>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawModelVariables {
-    #[serde(rename = "ScalarVariable", default)]
     variables: Vec<RawScalarVariable>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawScalarVariable {
-    #[serde(rename = "@name")]
     name: Option<String>,
-    #[serde(rename = "@valueReference")]
     value_reference: Option<u32>,
-    #[serde(rename = "@description")]
     description: Option<String>,
-    #[serde(rename = "@causality")]
     causality: Option<String>,
-    #[serde(rename = "@variability")]
     variability: Option<String>,
-    #[serde(rename = "@initial")]
     initial: Option<String>,
-    #[serde(rename = "Real")]
     real: Option<RawReal>,
-    #[serde(rename = "Integer")]
     integer: Option<RawInteger>,
-    #[serde(rename = "Boolean")]
     boolean: Option<RawBoolean>,
-    #[serde(rename = "String")]
     string: Option<RawString>,
-    #[serde(rename = "Enumeration")]
     enumeration: Option<RawInteger>,
+    /// How many type elements (`Real`, `Integer`, …) it has: exactly one
+    /// is allowed.
+    type_elements: usize,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawReal {
-    #[serde(rename = "@start")]
     start: Option<f64>,
-    #[serde(rename = "@unit")]
     unit: Option<String>,
-    #[serde(rename = "@nominal")]
     nominal: Option<f64>,
-    #[serde(rename = "@min")]
     min: Option<f64>,
-    #[serde(rename = "@max")]
     max: Option<f64>,
-    #[serde(rename = "@derivative")]
     derivative: Option<usize>,
 }
 
 /// `Integer` and `Enumeration` share their attributes.
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawInteger {
-    #[serde(rename = "@declaredType")]
     declared_type: Option<String>,
-    #[serde(rename = "@start")]
     start: Option<i32>,
-    #[serde(rename = "@min")]
     min: Option<i32>,
-    #[serde(rename = "@max")]
     max: Option<i32>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawBoolean {
-    #[serde(rename = "@start")]
     start: Option<bool>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawString {
-    #[serde(rename = "@start")]
     start: Option<String>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawModelStructure {
-    #[serde(rename = "Outputs")]
     outputs: Option<RawUnknowns>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawUnknowns {
-    #[serde(rename = "Unknown", default)]
     unknowns: Vec<RawUnknown>,
 }
 
-#[derive(Deserialize)]
+#[derive(Default)]
 struct RawUnknown {
-    #[serde(rename = "@index")]
     index: usize,
-    #[serde(rename = "@dependencies")]
     dependencies: Option<String>,
 }
 
 impl RawModelDescription {
     fn validate(self) -> Result<ModelDescription, FmuError> {
-        if self.fmi_version.trim() != "2.0" {
-            return Err(FmuError::UnsupportedFmiVersion {
-                found: self.fmi_version,
-            });
-        }
         let cs = self.co_simulation.ok_or(FmuError::NotCoSimulation)?;
         if !is_c_identifier(&cs.model_identifier) {
             return Err(invalid(
@@ -882,10 +1260,10 @@ impl RawScalarVariable {
                 max: e.max,
             });
         }
-        if kinds.len() != 1 {
+        if self.type_elements != 1 {
             return Err(invalid(
                 &location,
-                format!("expected exactly one of <Real>, <Integer>, <Boolean>, <String>, <Enumeration>, found {}", kinds.len()),
+                format!("expected exactly one of <Real>, <Integer>, <Boolean>, <String>, <Enumeration>, found {}", self.type_elements),
             ));
         }
         let kind = kinds.pop().expect("one element");
