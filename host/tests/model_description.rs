@@ -481,7 +481,10 @@ fn structural_errors_are_refused_with_the_element() {
         (
             r#"maxOutputDerivativeOrder="2""#,
             r#"maxOutputDerivativeOrder="-2""#,
-            &["maxOutputDerivativeOrder=\"-2\"", "not a valid integer"],
+            &[
+                "maxOutputDerivativeOrder=\"-2\"",
+                "not a valid non-negative integer",
+            ],
         ),
         (
             r#"<Boolean start="true"/>"#,

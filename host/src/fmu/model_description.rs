@@ -337,6 +337,27 @@ struct ElementAt<'x> {
     name: &'x str,
 }
 
+/// The numeric types of attributes, and what an error calls them.
+trait XmlNumber: std::str::FromStr {
+    const KIND: &'static str;
+}
+
+impl XmlNumber for f64 {
+    const KIND: &'static str = "number";
+}
+
+impl XmlNumber for i32 {
+    const KIND: &'static str = "integer";
+}
+
+impl XmlNumber for u32 {
+    const KIND: &'static str = "non-negative integer";
+}
+
+impl XmlNumber for usize {
+    const KIND: &'static str = "non-negative integer";
+}
+
 /// XML white space, which XML Schema allows around a number or boolean.
 const XML_SPACE: [char; 4] = [' ', '\t', '\n', '\r'];
 
@@ -351,17 +372,12 @@ impl ElementAt<'_> {
 
     /// An `xs:double`, `xs:int` or `xs:unsignedInt` attribute (`INF`,
     /// `-INF` and `NaN` included).
-    fn number<T: std::str::FromStr>(&self, key: &str, value: &str) -> Result<T, FmuError> {
+    fn number<T: XmlNumber>(&self, key: &str, value: &str) -> Result<T, FmuError> {
         value.trim_matches(XML_SPACE).parse().map_err(|_| {
             self.error(format!(
-                "<{}> {}=\"{value}\" is not a valid {}",
+                "<{}> {key}=\"{value}\" is not a valid {}",
                 self.name,
-                key,
-                if std::any::type_name::<T>() == "f64" {
-                    "number"
-                } else {
-                    "integer"
-                }
+                T::KIND
             ))
         })
     }
