@@ -38,6 +38,7 @@ pub mod rows;
 pub mod run;
 pub mod signals;
 pub mod ssp;
+pub mod stale;
 pub mod sweep;
 pub mod system;
 pub mod writer_thread;

@@ -389,27 +389,7 @@ fn free_in_child(files: Vec<File>) -> Option<i32> {
 /// Temporary files `<prefix><pid>` of processes that no longer run. Called
 /// with the lock held, so that no live run of this path owns one.
 fn remove_stale_partials(dir: &Path, prefix: &str) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let name = entry.file_name();
-        let Some(pid) = name
-            .to_str()
-            .and_then(|n| n.strip_prefix(prefix))
-            .and_then(|p| p.parse::<libc::pid_t>().ok())
-        else {
-            continue;
-        };
-        // kill(pid, 0): ESRCH when no such process (kill(2))
-        // SAFETY: signal 0 sends nothing, it only checks the pid
-        let gone = pid > 0
-            && unsafe { libc::kill(pid, 0) } != 0
-            && std::io::Error::last_os_error().raw_os_error() == Some(libc::ESRCH);
-        if gone {
-            let _ = std::fs::remove_file(entry.path());
-        }
-    }
+    crate::stale::remove_left_by_gone_processes(dir, prefix, |p| std::fs::remove_file(p));
 }
 
 /// The advisory lock of a result path, held by a locked lock file.

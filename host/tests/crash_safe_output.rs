@@ -8,7 +8,8 @@
 //!   get an empty `TMPDIR` of their own, whose entries are counted while
 //!   they run and after).
 //! * SIGKILL mid-run leaves the previous result byte for byte; the next
-//!   run at that path removes the killed run's temporary file.
+//!   run at that path removes the killed run's temporary file, and the
+//!   folders it unpacked its FMUs into.
 //! * A second writer of a path being written is refused at once naming
 //!   the first one's pid; the first one's result is whole.
 //! * `--out` naming an input (the .ssd, an .ssv, an FMU, the `--input`
@@ -297,7 +298,8 @@ fn sigkill_mid_run_leaves_the_previous_result_and_the_next_run_cleans_up() {
     let out = setup.path("out/r.csv");
     let previous = setup.previous_result(&out);
     let child = long_run(&setup, &out);
-    let partial = partial_of(&out, child.id());
+    let pid = child.id();
+    let partial = partial_of(&out, pid);
     send(&child, libc::SIGKILL);
     let o = wait_output(child);
     assert_eq!(o.status.code(), None, "killed by a signal");
@@ -306,13 +308,37 @@ fn sigkill_mid_run_leaves_the_previous_result_and_the_next_run_cleans_up() {
         previous,
         "the previous result changed"
     );
-    // the only trace: the temporary file, named as one (and the lock file)
+    // the traces: the temporary file, named as one (and the lock file),
+    // and the two folders the killed run unpacked its FMUs into, named
+    // with its pid
     assert!(partial.exists());
+    let folders = std::fs::read_dir(setup.path("tmp"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect::<Vec<_>>();
+    let killed = format!("fricsim-fmu-{pid}-");
+    assert_eq!(folders.len(), 2, "{folders:?}");
+    assert!(
+        folders.iter().all(|f| f.starts_with(&killed)),
+        "{folders:?}"
+    );
+    // beside them, a folder of a process that runs (this test's) and one
+    // without a pid, which are not the next run's to remove
+    let alive = format!("fricsim-fmu-{}-alive", std::process::id());
+    for kept in [alive.as_str(), "fricsim-fmu-nopid"] {
+        std::fs::create_dir(setup.path("tmp").join(kept)).unwrap();
+    }
     // the killed run's lock does not block the next run, which removes the
-    // killed run's temporary file
+    // killed run's temporary file and folders
     let again = setup.previous_result(&out);
     assert_eq!(again, previous, "the same run, the same bytes");
     assert!(!partial.exists());
+    let mut left = std::fs::read_dir(setup.path("tmp"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect::<Vec<_>>();
+    left.sort();
+    assert_eq!(left, [alive.as_str(), "fricsim-fmu-nopid"]);
     assert_only_the_result(&setup);
 }
 

@@ -66,6 +66,29 @@ impl Default for UnpackOptions {
     }
 }
 
+/// The start of the unpack folders' names: `fricsim-fmu-<pid>-XXXXXX`, the
+/// pid telling a later run whether the process that made the folder still
+/// runs ([`crate::stale`]).
+pub const FOLDER_PREFIX: &str = "fricsim-fmu-";
+
+/// Remove, once per process and parent folder, the unpack folders in
+/// `parent` of processes that no longer run: a run killed with SIGKILL or
+/// crashed runs no destructor, and its folders would stay for good. The
+/// first FMU opened pays for one listing of `parent`.
+fn remove_folders_of_killed_runs(parent: &Path) {
+    static SWEPT: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+    {
+        let mut swept = SWEPT.lock().unwrap_or_else(|p| p.into_inner());
+        if swept.iter().any(|p| p == parent) {
+            return;
+        }
+        swept.push(parent.to_path_buf());
+    }
+    crate::stale::remove_left_by_gone_processes(parent, FOLDER_PREFIX, |p| {
+        std::fs::remove_dir_all(p)
+    });
+}
+
 /// Unpack the FMU at `path` into a new temporary directory, which is removed
 /// when the returned [`TempDir`] is dropped (or at once if unpacking fails).
 pub fn unpack(path: &Path, options: &UnpackOptions) -> Result<TempDir, FmuError> {
@@ -162,17 +185,16 @@ pub fn unpack_requiring(
         ));
     }
 
+    let parent = options
+        .temp_parent
+        .clone()
+        .unwrap_or_else(std::env::temp_dir);
+    remove_folders_of_killed_runs(&parent);
     let mut builder = tempfile::Builder::new();
-    builder.prefix("fricsim-fmu-");
-    let dir = match &options.temp_parent {
-        Some(parent) => builder.tempdir_in(parent),
-        None => builder.tempdir(),
-    }
-    .map_err(|source| FmuError::Io {
-        path: options
-            .temp_parent
-            .clone()
-            .unwrap_or_else(std::env::temp_dir),
+    let prefix = format!("{FOLDER_PREFIX}{}-", std::process::id());
+    builder.prefix(&prefix);
+    let dir = builder.tempdir_in(&parent).map_err(|source| FmuError::Io {
+        path: parent.clone(),
         source,
     })?;
 
