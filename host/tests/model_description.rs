@@ -517,6 +517,11 @@ fn structural_errors_are_refused_with_the_element() {
             &["second root element"],
         ),
         (
+            "</fmiModelDescription>",
+            "</fmiModelDescription>\n  trailing words\n",
+            &["text outside the root element"],
+        ),
+        (
             r#"<Real unit="N"/>"#,
             r#"<Real unit="N" unit="m"/>"#,
             &["<Real>", "duplicated attribute"],
@@ -530,6 +535,17 @@ fn structural_errors_are_refused_with_the_element() {
             "{from} -> {to}: {e}"
         );
     }
+    // A root element written as an empty element ends the document too.
+    refused(
+        r#"<fmiModelDescription fmiVersion="2.0" modelName="M" guid="g"/>
+<fmiModelDescription fmiVersion="2.0" modelName="N" guid="h"/>"#,
+        &["modelDescription.xml:2:", "second root element"],
+    );
+    refused("just text", &["text outside the root element"]);
+    refused(
+        &VALID.replace("</fmiModelDescription>", "</fmiModelDescription>&amp;"),
+        &["text outside the root element"],
+    );
     // Cut inside <ModelVariables>, between elements and inside a tag: the
     // message names the element left open.
     let end = VALID.find("</ModelVariables>").unwrap();

@@ -448,6 +448,21 @@ impl<'x> DescriptionReader<'x> {
                     return Err(syntax(xml, at, message));
                 }
             };
+            // XML 1.0 §2.1: only markup and white space may come before
+            // and after the root element
+            let outside_root = self.open.is_empty()
+                && match &event {
+                    Event::Text(text) => !text.trim_matches(XML_SPACE).is_empty(),
+                    Event::GeneralRef(_) => true,
+                    _ => false,
+                };
+            if outside_root {
+                return Err(syntax(
+                    xml,
+                    position,
+                    "text outside the root element <fmiModelDescription>".into(),
+                ));
+            }
             match event {
                 Event::Start(e) => {
                     let scope = self.element(&e, position)?;
@@ -455,6 +470,8 @@ impl<'x> DescriptionReader<'x> {
                 }
                 Event::Empty(e) => {
                     self.element(&e, position)?;
+                    // a root written `<fmiModelDescription …/>` ends here
+                    self.root_closed |= self.open.is_empty();
                 }
                 Event::End(_) => {
                     self.open.pop();
