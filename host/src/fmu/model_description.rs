@@ -326,7 +326,6 @@ struct DescriptionReader<'x> {
     /// The open elements: what their children are read as, and the byte
     /// offset of their `<`, for the message of a truncated file.
     open: Vec<(Scope, usize)>,
-    root_closed: bool,
 }
 
 /// The element whose attributes are being read, for error messages.
@@ -424,7 +423,6 @@ impl<'x> DescriptionReader<'x> {
             reader,
             raw: None,
             open: Vec::new(),
-            root_closed: false,
         }
     }
 
@@ -470,12 +468,9 @@ impl<'x> DescriptionReader<'x> {
                 }
                 Event::Empty(e) => {
                     self.element(&e, position)?;
-                    // a root written `<fmiModelDescription …/>` ends here
-                    self.root_closed |= self.open.is_empty();
                 }
                 Event::End(_) => {
                     self.open.pop();
-                    self.root_closed = self.open.is_empty();
                 }
                 Event::Eof => {
                     if let Some(&(_, at)) = self.open.last() {
@@ -671,7 +666,8 @@ impl DescriptionReader<'_> {
         e: &quick_xml::events::BytesStart<'_>,
         at: &ElementAt<'_>,
     ) -> Result<Scope, FmuError> {
-        if self.root_closed {
+        // reached with no element open: a root read before has ended
+        if self.raw.is_some() {
             return Err(at.error(format!(
                 "a second root element <{}> after </fmiModelDescription>",
                 at.name
