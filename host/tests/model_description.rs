@@ -546,6 +546,13 @@ fn structural_errors_are_refused_with_the_element() {
         &VALID.replace("</fmiModelDescription>", "</fmiModelDescription>&amp;"),
         &["text outside the root element"],
     );
+    refused(
+        &VALID.replace(
+            "</fmiModelDescription>",
+            "</fmiModelDescription><![CDATA[x]]>",
+        ),
+        &["text outside the root element"],
+    );
     // Cut inside <ModelVariables>, between elements and inside a tag: the
     // message names the element left open.
     let end = VALID.find("</ModelVariables>").unwrap();

@@ -509,6 +509,41 @@ fn a_truncated_file_says_so() {
 }
 
 #[test]
+fn text_outside_the_root_element_is_refused_with_its_line() {
+    let text = valid_system();
+    let end = text.rfind('>').unwrap() + 1;
+    let (head, tail) = text.split_at(end);
+    // white space (and comments) around the root stay allowed: the valid
+    // system ends with a line break
+    assert!(tail.chars().all(char::is_whitespace), "{tail:?}");
+    let last_line = head.lines().count();
+    for (extra, where_) in [
+        ("stray words", "after"),
+        ("&amp;", "after"),
+        ("<![CDATA[x]]>", "after"),
+    ] {
+        let message = refused(&format!("{head}\n{extra}\n"));
+        assert_message(
+            &message,
+            &[
+                &format!("system.ssd:{}:", last_line + 1),
+                &format!("text {where_} the root element <SystemStructureDescription>"),
+            ],
+        );
+    }
+    let declaration_end = text.find("?>").unwrap() + 2;
+    let (declaration, rest) = text.split_at(declaration_end);
+    let message = refused(&format!("{declaration}\nstray{rest}"));
+    assert_message(
+        &message,
+        &[
+            "system.ssd:2:",
+            "text before the root element <SystemStructureDescription>",
+        ],
+    );
+}
+
+#[test]
 fn the_root_element_and_version_are_checked() {
     let text = valid_system().replace(
         "http://ssp-standard.org/SSP1/SystemStructureDescription",

@@ -451,7 +451,7 @@ impl<'x> DescriptionReader<'x> {
             let outside_root = self.open.is_empty()
                 && match &event {
                     Event::Text(text) => !text.trim_matches(XML_SPACE).is_empty(),
-                    Event::GeneralRef(_) => true,
+                    Event::GeneralRef(_) | Event::CData(_) => true,
                     _ => false,
                 };
             if outside_root {

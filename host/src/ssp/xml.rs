@@ -166,6 +166,26 @@ pub fn first_pass(xml: &str, root: &str, namespace: &str) -> Result<(String, Lin
                 return Err(at(reader.error_position().max(position), message));
             }
         };
+        // XML 1.0 §2.1: only markup and white space may come before and
+        // after the root element (other SSP tools' parsers refuse the rest)
+        // (where the stray text starts: a text event starts with the white
+        // space before it)
+        let outside_root = match &event {
+            _ if !open.is_empty() => None,
+            Event::Text(text) => text
+                .as_ref()
+                .find(|c: char| !matches!(c, ' ' | '\t' | '\n' | '\r'))
+                .map(|k| position + k as u64),
+            Event::GeneralRef(_) | Event::CData(_) => Some(position),
+            _ => None,
+        };
+        if let Some(stray) = outside_root {
+            let place = if version.is_some() { "after" } else { "before" };
+            return Err(at(
+                stray,
+                format!("text {place} the root element <{root}>: XML allows only markup and white space outside it"),
+            ));
+        }
         let is_empty = matches!(event, Event::Empty(_));
         match event {
             Event::Start(e) | Event::Empty(e) => {
