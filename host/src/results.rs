@@ -322,6 +322,7 @@ impl ResultWriter {
             time: k.time.clone(),
             rows: k.rows.clone(),
             error: None,
+            warnings: Vec::new(),
         })
     }
 

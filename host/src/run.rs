@@ -342,6 +342,7 @@ impl PreparedRun {
             ended: streamed.ended,
             master_report: self.master.report(),
             wall_time: started.elapsed().as_secs_f64(),
+            warnings: streamed.warnings,
         })
     }
 }
@@ -378,6 +379,10 @@ pub struct RunOutcome {
     pub master_report: Option<String>,
     /// Wall-clock time of the run, in seconds.
     pub wall_time: f64,
+    /// Instances that refused `fmi2Terminate` after the last step, one
+    /// sentence each ([`crate::system::System::terminate`]): the rows
+    /// stand, the command warns.
+    pub warnings: Vec<String>,
 }
 
 impl RunOutcome {

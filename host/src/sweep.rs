@@ -211,6 +211,11 @@ pub fn run_point(
             outcome.points = points;
             outcome.columns = run.columns;
             outcome.error = run.error;
+            // the rows stand: a warning, as `fricsim run` gives
+            for w in &run.warnings {
+                let at: Vec<String> = point.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+                eprintln!("warning: at {}: {w}", at.join(", "));
+            }
         }
         Err(e) => outcome.error = Some(e),
     }

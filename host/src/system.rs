@@ -504,6 +504,31 @@ impl System {
         &self.warnings
     }
 
+    /// End the simulation of every instance with `fmi2Terminate`, as an
+    /// FMI 2.0 co-simulation master does after its last step (§4.2.4; FMPy
+    /// and libcosim do the same): an FMU may finish its work there (close
+    /// a file or a connection, check a final condition). An instance in
+    /// the error state (a call returned `fmi2Error` or `fmi2Fatal`) is
+    /// left out: FMI 2.0 allows it only `fmi2Reset` and
+    /// `fmi2FreeInstance`. Each instance that refuses is named, with its
+    /// status and messages, in the list returned; the others are still
+    /// terminated. [`System::restart`] (`fmi2Reset`) makes the instances
+    /// ready for another run.
+    pub fn terminate(&mut self) -> Vec<String> {
+        let mut refused = Vec::new();
+        for c in &mut self.components {
+            if c.instance.has_failed() {
+                continue;
+            }
+            if let Err(e) = c.instance.terminate() {
+                refused.push(format!(
+                    "the run's rows are complete, but the FMU did not end cleanly: {e}"
+                ));
+            }
+        }
+        refused
+    }
+
     /// Start over at `start` with the same instances: `fmi2Reset` each,
     /// set up the experiment, enter initialization mode and set the
     /// parameters as [`System::from_fmus`] does. Cheaper than building the

@@ -6,7 +6,8 @@
 //! and the report names the instance, the call and the status; a discarded
 //! step also says how far the FMU got (fmi2LastSuccessfulTime) and whether
 //! it asks to end (fmi2Terminated); after fmi2Fatal the FMU is never called
-//! again, not even by fmi2FreeInstance. The same through `fricsim cosim`,
+//! again, not even by fmi2FreeInstance; after fmi2Error it is not asked to
+//! fmi2Terminate (not allowed in the error state), only freed. The same through `fricsim cosim`,
 //! whose CSV keeps the rows so far and ends with an `# INCOMPLETE` line.
 //! A step that takes too long (0.6 s of sleep in the FMU) under a time
 //! limit (`--step-timeout`) is reported the same way, naming the instance,
@@ -157,6 +158,9 @@ fn an_error_mid_run_stops_the_run_and_the_instance_is_still_freed() {
             assert!(error.contains(part), "{}: {error}", master.name());
         }
         assert!(!error.contains("fmi2LastSuccessfulTime"), "{error}");
+        // the rig is in the error state, where FMI 2.0 allows no
+        // fmi2Terminate (BeltOscillator refuses it): only LuGre is ended
+        assert!(run.warnings.is_empty(), "{:?}", run.warnings);
         let counters = Counters::of(&system.components[0].fmu);
         drop(system);
         assert_eq!(counters.live_instances(), 0);

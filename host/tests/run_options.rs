@@ -5,7 +5,9 @@
 //! Boolean outputs are recorded exactly; start values (`--set`,
 //! `--start-values`) are read by the variable's type, checked and applied
 //! in order; `--output-interval` records every k-th row of the full run,
-//! bit for bit, and the last.
+//! bit for bit, and the last; every run ends its instances with
+//! `fmi2Terminate` before `fmi2FreeInstance`, and an instance that refuses
+//! it is named in a warning while the rows stand.
 
 mod common;
 mod stair;
@@ -49,8 +51,15 @@ fn column(columns: &[String], name: &str) -> usize {
 }
 
 fn fricsim(args: &[&str]) -> (Option<i32>, String, String) {
+    fricsim_with(args, &[])
+}
+
+/// [`fricsim`] with environment variables set (Stair reads STAIR_TRACE and
+/// STAIR_TERMINATE_FAILS).
+fn fricsim_with(args: &[&str], env: &[(&str, &Path)]) -> (Option<i32>, String, String) {
     let output = Command::new(env!("CARGO_BIN_EXE_fricsim"))
         .args(args)
+        .envs(env.iter().copied())
         .output()
         .unwrap();
     (
@@ -150,6 +159,101 @@ fn a_discard_without_terminated_stays_a_failure() {
     let csv = std::fs::read_to_string(&out).unwrap();
     assert!(csv.contains("# INCOMPLETE"), "{csv}");
     assert!(csv.contains("\n8.0,9.0,9,0\n"), "{csv}");
+}
+
+/// The lines Stair wrote to `trace` (STAIR_TRACE), the file then removed.
+fn take_trace(trace: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(trace).unwrap_or_default();
+    let _ = std::fs::remove_file(trace);
+    text.lines().map(str::to_string).collect()
+}
+
+#[test]
+fn every_run_ends_its_instances_with_fmi2terminate_before_freeing_them() {
+    // FMI 2.0 §4.2.4: after the last step the master calls fmi2Terminate,
+    // then fmi2FreeInstance (as FMPy's simulate_fmu and libcosim do). Stair
+    // traces both with its phase: 8 = stepFailed (its discarded last step),
+    // 16 = terminated. A missing fmi2Terminate leaves one line.
+    let (dir, ssd) = stair_system(1.0);
+    let trace = dir.path().join("trace.txt");
+    let out = dir.path().join("stair.csv");
+    let env = [("STAIR_TRACE", trace.as_path())];
+    let ended = vec![
+        "fmi2Terminate phase=8 t=9".to_string(),
+        "fmi2FreeInstance phase=16 t=9".to_string(),
+    ];
+    for extra in [&[][..], &["--isolate"][..]] {
+        let mut args = vec!["run", ssd.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let (code, stdout, stderr) = fricsim_with(&args, &env);
+        assert_eq!(code, Some(0), "{extra:?}: {stdout}{stderr}");
+        assert_eq!(take_trace(&trace), ended, "{extra:?}");
+    }
+    // fricsim sweep: each point's instances
+    let table = dir.path().join("sweep.csv");
+    let (code, stdout, stderr) = fricsim_with(
+        &[
+            "sweep",
+            ssd.to_str().unwrap(),
+            "--param",
+            "stair.step_height=1,2",
+            "--out",
+            table.to_str().unwrap(),
+        ],
+        &env,
+    );
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    let mut lines = take_trace(&trace);
+    lines.sort();
+    assert_eq!(
+        lines,
+        [
+            "fmi2FreeInstance phase=16 t=9",
+            "fmi2FreeInstance phase=16 t=9",
+            "fmi2Terminate phase=8 t=9",
+            "fmi2Terminate phase=8 t=9"
+        ]
+    );
+    // a run stopped by a discarded step (not an error: stepFailed, where
+    // fmi2Terminate is allowed) ends its instance too
+    let (code, stdout, stderr) = fricsim_with(
+        &[
+            "run",
+            ssd.to_str().unwrap(),
+            "--set",
+            "stair.terminates=false",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &env,
+    );
+    assert_eq!(code, Some(1), "{stdout}{stderr}");
+    assert_eq!(
+        take_trace(&trace),
+        ["fmi2Terminate phase=8 t=9", "fmi2FreeInstance phase=16 t=9"]
+    );
+}
+
+#[test]
+fn an_instance_that_refuses_fmi2terminate_is_named_in_a_warning_and_the_rows_stand() {
+    let (dir, ssd) = stair_system(1.0);
+    let reason = dir.path().join("the final check failed");
+    let out = dir.path().join("stair.csv");
+    let (code, stdout, stderr) = fricsim_with(
+        &["run", ssd.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        &[("STAIR_TERMINATE_FAILS", reason.as_path())],
+    );
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    for part in [
+        "warning: the run's rows are complete, but the FMU did not end cleanly",
+        "fmi2Terminate failed for instance \"stair\" with fmi2Error",
+        "the final check failed",
+    ] {
+        assert!(stderr.contains(part), "{part}: {stderr}");
+    }
+    let csv = std::fs::read_to_string(&out).unwrap();
+    assert!(!csv.contains("INCOMPLETE"), "{csv}");
+    assert_eq!(csv.lines().count(), 11, "{csv}");
 }
 
 /// The time the top is reached with these `--set` and `--start-values`.

@@ -110,6 +110,7 @@ fn reference(name: &str, step: Option<f64>) -> Run {
         time: file.time,
         rows,
         error: None,
+        warnings: Vec::new(),
     }
 }
 

@@ -281,6 +281,7 @@ fn run_row(
             columns: table.columns,
             time: table.time,
             error: None,
+            warnings: Vec::new(),
         },
     );
     eprintln!(

@@ -101,6 +101,8 @@ fn run_isolated(a: &CosimArgs, output: OutputFile) -> Result<(), String> {
         rows: isolated.rows,
         error: isolated.error,
         ended,
+        // (the child printed its own warnings)
+        warnings: Vec::new(),
     };
     conclude(
         a,
@@ -129,6 +131,8 @@ pub fn child(a: &CosimArgs, link: &mut Child) -> Result<(), String> {
             &mut NoObserver,
         )
         .map_err(|e| e.to_string())?;
+    // on the standard error the parent shares
+    super::print_warnings(&run.warnings);
     let ending = Ending {
         master_report: master.report(),
         wall: started.elapsed().as_secs_f64(),
@@ -277,6 +281,7 @@ pub fn conclude(
     wall: f64,
 ) -> Result<(), String> {
     let CosimSink { writer, plot_error } = sink;
+    super::print_warnings(&run.warnings);
     let kept = writer.kept();
     let stats = writer.stats.clone();
     writer

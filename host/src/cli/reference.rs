@@ -82,6 +82,7 @@ pub fn run(a: &ReferenceArgs) -> Result<(), String> {
         time: table.time.clone(),
         rows: Rows::from_rows(table.columns.len(), &table.rows),
         error: None,
+        warnings: Vec::new(),
     };
     // The writer of `fricsim run`: the same format to the digit.
     let output = fricsim::output_file::OutputFile::create(&out, &file.files_read())

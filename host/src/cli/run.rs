@@ -247,6 +247,8 @@ fn run_isolated(
         stats,
         master_report: isolated.ending.master_report,
         wall_time: isolated.ending.wall,
+        // (the child printed its own warnings)
+        warnings: Vec::new(),
     };
     let plan = isolated.plan;
     let ran = Ran {
@@ -284,6 +286,8 @@ pub fn child(a: &RunArgs, link: &mut Child) -> Result<(), String> {
     };
     let run = link.run_prepared(prepared, progress)?;
     bar.finish_and_clear();
+    // on the standard error the parent shares
+    super::print_warnings(&run.warnings);
     let ending = Ending {
         master_report: run.master_report,
         wall: run.wall_time,
@@ -322,6 +326,7 @@ fn conclude(
         step,
         master,
     } = ran;
+    super::print_warnings(&run.warnings);
     let kept = writer.kept();
     writer
         .finish(run.error.as_deref())

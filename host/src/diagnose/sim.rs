@@ -91,6 +91,8 @@ impl FrictionSim {
             i.get_real(&[self.force], &mut f).map_err(fail)?;
             out.push(f[0]);
         }
+        // the FMI 2.0 end of a run (§4.2.4); the next run resets
+        i.terminate().map_err(fail)?;
         Ok(out)
     }
 }

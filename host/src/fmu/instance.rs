@@ -180,6 +180,10 @@ pub struct Instance {
     callbacks: ManuallyDrop<Box<fmi2CallbackFunctions>>,
     states: Vec<fmi2FMUstate>,
     fatal: bool,
+    /// A call returned `fmi2Error` or `fmi2Fatal` since instantiation or
+    /// the last `fmi2Reset`: the instance is in the error state, from
+    /// which FMI 2.0 allows no `fmi2Terminate` (§4.2.4).
+    failed: bool,
     /// `fatal`, a time limit or a black box set: every call goes through
     /// [`Instance::begin_guarded`], the rest skip these checks with one test.
     guarded: bool,
@@ -302,6 +306,7 @@ impl Instance {
             callbacks: ManuallyDrop::new(callbacks),
             states: Vec::new(),
             fatal: false,
+            failed: false,
             guarded: false,
             limit: None,
             black_box: None,
@@ -459,6 +464,9 @@ impl Instance {
                 Ok(Status::Warning)
             }
             status => {
+                if matches!(status, Status::Error | Status::Fatal) {
+                    self.failed = true;
+                }
                 if status == Status::Fatal {
                     self.fatal = true;
                     self.guarded = true;
@@ -556,7 +564,17 @@ impl Instance {
     pub fn reset(&mut self) -> Result<Status, FmuError> {
         let f = self.functions.reset;
         // SAFETY: the component is live.
-        self.component_call("fmi2Reset", |c| unsafe { f(c) })
+        let status = self.component_call("fmi2Reset", |c| unsafe { f(c) })?;
+        self.failed = false;
+        Ok(status)
+    }
+
+    /// Whether a call has returned `fmi2Error` or `fmi2Fatal` since
+    /// instantiation or the last successful `fmi2Reset`: the instance is
+    /// then in FMI 2.0's error state, where `fmi2Terminate` is not allowed
+    /// (only `fmi2Reset` and `fmi2FreeInstance`).
+    pub fn has_failed(&self) -> bool {
+        self.failed
     }
 
     /// `fmi2CancelStep` (§4.2.2).

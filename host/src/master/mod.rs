@@ -85,6 +85,9 @@ pub struct Run {
     /// a windowed run holds no more times than rows.
     pub rows: Rows,
     pub error: Option<String>,
+    /// Instances that refused `fmi2Terminate` at the end of the run
+    /// ([`System::terminate`]), one sentence each: the rows stand.
+    pub warnings: Vec<String>,
 }
 
 /// Something the run consults at each communication point: external
@@ -279,6 +282,7 @@ pub fn simulate_with(
     system.start_recording(n + 1);
     system.sample()?;
     let (error, ended) = Stop::split(step_range(system, master, observer, start, h, 0..n, n));
+    let warnings = system.terminate();
     // the times of the rows kept follow from their number: nothing is
     // stored for them as the run steps
     let rows = system.take_recording();
@@ -291,6 +295,7 @@ pub fn simulate_with(
         time,
         rows,
         error,
+        warnings,
     })
 }
 
@@ -349,6 +354,9 @@ pub struct Streamed {
     /// The component that ended the run, if one did ([`Ended`]): a normal
     /// end, its last row recorded.
     pub ended: Option<Ended>,
+    /// Instances that refused `fmi2Terminate` at the end of the run
+    /// ([`System::terminate`]), one sentence each: the rows stand.
+    pub warnings: Vec<String>,
 }
 
 /// A component that ended the simulation before the stop time, as FMI 2.0
@@ -470,11 +478,13 @@ pub fn simulate_streaming(
         written += handing;
     }
     system.take_recording();
+    let warnings = system.terminate();
     Ok(Streamed {
         columns,
         rows: written,
         error,
         ended,
+        warnings,
     })
 }
 

@@ -14,11 +14,19 @@
  * returns fmi2Discard: fmi2GetRealStatus(fmi2LastSuccessfulTime) gives the
  * time of that second and fmi2GetBooleanStatus(fmi2Terminated) gives
  * `terminates` (true: the FMU ends the simulation, FMI 2.0.4 §4.2.3; false:
- * only a discarded step). A later fmi2DoStep is an error. */
+ * only a discarded step). A later fmi2DoStep is an error.
+ *
+ * For the tests of how an importer ends a run, two environment variables:
+ *   STAIR_TRACE=FILE            fmi2Terminate and fmi2FreeInstance append
+ *                               a line each to FILE (the call, the phase,
+ *                               the time)
+ *   STAIR_TERMINATE_FAILS=TEXT  fmi2Terminate logs TEXT and returns
+ *                               fmi2Error */
 
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* fmi2TypesPlatform.h and fmi2FunctionTypes.h, as much as is used here. */
@@ -191,9 +199,20 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
     return s;
 }
 
+/* A line to the file STAIR_TRACE names, if it names one. */
+static void trace(const Stair *s, const char *function) {
+    const char *path = getenv("STAIR_TRACE");
+    if (path == NULL) return;
+    FILE *f = fopen(path, "a");
+    if (f == NULL) return;
+    fprintf(f, "%s phase=%d t=%g\n", function, (int)s->phase, s->time);
+    fclose(f);
+}
+
 EXPORT void fmi2FreeInstance(fmi2Component c) {
     Stair *s = c;
     if (s == NULL) return;
+    trace(s, "fmi2FreeInstance");
     fmi2CallbackFreeMemory free_ = s->free;
     free_(s->name);
     free_(s);
@@ -237,6 +256,13 @@ EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 
 EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
     ENTER("fmi2Terminate", STEP_COMPLETE | STEP_FAILED);
+    trace(s, "fmi2Terminate");
+    const char *fails = getenv("STAIR_TERMINATE_FAILS");
+    if (fails != NULL) {
+        logf_(s, fmi2Error, "logStatusError", "fmi2Terminate: %s", fails);
+        s->phase = ERROR_STATE;
+        return fmi2Error;
+    }
     s->phase = TERMINATED;
     return fmi2OK;
 }
