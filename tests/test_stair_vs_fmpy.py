@@ -79,3 +79,40 @@ def test_fricsim_records_the_rows_fmpy_records_up_to_the_end_at_t_9(stair):
 
     # Integer and Boolean columns are whole numbers in the file: `10,1`
     assert text.splitlines()[-1] == "9.0,10.0,10,1"
+
+
+def trace_of(trace):
+    """The lines Stair wrote to ``trace`` (STAIR_TRACE), the file then removed."""
+    lines = trace.read_text().splitlines() if trace.exists() else []
+    trace.unlink(missing_ok=True)
+    return lines
+
+
+def test_fricsim_ends_the_instance_as_fmpy_does(stair, monkeypatch):
+    """After the last step FMPy's simulate_fmu calls fmi2Terminate, then
+    fmi2FreeInstance (FMI 2.0 section 4.2.4); `fricsim run` makes the same
+    two calls in the same phases. Stair traces them with its phase
+    (8 = stepFailed after its discarded last step, 16 = terminated)."""
+    trace = stair / "trace.txt"
+    trace.unlink(missing_ok=True)
+    monkeypatch.setenv("STAIR_TRACE", str(trace))
+    simulate_fmu(str(stair / "Stair.fmu"), fmi_type="CoSimulation", stop_time=10, step_size=0.25)
+    by_fmpy = trace_of(trace)
+    run = subprocess.run([str(FRICSIM), "run", str(stair / "stair.ssd"), "--out",
+                          str(stair / "traced.csv"), "--quiet"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert by_fmpy == ["fmi2Terminate phase=8 t=9", "fmi2FreeInstance phase=16 t=9"]
+    assert trace_of(trace) == by_fmpy
+
+
+def test_the_python_package_warns_of_a_refused_fmi2terminate(stair, monkeypatch):
+    """fricsim.run returns every row and gives a FricsimWarning naming the
+    instance and its message when fmi2Terminate fails, as `fricsim run`
+    prints a warning."""
+    import fricsim
+
+    monkeypatch.setenv("STAIR_TERMINATE_FAILS", "the final check failed")
+    with pytest.warns(fricsim.FricsimWarning, match="fmi2Terminate failed for instance \"stair\"") as caught:
+        result = fricsim.run(stair / "stair.ssd")
+    assert "the final check failed" in str(caught[0].message)
+    assert len(result) == 37 and result["time"][-1] == 9.0

@@ -15,6 +15,8 @@ gives it Python's types:
 
 Every error of the host raises :class:`FricsimError` (a ``RuntimeError``)
 with the host's message: the file and line, the instance, the FMI call.
+What ``fricsim run`` prints as a warning (an instance that refused
+``fmi2Terminate`` after the last step) is a :class:`FricsimWarning`.
 Ctrl-C stops a run cleanly and raises ``KeyboardInterrupt``.
 """
 
@@ -23,6 +25,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, Optional, Sequence, Union
@@ -35,6 +38,7 @@ from ._tables import write_table_csv
 
 __all__ = [
     "FricsimError",
+    "FricsimWarning",
     "ModelInfo",
     "Variable",
     "Diagnosis",
@@ -46,6 +50,11 @@ __all__ = [
 ]
 
 PathLike = Union[str, os.PathLike]
+
+
+class FricsimWarning(RuntimeWarning):
+    """What ``fricsim run`` prints as a warning: the rows stand (an
+    instance that refused ``fmi2Terminate`` after the last step)."""
 
 
 @dataclass(frozen=True)
@@ -124,14 +133,16 @@ def run(
     limits each FMI call, in seconds.
 
     A run that stops early raises :class:`FricsimError`; the rows up to the
-    failure are its ``result`` attribute.
+    failure are its ``result`` attribute. An instance that refuses
+    ``fmi2Terminate`` after the last step gives a :class:`FricsimWarning`
+    naming it; the rows stand.
     """
     values = list((start_values or {}).items())
     with tempfile.TemporaryDirectory(prefix="fricsim-input-") as tmp:
         input_path = None
         if input is not None:
             input_path = _as_csv(input, Path(tmp) / "input.csv")
-        columns, data, error = _native.run(
+        columns, data, error, refused = _native.run(
             os.fspath(system),
             start=start,
             stop=stop,
@@ -145,6 +156,8 @@ def run(
         )
     dtype = np.dtype([(c, np.float64) for c in columns])
     result = np.frombuffer(data, dtype=dtype).copy()
+    for message in refused:
+        warnings.warn(message, FricsimWarning, stacklevel=2)
     if error is not None:
         failure = FricsimError(
             f"run INCOMPLETE (the {len(result)} rows up to the failure are in "

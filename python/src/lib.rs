@@ -157,8 +157,9 @@ impl RowSink for Collect {
 }
 
 /// What `run` hands back: the column names (`time` first), the rows, and
-/// why the run stopped early, if it did.
-type RunResult = (Vec<String>, Vec<f64>, Option<String>);
+/// why the run stopped early, if it did, and the warnings of its end
+/// (instances that refused `fmi2Terminate`).
+type RunResult = (Vec<String>, Vec<f64>, Option<String>, Vec<String>);
 
 /// `fricsim.run`: co-simulate a system file exactly as `fricsim run` does
 /// (one code path: [`fricsim::run::PreparedRun`]), returning the rows
@@ -178,7 +179,7 @@ fn run(
     record: Vec<String>,
     input: Option<PathBuf>,
     step_timeout: Option<f64>,
-) -> PyResult<(Vec<String>, Py<PyBytes>, Option<String>)> {
+) -> PyResult<(Vec<String>, Py<PyBytes>, Option<String>, Vec<String>)> {
     let call_time_limit = match step_timeout {
         None => None,
         Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
@@ -192,7 +193,7 @@ fn run(
         .into_iter()
         .map(|(k, v)| (k, StartValue::from(v)))
         .collect();
-    let (columns, values, error) = py.allow_threads(move || -> Result<RunResult, PyErr> {
+    let (columns, values, error, warnings) = py.allow_threads(move || -> Result<RunResult, PyErr> {
         let file = SystemFile::open(&system).map_err(|e| host_error(e.to_string()))?;
         let options = RunOptions {
             start,
@@ -219,10 +220,10 @@ fn run(
         }
         let mut columns = vec!["time".to_string()];
         columns.extend(outcome.columns);
-        Ok((columns, sink.values, outcome.error))
+        Ok((columns, sink.values, outcome.error, outcome.warnings))
     })?;
     let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_ne_bytes()).collect();
-    Ok((columns, PyBytes::new(py, &bytes).unbind(), error))
+    Ok((columns, PyBytes::new(py, &bytes).unbind(), error, warnings))
 }
 
 /// One run of a sweep: the recorded columns, their final and RMS values,
