@@ -130,6 +130,22 @@ def run_to_files(command, name, env=None):
     return status, out.read_text(encoding="utf-8"), err.read_text(encoding="utf-8", errors="replace")
 
 
+@pytest.fixture(scope="module", autouse=True)
+def no_wine_process_outlives_the_module():
+    """Stop the prefix's Wine server and its service processes
+    (winedevice.exe and others) when the module is done, and wait for
+    them. Left alone they outlive pytest and end a few seconds later on
+    their own; one was seen to crash then, and glibc prints such a crash
+    (`corrupted double-linked list`) on the terminal after pytest's last
+    line, although every test passed."""
+    yield
+    if PREFIX.exists() and shutil.which("wineserver"):
+        subprocess.run(["wineserver", "--kill"], env=wine_env(), timeout=60,
+                       stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        subprocess.run(["wineserver", "--wait"], env=wine_env(), timeout=60,
+                       stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
 @lru_cache(maxsize=None)
 def tools():
     """Both drivers compiled, the Wine prefix created."""
