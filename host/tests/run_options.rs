@@ -182,28 +182,19 @@ fn every_run_ends_its_instances_with_fmi2terminate_before_freeing_them() {
         "fmi2Terminate phase=8 t=9".to_string(),
         "fmi2FreeInstance phase=16 t=9".to_string(),
     ];
-    for extra in [&[][..], &["--isolate"][..]] {
-        let mut args = vec!["run", ssd.to_str().unwrap(), "--out", out.to_str().unwrap()];
-        args.extend_from_slice(extra);
-        let (code, stdout, stderr) = fricsim_with(&args, &env);
-        assert_eq!(code, Some(0), "{extra:?}: {stdout}{stderr}");
-        assert_eq!(take_trace(&trace), ended, "{extra:?}");
-    }
+    // `fricsim ARGS` exits with `code`; what Stair traced
+    let traced = |args: &[&str], code: i32| {
+        let (got, stdout, stderr) = fricsim_with(args, &env);
+        assert_eq!(got, Some(code), "{args:?}: {stdout}{stderr}");
+        take_trace(&trace)
+    };
+    let (ssd, out) = (ssd.to_str().unwrap(), out.to_str().unwrap());
+    assert_eq!(traced(&["run", ssd, "--out", out], 0), ended);
+    assert_eq!(traced(&["run", ssd, "--out", out, "--isolate"], 0), ended);
     // fricsim sweep: each point's instances
     let table = dir.path().join("sweep.csv");
-    let (code, stdout, stderr) = fricsim_with(
-        &[
-            "sweep",
-            ssd.to_str().unwrap(),
-            "--param",
-            "stair.step_height=1,2",
-            "--out",
-            table.to_str().unwrap(),
-        ],
-        &env,
-    );
-    assert_eq!(code, Some(0), "{stdout}{stderr}");
-    let mut lines = take_trace(&trace);
+    let sweep = ["sweep", ssd, "--param", "stair.step_height=1,2", "--out"];
+    let mut lines = traced(&[&sweep[..], &[table.to_str().unwrap()]].concat(), 0);
     lines.sort();
     assert_eq!(
         lines,
@@ -216,22 +207,8 @@ fn every_run_ends_its_instances_with_fmi2terminate_before_freeing_them() {
     );
     // a run stopped by a discarded step (not an error: stepFailed, where
     // fmi2Terminate is allowed) ends its instance too
-    let (code, stdout, stderr) = fricsim_with(
-        &[
-            "run",
-            ssd.to_str().unwrap(),
-            "--set",
-            "stair.terminates=false",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &env,
-    );
-    assert_eq!(code, Some(1), "{stdout}{stderr}");
-    assert_eq!(
-        take_trace(&trace),
-        ["fmi2Terminate phase=8 t=9", "fmi2FreeInstance phase=16 t=9"]
-    );
+    let stopped = ["run", ssd, "--set", "stair.terminates=false", "--out", out];
+    assert_eq!(traced(&stopped, 1), ended);
 }
 
 #[test]
