@@ -77,9 +77,10 @@ fn quick_mode_writes_every_table_between_its_markers() {
     let finals: Vec<f64> = cells[4].split(", ").map(|x| x.parse().unwrap()).collect();
     assert_eq!(finals[0], finals[1], "{cells:?}");
     for format in ["CSV", "MAT v4"] {
-        // a new file and replacing the previous result, each against FMPy
+        // a new file, and replacing the previous result back to back and
+        // with the runs apart, each against FMPy
         let cells = common::table_row(&text, "**The whole `fricsim run", format);
-        assert_eq!(cells.len(), 5, "{cells:?}");
+        assert_eq!(cells.len(), 7, "{cells:?}");
     }
     for stop in ["0.1 s", "0.2 s", "0.4 s"] {
         let cells = common::table_row(&text, "**Peak resident memory**", stop);

@@ -24,7 +24,9 @@
 //!      nothing but each call's status checked, every output recorded;
 //!      timed in turns with the host.
 //!    - the whole `fricsim run` command, as a fresh process, writing its
-//!      CSV and its MAT file in turns; and its peak resident memory
+//!      CSV and its MAT file in turns: a new file, and over the previous
+//!      result with the runs back to back and [`SETTLE`] apart; and its
+//!      peak resident memory
 //!      (`wait4`'s `ru_maxrss`) for 20, 200 and 2000 s runs in both
 //!      formats.
 //! 3. **Appels and Herder's Experiments 3 curve**: the force–displacement
@@ -538,10 +540,19 @@ struct ProcessTable {
     /// The same, replacing the previous result at the path.
     csv_replacing: f64,
     mat_replacing: f64,
+    /// The same, each run [`SETTLE`] after the one before.
+    csv_replacing_spaced: f64,
+    mat_replacing_spaced: f64,
     /// Stop time, peak resident memory (bytes) writing CSV and MAT, and
     /// the two files' sizes.
     memory: Vec<(f64, u64, u64, u64, u64)>,
 }
+
+/// The pause before each run of the spaced replacing figures: longer
+/// than a run's background work after it exits (a child process closing
+/// the result it replaced, which has the file system free that file's
+/// blocks: 30 to 60 ms of waiting on the disk here, little CPU).
+const SETTLE: std::time::Duration = std::time::Duration::from_millis(250);
 
 /// `fricsim run examples/stick_slip.ssd --stop STOP --out OUT`, a fresh
 /// process: its wall time from spawn to exit, s, and its peak resident
@@ -624,8 +635,16 @@ fn process_table(root: &Path, sizes: &Sizes) -> Result<ProcessTable, String> {
         || Ok(fricsim_process(root, stop, &csv_out)?.0),
         || Ok(fricsim_process(root, stop, &mat_out)?.0),
     )?;
+    // the same, each run after the previous one's background work is
+    // done: what replacing costs a command started by itself
+    let spaced = |out: &Path| {
+        std::thread::sleep(SETTLE);
+        Ok(fricsim_process(root, stop, out)?.0)
+    };
+    let (csv_replacing_spaced, mat_replacing_spaced) =
+        best_of_alternating(sizes.repeats, || spaced(&csv_out), || spaced(&mat_out))?;
     eprintln!(
-        "fricsim run, whole process: CSV {csv:.3} s ({csv_replacing:.3} s replacing), MAT {mat:.3} s ({mat_replacing:.3} s replacing)"
+        "fricsim run, whole process: CSV {csv:.3} s ({csv_replacing:.3} s replacing, {csv_replacing_spaced:.3} s spaced), MAT {mat:.3} s ({mat_replacing:.3} s replacing, {mat_replacing_spaced:.3} s spaced)"
     );
     let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
     let mut memory = Vec::new();
@@ -644,6 +663,8 @@ fn process_table(root: &Path, sizes: &Sizes) -> Result<ProcessTable, String> {
         mat,
         csv_replacing,
         mat_replacing,
+        csv_replacing_spaced,
+        mat_replacing_spaced,
         memory,
     })
 }
@@ -1558,20 +1579,26 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
     let against = |t: f64| fmpy_jacobi.map_or("–".to_string(), |f| format!("{:.0}×", f / t));
     let _ = writeln!(
         s,
-        "\n**The whole `fricsim run {STICK_SLIP} --out FILE`** ({} s), a fresh process each time (start, unpacking the FMUs, the run, writing the file and `fsync`, exit), CSV and MAT v4 in turns, against FMPy's Jacobi loop above (its own clock, without the interpreter's start), writing a new file and replacing the previous result (the rename that puts the new file in place then has the file system free the old one's blocks, as `rm` would):\n",
-        h.stop
+        "\n**The whole `fricsim run {STICK_SLIP} --out FILE`** ({} s), a fresh process each time (start, unpacking the FMUs, the run, writing the file and `fsync`, exit), CSV and MAT v4 in turns, against FMPy's Jacobi loop above (its own clock, without the interpreter's start), writing a new file and replacing the previous result (the rename that puts the new file in place then has the file system free the old one's blocks, as `rm` would; a child process does that after fricsim exits), the replacing runs back to back and {} ms apart (when the runs follow each other at once, each starts while the file system frees the file the run before it replaced):\n",
+        h.stop,
+        SETTLE.as_millis()
     );
     let _ = writeln!(
         s,
-        "| result file | whole process, new file | FMPy / process | whole process, replacing | FMPy / process |\n|---|---|---|---|---|\n| CSV | {} | {} | {} | {} |\n| MAT v4 | {} | {} | {} | {} |",
+        "| result file | new file | FMPy / process | replacing, back to back | FMPy / process | replacing, {} ms apart | FMPy / process |\n|---|---|---|---|---|---|---|\n| CSV | {} | {} | {} | {} | {} | {} |\n| MAT v4 | {} | {} | {} | {} | {} | {} |",
+        SETTLE.as_millis(),
         duration(p.csv),
         against(p.csv),
         duration(p.csv_replacing),
         against(p.csv_replacing),
+        duration(p.csv_replacing_spaced),
+        against(p.csv_replacing_spaced),
         duration(p.mat),
         against(p.mat),
         duration(p.mat_replacing),
-        against(p.mat_replacing)
+        against(p.mat_replacing),
+        duration(p.mat_replacing_spaced),
+        against(p.mat_replacing_spaced)
     );
     let mb = |b: u64| format!("{:.1} MB", b as f64 / 1e6);
     let _ = writeln!(
@@ -1711,8 +1738,22 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
     for (format, t) in [
         ("a new CSV file", p.csv),
         ("a new MAT v4 file", p.mat),
-        ("CSV over the previous result", p.csv_replacing),
-        ("MAT v4 over the previous result", p.mat_replacing),
+        (
+            "CSV over the previous result, back to back",
+            p.csv_replacing,
+        ),
+        (
+            "MAT v4 over the previous result, back to back",
+            p.mat_replacing,
+        ),
+        (
+            "CSV over the previous result, runs apart",
+            p.csv_replacing_spaced,
+        ),
+        (
+            "MAT v4 over the previous result, runs apart",
+            p.mat_replacing_spaced,
+        ),
     ] {
         let _ = match fmpy_jacobi {
             Some(f) => writeln!(
