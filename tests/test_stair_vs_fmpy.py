@@ -88,11 +88,13 @@ def trace_of(trace):
     return lines
 
 
-def test_fricsim_ends_the_instance_as_fmpy_does(stair, monkeypatch):
-    """After the last step FMPy's simulate_fmu calls fmi2Terminate, then
+def test_fricsim_sets_up_and_ends_the_instance_as_fmpy_does(stair, monkeypatch):
+    """FMPy's simulate_fmu tells the instance the stop time in
+    fmi2SetupExperiment and, after the last step, calls fmi2Terminate, then
     fmi2FreeInstance (FMI 2.0 section 4.2.4); `fricsim run` makes the same
-    two calls in the same phases. Stair traces them with its phase
-    (8 = stepFailed after its discarded last step, 16 = terminated)."""
+    calls in the same phases with the same stop time. Stair traces them
+    with its phase (1 = instantiated, 8 = stepFailed after its discarded
+    last step, 16 = terminated)."""
     trace = stair / "trace.txt"
     trace.unlink(missing_ok=True)
     monkeypatch.setenv("STAIR_TRACE", str(trace))
@@ -101,7 +103,8 @@ def test_fricsim_ends_the_instance_as_fmpy_does(stair, monkeypatch):
     run = subprocess.run([str(FRICSIM), "run", str(stair / "stair.ssd"), "--out",
                           str(stair / "traced.csv"), "--quiet"], capture_output=True, text=True)
     assert run.returncode == 0, run.stdout + run.stderr
-    assert by_fmpy == ["fmi2Terminate phase=8 t=9", "fmi2FreeInstance phase=16 t=9"]
+    assert by_fmpy == ["fmi2SetupExperiment phase=1 t=0 stop=10",
+                       "fmi2Terminate phase=8 t=9", "fmi2FreeInstance phase=16 t=9"]
     assert trace_of(trace) == by_fmpy
 
 

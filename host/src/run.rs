@@ -37,7 +37,7 @@ use crate::master::{
 };
 use crate::results::ColumnStats;
 use crate::ssp::{SystemFile, Value};
-use crate::system::{ParameterValue, RecordedType, System};
+use crate::system::{Experiment, ParameterValue, RecordedType, System};
 use crate::FmuError;
 use std::time::Duration;
 
@@ -180,8 +180,13 @@ impl PreparedRun {
                 Ok((port.clone(), check_start_value(port, var, value)?))
             })
             .collect::<Result<Vec<_>, String>>()?;
+        // the FMUs are told the stop time, as FMPy tells them
         let mut system = file
-            .instantiate(&checked, start, &start_values)
+            .instantiate(
+                &checked,
+                Experiment::stepped(start, step, stop),
+                &start_values,
+            )
             .map_err(|e| e.to_string())?;
         system.set_call_time_limit(options.call_time_limit);
         system.record_discrete_outputs();

@@ -13,7 +13,7 @@
 use crate::master::{by_name, simulate_with, NoObserver};
 use crate::output_file::{OutputError, OutputFile};
 use crate::ssp::{CheckedSystem, SystemFile};
-use crate::system::ParameterValue;
+use crate::system::{Experiment, ParameterValue};
 use rayon::prelude::*;
 use std::io::Write as _;
 use std::time::Instant;
@@ -175,6 +175,8 @@ pub fn run_point(
         wall: 0.0,
         error: None,
     };
+    // told to each instance, as `fricsim run` tells it
+    let experiment = Experiment::stepped(plan.start, plan.step, plan.stop);
     let run = by_name(&plan.master).and_then(|mut master| {
         let once_per_process = checked.fmus.iter().any(|(_, fmu)| {
             fmu.description()
@@ -182,9 +184,9 @@ pub fn run_point(
                 .can_be_instantiated_only_once_per_process
         });
         let mut system = if once_per_process {
-            file.build_with(plan.start, &overrides)
+            file.build_with(experiment, &overrides)
         } else {
-            file.instantiate(checked, plan.start, &overrides)
+            file.instantiate(checked, experiment, &overrides)
         }
         .map_err(|e| e.to_string())?;
         // a summary is all a sweep keeps: no run holds its whole table

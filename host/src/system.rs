@@ -359,14 +359,57 @@ pub enum ParameterValue {
     Text(String),
 }
 
+/// The experiment each instance is told of by `fmi2SetupExperiment`: it
+/// starts at `start` and, if `stop` is given, ends there (FMI 2.0.4
+/// §2.1.6: the FMU may rely on it and must not compute past it). A start
+/// time alone converts into one without a stop time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Experiment {
+    pub start: f64,
+    pub stop: Option<f64>,
+}
+
+impl From<f64> for Experiment {
+    fn from(start: f64) -> Experiment {
+        Experiment { start, stop: None }
+    }
+}
+
+impl Experiment {
+    /// A run from `start` in macro steps of `step` towards `stop`, as the
+    /// masters step it ([`crate::master::step_count`]): its stop time is
+    /// the last communication point, `start + n·step`, which the last
+    /// step reaches exactly (FMPy tells the FMUs its stop time too; a
+    /// `stop` that is not a whole number of steps from `start` would
+    /// otherwise be short of the last point or past it).
+    pub fn stepped(start: f64, step: f64, stop: f64) -> Experiment {
+        let n = crate::master::step_count(start, step, stop);
+        Experiment {
+            start,
+            stop: Some(crate::master::communication_time(start, step, n)),
+        }
+    }
+}
+
 impl System {
     /// Open and instantiate each `(name, fmu path)`, set the parameters
     /// (`component.variable`, value), connect `(output port, input port)`;
-    /// the experiment starts at t = 0.
+    /// the experiment starts at t = 0, with no stop time.
     pub fn build(
         components: &[(String, &Path)],
         parameters: &[(String, f64)],
         connections: &[(String, String)],
+    ) -> Result<System, SystemError> {
+        System::build_for(components, parameters, connections, 0.0)
+    }
+
+    /// [`System::build`] for `experiment`: its start, and its stop time if
+    /// it has one.
+    pub fn build_for(
+        components: &[(String, &Path)],
+        parameters: &[(String, f64)],
+        connections: &[(String, String)],
+        experiment: impl Into<Experiment>,
     ) -> Result<System, SystemError> {
         let mut fmus = Vec::with_capacity(components.len());
         for (name, path) in components {
@@ -376,19 +419,21 @@ impl System {
             .iter()
             .map(|(k, v)| (k.clone(), ParameterValue::Number(*v)))
             .collect();
-        System::from_fmus(fmus, &parameters, connections, 0.0)
+        System::from_fmus(fmus, &parameters, connections, experiment)
     }
 
     /// Instantiate already opened FMUs `(name, fmu)`, connect
-    /// `(output port, input port)`, set up the experiment at `start`, enter
+    /// `(output port, input port)`, set up the experiment (its start, and
+    /// its stop if given: a start time alone has none), enter
     /// initialization mode and set the parameters (`component.variable`,
     /// value) there, in order (a later value for the same variable wins).
     pub fn from_fmus(
         fmus: Vec<(String, Fmu)>,
         parameters: &[(String, ParameterValue)],
         connections: &[(String, String)],
-        start: f64,
+        experiment: impl Into<Experiment>,
     ) -> Result<System, SystemError> {
+        let experiment = experiment.into();
         let mut list: Vec<Component> = Vec::new();
         for (name, fmu) in fmus {
             if list.iter().any(|c| c.name == name) {
@@ -491,7 +536,8 @@ impl System {
         }
         system.plan();
         for c in &mut system.components {
-            c.instance.setup_experiment(start, None)?;
+            c.instance
+                .setup_experiment(experiment.start, experiment.stop)?;
             c.instance.enter_initialization_mode()?;
         }
         system.set_parameters(parameters)?;

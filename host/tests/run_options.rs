@@ -169,16 +169,18 @@ fn take_trace(trace: &Path) -> Vec<String> {
 }
 
 #[test]
-fn every_run_ends_its_instances_with_fmi2terminate_before_freeing_them() {
-    // FMI 2.0 §4.2.4: after the last step the master calls fmi2Terminate,
-    // then fmi2FreeInstance (as FMPy's simulate_fmu and libcosim do). Stair
-    // traces both with its phase: 8 = stepFailed (its discarded last step),
-    // 16 = terminated. A missing fmi2Terminate leaves one line.
+fn every_run_tells_the_stop_time_and_ends_its_instances_with_fmi2terminate() {
+    // As FMPy's simulate_fmu does: fmi2SetupExperiment with the stop time
+    // (the last communication point), and after the last step
+    // fmi2Terminate, then fmi2FreeInstance (FMI 2.0 §4.2.4). Stair traces
+    // the three with its phase: 1 = instantiated, 8 = stepFailed (its
+    // discarded last step), 16 = terminated.
     let (dir, ssd) = stair_system(1.0);
     let trace = dir.path().join("trace.txt");
     let out = dir.path().join("stair.csv");
     let env = [("STAIR_TRACE", trace.as_path())];
     let ended = vec![
+        "fmi2SetupExperiment phase=1 t=0 stop=10".to_string(),
         "fmi2Terminate phase=8 t=9".to_string(),
         "fmi2FreeInstance phase=16 t=9".to_string(),
     ];
@@ -201,10 +203,17 @@ fn every_run_ends_its_instances_with_fmi2terminate_before_freeing_them() {
         [
             "fmi2FreeInstance phase=16 t=9",
             "fmi2FreeInstance phase=16 t=9",
+            "fmi2SetupExperiment phase=1 t=0 stop=10",
+            "fmi2SetupExperiment phase=1 t=0 stop=10",
             "fmi2Terminate phase=8 t=9",
             "fmi2Terminate phase=8 t=9"
         ]
     );
+    // a stop time that is not a whole number of steps: the last
+    // communication point, which the masters reach (round(9.4 / 1) = 9
+    // steps)
+    let short = traced(&["run", ssd, "--stop", "9.4", "--out", out], 0);
+    assert_eq!(short[0], "fmi2SetupExperiment phase=1 t=0 stop=9");
     // a run stopped by a discarded step (not an error: stepFailed, where
     // fmi2Terminate is allowed) ends its instance too
     let stopped = ["run", ssd, "--set", "stair.terminates=false", "--out", out];

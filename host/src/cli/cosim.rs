@@ -6,7 +6,7 @@ use fricsim::isolate::child::Child;
 use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, Streamed};
 use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
-use fricsim::system::{RecordedType, System};
+use fricsim::system::{Experiment, RecordedType, System};
 use fricsim::writer_thread::on_writer_thread;
 use std::path::{Path, PathBuf};
 
@@ -222,8 +222,14 @@ fn build(
     a: &CosimArgs,
     parsed: &Parsed,
 ) -> Result<(System, Box<dyn MasterAlgorithm>, CosimPlan), String> {
-    let mut system = System::build(&parsed.components, &parsed.parameters, &parsed.connections)
-        .map_err(|e| e.to_string())?;
+    // the FMUs are told the stop time, as `run` and FMPy tell them
+    let mut system = System::build_for(
+        &parsed.components,
+        &parsed.parameters,
+        &parsed.connections,
+        Experiment::stepped(0.0, a.step, a.stop),
+    )
+    .map_err(|e| e.to_string())?;
     system.set_call_time_limit(super::call_time_limit(a.step_timeout)?);
     // every output, Integer and Boolean ones too, as `run` records them
     system.record_discrete_outputs();

@@ -37,7 +37,7 @@ pub use pack::pack;
 use crate::fmu::archive::{unpack_requiring, UnpackOptions};
 use crate::fmu::model_description::{Causality, ScalarVariable, Variability, VariableKind};
 use crate::fmu::Fmu;
-use crate::system::{ParameterValue, System, SystemError};
+use crate::system::{Experiment, ParameterValue, System, SystemError};
 use crate::FmuError;
 use std::path::{Component as PathPart, Path, PathBuf};
 use tempfile::TempDir;
@@ -1184,10 +1184,10 @@ impl SystemFile {
     /// point of a parameter sweep (`fricsim sweep`).
     pub fn build_with(
         &self,
-        start: f64,
+        experiment: impl Into<Experiment>,
         overrides: &[(String, ParameterValue)],
     ) -> Result<System, SspError> {
-        self.instantiate(&self.check()?, start, overrides)
+        self.instantiate(&self.check()?, experiment, overrides)
     }
 
     /// [`SystemFile::build_with`] on FMUs already opened and checked by
@@ -1196,7 +1196,7 @@ impl SystemFile {
     pub fn instantiate(
         &self,
         checked: &CheckedSystem,
-        start: f64,
+        experiment: impl Into<Experiment>,
         overrides: &[(String, ParameterValue)],
     ) -> Result<System, SspError> {
         let parameters: Vec<(String, ParameterValue)> = self
@@ -1218,8 +1218,9 @@ impl SystemFile {
             .iter()
             .map(|c| (c.from.clone(), c.to.clone()))
             .collect();
-        let mut system = System::from_fmus(checked.fmus.clone(), &parameters, &connections, start)
-            .map_err(|e| error(&self.ssd, system_error(e)))?;
+        let mut system =
+            System::from_fmus(checked.fmus.clone(), &parameters, &connections, experiment)
+                .map_err(|e| error(&self.ssd, system_error(e)))?;
         for s in self.settings.record.iter().chain(&self.settings.plot) {
             system.record(s).map_err(|e| {
                 error(

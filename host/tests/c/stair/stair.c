@@ -17,9 +17,10 @@
  * only a discarded step). A later fmi2DoStep is an error.
  *
  * For the tests of how an importer ends a run, two environment variables:
- *   STAIR_TRACE=FILE            fmi2Terminate and fmi2FreeInstance append
- *                               a line each to FILE (the call, the phase,
- *                               the time)
+ *   STAIR_TRACE=FILE            fmi2SetupExperiment (with the stop time
+ *                               it was told, if any), fmi2Terminate and
+ *                               fmi2FreeInstance append a line each to
+ *                               FILE (the call, the phase, the time)
  *   STAIR_TERMINATE_FAILS=TEXT  fmi2Terminate logs TEXT and returns
  *                               fmi2Error */
 
@@ -199,20 +200,21 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
     return s;
 }
 
-/* A line to the file STAIR_TRACE names, if it names one. */
-static void trace(const Stair *s, const char *function) {
+/* A line to the file STAIR_TRACE names, if it names one: the call, the
+ * phase, the time, then `detail`. */
+static void trace(const Stair *s, const char *function, const char *detail) {
     const char *path = getenv("STAIR_TRACE");
     if (path == NULL) return;
     FILE *f = fopen(path, "a");
     if (f == NULL) return;
-    fprintf(f, "%s phase=%d t=%g\n", function, (int)s->phase, s->time);
+    fprintf(f, "%s phase=%d t=%g%s\n", function, (int)s->phase, s->time, detail);
     fclose(f);
 }
 
 EXPORT void fmi2FreeInstance(fmi2Component c) {
     Stair *s = c;
     if (s == NULL) return;
-    trace(s, "fmi2FreeInstance");
+    trace(s, "fmi2FreeInstance", "");
     fmi2CallbackFreeMemory free_ = s->free;
     free_(s->name);
     free_(s);
@@ -224,8 +226,6 @@ EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolerance_def
                                       fmi2Real start, fmi2Boolean stop_defined, fmi2Real stop) {
     (void)tolerance_defined;
     (void)tolerance;
-    (void)stop_defined;
-    (void)stop;
     ENTER("fmi2SetupExperiment", INSTANTIATED);
     if (!isfinite(start)) {
         logf_(s, fmi2Error, "logStatusError", "fmi2SetupExperiment: start time %g is not finite", start);
@@ -233,6 +233,13 @@ EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolerance_def
     }
     s->time = s->last_successful_time = start;
     s->next_stair = floor(start) + 1.0;
+    char told[64];
+    if (stop_defined) {
+        snprintf(told, sizeof told, " stop=%g", stop);
+    } else {
+        snprintf(told, sizeof told, " stop=undefined");
+    }
+    trace(s, "fmi2SetupExperiment", told);
     return fmi2OK;
 }
 
@@ -256,7 +263,7 @@ EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 
 EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
     ENTER("fmi2Terminate", STEP_COMPLETE | STEP_FAILED);
-    trace(s, "fmi2Terminate");
+    trace(s, "fmi2Terminate", "");
     const char *fails = getenv("STAIR_TERMINATE_FAILS");
     if (fails != NULL) {
         logf_(s, fmi2Error, "logStatusError", "fmi2Terminate: %s", fails);
