@@ -10,14 +10,15 @@ set -euo pipefail
 cd "$(dirname "$0")"
 # the MinGW-w64 linker, Wine for the tests, the Rust target (idempotent)
 scripts/setup-windows.sh
-cargo build --release -p friction-fmu-c -p rig-fmu-c -p fmu-packager -p friction-fmu
+# the host too, in the same cargo call: the link-time optimisation of each
+# library and of fricsim (one thread each) run side by side
+cargo build --release -p friction-fmu-c -p rig-fmu-c -p fmu-packager -p friction-fmu -p fricsim
 # the linker and flags of this target are in .cargo/config.toml
 cargo build --release --target x86_64-pc-windows-gnu -p friction-fmu-c -p rig-fmu-c
 target/release/fmu-package check modelDescription
 target/release/fmu-package build --out dist \
     --platform linux64=target/release \
     --platform win64=target/x86_64-pc-windows-gnu/release
-cargo build --release -p fricsim
 # (packed afresh: an example renamed or removed leaves no stale archive)
 rm -f dist/*.ssp
 for ssd in examples/*.ssd; do

@@ -7,15 +7,51 @@
 # (libclang for its bindings), build and install the Python package
 # fricsim (python/, maturin) and run the Python tests (pytest-xdist, two
 # workers).
+#
+# The set-ups that mostly wait on the network (pip's downloads, apt's)
+# run in the background while the Rust builds and tests keep the cores
+# busy; their output is in target/set-up/ and shown when they end. apt
+# runs one install at a time: MinGW and Wine first, then the browser and
+# libclang in one background chain (apt refuses a second install while
+# one holds its lock).
 set -euo pipefail
 cd "$(dirname "$0")"
+mkdir -p target/set-up
+
+declare -A pids
+# start NAME COMMAND...: run COMMAND in the background, its output in
+# target/set-up/NAME.log
+start() {
+    local name=$1
+    shift
+    "$@" > "target/set-up/$name.log" 2>&1 &
+    pids[$name]=$!
+}
+# finish NAME: wait for NAME, show its output, stop here if it failed
+finish() {
+    local name=$1 status=0
+    wait "${pids[$name]}" || status=$?
+    unset "pids[$name]"
+    cat "target/set-up/$name.log"
+    if [ "$status" -ne 0 ]; then
+        echo "run-tests.sh: the set-up '$name' failed (exit status $status), output above" >&2
+        exit "$status"
+    fi
+}
+# a failure in the foreground stops the background set-ups too
+trap 'for pid in "${pids[@]}"; do kill "$pid" 2> /dev/null || true; done' EXIT
+
+start venv scripts/setup-venv.sh
+scripts/setup-windows.sh
+start browser-and-fmi-crate bash -c 'scripts/setup-browser.sh && scripts/setup-fmi-crate.sh'
 ./build-fmu.sh
 cargo test --workspace --profile release-test
-scripts/setup-venv.sh
-scripts/setup-browser.sh
-scripts/setup-fmi-crate.sh
+finish venv
+finish browser-and-fmi-crate
 scripts/setup-python-package.sh
-# on two workers, each test file whole on one of them (--dist loadfile:
-# a file's module fixtures, such as its Dask cluster or the Wine prefix
-# of test_windows_dll.py, stay in one process)
-.venv/bin/python -m pytest tests -q -n 2 --dist loadfile
+# on two workers, each test file whole on one of them (a file's module
+# fixtures, such as its Dask cluster or the Wine prefix of
+# test_windows_dll.py, stay in one process) but the long files whose tests
+# share nothing, spread test by test (tests/conftest.py, SPREAD_FILES);
+# the slowest tests listed at the end
+.venv/bin/python -m pytest tests -q -n 2 --dist loadfile --durations=15

@@ -12,6 +12,6 @@ if [ "$(id -u)" -ne 0 ]; then
     sudo="sudo"
 fi
 echo "setup-browser.sh: installing chromium (Debian package) for the report tests" >&2
-$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium > /dev/null \
-    || { $sudo apt-get update -q > /dev/null && $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium > /dev/null; }
+$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -o DPkg::Lock::Timeout=600 -y -q chromium > /dev/null \
+    || { $sudo apt-get update -o DPkg::Lock::Timeout=600 -q > /dev/null && $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -o DPkg::Lock::Timeout=600 -y -q chromium > /dev/null; }
 command -v chromium > /dev/null

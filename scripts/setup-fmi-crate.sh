@@ -15,8 +15,8 @@ if ! dpkg -s libclang-dev > /dev/null 2>&1; then
         sudo="sudo"
     fi
     echo "setup-fmi-crate.sh: installing libclang-dev (Debian package) for the fmi crate's bindgen" >&2
-    install="$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends libclang-dev"
-    $install > /dev/null || { $sudo apt-get update -q > /dev/null && $install > /dev/null; }
+    install="$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -o DPkg::Lock::Timeout=600 -y -q --no-install-recommends libclang-dev"
+    $install > /dev/null || { $sudo apt-get update -o DPkg::Lock::Timeout=600 -q > /dev/null && $install > /dev/null; }
 fi
 cargo build --locked --quiet --manifest-path tests/fmi-crate/Cargo.toml \
     --target-dir target/fmi-crate

@@ -22,9 +22,9 @@ if [ ${#need[@]} -gt 0 ]; then
     # not needed to run a 64-bit console program.
     install() {
         $sudo env DEBIAN_FRONTEND=noninteractive \
-            apt-get install -y -q --no-install-recommends "${need[@]}" > /dev/null
+            apt-get install -o DPkg::Lock::Timeout=600 -y -q --no-install-recommends "${need[@]}" > /dev/null
     }
-    install || { $sudo apt-get update -q > /dev/null && install; }
+    install || { $sudo apt-get update -o DPkg::Lock::Timeout=600 -q > /dev/null && install; }
 fi
 command -v x86_64-w64-mingw32-gcc > /dev/null
 command -v x86_64-w64-mingw32-objdump > /dev/null

@@ -126,3 +126,31 @@ def run_in_process(model, times, columns, slopes, parameters, tmp_path):
     args += [f"{k}={str(v).lower() if isinstance(v, bool) else repr(v)}" for k, v in parameters.items()]
     subprocess.run(args, check=True, capture_output=True, text=True)
     return np.genfromtxt(out, delimiter=",", names=True)
+
+
+
+#: Test files whose tests share nothing (each works in its own tmp_path and
+#: processes) and take long: spread test by test over the pytest-xdist
+#: workers. Every other file runs whole on one worker, as `--dist loadfile`
+#: has it (its module fixtures, such as the Dask cluster of
+#: test_python_dask.py or the Wine prefix of test_windows_dll.py, are made
+#: once).
+SPREAD_FILES = {"test_diagnose_independent.py", "test_libcosim.py"}
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """`--dist loadfile` (run-tests.sh), but the tests of SPREAD_FILES one
+    by one: pytest-xdist's scope scheduling with a scope per file, and per
+    test in those files. (Not `--dist loadgroup` with marks: pytest-xdist
+    3.8 renames a marked test's node id, which pytest 9.2 no longer lets
+    it do, so the marks group nothing.)"""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class FileOrTestScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid):
+            file = nodeid.split("::", 1)[0]
+            return nodeid if Path(file).name in SPREAD_FILES else file
+
+    return FileOrTestScheduling(config, log)

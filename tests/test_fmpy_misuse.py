@@ -1,5 +1,5 @@
 """Misuse of every shipped FMU through FMPy (the Rust twin is
-host/tests/misuse.rs): every FMI 2.0 Co-Simulation function called in every
+host/tests/integration/misuse.rs): every FMI 2.0 Co-Simulation function called in every
 reachable state in which the standard (FMI 2.0.4 section 4.2.4) does not
 allow it, NULL arrays, unknown value references, fixed parameters after
 initialization, NaN and +-inf for every real input and parameter, wrong

@@ -264,7 +264,7 @@ def test_dahl_model_exchange_follows_the_closed_form(alpha):
 def stick_slip_figures(t, v, f, threshold=0.05):
     """First slip (v first above `threshold`), period (between the last two
     such crossings), peak friction force and peak velocity, as
-    host/tests/stick_slip.rs and docs/models.md state them."""
+    host/tests/integration/stick_slip.rs and docs/models.md state them."""
     up = [t[i - 1] + (threshold - v[i - 1]) / (v[i] - v[i - 1]) * (t[i] - t[i - 1])
           for i in range(1, len(v)) if v[i - 1] < threshold <= v[i]]
     assert len(up) >= 3, f"expected periodic stick-slip, got slips at {up}"
@@ -282,7 +282,7 @@ def stick_slip_figures(t, v, f, threshold=0.05):
 def stick_slip_reference(tmp_path_factory):
     """`fricsim reference` of examples/stick_slip.ssd (the monolithic
     Radau IIA solution, rtol 1e-10) over 30 s (three slips, as
-    host/tests/stick_slip.rs runs it) at 1e-3 s: time, rig.v,
+    host/tests/integration/stick_slip.rs runs it) at 1e-3 s: time, rig.v,
     friction.F."""
     assert FRICSIM.exists(), f"{FRICSIM} is missing: run ./build-fmu.sh"
     out = tmp_path_factory.mktemp("reference") / "stick_slip_reference.csv"

@@ -1,6 +1,6 @@
 //! The benchmark programs' help texts work and cite the papers by author
 //! and year, never by an internal number ("seed 000"), as every text a
-//! user reads (host/tests/docs.rs checks fricsim's and the documents).
+//! user reads (host/tests/integration/docs.rs checks fricsim's and the documents).
 
 use std::process::Command;
 

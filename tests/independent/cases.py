@@ -79,10 +79,14 @@ def simulator() -> Path:
     src = HERE / "lugre_rig.c"
     if not out.exists() or out.stat().st_mtime < src.stat().st_mtime:
         out.parent.mkdir(parents=True, exist_ok=True)
+        # built beside it and renamed into place: the test workers may
+        # build it at the same time, and none must run a half-written one
+        part = out.with_name(f"{out.name}.{os.getpid()}")
         subprocess.run(
-            [os.environ.get("CC", "cc"), "-O2", "-o", str(out), str(src), "-lm"],
+            [os.environ.get("CC", "cc"), "-O2", "-o", str(part), str(src), "-lm"],
             check=True,
         )
+        os.replace(part, out)
     return out
 
 

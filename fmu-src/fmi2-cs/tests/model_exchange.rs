@@ -373,7 +373,7 @@ fn life_cycle_with_a_state_event() {
 
 /// Every probe in every Model Exchange state an importer reaches agrees
 /// with the layer's Model Exchange table (the table against the standard:
-/// `host/tests/model_exchange.rs`, on the shipped FMUs): allowed calls
+/// `host/tests/integration/model_exchange.rs`, on the shipped FMUs): allowed calls
 /// succeed, the others are refused with the function, "illegal call
 /// sequence" and the state in the message; Co-Simulation functions in
 /// none.

@@ -19,7 +19,7 @@
 //!   error alone).
 //!
 //! `hidden-effect-suite` (bench/src/bin) runs a grid of cases and writes
-//! the table of BENCHMARKS.md; `host/tests/diagnose_hidden_effects.rs`
+//! the table of BENCHMARKS.md; `host/tests/integration/diagnose_hidden_effects.rs`
 //! runs a few.
 
 use super::model::{Effect, FrictionModel};

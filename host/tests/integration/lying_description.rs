@@ -7,7 +7,7 @@
 //! instance, the call and the FMU's own message. Nothing is written outside
 //! the host's temporary directory, which is removed when the FMU is dropped.
 
-mod common;
+use crate::common;
 use common::assert_message;
 use fricsim::fmu::{Fmu, UnpackOptions};
 use fricsim::system::System;

@@ -2,7 +2,7 @@
 //! `build-fmu.sh` if missing): steady state, state save/restore, NaN input,
 //! derivatives, and `fricsim info`.
 
-mod common;
+use crate::common;
 
 use fricsim::fmu::{Fmu, Instance, Status};
 use fricsim::FmuError;

@@ -6,7 +6,7 @@
 //! output driving an input with a unit (no third-party FMU without units
 //! could drive ours from an SSP file), and `cosim` checked no units at all.
 
-mod common;
+use crate::common;
 use common::assert_message;
 use fricsim::ssp::SystemFile;
 use fricsim::system::System;

@@ -4,7 +4,7 @@
 //! temporary directories and point at the repository's dist/*.fmu by
 //! absolute path.
 
-mod common;
+use crate::common;
 use common::{assert_message, repository};
 use fricsim::inputs::{interpolate, ExternalInputs, InputTable};
 use fricsim::master::{jacobi::Jacobi, simulate, simulate_with};

@@ -1,7 +1,7 @@
 //! Unpacking refuses malicious and broken archives, names the problem, and
 //! writes nothing outside its temporary directory.
 
-mod common;
+use crate::common;
 use common::assert_message;
 use fricsim::fmu::archive::{unpack, UnpackOptions, DEFAULT_MAX_BYTES, DEFAULT_MAX_ENTRIES};
 use fricsim::{ArchiveProblem, FmuError};

@@ -9,8 +9,8 @@
 //! the temporary directory. A run that goes well gives the in-process
 //! run's file byte for byte.
 
-mod belt;
-mod common;
+use crate::belt;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -11,8 +11,8 @@
 //! (the host then does not even resolve the functions), and BeltOscillator,
 //! a hand-written C FMU that declares neither (tests/c/belt_oscillator).
 
-mod belt;
-mod common;
+use crate::belt;
+use crate::common;
 
 use fricsim::master::strong::{JacobianSource, StrongCoupling, Update};
 use fricsim::master::{by_name, jacobi::Jacobi, simulate, MasterAlgorithm, Run};

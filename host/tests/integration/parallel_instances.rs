@@ -5,7 +5,7 @@
 //! support several instances; ours keep no global state besides the table
 //! of live instances).
 
-mod fmi;
+use crate::fmi;
 use fmi::*;
 
 const STEPS: usize = 400;

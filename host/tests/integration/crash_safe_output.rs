@@ -20,8 +20,8 @@
 //! * An FMU failing mid-run puts its rows so far, marked, in place of the
 //!   previous result.
 
-mod belt;
-mod common;
+use crate::belt;
+use crate::common;
 
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};

@@ -9,8 +9,8 @@
 //! `fmi2Terminate` before `fmi2FreeInstance`, and an instance that refuses
 //! it is named in a warning while the rows stand.
 
-mod common;
-mod stair;
+use crate::common;
+use crate::stair;
 
 use fricsim::master::{RowSink, Rows};
 use fricsim::run::{run, PreparedRun, RunOptions, StartValue};

@@ -6,8 +6,8 @@
 //! or asks to stop stops the run; the CSV written as the rows come is the
 //! one written from the whole run, byte for byte.
 
-mod belt;
-mod common;
+use crate::belt;
+use crate::common;
 
 use fricsim::master::{
     by_name, simulate_streaming, simulate_with, NoObserver, RowSink, Rows, Run, Streamed,

@@ -12,7 +12,7 @@
 //!   `.ssd`/`.ssv` files to the system-file reader: an error or a result,
 //!   never a panic.
 
-mod fmi;
+use crate::fmi;
 use fmi::*;
 use std::time::Instant;
 

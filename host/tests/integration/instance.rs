@@ -2,7 +2,7 @@
 //! steps, statuses turned into errors with the FMU's own messages, the
 //! variadic logger (formatting and long messages), and freeing.
 
-mod common;
+use crate::common;
 
 use common::stub_fmu_dir;
 use fricsim::fmu::{Fmu, Status};

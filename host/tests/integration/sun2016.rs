@@ -11,7 +11,7 @@
 //! x = −(Fs/σ0)·ln(1 − F/Fs) (the tests check these values; the paper's
 //! identification assumed z = x in pre-sliding, eq. 19–21).
 
-mod paper_examples;
+use crate::paper_examples;
 use paper_examples::*;
 
 /// Sun et al.'s LuGre parameters (examples/lugre_sun2016.ssv).

@@ -3,7 +3,7 @@
 //! the instance that sent them (`[name] status [category]: message`), and
 //! an FMU error carries the FMU's message and the instance name.
 
-mod common;
+use crate::common;
 use fricsim::fmu::{Fmu, Status};
 
 #[test]

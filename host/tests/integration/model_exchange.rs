@@ -13,7 +13,7 @@
 //! Modelica Reference FMUs), independently of the FMUs' own table in
 //! `fmi2-cs/src/state_machine.rs`.
 
-mod fmi;
+use crate::fmi;
 use fmi::*;
 use std::os::raw::c_int;
 use std::ptr::{null, null_mut};

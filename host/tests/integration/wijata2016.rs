@@ -23,7 +23,7 @@
 //! Radau IIA with the stick/slide switches located), on which the paper's
 //! behaviours are checked as well.
 
-mod common;
+use crate::common;
 use common::repository;
 use fricsim::compare::ResultFile;
 use fricsim::master::{by_name, simulate, Run};

@@ -1,7 +1,7 @@
 //! Loading the binary: missing platform, not a shared library, missing
 //! required or declared functions, wrong FMI version.
 
-mod common;
+use crate::common;
 use common::assert_message;
 
 use common::{stub_description, stub_fmu_dir};

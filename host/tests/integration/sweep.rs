@@ -3,7 +3,7 @@
 //! anything runs; a sweep's run, which keeps its last rows only, keeps
 //! their times only. Nothing here depends on how fast the machine is.
 
-mod common;
+use crate::common;
 
 use fricsim::master::{by_name, communication_time, simulate_with, NoObserver, Run};
 use fricsim::ssp::SystemFile;

@@ -2,7 +2,7 @@
 //! values; malformed, truncated or rule-breaking ones are refused with a
 //! message that says what and where.
 
-mod common;
+use crate::common;
 use fricsim::fmu::model_description::Unknown;
 use fricsim::fmu::{Causality, Initial, ModelDescription, Variability, VariableKind};
 use fricsim::FmuError;

@@ -12,7 +12,7 @@
 //! The rig–bristle loop is algebraic (both sides direct feedthrough, loop
 //! gain σ_ini/k ≈ 120): the newton master solves it, jacobi cannot.
 
-mod paper_examples;
+use crate::paper_examples;
 use fricsim::master::{by_name, simulate};
 use paper_examples::*;
 

@@ -7,8 +7,8 @@
 //! (the plant fails at its 500th step, every fallback too), the diagnosis
 //! ends with a message naming the time, the component and the call.
 
-mod belt;
-mod common;
+use crate::belt;
+use crate::common;
 
 use fricsim::diagnose::model::Effect;
 use fricsim::diagnose::{diagnose, Options};

@@ -7,8 +7,8 @@
 //! (The importer's own tests, archive.rs, model_description.rs, library.rs
 //! and stick_slip.rs, check the same cases and more through the library.)
 
-mod belt;
-mod common;
+use crate::belt;
+use crate::common;
 
 use std::io::Write;
 use std::path::PathBuf;

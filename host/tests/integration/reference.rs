@@ -4,7 +4,7 @@
 //! monolithic model are refused by component. The systems are written into
 //! temporary directories and point at the repository's dist/*.fmu.
 
-mod common;
+use crate::common;
 use common::{lugre_fmu, repository};
 use fricsim::compare::{compare, ResultFile};
 use std::path::Path;

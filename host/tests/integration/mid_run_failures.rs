@@ -14,8 +14,8 @@
 //! the call, its duration and the limit; the watchdog says so on stderr
 //! while the call is still running.
 
-mod belt;
-mod common;
+use crate::belt;
+use crate::common;
 
 use belt::Counters;
 use fricsim::master::{gauss_seidel::GaussSeidel, jacobi::Jacobi, simulate, MasterAlgorithm, Run};

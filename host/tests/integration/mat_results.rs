@@ -4,8 +4,8 @@
 //! `fricsim compare` gives the same figures on either format; `fricsim
 //! diagnose`'s reader (`InputTable`) reads the same table from both.
 
-mod belt;
-mod common;
+use crate::belt;
+use crate::common;
 
 use fricsim::compare::{compare, ResultFile};
 use fricsim::inputs::InputTable;
