@@ -52,6 +52,6 @@ scripts/setup-python-package.sh
 # on two workers, each test file whole on one of them (a file's module
 # fixtures, such as its Dask cluster or the Wine prefix of
 # test_windows_dll.py, stay in one process) but the long files whose tests
-# share nothing, spread test by test (tests/conftest.py, SPREAD_FILES);
-# the slowest tests listed at the end
-.venv/bin/python -m pytest tests -q -n 2 --dist loadfile --durations=15
+# share nothing, spread test by test and handed out first (tests/conftest.py,
+# SPREAD_FILES); the slowest tests listed at the end
+.venv/bin/python -m pytest tests -q -n 2 --dist loadfile --no-loadscope-reorder --durations=15

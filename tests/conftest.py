@@ -154,3 +154,12 @@ def pytest_xdist_make_scheduler(config, log):
             return nodeid if Path(file).name in SPREAD_FILES else file
 
     return FileOrTestScheduling(config, log)
+
+
+def pytest_collection_modifyitems(config, items):
+    """The tests of SPREAD_FILES first. run-tests.sh passes
+    `--no-loadscope-reorder`, so the scheduler hands the work out in this
+    order: the long single tests start at once on both workers instead of
+    last (pytest-xdist's own order puts the files with the most tests
+    first), when one worker could be left running the longest alone."""
+    items.sort(key=lambda item: item.path.name not in SPREAD_FILES)
