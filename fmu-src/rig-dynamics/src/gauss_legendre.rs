@@ -73,38 +73,69 @@ pub(crate) fn stage_derivatives(
 /// arithmetic differs by rounding.
 #[inline]
 pub(crate) fn linear_stage_sums(hs: f64, l: [[f64; 2]; 2], b: [f64; 4]) -> [f64; 2] {
-    let p = [[hs * l[0][0], hs * l[0][1]], [hs * l[1][0], hs * l[1][1]]];
-    let p2 = [
+    StageSolver::new(hs, l).sums(b)
+}
+
+/// [`linear_stage_sums`] for one step length `hs` and linear part `L`,
+/// for many right-hand sides: `P = hs·L` and the matrix
+/// `Q = I − P/2 + P²/12` with its determinant are formed once, and each
+/// [`StageSolver::sums`] does the rest, operation for operation as
+/// [`linear_stage_sums`] does it (the results are the same to the bit).
+/// The rigs step with the same `hs` and `L` step after step, so forming
+/// `Q` was most of a step's arithmetic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StageSolver {
+    /// The step length the solver was formed for.
+    pub(crate) hs: f64,
+    p: [[f64; 2]; 2],
+    q: [[f64; 2]; 2],
+    det: f64,
+}
+
+impl StageSolver {
+    #[inline]
+    pub(crate) fn new(hs: f64, l: [[f64; 2]; 2]) -> Self {
+        let p = [[hs * l[0][0], hs * l[0][1]], [hs * l[1][0], hs * l[1][1]]];
+        let p2 = [
+            [
+                p[0][0] * p[0][0] + p[0][1] * p[1][0],
+                p[0][0] * p[0][1] + p[0][1] * p[1][1],
+            ],
+            [
+                p[1][0] * p[0][0] + p[1][1] * p[1][0],
+                p[1][0] * p[0][1] + p[1][1] * p[1][1],
+            ],
+        ];
+        const TWELFTH: f64 = 1.0 / 12.0;
+        let q = [
+            [
+                1.0 - 0.5 * p[0][0] + TWELFTH * p2[0][0],
+                -0.5 * p[0][1] + TWELFTH * p2[0][1],
+            ],
+            [
+                -0.5 * p[1][0] + TWELFTH * p2[1][0],
+                1.0 - 0.5 * p[1][1] + TWELFTH * p2[1][1],
+            ],
+        ];
+        let det = q[0][0] * q[1][1] - q[0][1] * q[1][0];
+        StageSolver { hs, p, q, det }
+    }
+
+    /// The stage sums `S` for the right-hand sides `b = (b¹, b²)`:
+    /// `Q·S = (b¹ + b²) + (√3/6)·P·(b¹ − b²)` by Cramer's rule.
+    #[inline]
+    pub(crate) fn sums(&self, b: [f64; 4]) -> [f64; 2] {
+        let (p, q, det) = (&self.p, &self.q, self.det);
+        let (sum, diff) = ([b[0] + b[2], b[1] + b[3]], [b[0] - b[2], b[1] - b[3]]);
+        let r = [
+            sum[0] + S3 * (p[0][0] * diff[0] + p[0][1] * diff[1]),
+            sum[1] + S3 * (p[1][0] * diff[0] + p[1][1] * diff[1]),
+        ];
         [
-            p[0][0] * p[0][0] + p[0][1] * p[1][0],
-            p[0][0] * p[0][1] + p[0][1] * p[1][1],
-        ],
-        [
-            p[1][0] * p[0][0] + p[1][1] * p[1][0],
-            p[1][0] * p[0][1] + p[1][1] * p[1][1],
-        ],
-    ];
-    const TWELFTH: f64 = 1.0 / 12.0;
-    let q = [
-        [
-            1.0 - 0.5 * p[0][0] + TWELFTH * p2[0][0],
-            -0.5 * p[0][1] + TWELFTH * p2[0][1],
-        ],
-        [
-            -0.5 * p[1][0] + TWELFTH * p2[1][0],
-            1.0 - 0.5 * p[1][1] + TWELFTH * p2[1][1],
-        ],
-    ];
-    let (sum, diff) = ([b[0] + b[2], b[1] + b[3]], [b[0] - b[2], b[1] - b[3]]);
-    let r = [
-        sum[0] + S3 * (p[0][0] * diff[0] + p[0][1] * diff[1]),
-        sum[1] + S3 * (p[1][0] * diff[0] + p[1][1] * diff[1]),
-    ];
-    let det = q[0][0] * q[1][1] - q[0][1] * q[1][0];
-    [
-        (q[1][1] * r[0] - q[0][1] * r[1]) / det,
-        (q[0][0] * r[1] - q[1][0] * r[0]) / det,
-    ]
+            (q[1][1] * r[0] - q[0][1] * r[1]) / det,
+            (q[0][0] * r[1] - q[1][0] * r[0]) / det,
+        ]
+    }
 }
 
 /// Gaussian elimination with partial pivoting for a 4×4 system.

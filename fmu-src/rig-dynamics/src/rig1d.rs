@@ -73,7 +73,7 @@
 //! the first version of this file to rounding (the stage equations are
 //! solved in closed form, `gauss_legendre::linear_stage_sums`).
 
-use crate::gauss_legendre::{linear_stage_sums, C};
+use crate::gauss_legendre::{linear_stage_sums, StageSolver, C};
 use crate::signals::Sinusoid;
 use crate::{check_finite, check_non_negative};
 
@@ -427,6 +427,9 @@ pub struct Rig1D {
     /// The linear part of the right-hand side, unsaturated
     /// ([`Rig1D::linear_part`] of piece 0; from the parameters only).
     linear: [[f64; 2]; 2],
+    /// The stage equations of `linear` formed for the last sub-step length
+    /// (`hs` NaN before the first step): formed once, not every sub-step.
+    solver: StageSolver,
     /// The plain mode of [`Rig1D::step_plain`]: m > 0, no controller, the
     /// prescribed ramp without a sinusoid, no drive force (a dither is
     /// allowed: it moves the surface, not the body).
@@ -444,6 +447,7 @@ impl Rig1D {
             xi: 0.0,
             omega: 0.0,
             linear: [[0.0; 2]; 2],
+            solver: StageSolver::new(f64::NAN, [[0.0; 2]; 2]),
             plain: p.m > 0.0
                 && !p.control.on()
                 && p.actuator == Actuator::Prescribed
@@ -453,6 +457,7 @@ impl Rig1D {
         };
         rig.omega = rig.substep_omega(p.m == 0.0);
         rig.linear = rig.linear_part(0, p.m == 0.0);
+        rig.solver = StageSolver::new(f64::NAN, rig.linear);
         if p.m == 0.0 {
             rig.xd = rig.quasi_static_velocity(&Rig1DInputs::default(), &Rig1DInputs::default());
         }
@@ -758,7 +763,10 @@ impl Rig1D {
             (xd, force / p.m)
         };
         let ((a0, a1), (b0, b1)) = (rhs(C[0]), rhs(C[1]));
-        let sums = linear_stage_sums(h, self.linear, [a0, a1, b0, b1]);
+        if self.solver.hs != h {
+            self.solver = StageSolver::new(h, self.linear);
+        }
+        let sums = self.solver.sums([a0, a1, b0, b1]);
         self.x = x + h * 0.5 * sums[0];
         self.xd = xd + h * 0.5 * sums[1];
         self.t += h;
@@ -827,6 +835,9 @@ impl Rig1D {
         let q = self.omega * len / OMEGA_H_MAX;
         let n = if q <= 1.0 { 1 } else { q.ceil() as usize }.clamp(1, 1_000_000);
         let hs = len / n as f64;
+        if self.solver.hs != hs {
+            self.solver = StageSolver::new(hs, self.linear);
+        }
         for i in 0..n {
             let tau0 = tau_start + i as f64 * hs;
             self.substep(tau0, hs, u, du, first_order);
@@ -962,12 +973,15 @@ impl Rig1D {
             (xd, force / p.m)
         };
         let ((a0, a1), (b0, b1)) = (rhs(C[0]), rhs(C[1]));
-        let linear = if piece == 0 {
-            self.linear
+        let b = [a0, a1, b0, b1];
+        // a whole unsaturated sub-step: the solver formed for it
+        let sums = if piece == 0 && len == self.solver.hs {
+            self.solver.sums(b)
+        } else if piece == 0 {
+            linear_stage_sums(len, self.linear, b)
         } else {
-            self.linear_part(piece, first_order)
+            linear_stage_sums(len, self.linear_part(piece, first_order), b)
         };
-        let sums = linear_stage_sums(len, linear, [a0, a1, b0, b1]);
         let x_new = x + len * 0.5 * sums[0];
         let xd_new = if first_order {
             0.5 * sums[0]

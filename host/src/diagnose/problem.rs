@@ -443,11 +443,15 @@ impl Setup {
             }
             let simulated = self.input_source(system, var).and_then(|src| series(&src));
             match simulated {
-                Some(s) => data
-                    .time
-                    .iter()
-                    .map(|&t| crate::inputs::interpolate(t, &run.time, &s, false))
-                    .collect(),
+                Some(s) => {
+                    let mut cursor = crate::inputs::Cursor::default();
+                    data.time
+                        .iter()
+                        .map(|&t| {
+                            crate::inputs::interpolate_from(&mut cursor, t, &run.time, &s, false)
+                        })
+                        .collect()
+                }
                 None => vec![0.0; data.time.len()],
             }
         };
@@ -479,6 +483,7 @@ impl Setup {
                     > fn_.iter().cloned().fold(f64::INFINITY, f64::min),
             trusted: Vec::new(),
         };
+        let mut force_cursor = crate::inputs::Cursor::default();
         for k in 0..n - 1 {
             if data.time[k + 1] > data.time[k] {
                 d.t.push(data.time[k]);
@@ -487,7 +492,8 @@ impl Setup {
                 d.v.push(v[k]);
                 d.x.push(x[k]);
                 d.fn_.push(fn_[k]);
-                d.f.push(crate::inputs::interpolate(
+                d.f.push(crate::inputs::interpolate_from(
+                    &mut force_cursor,
                     data.time[k + 1],
                     &run.time,
                     &force,

@@ -277,9 +277,13 @@ pub fn co_simulate_with(
             .position(|c| c == name)
             .ok_or_else(|| format!("the co-simulation does not record `{name}`"))?;
         let series: Vec<f64> = run.rows.iter().map(|r| r[col]).collect();
+        let mut cursor = crate::inputs::Cursor::default();
         let sim: Vec<f64> = samples
             .iter()
-            .map(|&k| crate::inputs::interpolate(data.time[k], &run.time, &series, false))
+            .map(|&k| {
+                let time = data.time[k];
+                crate::inputs::interpolate_from(&mut cursor, time, &run.time, &series, false)
+            })
             .collect();
         residuals.push(
             samples
