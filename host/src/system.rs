@@ -2,7 +2,7 @@
 //! connections from outputs to inputs, checked when built.
 
 use crate::fmu::model_description::{Causality, VariableKind};
-use crate::fmu::{Fmu, Instance, ValueReference};
+use crate::fmu::{Fmu, Instance, Rollback, ValueReference};
 use crate::rows::Rows;
 use crate::FmuError;
 use std::path::Path;
@@ -315,7 +315,7 @@ fn set_gathered(
         }
         values = rest;
         if let Some((t, h)) = step {
-            c.instance.do_step(t, h)?;
+            c.instance.do_step_with(t, h, Rollback::Never)?;
         }
     }
     Ok(())
@@ -682,7 +682,7 @@ impl System {
                 if !now.is_empty() {
                     c.instance.set_real(&c.inputs, now)?;
                 }
-                c.instance.do_step(t, h)?;
+                c.instance.do_step_with(t, h, Rollback::Never)?;
             }
             return Ok(());
         }

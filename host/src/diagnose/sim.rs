@@ -12,7 +12,7 @@
 use super::model::FrictionModel;
 use super::problem::{FrictionData, Measured, Setup};
 use crate::fmu::model_description::VariableKind;
-use crate::fmu::{Fmu, Instance, ValueReference};
+use crate::fmu::{Fmu, Instance, Rollback, ValueReference};
 use crate::inputs::ExternalInputs;
 use crate::master::{by_name, simulate_with};
 use crate::ssp::SystemFile;
@@ -87,7 +87,8 @@ impl FrictionSim {
         for k in 0..d.t.len() {
             i.set_real(&self.inputs, &[d.v[k], d.x[k], d.fn_[k]])
                 .map_err(fail)?;
-            i.do_step(d.t[k], d.h[k]).map_err(fail)?;
+            i.do_step_with(d.t[k], d.h[k], Rollback::Never)
+                .map_err(fail)?;
             i.get_real(&[self.force], &mut f).map_err(fail)?;
             out.push(f[0]);
         }

@@ -163,6 +163,18 @@ pub struct FmuState {
     owner: u64,
 }
 
+/// Whether a master may restore a state saved before the end of the step
+/// it asks for ([`Instance::do_step_with`]):
+/// `noSetFMUStatePriorToCurrentPoint` of `fmi2DoStep` is true for `Never`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rollback {
+    /// The step may be undone (`fmi2SetFMUstate` to an earlier state): an
+    /// iterating master's steps.
+    Possible,
+    /// The step is final: no state from before its end is restored.
+    Never,
+}
+
 static NEXT_INSTANCE_ID: AtomicU64 = AtomicU64::new(1);
 
 /// One FMU instance in co-simulation mode. Dropping it frees its states and
@@ -763,23 +775,40 @@ impl Instance {
     }
 
     /// `fmi2DoStep` from communication point `t` over `h`, with
-    /// `noSetFMUStatePriorToCurrentPoint = false` (states may be restored).
-    /// Does not allocate unless it fails.
+    /// `noSetFMUStatePriorToCurrentPoint = false`: the caller may still
+    /// restore a state saved before `t + h` ([`Rollback::Possible`]; see
+    /// [`Instance::do_step_with`]). Does not allocate unless it fails.
     ///
     /// `fmi2Discard` means the FMU completed only part of the step (§4.2.2).
     /// The error then also says how far it got and whether it wants
     /// the simulation to end, asked through `fmi2GetRealStatus
     /// (fmi2LastSuccessfulTime)` and `fmi2GetBooleanStatus(fmi2Terminated)`,
     /// or why the FMU could not say.
-    #[inline] // the hot path is a few instructions; the rest is in `step_failed`
+    #[inline]
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Status, FmuError> {
+        self.do_step_with(t, h, Rollback::Possible)
+    }
+
+    /// [`Instance::do_step`], telling the FMU whether a state from before
+    /// the step's end may still be restored: `rollback` is
+    /// `noSetFMUStatePriorToCurrentPoint` (FMI 2.0.4 §4.2.2), true for
+    /// [`Rollback::Never`]. A master that only goes forward (Jacobi,
+    /// Gauss–Seidel: FMPy's `simulate_fmu` passes true too) says
+    /// `Never`, so that an FMU may drop what it keeps for rollbacks;
+    /// one that iterates a step (`newton`) says `Possible`.
+    #[inline] // the hot path is a few instructions; the rest is in `step_failed`
+    pub fn do_step_with(&mut self, t: f64, h: f64, rollback: Rollback) -> Result<Status, FmuError> {
         if self.guarded {
             self.record_step_time(t);
         }
         let f = self.functions.do_step;
+        let no_set_prior = match rollback {
+            Rollback::Possible => fmi2False,
+            Rollback::Never => fmi2True,
+        };
         match self.call(DO_STEP, |component| {
             // SAFETY: plain values.
-            Ok(unsafe { f(component, t, h, fmi2False) })
+            Ok(unsafe { f(component, t, h, no_set_prior) })
         }) {
             Err(e) => self.step_failed(e),
             ok => ok,

@@ -20,7 +20,7 @@ mod status;
 pub mod watchdog;
 
 pub use archive::UnpackOptions;
-pub use instance::{Fmu, FmuState, Instance};
+pub use instance::{Fmu, FmuState, Instance, Rollback};
 pub use library::Library;
 pub use logger::{Log, LogMessage};
 pub use model_description::{

@@ -8,6 +8,7 @@
 //! receiving FMU declares `canInterpolateInputs`.
 
 use super::MasterAlgorithm;
+use crate::fmu::Rollback;
 use crate::system::System;
 use crate::FmuError;
 
@@ -118,7 +119,9 @@ impl MasterAlgorithm for GaussSeidel {
                     target.set_real(&[c.to.1], &now)?;
                 }
             }
-            system.components[comp].instance.do_step(t, h)?;
+            // Gauss–Seidel only goes forward: the step is final
+            let instance = &mut system.components[comp].instance;
+            instance.do_step_with(t, h, Rollback::Never)?;
             stepped[comp] = true;
         }
         Ok(())

@@ -9,7 +9,9 @@
  *   - fmi2SetReal refuses NaN for u with a formatted error message;
  *   - u = 12345 logs a 3000-character warning ending in "END";
  *   - fmi2DoStep with h <= 0 returns fmi2Discard, with u = -1 fmi2Fatal;
- *   - stub_live_instances() counts instances not yet freed. */
+ *   - stub_live_instances() counts instances not yet freed;
+ *   - stub_steps(flag) counts the fmi2DoStep calls whose
+ *     noSetFMUStatePriorToCurrentPoint was true (flag 1) or false (0). */
 
 #include <math.h>
 #include <stddef.h>
@@ -45,6 +47,10 @@ enum { OK = 0, WARNING = 1, DISCARD = 2, ERROR = 3, FATAL = 4 };
 static int live = 0;
 
 EXPORT int stub_live_instances(void) { return live; }
+
+static int steps_by_flag[2] = {0, 0};
+
+EXPORT int stub_steps(int no_prior) { return steps_by_flag[no_prior != 0]; }
 
 EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
 
@@ -131,7 +137,7 @@ EXPORT int fmi2SetString(void *c, const unsigned *vr, size_t n, const char *cons
 
 EXPORT int fmi2DoStep(void *c, double t, double h, int no_prior) {
     Stub *s = c;
-    (void)no_prior;
+    steps_by_flag[no_prior != 0]++;
     if (!(h > 0)) {
         s->cb.logger(s->cb.env, s->name, DISCARD, "logWarning", "fmi2DoStep: step size h = %g must be > 0", h);
         return DISCARD;

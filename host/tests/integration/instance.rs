@@ -5,7 +5,9 @@
 use crate::common;
 
 use common::stub_fmu_dir;
-use fricsim::fmu::{Fmu, Status};
+use fricsim::fmu::{Fmu, Rollback, Status};
+use fricsim::master::{by_name, simulate};
+use fricsim::system::System;
 use fricsim::FmuError;
 use tempfile::TempDir;
 
@@ -28,6 +30,52 @@ fn live_instances(fmu: &Fmu) -> i32 {
             library.get("stub_live_instances").unwrap();
         f()
     }
+}
+
+/// How many `fmi2DoStep` calls the loaded stub has seen with
+/// `noSetFMUStatePriorToCurrentPoint` = `no_prior`, all instances together.
+fn steps_with(fmu: &Fmu, no_prior: bool) -> i32 {
+    // SAFETY: the stub exports `int stub_steps(int)`.
+    unsafe {
+        let library = libloading::Library::new(fmu.library().path()).unwrap();
+        let f: libloading::Symbol<unsafe extern "C" fn(i32) -> i32> =
+            library.get("stub_steps").unwrap();
+        f(i32::from(no_prior))
+    }
+}
+
+/// `noSetFMUStatePriorToCurrentPoint` (FMI 2.0.4 §4.2.2): true from the
+/// masters that only go forward, as FMPy's `simulate_fmu` passes it, so
+/// that an FMU may drop what it keeps for rollbacks; false from
+/// `Instance::do_step`, and from `do_step_with(Rollback::Possible)`.
+#[test]
+fn forward_masters_tell_the_fmu_no_state_is_restored() {
+    let (dir, fmu) = stub();
+    for master in ["jacobi", "gauss-seidel", "gauss-seidel-interpolated"] {
+        let fmus = ["a", "b"].map(|name| (name.to_string(), Fmu::from_dir(dir.path()).unwrap()));
+        let connections = [("a.y".to_string(), "b.u".to_string())];
+        let mut system = System::from_fmus(fmus.into(), &[], &connections, 0.0).unwrap();
+        let before = (steps_with(&fmu, false), steps_with(&fmu, true));
+        let run = simulate(&mut system, by_name(master).unwrap().as_mut(), 0.1, 1.0).unwrap();
+        assert_eq!(run.time.len(), 11, "{master}");
+        assert_eq!(
+            (steps_with(&fmu, false), steps_with(&fmu, true)),
+            (before.0, before.1 + 20),
+            "{master}: every step of both instances final"
+        );
+    }
+    let mut a = fmu.instantiate("a").unwrap();
+    a.setup_experiment(0.0, None).unwrap();
+    a.enter_initialization_mode().unwrap();
+    a.exit_initialization_mode().unwrap();
+    let before = (steps_with(&fmu, false), steps_with(&fmu, true));
+    a.do_step(0.0, 0.5).unwrap();
+    a.do_step_with(0.5, 0.5, Rollback::Possible).unwrap();
+    a.do_step_with(1.0, 0.5, Rollback::Never).unwrap();
+    assert_eq!(
+        (steps_with(&fmu, false), steps_with(&fmu, true)),
+        (before.0 + 2, before.1 + 1)
+    );
 }
 
 #[test]
