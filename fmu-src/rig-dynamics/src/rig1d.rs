@@ -428,7 +428,8 @@ pub struct Rig1D {
     /// ([`Rig1D::linear_part`] of piece 0; from the parameters only).
     linear: [[f64; 2]; 2],
     /// The stage equations of `linear` formed for the last sub-step length
-    /// (`hs` NaN before the first step): formed once, not every sub-step.
+    /// (a cache: `hs` is NaN until the first step forms it), so that they
+    /// are formed once, not at every sub-step.
     solver: StageSolver,
     /// The plain mode of [`Rig1D::step_plain`]: m > 0, no controller, the
     /// prescribed ramp without a sinusoid, no drive force (a dither is
@@ -457,7 +458,6 @@ impl Rig1D {
         };
         rig.omega = rig.substep_omega(p.m == 0.0);
         rig.linear = rig.linear_part(0, p.m == 0.0);
-        rig.solver = StageSolver::new(f64::NAN, rig.linear);
         if p.m == 0.0 {
             rig.xd = rig.quasi_static_velocity(&Rig1DInputs::default(), &Rig1DInputs::default());
         }
@@ -977,10 +977,13 @@ impl Rig1D {
         // a whole unsaturated sub-step: the solver formed for it
         let sums = if piece == 0 && len == self.solver.hs {
             self.solver.sums(b)
-        } else if piece == 0 {
-            linear_stage_sums(len, self.linear, b)
         } else {
-            linear_stage_sums(len, self.linear_part(piece, first_order), b)
+            let linear = if piece == 0 {
+                self.linear
+            } else {
+                self.linear_part(piece, first_order)
+            };
+            linear_stage_sums(len, linear, b)
         };
         let x_new = x + len * 0.5 * sums[0];
         let xd_new = if first_order {
