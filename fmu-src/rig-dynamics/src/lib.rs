@@ -11,6 +11,7 @@
 
 #[cfg(test)]
 mod closed_form;
+mod exact;
 mod gauss_legendre;
 pub mod rig1d;
 pub mod rig2d;

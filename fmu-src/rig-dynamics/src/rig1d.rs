@@ -36,18 +36,30 @@
 //!   ξ is integrated exactly: over any interval ξ changes by ∫v_ref − Δx.
 //!   There is no anti-windup: ξ integrates the error also while saturated.
 //!
-//! Integration: 2-stage Gauss–Legendre (order 4, A-stable), sub-stepped so
-//! that ω·h_sub ≤ 0.02, with ω = √(K/m + (C/2m)²) + C/2m from the effective
-//! stiffness K = k + G·(Kp + Ki) and damping C = c + G·Kd of the unsaturated
-//! loop, and ω at least every active forcing frequency. Gauss–Legendre has
-//! no amplitude error on an undamped oscillator; its phase error at the
-//! bound ω·h_sub = 0.02 is 1.4e-9 of a radian per natural period (∝ (ω·h)⁴:
-//! 9e-11 at ω·h = 0.01, and one sub-step of h is used when ω·h ≤ 0.02).
-//! Inputs (F, F_ext, x_act_in, x_ref, v_ref) move linearly over a step
-//! with their slopes (first-order input interpolation). The right-hand side
-//! is affine in (x, ẋ) with a linear part fixed by the parameters (and the
-//! saturation piece), so the stage equations reduce to a 2×2 system solved
-//! in closed form (`gauss_legendre::linear_stage_sums`).
+//! Integration. The right-hand side is affine in (x, ẋ) with a linear part
+//! L fixed by the parameters (and by the saturation's piece), and the
+//! inputs (F, F_ext, x_act_in, x_ref, v_ref) move linearly over a step
+//! with their slopes (first-order input interpolation).
+//!
+//! - **Exact step** (`exact::ExactStep`) when m > 0, the controller is off
+//!   or does not saturate (u_max = 0), and no sinusoid drives the body
+//!   (actuator, drive force, built-in reference; a surface dither is
+//!   allowed): the forcing is then a polynomial of degree ≤ 2 in time
+//!   between drive steps, and the step is y(h) = e^{hL}·y(0) plus the
+//!   forcing integrated against e^{(h−s)L} in closed form (φ-functions
+//!   from one matrix exponential, formed once per step length). Exact for
+//!   any step length, to rounding: no sub-steps, no stability limit. This
+//!   covers the default mode (the 1995 benchmark), the unsaturated loops
+//!   and the actuator input.
+//! - **Otherwise** 2-stage Gauss–Legendre (order 4, A-stable), sub-stepped
+//!   so that ω·h_sub ≤ 0.02, with ω = √(K/m + (C/2m)²) + C/2m from the
+//!   effective stiffness K = k + G·(Kp + Ki) and damping C = c + G·Kd of the
+//!   unsaturated loop, and ω at least every active forcing frequency.
+//!   Gauss–Legendre has no amplitude error on an undamped oscillator; its
+//!   phase error at the bound ω·h_sub = 0.02 is 1.4e-9 of a radian per
+//!   natural period (∝ (ω·h)⁴: 9e-11 at ω·h = 0.01, and one sub-step of h is
+//!   used when ω·h ≤ 0.02). The stage equations reduce to a 2×2 system
+//!   solved in closed form (`gauss_legendre::linear_stage_sums`).
 //!
 //! **Saturation** is handled piecewise and exactly up to event location:
 //! sat(u) is continuous, and on each side of ±u_max the closed loop is
@@ -69,10 +81,11 @@
 //! the acceleration output is 0.
 //!
 //! Defaults: the 1995 stick-slip benchmark (m = 1 kg, k = 2 N/m, pulled at
-//! 0.1 m/s, everything else off); in that mode the results are those of
-//! the first version of this file to rounding (the stage equations are
-//! solved in closed form, `gauss_legendre::linear_stage_sums`).
+//! 0.1 m/s, everything else off), stepped exactly; the first version of
+//! this file stepped it with Gauss–Legendre, which the results match to
+//! that method's truncation error (the tests give the figures).
 
+use crate::exact::{ExactStep, NODES};
 use crate::gauss_legendre::{linear_stage_sums, StageSolver, C};
 use crate::signals::Sinusoid;
 use crate::{check_finite, check_non_negative};
@@ -431,9 +444,19 @@ pub struct Rig1D {
     /// (a cache: `hs` is NaN until the first step forms it), so that they
     /// are formed once, not at every sub-step.
     solver: StageSolver,
+    /// The exact step formed for the last step (or segment) length, of
+    /// `linear` with the forcing scaled by 1/m (a cache: `h` is NaN until
+    /// the first step forms it).
+    exact: ExactStep,
+    /// Whether the rig steps exactly ([`Rig1D::exact_segment`]): m > 0, a
+    /// controller that does not saturate or none, and no active sinusoid
+    /// in the forcing (actuator, drive force, built-in reference), so that
+    /// between drive steps the forcing is a polynomial of degree ≤ 2 in
+    /// time and the loop linear.
+    exactly: bool,
     /// The plain mode of [`Rig1D::step_plain`]: m > 0, no controller, the
     /// prescribed ramp without a sinusoid, no drive force (a dither is
-    /// allowed: it moves the surface, not the body).
+    /// allowed: it moves the surface, not the body). A case of `exactly`.
     plain: bool,
 }
 
@@ -449,6 +472,8 @@ impl Rig1D {
             omega: 0.0,
             linear: [[0.0; 2]; 2],
             solver: StageSolver::new(f64::NAN, [[0.0; 2]; 2]),
+            exact: ExactStep::UNFORMED,
+            exactly: steps_exactly(&p),
             plain: p.m > 0.0
                 && !p.control.on()
                 && p.actuator == Actuator::Prescribed
@@ -691,36 +716,24 @@ impl Rig1D {
 
     /// Advance by `h` with inputs u(τ) = u + du·τ, τ ∈ [0, h].
     pub fn step(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
-        if self.steps_plainly(h) {
+        if self.plain {
             self.step_plain(u, du, h);
         } else {
             self.step_general(u, du, h);
         }
     }
 
-    /// Whether [`Rig1D::step`] over `h` takes [`Rig1D::step_plain`]: the
-    /// plain mode, and one sub-step (ω·h ≤ [`OMEGA_H_MAX`]).
-    #[inline(always)]
-    fn steps_plainly(&self, h: f64) -> bool {
-        self.plain && self.omega * h <= OMEGA_H_MAX
-    }
-
     /// The step sensitivity to the friction force of the last step, of
-    /// length `h`, if it took the plain path ([`Rig1D::step_plain`]; else
-    /// `None`) with `F` held over it: `∂/∂F` of the state after the step
-    /// and of the outputs linear in it and in `F`.
+    /// length `h`, in the plain mode ([`Rig1D::step_plain`]; else `None`)
+    /// with `F` held over it: `∂/∂F` of the state after the step and of
+    /// the outputs linear in it and in `F`.
     ///
-    /// The step is one Gauss–Legendre step of the linear system
-    /// `(x, ẋ)' = L·(x, ẋ) + (0, (k·x_a(t) + F_ext − F)/m)` (no controller,
-    /// no drive force), `x⁺ = x + h/2·S₀`, `ẋ⁺ = ẋ + h/2·S₁` with the stage
-    /// sums `S = Q⁻¹·(b¹ + b² + (√3/6)·P·(b¹ − b²))`
-    /// (`gauss_legendre::linear_stage_sums`), linear in the right-hand
-    /// sides `b^j` at the two stages. A held `F` enters both as
-    /// `∂b^j/∂F = (0, −1/m)`, so `∂S/∂F` is the same stage sums of
-    /// `((0, −1/m), (0, −1/m))` and
+    /// The step is exact ([`ExactStep`]): `(x, ẋ)⁺ = e^{hL}·(x, ẋ) +
+    /// Σ_j w_j·g_j/m`, with the forcing `g_j = k·x_a + F_ext − F` at the
+    /// three nodes. A held `F` enters every sample as `−F`, so
     ///
     /// ```text
-    /// ∂x⁺/∂F = h/2·∂S₀/∂F,   ∂ẋ⁺/∂F = h/2·∂S₁/∂F,
+    /// ∂(x, ẋ)⁺/∂F = −Σ_j w_j/m = −h·φ₁(hL)·e₂/m,
     /// ```
     ///
     /// whatever the state (the step is affine in it and in `F`). The
@@ -730,13 +743,18 @@ impl Rig1D {
     /// (its direct feedthrough `−F/m` included). `F_ext` enters with the
     /// opposite sign.
     pub fn held_step_sensitivity(&self, h: f64) -> Option<StepSensitivity> {
-        if !self.steps_plainly(h) {
+        if !self.plain || h.is_nan() || h <= 0.0 {
             return None;
         }
         let p = &self.p;
-        let b = -1.0 / p.m;
-        let sums = linear_stage_sums(h, self.linear, [0.0, b, 0.0, b]);
-        let (x, xd) = (h * 0.5 * sums[0], h * 0.5 * sums[1]);
+        // the step's own weights when they cover this length (the usual
+        // case: asked after the step), else formed for `h`
+        let step = if self.exact.covers(h) {
+            self.exact
+        } else {
+            ExactStep::new(h, self.linear, 1.0 / p.m)
+        };
+        let [x, xd] = step.held_response(h).map(|r| -r);
         Some(StepSensitivity {
             x,
             xd,
@@ -745,30 +763,29 @@ impl Rig1D {
         })
     }
 
-    /// [`Rig1D::step`] in the plain mode with one sub-step: what the general
-    /// path computes there, bit for bit (the terms that are zero in this
-    /// mode are added as zeros, as it adds them), without its mode
-    /// dispatch.
+    /// [`Rig1D::step`] in the plain mode: what the general path's exact
+    /// segment ([`Rig1D::exact_segment`]) computes there, bit for bit (the
+    /// terms that are zero in this mode are added as zeros, as it adds
+    /// them), without its mode dispatch.
     fn step_plain(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
+        if !self.exact.covers(h) {
+            self.exact = ExactStep::new(h, self.linear, 1.0 / self.p.m);
+        }
+        // the nodes of the step length the exact step was formed for
+        let hs = self.exact.h;
         let p = &self.p;
-        let (x, xd) = (self.x, self.xd);
         let (t0, tau0) = (self.t + 0.0, 0.0);
-        let rhs = |c: f64| -> (f64, f64) {
-            let (t, tau) = (t0 + c * h, tau0 + c * h);
+        // the force without its part linear in the state (−k·x − c·ẋ)
+        let forcing = |node: f64| -> f64 {
+            let (t, tau) = (t0 + node * hs, tau0 + node * hs);
             // x_a0 + v_a·t + (inactive sinusoid); F_d and F_ctrl are 0
             let xa = p.x_a0 + p.v_a * t + 0.0;
             let ext = u.f_ext + du.f_ext * tau;
             let fr = u.friction + du.friction * tau;
-            let force = p.k * (xa - x) - p.c * xd + ext - fr + (0.0 + 0.0) + 0.0;
-            (xd, force / p.m)
+            p.k * xa + ext - fr + 0.0 + 0.0
         };
-        let ((a0, a1), (b0, b1)) = (rhs(C[0]), rhs(C[1]));
-        if self.solver.hs != h {
-            self.solver = StageSolver::new(h, self.linear);
-        }
-        let sums = self.solver.sums([a0, a1, b0, b1]);
-        self.x = x + h * 0.5 * sums[0];
-        self.xd = xd + h * 0.5 * sums[1];
+        let g = NODES.map(forcing);
+        [self.x, self.xd] = self.exact.advance([self.x, self.xd], g, h);
         self.t += h;
     }
 
@@ -830,8 +847,12 @@ impl Rig1D {
         du: &Rig1DInputs,
         first_order: bool,
     ) {
-        let _ = first_order; // ω is kept from the parameters
-                             // ⌈q⌉ is 1 for 0 < q ≤ 1: no call to ceil at the usual step
+        if self.exactly {
+            let end = self.exact_segment(tau_start, len, u, du);
+            self.set(end);
+            return;
+        }
+        // ⌈q⌉ is 1 for 0 < q ≤ 1: no call to ceil at the usual step
         let q = self.omega * len / OMEGA_H_MAX;
         let n = if q <= 1.0 { 1 } else { q.ceil() as usize }.clamp(1, 1_000_000);
         let hs = len / n as f64;
@@ -1004,6 +1025,64 @@ impl Rig1D {
         }
     }
 
+    /// The exact step ([`ExactStep`]) of length `len` from the current
+    /// state at τ = tau0 of the step, in a mode where the rig steps
+    /// exactly (`exactly`: no saturation, no sinusoid in the forcing, and
+    /// no drive step inside the segment). Returns the state at its end.
+    ///
+    /// The forcing is the force without its part linear in the state,
+    /// which `linear` holds: `−k·x − c·ẋ` and, with the controller,
+    /// `−G·((Kp + Ki)·x + Kd·ẋ)`, since ξ(s) = ξ₀ + ∫v_ref − (x(s) − x₀)
+    /// (ξ̇ = v_ref − ẋ, exactly). What is left is a polynomial of degree ≤ 2
+    /// in time: ramps, inputs linear over the step, and the integral of a
+    /// ramped reference velocity.
+    fn exact_segment(&mut self, tau0: f64, len: f64, u: &Rig1DInputs, du: &Rig1DInputs) -> Point {
+        if !self.exact.covers(len) {
+            self.exact = ExactStep::new(len, self.linear, 1.0 / self.p.m);
+        }
+        // the nodes of the length the exact step was formed for
+        let hs = self.exact.h;
+        let p = &self.p;
+        let ctrl = &p.control;
+        let (x, xd, xi) = (self.x, self.xd, self.xi);
+        let t0 = self.t + tau0;
+        let r0 = if ctrl.on() {
+            self.reference(t0, tau0, u, du).2
+        } else {
+            0.0
+        };
+        let forcing = |node: f64| -> f64 {
+            let (t, tau) = (t0 + node * hs, tau0 + node * hs);
+            let xa = self.actuator_at(t, u.x_act + du.x_act * tau);
+            let ext = u.f_ext + du.f_ext * tau;
+            let fr = u.friction + du.friction * tau;
+            let drive = p.drive.value(t);
+            let control = if ctrl.on() {
+                let (x_ref, v_ref, r) = self.reference(t, tau, u, du);
+                // ξ(s) + x(s) = ξ₀ + (R(s) − R₀) + x₀
+                let xi_base = xi + (r - r0) + x;
+                ctrl.gain * (ctrl.kp * x_ref + ctrl.kd * (ctrl.ff * v_ref) + ctrl.ki * xi_base)
+            } else {
+                0.0
+            };
+            // m·ẍ = k·x_a + F_ext − F + F_d + (F_ctrl's forcing) + L-part
+            p.k * xa + ext - fr + drive + control
+        };
+        let g = NODES.map(forcing);
+        let [x_new, xd_new] = self.exact.advance([x, xd], g, len);
+        let xi_new = if ctrl.on() {
+            let r1 = self.reference(t0 + len, tau0 + len, u, du).2;
+            xi + (r1 - r0) - (x_new - x)
+        } else {
+            xi
+        };
+        Point {
+            x: x_new,
+            xd: xd_new,
+            xi: xi_new,
+        }
+    }
+
     /// The number of values of the state (4).
     #[inline]
     pub fn state_len(&self) -> usize {
@@ -1045,6 +1124,18 @@ impl Rig1D {
             _ => Err(state_refused(s)),
         }
     }
+}
+
+/// Whether a rig with parameters `p` steps exactly ([`Rig1D::exact_segment`]):
+/// m > 0, no saturation, and no sinusoid driving the body.
+fn steps_exactly(p: &Rig1DParams) -> bool {
+    let sine_actuator = p.actuator == Actuator::Prescribed && p.act_sine.is_active();
+    let sine_reference = p.control.mode == Control::BuiltIn && p.control.reference.sine.is_active();
+    p.m > 0.0
+        && !p.control.saturates()
+        && !sine_actuator
+        && !p.drive.sine.is_active()
+        && !sine_reference
 }
 
 /// Why [`Rig1D::state_from_slice`] refused `s`.
