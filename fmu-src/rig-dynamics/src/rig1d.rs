@@ -955,11 +955,7 @@ impl Rig1D {
         let ctrl = &p.control;
         let (x, xd, xi) = (self.x, self.xd, self.xi);
         let t0 = self.t + tau0;
-        let r0 = if ctrl.on() {
-            self.reference(t0, tau0, u, du).2
-        } else {
-            0.0
-        };
+        let r0 = self.reference_integral(t0, tau0, u, du);
         // The right-hand side at the start state (x, ẋ) at stage time
         // t0 + c·len: affine in the state with the linear part
         // `linear_part`, so the stage equations are solved in closed form
@@ -1012,17 +1008,38 @@ impl Rig1D {
         } else {
             xd + len * 0.5 * sums[1]
         };
-        let xi_new = if ctrl.on() {
-            let r1 = self.reference(t0 + len, tau0 + len, u, du).2;
-            xi + (r1 - r0) - (x_new - x)
+        self.segment_end((t0, tau0, len), r0, (x_new, xd_new), u, du)
+    }
+
+    /// R(t) of [`Rig1D::reference`] (an antiderivative of v_ref) at time
+    /// `t`, `tau` into the step; 0 without the controller.
+    fn reference_integral(&self, t: f64, tau: f64, u: &Rig1DInputs, du: &Rig1DInputs) -> f64 {
+        if self.p.control.on() {
+            self.reference(t, tau, u, du).2
         } else {
-            xi
-        };
-        Point {
-            x: x_new,
-            xd: xd_new,
-            xi: xi_new,
+            0.0
         }
+    }
+
+    /// The state at the end of a segment of length `len` from the current
+    /// state at time `t0`, `tau0` into the step (`r0`: R there), whose
+    /// position and velocity reached `(x, ẋ)`: ξ changes exactly by
+    /// ∫v_ref − Δx (ξ̇ = v_ref − ẋ).
+    fn segment_end(
+        &self,
+        (t0, tau0, len): (f64, f64, f64),
+        r0: f64,
+        (x, xd): (f64, f64),
+        u: &Rig1DInputs,
+        du: &Rig1DInputs,
+    ) -> Point {
+        let xi = if self.p.control.on() {
+            let r1 = self.reference(t0 + len, tau0 + len, u, du).2;
+            self.xi + (r1 - r0) - (x - self.x)
+        } else {
+            self.xi
+        };
+        Point { x, xd, xi }
     }
 
     /// The exact step ([`ExactStep`]) of length `len` from the current
@@ -1046,11 +1063,7 @@ impl Rig1D {
         let ctrl = &p.control;
         let (x, xd, xi) = (self.x, self.xd, self.xi);
         let t0 = self.t + tau0;
-        let r0 = if ctrl.on() {
-            self.reference(t0, tau0, u, du).2
-        } else {
-            0.0
-        };
+        let r0 = self.reference_integral(t0, tau0, u, du);
         let forcing = |node: f64| -> f64 {
             let (t, tau) = (t0 + node * hs, tau0 + node * hs);
             let xa = self.actuator_at(t, u.x_act + du.x_act * tau);
@@ -1070,17 +1083,7 @@ impl Rig1D {
         };
         let g = NODES.map(forcing);
         let [x_new, xd_new] = self.exact.advance([x, xd], g, len);
-        let xi_new = if ctrl.on() {
-            let r1 = self.reference(t0 + len, tau0 + len, u, du).2;
-            xi + (r1 - r0) - (x_new - x)
-        } else {
-            xi
-        };
-        Point {
-            x: x_new,
-            xd: xd_new,
-            xi: xi_new,
-        }
+        self.segment_end((t0, tau0, len), r0, (x_new, xd_new), u, du)
     }
 
     /// The number of values of the state (4).
