@@ -22,6 +22,7 @@ Ctrl-C stops a run cleanly and raises ``KeyboardInterrupt``.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import tempfile
@@ -138,10 +139,7 @@ def run(
     naming it; the rows stand.
     """
     values = list((start_values or {}).items())
-    with tempfile.TemporaryDirectory(prefix="fricsim-input-") as tmp:
-        input_path = None
-        if input is not None:
-            input_path = _as_csv(input, Path(tmp) / "input.csv")
+    with _as_csv_paths("fricsim-input-", input=input) as paths:
         columns, data, error, refused = _native.run(
             os.fspath(system),
             start=start,
@@ -151,7 +149,7 @@ def run(
             start_values=values,
             output_interval=output_interval,
             record=list(record),
-            input=input_path,
+            input=paths["input"],
             step_timeout=step_timeout,
         )
     dtype = np.dtype([(c, np.float64) for c in columns])
@@ -175,6 +173,25 @@ def _as_csv(table: Any, path: Path) -> str:
         return os.fspath(table)
     write_table_csv(table, path)
     return os.fspath(path)
+
+
+@contextlib.contextmanager
+def _as_csv_paths(prefix: str, **tables: Any):
+    """Each of ``tables`` as a CSV path (``None`` stays ``None``): a path
+    as given; a DataFrame or structured array written, every number
+    exactly, as ``NAME.csv`` in a temporary directory that is made only
+    when some table needs it and removed on the way out. With paths only,
+    nothing is created: Python code between the call and the host (where
+    Ctrl-C would land) stays as short as it can be, and an interrupted
+    call leaves no directory behind."""
+    if all(t is None or isinstance(t, (str, os.PathLike)) for t in tables.values()):
+        yield {k: None if t is None else os.fspath(t) for k, t in tables.items()}
+        return
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        yield {
+            k: None if t is None else _as_csv(t, Path(tmp) / f"{k}.csv")
+            for k, t in tables.items()
+        }
 
 
 class Diagnosis:
@@ -256,16 +273,12 @@ def diagnose(
         )
     if "lugre" in options and options["lugre"] is not None:
         options["lugre"] = os.fspath(options["lugre"])
-    with tempfile.TemporaryDirectory(prefix="fricsim-data-") as tmp:
-        data_path = _as_csv(data, Path(tmp) / "data.csv")
-        heldout_path = None
-        if heldout is not None:
-            heldout_path = _as_csv(heldout, Path(tmp) / "heldout.csv")
+    with _as_csv_paths("fricsim-data-", data=data, heldout=heldout) as paths:
         report = _native.diagnose(
             os.fspath(system),
-            data_path,
+            paths["data"],
             os.fspath(out),
-            heldout=heldout_path,
+            heldout=paths["heldout"],
             **options,
         )
     return Diagnosis(json.loads(report), Path(out))
