@@ -6,13 +6,16 @@ one), and a point the FMU refuses is a row with its error."""
 
 import os
 import signal
+import tempfile
 import threading
+from pathlib import Path
 
 import distributed
 import numpy as np
 import pytest
 
 import fricsim
+from fricsim._distributed import _local_system, _payload
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parent.parent
 STICK_SLIP = ROOT / "examples" / "stick_slip.ssd"
@@ -80,10 +83,16 @@ def test_a_sweep_survives_a_killed_worker(client):
     pids = client.run(os.getpid)
     runner = threading.Thread(target=sweep)
     runner.start()
-    # once a task is running on the first worker, kill that worker's process
+    # once the first worker runs a task (it has written the system to its
+    # folder), kill that worker's process
     victim = sorted(pids)[0]
-    while not client.processing().get(victim):
-        assert runner.is_alive(), "the sweep ended before any task ran"
+    temp = Path(tempfile.gettempdir())
+
+    def folders_of(pid):
+        return list(temp.glob(f"fricsim-worker-{pid}-*"))
+
+    while not (client.processing().get(victim) and folders_of(pids[victim])):
+        assert runner.is_alive(), "the sweep ended before the worker ran a task"
         threading.Event().wait(0.01)
     os.kill(pids[victim], signal.SIGKILL)
     runner.join(timeout=600)
@@ -92,7 +101,16 @@ def test_a_sweep_survives_a_killed_worker(client):
     assert result["frame"]["error"].isna().all()
     # the nanny started a new worker process in its place
     client.wait_for_workers(2, timeout=60)
-    assert pids[victim] not in client.run(os.getpid).values()
+    now = client.run(os.getpid)
+    assert pids[victim] not in now.values()
+    # the killed worker had written the system to its folder (above); the
+    # next folder a worker makes on this machine removes it (here, if the
+    # new worker has not yet made one for a retried task), and not the
+    # folders of workers that run
+    client.run(_local_system, _payload(STICK_SLIP, shared_path=False))
+    assert folders_of(pids[victim]) == []
+    for pid in now.values():
+        assert folders_of(pid)
 
 
 def test_diagnose_many_on_the_cluster_equals_diagnose(client, tmp_path):
