@@ -53,5 +53,8 @@ scripts/setup-python-package.sh
 # fixtures, such as its Dask cluster or the Wine prefix of
 # test_windows_dll.py, stay in one process) but the long files whose tests
 # share nothing, spread test by test and handed out first (tests/conftest.py,
-# SPREAD_FILES); the slowest tests listed at the end
-.venv/bin/python -m pytest tests -q -n 2 --dist loadfile --no-loadscope-reorder --durations=15
+# SPREAD_FILES); the slowest tests listed at the end. PYTHONFAULTHANDLER:
+# a worker that dies of a signal, also while it tears its modules down
+# after its last test, prints the Python stack of each of its threads
+# (not once the interpreter has shut the handler down, at its very end)
+PYTHONFAULTHANDLER=1 .venv/bin/python -m pytest tests -q -n 2 --dist loadfile --no-loadscope-reorder --durations=15
