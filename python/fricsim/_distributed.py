@@ -166,37 +166,6 @@ _WRITTEN: dict = {}
 _FOLDER_PREFIX = "fricsim-worker-"
 
 
-def _process_gone(pid: int) -> bool:
-    """Whether no process has the id ``pid`` (``kill(pid, 0)`` fails with
-    ESRCH; another user's process, EPERM, counts as running). POSIX only:
-    elsewhere nothing is known to be gone."""
-    if os.name != "posix" or pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except OSError:
-        return False
-    return False
-
-
-def _remove_folders_of_gone_workers(folder: Path) -> None:
-    """Remove the worker folders (``_FOLDER_PREFIX<pid>-…``) in ``folder``
-    whose process no longer runs. A worker removes its own when it exits,
-    but not when it is killed: Dask's nanny kills a worker that goes past
-    its memory limit, and a lost machine's processes are gone at once.
-    Errors are ignored (the folder stays for the next worker)."""
-    try:
-        entries = list(os.scandir(folder))
-    except OSError:
-        return
-    for entry in entries:
-        pid = entry.name[len(_FOLDER_PREFIX):].partition("-")[0]
-        if entry.name.startswith(_FOLDER_PREFIX) and pid.isdigit() and _process_gone(int(pid)):
-            shutil.rmtree(entry.path, ignore_errors=True)
-
-
 def _local_system(payload) -> str:
     """A path to the system of ``payload`` in this process: the shared
     path, or the bytes written once to a temporary file (removed when the
@@ -207,7 +176,10 @@ def _local_system(payload) -> str:
     name, data, _, key = payload
     path = _WRITTEN.get(key)
     if path is None or not os.path.exists(path):
-        _remove_folders_of_gone_workers(Path(tempfile.gettempdir()))
+        # a worker removes its own folder when it exits, but not when it
+        # is killed (Dask's nanny kills one past its memory limit): the
+        # folders of workers that no longer run go here
+        _native.remove_folders_of_gone_processes(tempfile.gettempdir(), _FOLDER_PREFIX)
         folder = tempfile.mkdtemp(prefix=f"{_FOLDER_PREFIX}{os.getpid()}-")
         atexit.register(shutil.rmtree, folder, True)
         path = os.path.join(folder, name)

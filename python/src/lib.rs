@@ -369,6 +369,14 @@ fn pack(py: Python<'_>, ssd: PathBuf, out: PathBuf) -> PyResult<()> {
         .map_err(|e| host_error(e.to_string()))
 }
 
+/// The folders `<prefix><pid>-…` in `dir` whose process no longer runs,
+/// removed ([`fricsim::stale`], as `fricsim run` removes the FMU folders
+/// of a killed run): the folders of killed Dask workers.
+#[pyfunction]
+fn remove_folders_of_gone_processes(dir: PathBuf, prefix: &str) {
+    fricsim::stale::remove_left_by_gone_processes(&dir, prefix, |p| std::fs::remove_dir_all(p));
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FricsimError", m.py().get_type::<FricsimError>())?;
@@ -377,6 +385,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(pack, m)?)?;
+    m.add_function(wrap_pyfunction!(remove_folders_of_gone_processes, m)?)?;
     m.add_function(wrap_pyfunction!(seed_ports, m)?)?;
     Ok(())
 }
