@@ -193,35 +193,36 @@ fn run(
         .into_iter()
         .map(|(k, v)| (k, StartValue::from(v)))
         .collect();
-    let (columns, values, error, warnings) = py.allow_threads(move || -> Result<RunResult, PyErr> {
-        let file = SystemFile::open(&system).map_err(|e| host_error(e.to_string()))?;
-        let options = RunOptions {
-            start,
-            stop,
-            step,
-            master,
-            start_values,
-            output_interval,
-            record,
-            inputs: match &input {
-                Some(path) => Some(InputTable::read(path).map_err(host_error)?),
-                None => None,
-            },
-            call_time_limit,
-        };
-        let prepared = PreparedRun::new(&file, &options).map_err(host_error)?;
-        let mut sink = Collect {
-            values: Vec::new(),
-            interrupt: RefCell::new(None),
-        };
-        let outcome = prepared.run(&mut sink, None).map_err(host_error)?;
-        if let Some(signal) = sink.interrupt.into_inner() {
-            return Err(signal);
-        }
-        let mut columns = vec!["time".to_string()];
-        columns.extend(outcome.columns);
-        Ok((columns, sink.values, outcome.error, outcome.warnings))
-    })?;
+    let (columns, values, error, warnings) =
+        py.allow_threads(move || -> Result<RunResult, PyErr> {
+            let file = SystemFile::open(&system).map_err(|e| host_error(e.to_string()))?;
+            let options = RunOptions {
+                start,
+                stop,
+                step,
+                master,
+                start_values,
+                output_interval,
+                record,
+                inputs: match &input {
+                    Some(path) => Some(InputTable::read(path).map_err(host_error)?),
+                    None => None,
+                },
+                call_time_limit,
+            };
+            let prepared = PreparedRun::new(&file, &options).map_err(host_error)?;
+            let mut sink = Collect {
+                values: Vec::new(),
+                interrupt: RefCell::new(None),
+            };
+            let outcome = prepared.run(&mut sink, None).map_err(host_error)?;
+            if let Some(signal) = sink.interrupt.into_inner() {
+                return Err(signal);
+            }
+            let mut columns = vec!["time".to_string()];
+            columns.extend(outcome.columns);
+            Ok((columns, sink.values, outcome.error, outcome.warnings))
+        })?;
     let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_ne_bytes()).collect();
     Ok((columns, PyBytes::new(py, &bytes).unbind(), error, warnings))
 }
