@@ -414,7 +414,15 @@ impl LuGre {
     /// [`LuGre::g_unit`] without [`LuGre::level`].
     fn g_unit_computed(&self, w: f64, dir: f64, x: f64) -> f64 {
         let (fc, fs, e) = self.stribeck_terms(w, dir);
-        self.scale(dir, x) * (fc + (fs - fc) * exp_neg(e))
+        // Without a Stribeck term (Fs = Fc: Dahl's level, as `diagnose`
+        // starts a Dahl nominal moved to LuGre) (Fs − Fc)·e^(−e) is 0
+        // exactly, and the exponential is not taken.
+        let stribeck = if fs == fc {
+            0.0
+        } else {
+            (fs - fc) * exp_neg(e)
+        };
+        self.scale(dir, x) * (fc + stribeck)
     }
 
     /// The levels `(Fc', Fs')` of direction `dir` and the exponent
@@ -921,18 +929,7 @@ impl LuGre {
             let wm = v.at(tm).abs();
             let lambda = self.p.sigma0 * wm / self.g_unit(wm, s, x.at(tm));
             let zss_b = self.zss(v.at(t1).abs(), s, x.at(t1));
-            let lh = lambda * hs;
-            let decay = exp_neg(lh);
-            let phi = if lh > 0.0 {
-                // 1 − e^(−lh) is 1 to the last bit beyond lh = 40
-                if lh > 40.0 {
-                    1.0 / lh
-                } else {
-                    -(-lh).exp_m1() / lh
-                }
-            } else {
-                1.0
-            };
+            let (decay, phi) = decay_and_mean(lambda * hs);
             z = zss_b + (z - zss_a) * decay - (zss_b - zss_a) * phi;
             zss_a = zss_b;
             t = t1;
@@ -942,6 +939,27 @@ impl LuGre {
 
     // The state: the mean bristle deflection z, any finite value.
     one_value_state!("LuGre", "z", z);
+}
+
+/// The two factors of a sub-step's update over `lh = λ·hs ≥ 0`:
+/// `e^(−lh)` and `φ = (1 − e^(−lh))/lh` (the mean of `e^(−λτ)` over the
+/// sub-step; 1 at `lh = 0`), both to within a few units in the last place,
+/// from one call of libm: beyond `lh = 0.5`, `1 − e^(−lh) ≥ 0.39` is taken
+/// from `e^(−lh)` with no cancellation to speak of (and is 1 to the last
+/// bit beyond `lh = 40`); below, `e^(−lh) − 1` comes from `exp_m1`, which
+/// keeps `φ` exact for small `lh`, and `e^(−lh)` is 1 plus it. (A NaN `lh`
+/// gives a NaN decay, as `exp` would.)
+#[inline]
+fn decay_and_mean(lh: f64) -> (f64, f64) {
+    if lh > 0.5 {
+        let decay = exp_neg(lh);
+        (decay, (1.0 - decay) / lh)
+    } else if lh > 0.0 {
+        let decay_m1 = (-lh).exp_m1();
+        (1.0 + decay_m1, -decay_m1 / lh)
+    } else {
+        (exp_neg(lh), 1.0)
+    }
 }
 
 /// `e^(−a)` for `a ≥ 0`, with 0 beyond the smallest subnormal (a > 745.2,
@@ -978,6 +996,55 @@ mod tests {
 
     fn rel(a: f64, b: f64) -> f64 {
         (a - b).abs() / b.abs()
+    }
+
+    /// The sub-step factors from one call of libm equal the two-call
+    /// forms `e^(−lh)` and `−expm1(−lh)/lh` (each within an ulp) to a few
+    /// ulp, from where `1 − e^(−lh)` would lose every digit (lh = 1e-14)
+    /// to where the decay underflows.
+    #[test]
+    fn decay_and_mean_match_their_two_call_forms() {
+        assert_eq!(decay_and_mean(0.0), (1.0, 1.0));
+        assert!(decay_and_mean(f64::NAN).0.is_nan());
+        let mut lh = 1e-14;
+        while lh < 1e3 {
+            let (decay, mean) = decay_and_mean(lh);
+            let (decay_ref, mean_ref) = (exp_neg(lh), -(-lh).exp_m1() / lh);
+            if decay_ref > 0.0 {
+                assert!(
+                    rel(decay, decay_ref) <= 4.5e-16,
+                    "lh = {lh}: {decay} against {decay_ref}"
+                );
+            } else {
+                assert_eq!(decay, 0.0, "lh = {lh}");
+            }
+            assert!(
+                rel(mean, mean_ref) <= 1e-15,
+                "lh = {lh}: {mean} against {mean_ref}"
+            );
+            lh *= 1.37;
+        }
+    }
+
+    /// Without a Stribeck term (Fs = Fc) the level is Fc, bit for bit, as
+    /// the formula with the exponential gives it; with one, the term is
+    /// there.
+    #[test]
+    fn level_without_a_stribeck_term_is_fc_exactly() {
+        let mut p = LuGreParams::default();
+        p.fs = p.fc;
+        let law = LuGre::new(p).unwrap();
+        for w in [1e-9, 1e-3, p.vs, 0.37, 50.0] {
+            let e = (w / p.vs).powi(2);
+            let with_exponential = p.fc + (p.fs - p.fc) * exp_neg(e);
+            assert_eq!(
+                law.g_unit_computed(w, 1.0, 0.0).to_bits(),
+                with_exponential.to_bits()
+            );
+        }
+        let stribeck = LuGre::new(LuGreParams::default()).unwrap();
+        let p = LuGreParams::default();
+        assert!(stribeck.g_unit_computed(p.vs, 1.0, 0.0) > p.fc);
     }
 
     /// `force_and_sliding` is `force` and `sliding` bit for bit: at rest,
