@@ -411,6 +411,16 @@ impl LuGre {
         self.g_unit_computed(w, dir, x)
     }
 
+    /// Whether the Stribeck term of direction `dir` is 0 to the last bit
+    /// at `w = |v|`: no term (Fs = Fc), or an exponent beyond
+    /// [`EXP_NEG_ZERO_BEYOND`] (no exponential taken to tell; the few
+    /// exponents just below it whose `exp` rounds to 0 count as not 0,
+    /// which costs sub-steps, not accuracy).
+    fn stribeck_vanishes(&self, w: f64, dir: f64) -> bool {
+        let (fc, fs, e) = self.stribeck_terms(w, dir);
+        fs == fc || e > EXP_NEG_ZERO_BEYOND
+    }
+
     /// [`LuGre::g_unit`] without [`LuGre::level`].
     fn g_unit_computed(&self, w: f64, dir: f64, x: f64) -> f64 {
         let (fc, fs, e) = self.stribeck_terms(w, dir);
@@ -606,7 +616,10 @@ impl LuGre {
     /// `z ← zss_b + (z − zss_a)·e^(−λh) − (zss_b − zss_a)·(1 − e^(−λh))/(λh)`.
     /// This reduces to the exact constant-input update and, unlike freezing
     /// `zss` at the midpoint too, stays second-order accurate when `λh ≫ 1`
-    /// (sliding), where `z` tracks `zss(v(t))`. `Fn` does not enter.
+    /// (sliding), where `z` tracks `zss(v(t))`. A piece over which the
+    /// level is constant (no Stribeck term, or one that is 0 there; no
+    /// position table in use) is one sub-step, which is then exact. `Fn`
+    /// does not enter.
     pub fn step(&mut self, inp: &LuGreInputs, h: f64) {
         if h.is_nan() || h <= 0.0 {
             return;
@@ -900,6 +913,15 @@ impl LuGre {
                 }
             }
         }
+        // A level constant over the piece (no Stribeck term, or one that is
+        // 0 to the last bit at both ends and so between them, |v| being
+        // monotone on a one-sign piece; the scale fixed): zss is constant
+        // and λ = σ0·|v|/g linear in t, so one sub-step, whose midpoint λ
+        // integrates λ exactly, is the exact solution
+        // z = zss + (z − zss)·e^(−∫λ).
+        let level_constant = (!self.p.position_dependent || x.slope == 0.0)
+            && self.stribeck_vanishes(v.at(a).abs(), s)
+            && self.stribeck_vanishes(v.at(b).abs(), s);
         let mut next_kink = 0;
         let mut t = a;
         let mut zss_a = self.zss(v.at(t).abs(), s, x.at(t));
@@ -917,7 +939,7 @@ impl LuGre {
             };
             let rest = end - t;
             let mut len = rest;
-            if count < MAX_SUBSTEPS {
+            if count < MAX_SUBSTEPS && !level_constant {
                 let rate = (v.slope.abs() / (v.at(t).abs() + vs) / KAPPA_V).max(rate_x / KAPPA_X);
                 if rate * rest > 1.0 {
                     len = (1.0 / rate).max(min_len);
@@ -962,13 +984,18 @@ fn decay_and_mean(lh: f64) -> (f64, f64) {
     }
 }
 
+/// Beyond this [`exp_neg`] is 0 without calling `exp`, which would give
+/// 0 too: `e^(−745.2)` is below half the least subnormal (4.9e-324).
+/// (`exp` already rounds to 0 from about 745.13.)
+const EXP_NEG_ZERO_BEYOND: f64 = 745.2;
+
 /// `e^(−a)` for `a ≥ 0`, with 0 beyond the smallest subnormal (a > 745.2,
 /// where `exp` returns 0 anyway) without libm's slow underflow path, which
 /// a stiff contact (σ0|v|h/g in the thousands) or a Stribeck term far above
 /// vs would otherwise take at every step.
 #[inline]
 fn exp_neg(a: f64) -> f64 {
-    if a > 745.2 {
+    if a > EXP_NEG_ZERO_BEYOND {
         0.0
     } else {
         (-a).exp()
@@ -1244,6 +1271,33 @@ mod tests {
             q.scale_neg[i] = 1.0 + 0.2 * (i as f64).cos();
         }
         check_against_rk4(q, 2e-2, 60, |t| 3e-3 * (5.0 * t).sin());
+    }
+
+    /// With a level constant over a ramped step (Fs = Fc, or a speed far
+    /// above vs where the Stribeck term is 0), the step is the closed form
+    /// z = zss + (z0 − zss)·e^(−σ0/g·∫|v|) in one sub-step; it also matches
+    /// the RK4 reference through zero crossings.
+    #[test]
+    fn ramped_inputs_at_a_constant_level_take_the_closed_form() {
+        let mut p = LuGreParams::default();
+        p.fs = p.fc;
+        check_against_rk4(p, 1e-2, 150, |t| {
+            5e-3 * (2.0 * std::f64::consts::PI * t).sin()
+        });
+        let fast = LuGreParams::default();
+        // (v0, v1): from rest upward with Fs = Fc; 30·vs and more with the
+        // default Stribeck term (e^(−900) = 0)
+        for (params, v0, v1, g) in [(p, 1e-4, 2e-2, p.fc), (fast, 30.0 * fast.vs, 0.5, fast.fc)] {
+            let h = 1e-3;
+            let mut law = LuGre::new(params).unwrap();
+            law.set_z(0.2 * g / params.sigma0);
+            let z0 = law.z;
+            law.step(&inputs(Ramp::new(v0, (v1 - v0) / h)), h);
+            let zss = g / params.sigma0;
+            let travel = 0.5 * (v0 + v1) * h;
+            let closed = zss + (z0 - zss) * (-params.sigma0 / g * travel).exp();
+            assert!(rel(law.z, closed) < 1e-13, "{} against {closed}", law.z);
+        }
     }
 
     #[test]
