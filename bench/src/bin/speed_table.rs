@@ -268,6 +268,15 @@ fn best_of_alternating(
     Ok((best_f, best_g))
 }
 
+/// Fold one FMPy run's wall time (or why it failed) into the best so far:
+/// the shorter time, or the run's error, which ends the series.
+fn keep_best(best: &mut Result<f64, String>, run: Result<f64, String>) {
+    *best = match run {
+        Ok(wall) => Ok(best.as_ref().map_or(wall, |b| b.min(wall))),
+        Err(e) => Err(e),
+    };
+}
+
 /// FMPy's Jacobi loop runs, in turns with the host's (five seconds each):
 /// the best counts.
 const FMPY_RUNS: usize = 3;
@@ -389,13 +398,11 @@ fn host_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<HostTable, St
                 // tried again)
                 let counted_round = (1..=fmpy_runs).contains(&rounds);
                 if counted_round && (rounds == 1 || fmpy.is_ok()) {
-                    match fmpy_run(&file, python, master, h, stop) {
-                        Ok((wall, force)) => {
-                            fmpy_final = force;
-                            fmpy = Ok(fmpy.as_ref().map_or(wall, |best| best.min(wall)));
-                        }
-                        Err(e) => fmpy = Err(e),
+                    let run = fmpy_run(&file, python, master, h, stop);
+                    if let Ok((_, force)) = run {
+                        fmpy_final = force;
                     }
+                    keep_best(&mut fmpy, run.map(|(wall, _)| wall));
                 }
                 rounds += 1;
                 Ok(wall)
@@ -637,6 +644,7 @@ fn process_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<ProcessTab
     // best come from the same spell of the machine: the machine's speed
     // drifts by tens of percent over a minute.
     let mut fmpy: Result<f64, String> = Err("not run".to_string());
+    let fmpy_runs = sizes.repeats.min(FMPY_RUNS);
     let (mut csv_runs, mut mat_runs) = (0, 0);
     let (csv, mat) = best_of_alternating(
         sizes.repeats,
@@ -651,12 +659,10 @@ fn process_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<ProcessTab
             let wall = fricsim_process(root, stop, &out)?.0;
             // (run 1 is the untimed one; a failed FMPy run is not tried
             // again)
-            let counted_round = (2..=sizes.repeats.min(FMPY_RUNS) + 1).contains(&mat_runs);
+            let counted_round = (2..=fmpy_runs + 1).contains(&mat_runs);
             if counted_round && (mat_runs == 2 || fmpy.is_ok()) {
-                fmpy = match fmpy_run(&file, python, "jacobi", STICK_SLIP_STEP, stop) {
-                    Ok((t, _)) => Ok(fmpy.as_ref().map_or(t, |best| best.min(t))),
-                    Err(e) => Err(e),
-                };
+                let run = fmpy_run(&file, python, "jacobi", STICK_SLIP_STEP, stop);
+                keep_best(&mut fmpy, run.map(|(wall, _)| wall));
             }
             Ok(wall)
         },
@@ -701,7 +707,7 @@ fn process_table(root: &Path, python: &Path, sizes: &Sizes) -> Result<ProcessTab
         csv,
         mat,
         fmpy,
-        fmpy_runs: sizes.repeats.min(FMPY_RUNS),
+        fmpy_runs,
         csv_replacing,
         mat_replacing,
         csv_replacing_spaced,
