@@ -8,6 +8,7 @@ names the FMU variables with their units."""
 
 from __future__ import annotations
 
+import html
 import re
 import shutil
 import subprocess
@@ -133,11 +134,13 @@ def test_verdict_names_fmu_variables_with_units(emps, hidden):
     hidden_html = (hidden / "report.html").read_text()
     assert re.search(r"<code>scale_pos\[1\]</code> = [-0-9.e]+ \(was 1\)", hidden_html), "position verdict"
     # and the refitted system reruns with the command the report gives
-    command = re.search(r"Rerun the refitted system: <code>fricsim run (\S+) --input (\S+)</code>", emps_html)
-    assert command, "no rerun command"
-    run = subprocess.run(
-        [str(FRICSIM), "run", command.group(1), "--input", command.group(2), "--quiet",
-         "--out", str(emps / "rerun.csv")],
-        capture_output=True, text=True,
-    )
-    assert run.returncode == 0, run.stderr
+    # (one on the training inputs, one on the held-out file's)
+    section = emps_html[emps_html.index("Rerun the refitted system"):]
+    commands = re.findall(r"<li><code>fricsim run ([^<]+)</code></li>", section)
+    assert len(commands) == 2, "no rerun commands"
+    for command in commands:
+        args = html.unescape(command).split()
+        assert {"--input", "--master", "--step", "--out"} <= set(args), args
+        run = subprocess.run([str(FRICSIM), "run", *args, "--quiet"], capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        assert Path(args[args.index("--out") + 1]).stat().st_size > 0

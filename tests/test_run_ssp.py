@@ -160,12 +160,10 @@ SINGLE = """<?xml version="1.0" encoding="UTF-8"?>
 """
 
 
-def test_fricsim_run_with_an_input_csv_equals_fmpy_simulate_fmu(tmp_path):
-    fmu = fmu_path("LuGre")
-    ssd = tmp_path / "lugre.ssd"
-    ssd.write_text(SINGLE.format(fmu=fmu))
-    # samples every 0.05 s (the step is 1e-3 s, so most communication points
-    # fall between samples), with an event at t = 1 (a repeated time)
+def sampled_velocity(tmp_path):
+    """A velocity sampled every 0.05 s (the step is 1e-3 s, so most
+    communication points fall between samples), with an event at t = 1 (a
+    repeated time): the signal and its input CSV."""
     t = np.linspace(0.0, 2.0, 41)
     v = 2e-3 * np.sin(2 * np.pi * t)
     t = np.insert(t, 21, 1.0)
@@ -173,9 +171,19 @@ def test_fricsim_run_with_an_input_csv_equals_fmpy_simulate_fmu(tmp_path):
     signal = np.rec.fromarrays([t, v], names=["time", "v"])
     csv = tmp_path / "input.csv"
     csv.write_text("time,v\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), v.tolist())))
+    return signal, csv
+
+
+def test_fricsim_run_with_an_input_csv_held_equals_fmpy_simulate_fmu(tmp_path):
+    """`--input-hold`: each input held over the step, as FMPy's
+    simulate_fmu holds it."""
+    fmu = fmu_path("LuGre")
+    ssd = tmp_path / "lugre.ssd"
+    ssd.write_text(SINGLE.format(fmu=fmu))
+    signal, csv = sampled_velocity(tmp_path)
 
     out = tmp_path / "run.csv"
-    fricsim("run", ssd, "--input", csv, "--out", out, "--quiet")
+    fricsim("run", ssd, "--input", csv, "--input-hold", "--out", out, "--quiet")
     header, ours = read_csv(out)
 
     theirs = simulate_fmu(str(fmu), fmi_type="CoSimulation", start_time=0.0, stop_time=2.0,
@@ -187,6 +195,60 @@ def test_fricsim_run_with_an_input_csv_equals_fmpy_simulate_fmu(tmp_path):
     # the input mattered: the force changes sign with the velocity
     force = theirs["F"]
     assert force.max() > 0 > force.min()
+
+
+def test_fricsim_run_with_an_input_csv_interpolates_it_over_each_step(tmp_path):
+    """By default each input is given its slope over the step: the run
+    equals FMPy's FMU2Slave stepping the FMU with the input at t (FMPy's
+    own interpolation) and the slope (v(t + h) - v(t))/h set by
+    fmi2SetRealInputDerivatives, and differs from the held run."""
+    from ctypes import c_double, c_int, c_uint32
+    from fmpy.simulation import Input
+
+    fmu = fmu_path("LuGre")
+    ssd = tmp_path / "lugre.ssd"
+    ssd.write_text(SINGLE.format(fmu=fmu))
+    signal, csv = sampled_velocity(tmp_path)
+    out = tmp_path / "run.csv"
+    fricsim("run", ssd, "--input", csv, "--out", out, "--quiet")
+    header, ours = read_csv(out)
+
+    table = np.array([signal["v"]])
+    velocity = lambda t: float(Input.interpolate(time=t, t=signal["time"], table=table, discrete=False,
+                                                 after_event=True)[0][0])
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    unzipdir = extract(str(fmu), unzipdir=str(tmp_path / "unzipped"))
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="LuGre", instanceName="cs")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0, stopTime=2.0)
+    slave.enterInitializationMode()
+    slave.setReal([vr["v"]], [velocity(0.0)])
+    slave.exitInitializationMode()
+    h, outputs = 1e-3, [vr["F"], vr["z"]]
+    rows = [slave.getReal(outputs)]
+    for i in range(2000):
+        t, t_next = i * h, (i + 1) * h
+        now = velocity(t)
+        slave.setReal([vr["v"]], [now])
+        slave.fmi2SetRealInputDerivatives(slave.component, (c_uint32 * 1)(vr["v"]), 1, (c_int * 1)(1),
+                                          (c_double * 1)((velocity(t_next) - now) / h))
+        slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        rows.append(slave.getReal(outputs))
+    slave.terminate()
+    slave.freeInstance()
+    theirs = np.array(rows)
+    assert len(theirs) == len(ours)
+    for k, name in enumerate(("F", "z")):
+        assert_close(name, ours[:, header.index(f"friction.{name}")], theirs[:, k])
+
+    held = tmp_path / "held.csv"
+    fricsim("run", ssd, "--input", csv, "--input-hold", "--out", held, "--quiet")
+    _, held_rows = read_csv(held)
+    # the force feeds the velocity through: at a row's time held, its
+    # value a step old
+    column = header.index("friction.F")
+    assert np.max(np.abs(held_rows[:, column] - ours[:, column])) > 1e-4 * np.max(np.abs(ours[:, column]))
 
 
 def test_fricsim_run_reports_an_incomplete_run(tmp_path):

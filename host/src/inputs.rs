@@ -4,7 +4,9 @@
 //! class applies them in `simulate_fmu` (FMPy 0.3.32,
 //! `fmpy/simulation.py`): at the start time in initialization mode and at
 //! each communication point `t` before the step from `t`, held over the
-//! step. Continuous Real inputs are interpolated linearly in time; before
+//! step; by default ([`ExternalInputs::with_slopes`]) with their slopes
+//! over the step as well, and set again at the point a step reaches
+//! before its row is recorded. Continuous Real inputs are interpolated linearly in time; before
 //! the first sample the first value holds, after the last the last. At a
 //! repeated time (an event: two rows with the same time) the value after
 //! the event is taken from that time on. Inputs of variability `discrete`
@@ -337,11 +339,23 @@ impl ExternalInputs {
         })
     }
 
-    /// Also give each continuous input its slope over the macro step `h`
+    /// Interpolate the inputs over each macro step `h` (what `fricsim
+    /// run`, `cosim`, `fricsim.run` and `diagnose` do unless told to hold
+    /// them): each continuous input is given its slope over the step
     /// (`fmi2SetRealInputDerivatives`, first order) when its FMU can
     /// interpolate inputs, so that a sampled input moves linearly between
-    /// samples inside the step instead of being held (FMPy holds it; this
-    /// is for `fricsim diagnose`, which compares with the measurements).
+    /// samples inside the step instead of being held; and at each
+    /// communication point, before its row is recorded, the inputs of an
+    /// FMU that does not move them itself (and the discrete ones) are set
+    /// to their values at that time, so that a row holds the inputs of
+    /// its own time ([`Observer::at_communication_point`]).
+    ///
+    /// Without it the inputs are held over the step, as FMPy's
+    /// `simulate_fmu` holds them. Held, a sampled reference reaches a
+    /// closed loop half a step late on average: on the EMPS benchmark
+    /// (1 ms samples, a loop gain of 39 000 V/m) that put the simulated
+    /// motor voltage 110 % of its own RMS off the measurement, against
+    /// 8 % interpolated.
     pub fn with_slopes(mut self, h: f64) -> Self {
         self.slopes = Some(h);
         self
@@ -375,6 +389,33 @@ impl ExternalInputs {
         self.cursor.set(cursor);
         Ok(())
     }
+
+    /// With slopes ([`ExternalInputs::with_slopes`]), set the inputs at
+    /// `t` that a step did not bring there: those of FMUs that cannot
+    /// interpolate inputs, and the discrete ones. An FMU that interpolates
+    /// has moved its continuous inputs along their slopes to `t` itself.
+    fn bring_to(&self, system: &mut System, t: f64) -> Result<(), FmuError> {
+        if self.slopes.is_none() {
+            return Ok(());
+        }
+        // a search of its own: the next step's starts where this one does
+        let mut cursor = self.cursor.get();
+        for b in &self.bindings {
+            let instance = &mut system.components[b.component].instance;
+            let moved_by_the_fmu = !b.discrete
+                && instance
+                    .fmu()
+                    .description()
+                    .co_simulation
+                    .can_interpolate_inputs;
+            if !moved_by_the_fmu {
+                let column = &self.table.columns[b.column].1;
+                let x = interpolate_from(&mut cursor, t, &self.table.time, column, b.discrete);
+                instance.set_real(&[b.vr], &[x])?;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// `; unconnected inputs: a.b, c.d` for messages.
@@ -402,6 +443,10 @@ fn unconnected_inputs(system: &System) -> String {
 impl Observer for ExternalInputs {
     fn before_step(&mut self, system: &mut System, t: f64, _: bool) -> Result<(), FmuError> {
         self.apply(system, t)
+    }
+
+    fn at_communication_point(&mut self, system: &mut System, t: f64) -> Result<(), FmuError> {
+        self.bring_to(system, t)
     }
 }
 

@@ -67,8 +67,16 @@ pub struct RunOptions {
     /// those of the file's annotation).
     pub record: Vec<String>,
     /// External inputs: a table of unconnected inputs over time,
-    /// interpolated linearly, as FMPy does.
+    /// interpolated linearly. Each continuous input is given its slope
+    /// over the step when its FMU can interpolate inputs, and a recorded
+    /// row holds the inputs at its own time
+    /// ([`ExternalInputs::with_slopes`]), unless [`RunOptions::hold_inputs`].
     pub inputs: Option<InputTable>,
+    /// Hold each external input over the macro step, as FMPy's
+    /// `simulate_fmu` does (for parity with it): no slopes, and a row
+    /// recorded at a communication point holds the inputs of the step
+    /// that ended there.
+    pub hold_inputs: bool,
     /// A time limit on each FMI call (see [`crate::fmu::watchdog`]).
     pub call_time_limit: Option<Duration>,
 }
@@ -194,7 +202,14 @@ impl PreparedRun {
             system.record(s).map_err(|e| e.to_string())?;
         }
         let inputs = match &options.inputs {
-            Some(table) => Some(ExternalInputs::bind(table.clone(), &system)?),
+            Some(table) => {
+                let bound = ExternalInputs::bind(table.clone(), &system)?;
+                Some(if options.hold_inputs {
+                    bound
+                } else {
+                    bound.with_slopes(step)
+                })
+            }
             None => None,
         };
         Ok(PreparedRun {
@@ -427,6 +442,16 @@ impl Observer for Watch<'_, '_> {
         }
         match &mut self.inputs {
             Some(i) => i.before_step(system, t, init),
+            None => Ok(()),
+        }
+    }
+
+    fn at_communication_point(&mut self, system: &mut System, t: f64) -> Result<(), FmuError> {
+        if let Some(o) = &mut self.observer {
+            o.at_communication_point(system, t)?;
+        }
+        match &mut self.inputs {
+            Some(i) => i.at_communication_point(system, t),
             None => Ok(()),
         }
     }

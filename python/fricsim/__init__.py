@@ -118,6 +118,7 @@ def run(
     input: Any = None,
     record: Sequence[str] = (),
     step_timeout: Optional[float] = None,
+    input_hold: bool = False,
 ) -> np.ndarray:
     """Co-simulate the system file ``system`` (``.ssd`` or ``.ssp``) as
     ``fricsim run`` does, and return its rows as a numpy structured array:
@@ -129,8 +130,11 @@ def run(
     ``DefaultExperiment`` and annotation; ``output_interval`` (a whole
     multiple of the step) records every k-th communication point only. ``input`` is a CSV path, a
     structured array or a DataFrame with ``time`` first and a column per
-    unconnected input, interpolated linearly in time as FMPy does.
-    ``record`` names further Real variables to record. ``step_timeout``
+    unconnected input, interpolated linearly in time: an FMU that can
+    interpolate inputs is given each one's slope over the step, and a row
+    holds the inputs of its own time. ``input_hold=True`` holds each input
+    over the step instead, as FMPy's ``simulate_fmu`` does (``fricsim run
+    --input-hold``). ``record`` names further Real variables to record. ``step_timeout``
     limits each FMI call, in seconds.
 
     A run that stops early raises :class:`FricsimError`; the rows up to the
@@ -151,6 +155,7 @@ def run(
             record=list(record),
             input=paths["input"],
             step_timeout=step_timeout,
+            input_hold=input_hold,
         )
     dtype = np.dtype([(c, np.float64) for c in columns])
     result = np.frombuffer(data, dtype=dtype).copy()

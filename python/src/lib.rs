@@ -165,7 +165,7 @@ type RunResult = (Vec<String>, Vec<f64>, Option<String>, Vec<String>);
 /// (one code path: [`fricsim::run::PreparedRun`]), returning the rows
 /// instead of writing a CSV.
 #[pyfunction]
-#[pyo3(signature = (system, start=None, stop=None, step=None, master=None, start_values=Vec::new(), output_interval=None, record=Vec::new(), input=None, step_timeout=None))]
+#[pyo3(signature = (system, start=None, stop=None, step=None, master=None, start_values=Vec::new(), output_interval=None, record=Vec::new(), input=None, step_timeout=None, input_hold=false))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -179,6 +179,7 @@ fn run(
     record: Vec<String>,
     input: Option<PathBuf>,
     step_timeout: Option<f64>,
+    input_hold: bool,
 ) -> PyResult<(Vec<String>, Py<PyBytes>, Option<String>, Vec<String>)> {
     let call_time_limit = match step_timeout {
         None => None,
@@ -208,6 +209,7 @@ fn run(
                     Some(path) => Some(InputTable::read(path).map_err(host_error)?),
                     None => None,
                 },
+                hold_inputs: input_hold,
                 call_time_limit,
             };
             let prepared = PreparedRun::new(&file, &options).map_err(host_error)?;

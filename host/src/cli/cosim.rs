@@ -2,8 +2,9 @@
 //! with a fixed macro step, write a CSV and a plot, print a summary.
 
 use super::isolated::{json, Ending};
+use fricsim::inputs::{ExternalInputs, InputTable};
 use fricsim::isolate::child::Child;
-use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, Streamed};
+use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, Observer, Streamed};
 use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
 use fricsim::system::{Experiment, RecordedType, System};
@@ -35,6 +36,17 @@ pub struct CosimArgs {
     /// Stop time in seconds.
     #[arg(long, default_value_t = 1.0)]
     pub stop: f64,
+    /// External inputs: CSV with `time` first, then component.variable
+    /// columns for unconnected inputs, interpolated linearly in time: an
+    /// FMU that can interpolate inputs is given each one's slope over the
+    /// step, and a recorded row holds the inputs of its own time (see
+    /// --input-hold; as in `fricsim run --input`).
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+    /// Hold each --input value over the macro step, as FMPy's
+    /// simulate_fmu does.
+    #[arg(long = "input-hold", requires = "input")]
+    pub input_hold: bool,
     /// Result file: CSV, or MAT v4 in the Dymola/OpenModelica layout if
     /// it ends in .mat.
     #[arg(long, default_value = "out/result.csv")]
@@ -70,6 +82,7 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
         return run_isolated(a, output);
     }
     let (mut system, mut master, plan) = build(a, &parsed)?;
+    let mut inputs = external_inputs(a, &system)?;
     let sink = CosimSink::new(a, output, &system.columns(), &plan);
     let started = std::time::Instant::now();
     // the result written on a thread of its own while the run steps on
@@ -80,7 +93,7 @@ pub fn run(a: &CosimArgs) -> Result<(), String> {
             0.0,
             a.step,
             a.stop,
-            &mut NoObserver,
+            inputs.as_mut(),
             front,
         )
     });
@@ -119,6 +132,7 @@ fn run_isolated(a: &CosimArgs, output: OutputFile) -> Result<(), String> {
 pub fn child(a: &CosimArgs, link: &mut Child) -> Result<(), String> {
     let parsed = parse(a)?;
     let (mut system, mut master, plan) = build(a, &parsed)?;
+    let mut inputs = external_inputs(a, &system)?;
     link.started(&mut system, json(&plan)?)?;
     let started = std::time::Instant::now();
     let run = link
@@ -128,7 +142,7 @@ pub fn child(a: &CosimArgs, link: &mut Child) -> Result<(), String> {
             0.0,
             a.step,
             a.stop,
-            &mut NoObserver,
+            inputs.as_mut(),
         )
         .map_err(|e| e.to_string())?;
     // on the standard error the parent shares
@@ -139,6 +153,20 @@ pub fn child(a: &CosimArgs, link: &mut Child) -> Result<(), String> {
         ended: run.ended.clone().map(|e| (e.instance, e.time)),
     };
     link.finished(&run, json(ending)?)
+}
+
+/// The `--input` table bound to the system's unconnected inputs,
+/// interpolated unless `--input-hold`; without `--input`, no observer.
+fn external_inputs(a: &CosimArgs, system: &System) -> Result<Box<dyn Observer>, String> {
+    let Some(path) = &a.input else {
+        return Ok(Box::new(NoObserver));
+    };
+    let bound = ExternalInputs::bind(InputTable::read(path)?, system)?;
+    Ok(Box::new(if a.input_hold {
+        bound
+    } else {
+        bound.with_slopes(a.step)
+    }))
 }
 
 /// What the summary and the plot need to know of a run (sent by an
@@ -213,6 +241,7 @@ fn claim_output(a: &CosimArgs, parsed: &Parsed) -> Result<OutputFile, String> {
         .iter()
         .map(|(_, p)| ("the FMU", *p))
         .collect();
+    inputs.extend(a.input.as_deref().map(|p| ("the --input table", p)));
     inputs.extend(a.plot.as_deref().map(|p| ("the plot", p)));
     OutputFile::create(&a.out, &inputs).map_err(|e| e.to_string())
 }

@@ -58,9 +58,16 @@ pub struct RunArgs {
     pub output_interval: Option<f64>,
     /// External inputs: CSV with `time` first, then component.variable
     /// columns for unconnected inputs (bare names for a one-component
-    /// system), interpolated linearly in time as FMPy does.
+    /// system), interpolated linearly in time: an FMU that can interpolate
+    /// inputs is given each one's slope over the step, and a recorded row
+    /// holds the inputs of its own time (see --input-hold).
     #[arg(long)]
     pub input: Option<PathBuf>,
+    /// Hold each --input value over the macro step, as FMPy's
+    /// simulate_fmu does (for parity with it): no slopes, and a row holds
+    /// the inputs of the step that ended at it.
+    #[arg(long = "input-hold", requires = "input")]
+    pub input_hold: bool,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -177,6 +184,7 @@ fn options(a: &RunArgs, file: &SystemFile) -> Result<RunOptions, String> {
             Some(path) => Some(InputTable::read(path)?),
             None => None,
         },
+        hold_inputs: a.input_hold,
         call_time_limit: super::call_time_limit(a.step_timeout)?,
     })
 }

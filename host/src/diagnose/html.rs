@@ -148,8 +148,8 @@ fn strip_declaration(svg: &str) -> &str {
     }
 }
 
-/// The page. `rerun` is the command that reruns the refitted system.
-pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &str, min_gain: f64) -> String {
+/// The page. `rerun` are the commands that rerun the refitted system.
+pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) -> String {
     let mut s = String::new();
     let _ = write!(
         s,
@@ -391,7 +391,7 @@ fn candidates(s: &mut String, d: &Diagnosis, min_gain: f64) {
     s.push_str("</section>\n");
 }
 
-fn changes(s: &mut String, d: &Diagnosis, rerun: &str) {
+fn changes(s: &mut String, d: &Diagnosis, rerun: &[String]) {
     let _ = writeln!(
         s,
         "<section id=\"changes\">\n<h2>What changed</h2>\n<p>The friction component <code>{}</code>'s parameters in the refitted system, against the nominal file:</p>",
@@ -418,11 +418,11 @@ fn changes(s: &mut String, d: &Diagnosis, rerun: &str) {
         }
         s.push_str("</table>\n");
     }
-    let _ = writeln!(
-        s,
-        "<p>Rerun the refitted system: <code>{}</code></p>",
-        escape(rerun)
-    );
+    s.push_str("<p>Rerun the refitted system (on the training inputs, then on the held-out file's, with the master and step the diagnosis used: the results are the co-simulations scored here):</p>\n<ul>\n");
+    for command in rerun {
+        let _ = writeln!(s, "<li><code>{}</code></li>", escape(command));
+    }
+    s.push_str("</ul>\n");
     for (title, lines) in [
         ("Notes", &d.notes),
         ("Co-simulation fallbacks", &d.fallbacks),

@@ -420,6 +420,15 @@ pub struct Diagnosis {
     /// `inputs.csv` that reruns the refitted system).
     #[serde(skip)]
     pub measured_inputs: (Vec<f64>, Vec<(String, Vec<f64>)>),
+    /// The same of the held-out file, when one was given
+    /// (`heldout-inputs.csv`).
+    #[serde(skip)]
+    pub heldout_inputs: Option<(Vec<f64>, Vec<(String, Vec<f64>)>)>,
+    /// The commands that rerun the refitted system on the training data's
+    /// inputs and, with a held-out file, on its inputs, with the master
+    /// and step the diagnosis co-simulated with: their results are the
+    /// co-simulations the report scored (filled in by the report).
+    pub rerun: Vec<String>,
 }
 
 /// The nominal's levels refitted (Fc, Fc_neg or the position scales, from
@@ -1358,6 +1367,10 @@ pub fn diagnose(
         master,
         plots,
         measured_inputs: (train.time.clone(), train.inputs.clone()),
+        heldout_inputs: heldout_file
+            .as_ref()
+            .map(|h| (h.time.clone(), h.inputs.clone())),
+        rerun: Vec::new(),
     })
 }
 

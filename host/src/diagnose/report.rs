@@ -37,20 +37,21 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
             )
         })?;
     let dir = tmp.path();
+    let mut d = d.clone();
+    d.rerun = rerun_commands(&d, out);
+    let d = &d;
     let json = serde_json::to_string_pretty(d).map_err(|e| e.to_string())?;
     std::fs::write(dir.join("report.json"), json + "\n").map_err(|e| e.to_string())?;
     std::fs::write(dir.join("report.md"), markdown(d)).map_err(|e| e.to_string())?;
     let figures = super::figures::draw_all(d, dir)?;
-    write_inputs(d, &dir.join("inputs.csv"))?;
+    write_inputs(&d.measured_inputs, &dir.join("inputs.csv"))?;
+    if let Some(held) = &d.heldout_inputs {
+        write_inputs(held, &dir.join("heldout-inputs.csv"))?;
+    }
     write_ssp(file, friction, &d.final_model, &dir.join("refitted.ssp"))?;
-    let rerun = format!(
-        "fricsim run {} --input {}",
-        out.join("refitted.ssp").display(),
-        out.join("inputs.csv").display()
-    );
     std::fs::write(
         dir.join("report.html"),
-        super::html::page(d, &figures, &rerun, d.min_gain),
+        super::html::page(d, &figures, &d.rerun, d.min_gain),
     )
     .map_err(|e| e.to_string())?;
     if out.exists() {
@@ -280,7 +281,10 @@ pub fn markdown(d: &Diagnosis) -> String {
             a.rms
         );
     }
-    let _ = writeln!(s, "\nThe same with figures: `report.html`; the figures as PNG: `gap.png` (held-out error per round), `fit.png` (measured, given, final and residuals against time), `law.png` (force against velocity), `levels.png` (position dependence), `residual.png` (friction residual binned against the states). The refitted system: `refitted.ssp` (`fricsim run refitted.ssp --input inputs.csv`).");
+    let _ = writeln!(s, "\nThe same with figures: `report.html`; the figures as PNG: `gap.png` (held-out error per round), `fit.png` (measured, given, final and residuals against time), `law.png` (force against velocity), `levels.png` (position dependence), `residual.png` (friction residual binned against the states). The refitted system: `refitted.ssp`, rerun (with the master and step the diagnosis co-simulated with, so that the results are the co-simulations scored here) by");
+    for command in &d.rerun {
+        let _ = writeln!(s, "\n    {command}");
+    }
     s
 }
 
@@ -319,10 +323,36 @@ pub fn where_line(w: &super::localise::Where) -> String {
 
 type Fail = String;
 
-/// The data file's input columns (what drives the system), for
+/// `fricsim run DIR/refitted.ssp --input DIR/inputs.csv …` over the
+/// training record and, with a held-out file, the same over
+/// `heldout-inputs.csv`: each with the diagnosis's master, step and the
+/// record's time span, so that the run is the co-simulation the report
+/// scored (the inputs interpolated over each step, as the diagnosis
+/// gives them).
+pub fn rerun_commands(d: &Diagnosis, out: &Path) -> Vec<String> {
+    let ssp = out.join("refitted.ssp");
+    let command = |inputs: &str, time: &[f64], result: &str| {
+        let (start, stop) = (time[0], *time.last().unwrap_or(&time[0]));
+        format!(
+            "fricsim run {} --input {} --master {} --step {:?} --start {start:?} --stop {stop:?} --out {}",
+            ssp.display(),
+            out.join(inputs).display(),
+            d.master,
+            d.step,
+            out.join(result).display()
+        )
+    };
+    let mut commands = vec![command("inputs.csv", &d.measured_inputs.0, "rerun.csv")];
+    if let Some((time, _)) = &d.heldout_inputs {
+        commands.push(command("heldout-inputs.csv", time, "rerun-heldout.csv"));
+    }
+    commands
+}
+
+/// A data file's input columns (what drives the system), for
 /// `fricsim run refitted.ssp --input inputs.csv`.
-fn write_inputs(d: &Diagnosis, path: &Path) -> Result<(), Fail> {
-    let (time, columns) = &d.measured_inputs;
+fn write_inputs(inputs: &(Vec<f64>, Vec<(String, Vec<f64>)>), path: &Path) -> Result<(), Fail> {
+    let (time, columns) = inputs;
     let mut text = String::from("time");
     for (name, _) in columns {
         text.push(',');

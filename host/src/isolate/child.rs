@@ -204,6 +204,10 @@ impl Observer for SendingObserver<'_> {
         self.inner.before_step(system, t, initializing)
     }
 
+    fn at_communication_point(&mut self, system: &mut System, t: f64) -> Result<(), FmuError> {
+        self.inner.at_communication_point(system, t)
+    }
+
     fn after_step(&mut self, done: usize, total: usize) {
         self.inner.after_step(done, total)
     }

@@ -103,10 +103,18 @@ pub trait Observer {
     ) -> Result<(), FmuError> {
         Ok(())
     }
+    /// Called at the communication point `t` a step has just reached,
+    /// before its row is recorded: set the outside inputs that are to
+    /// hold at `t` in that row (interpolated external inputs of an FMU
+    /// that does not move its inputs along their slopes itself).
+    fn at_communication_point(&mut self, _system: &mut System, _t: f64) -> Result<(), FmuError> {
+        Ok(())
+    }
     /// Called after step `done` of `total` (1-based).
     fn after_step(&mut self, _done: usize, _total: usize) {}
-    /// Whether [`Observer::before_step`] and [`Observer::after_step`] are
-    /// to be called between steps; `false` (an observer that does nothing
+    /// Whether [`Observer::before_step`],
+    /// [`Observer::at_communication_point`] and [`Observer::after_step`]
+    /// are to be called between steps; `false` (an observer that does nothing
     /// there) spares the run two calls per step. Asked once, when the run
     /// starts.
     fn between_steps(&self) -> bool {
@@ -600,7 +608,14 @@ fn step_all<M: Advance + ?Sized, const BETWEEN_STEPS: bool>(
         // without the observer, nothing comes between the row read at the
         // end of the last step (or by `simulate_with` before the first)
         // and this step
-        .and_then(|()| master.advance(system, t, t_next - t, !BETWEEN_STEPS));
+        .and_then(|()| master.advance(system, t, t_next - t, !BETWEEN_STEPS))
+        .and_then(|()| {
+            if BETWEEN_STEPS {
+                observer.at_communication_point(system, t_next)
+            } else {
+                Ok(())
+            }
+        });
         let ended = match stepped {
             Ok(()) => None,
             Err(e) => match ended_by(system, &e) {

@@ -29,6 +29,7 @@ mod diagnose;
 mod diagnose_any_plant;
 mod diagnose_hidden_effects;
 mod docs;
+mod emps;
 mod fmu_logging;
 mod fuzz_bounded;
 mod instance;
