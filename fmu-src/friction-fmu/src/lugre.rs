@@ -43,6 +43,10 @@ pub mod vr {
     pub const SCALE_NEG: u32 = SCALE_POS + super::TABLE_POINTS as u32;
     /// `der(z)`, after the tables.
     pub const DER_Z: u32 = SCALE_NEG + super::TABLE_POINTS as u32;
+    /// The parameters added after the first version, after `der(z)`.
+    pub const DIRECTION_DEPENDENT_VISCOUS: u32 = DER_Z + 1;
+    pub const SIGMA2_NEG: u32 = DER_Z + 2;
+    pub const F_OFFSET: u32 = DER_Z + 3;
 }
 
 const INPUTS: &[u32] = &[vr::V, vr::X, vr::FN];
@@ -71,7 +75,7 @@ fn variables() -> Vec<Variable> {
             vr::F,
             "F",
             "N",
-            "Friction force F = sigma0*z + sigma1(v)*dz/dt + sigma2*v",
+            "Friction force F = sigma0*z + sigma1(v)*dz/dt + sigma2*v + F_offset",
             INPUTS,
         )
         .with_state_dependencies(&[vr::Z]),
@@ -105,7 +109,7 @@ fn variables() -> Vec<Variable> {
             "sigma2",
             d.sigma2,
             "N.s/m",
-            "Viscous friction (per unit Fn, s/m, in the normal-force form)",
+            "Viscous friction, for v >= 0 when direction_dependent_viscous (per unit Fn, s/m, in the normal-force form)",
         )
         .with_min(0.0),
         Variable::parameter(
@@ -229,6 +233,29 @@ fn variables() -> Vec<Variable> {
         &[vr::V, vr::X],
         &[vr::Z],
     ));
+    v.push(Variable::boolean_parameter(
+        vr::DIRECTION_DEPENDENT_VISCOUS,
+        "direction_dependent_viscous",
+        false,
+        "Use sigma2_neg instead of sigma2 for v < 0 (the asymmetric viscous friction of Janot, Gautier, Brunot 2019)",
+    ));
+    v.push(
+        Variable::parameter(
+            vr::SIGMA2_NEG,
+            "sigma2_neg",
+            d.sigma2_neg,
+            "N.s/m",
+            "Viscous friction for v < 0 (when direction_dependent_viscous; per unit Fn, s/m, in the normal-force form)",
+        )
+        .with_min(0.0),
+    );
+    v.push(Variable::parameter(
+        vr::F_OFFSET,
+        "F_offset",
+        d.f_offset,
+        "N",
+        "Constant force on the contact, added to F at rest and in motion (the offset of Janot, Gautier, Brunot 2019); not scaled by Fn",
+    ));
     v
 }
 
@@ -237,8 +264,8 @@ pub static INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
     model_name: "LuGre",
     model_identifier: "LuGre",
     guid: "{cc09ec7b-20f5-4798-9c84-4aa863242977}",
-    description: "LuGre friction: dz/dt = v - sigma0*|v|*z/g(v), g(v) = Fc + (Fs - Fc)*exp(-|v/vs|^delta), F = sigma0*z + sigma1(v)*dz/dt + sigma2*v; exact exponential update for piecewise-constant inputs. Defaults: Canudas de Wit et al. 1995.",
-    source: "Canudas de Wit et al. 1995; Sun et al. 2016 eq. 9-12; Dion et al. 2013 eq. 1 (normal-force form); Thimmalapura 2004 eq. 2.8-2.9 and Table I (position and direction dependence). See docs/models.md.",
+    description: "LuGre friction: dz/dt = v - sigma0*|v|*z/g(v), g(v) = Fc + (Fs - Fc)*exp(-|v/vs|^delta), F = sigma0*z + sigma1(v)*dz/dt + sigma2*v + F_offset; exact exponential update for piecewise-constant inputs. Defaults: Canudas de Wit et al. 1995.",
+    source: "Canudas de Wit et al. 1995; Sun et al. 2016 eq. 9-12; Dion et al. 2013 eq. 1 (normal-force form); Thimmalapura 2004 eq. 2.8-2.9 and Table I (position and direction dependence); Janot, Gautier, Brunot 2019 (offset, direction-dependent viscous friction). See docs/models.md.",
     variables: Box::leak(variables().into_boxed_slice()),
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
@@ -272,6 +299,9 @@ impl LuGreFmu {
             sigma0: values.real(vr::SIGMA0),
             sigma1: values.real(vr::SIGMA1),
             sigma2: values.real(vr::SIGMA2),
+            direction_dependent_viscous: values.boolean(vr::DIRECTION_DEPENDENT_VISCOUS),
+            sigma2_neg: values.real(vr::SIGMA2_NEG),
+            f_offset: values.real(vr::F_OFFSET),
             fc: values.real(vr::FC),
             fs: values.real(vr::FS),
             vs: values.real(vr::VS),
@@ -411,9 +441,11 @@ impl Model for LuGreFmu {
         true
     }
 
-    /// dz/dt from the state equation; dF/dt = σ0·ż + σ1·z̈ + σ2·v̇ with
+    /// dz/dt from the state equation; dF/dt = σ0·ż + σ1·z̈ + σ2(v)·v̇ with
     /// z̈ = v̇ − σ0·d(|v|·z/g)/dt, for constant σ1 and x, Fn at rest (the
-    /// general case is not offered: `None`).
+    /// general case is not offered: `None`; nor at v = 0 with a
+    /// direction-dependent σ2, whose kink is there). The offset is
+    /// constant.
     fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {
         let (v, x, fn_) = Self::inputs(values);
         let z_dot = self.law.z_dot(v, x, fn_);
@@ -425,6 +457,13 @@ impl Model for LuGreFmu {
                 if p.vd != 0.0 || p.normal_force_form || moving_levels {
                     return None;
                 }
+                let sigma2 = if !p.direction_dependent_viscous || v > 0.0 {
+                    p.sigma2
+                } else if v < 0.0 {
+                    p.sigma2_neg
+                } else {
+                    return None;
+                };
                 let a = slopes[vr::V as usize];
                 let g = self.law.g(v, x, fn_);
                 let dv = 1e-7 * v.abs().max(p.vs);
@@ -434,7 +473,7 @@ impl Model for LuGreFmu {
                 let d_abs_v = v.signum() * a;
                 let z_ddot = a - p.sigma0
                     * (d_abs_v * z / g + v.abs() * z_dot / g - v.abs() * z * g_prime * a / (g * g));
-                Some(p.sigma0 * z_dot + p.sigma1 * z_ddot + p.sigma2 * a)
+                Some(p.sigma0 * z_dot + p.sigma1 * z_ddot + sigma2 * a)
             }
             _ => None,
         }

@@ -50,3 +50,12 @@ pub fn require_non_negative(name: &'static str, value: f64) -> Result<(), ParamE
         Err(ParamError::new(name, value, "must be finite and >= 0"))
     }
 }
+
+/// `Ok` when `value` is finite (any sign).
+pub fn require_finite(name: &'static str, value: f64) -> Result<(), ParamError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, value, "must be finite"))
+    }
+}

@@ -3,11 +3,20 @@
 //! "LuGre").
 //!
 //! `ż = v − σ0·|v|·z / g(v)`, `g(v) = Fc + (Fs − Fc)·exp(−|v/vs|^δ)`,
-//! `F = σ0·z + σ1(v)·ż + σ2·v`, `σ1(v) = σ1·exp(−(v/vd)²)` (vd = 0: constant).
+//! `F = σ0·z + σ1(v)·ż + σ2·v + F_offset`, `σ1(v) = σ1·exp(−(v/vd)²)`
+//! (vd = 0: constant).
+//!
+//! `F_offset` is a constant force on the contact (0 by default), which
+//! acts at rest as in motion: the offset term of the EMPS reference model
+//! (Janot, Gautier, Brunot 2019), not a level of the law (it is not
+//! scaled by the normal force).
 //!
 //! Options:
 //! - direction-dependent levels: `Fc_neg`, `Fs_neg` (and `scale_neg`) for
 //!   `v < 0` (Thimmalapura 2004);
+//! - direction-dependent viscous friction: `sigma2_neg` instead of σ2 for
+//!   `v < 0` (the asymmetric EMPS model of Janot, Gautier, Brunot 2019:
+//!   Fv+ and Fv−);
 //! - position-dependent levels: `Fc` and `Fs` multiplied by a scale factor
 //!   piecewise-linear in the position input `x`, constant beyond the table
 //!   ends (Thimmalapura 2004);
@@ -41,8 +50,15 @@ pub struct LuGreParams {
     pub sigma0: f64,
     /// Micro-damping σ1 (N·s/m).
     pub sigma1: f64,
-    /// Viscous coefficient σ2 (N·s/m).
+    /// Viscous coefficient σ2 (N·s/m), for `v ≥ 0` when the viscous
+    /// friction is direction-dependent.
     pub sigma2: f64,
+    /// Use `sigma2_neg` instead of σ2 for `v < 0`.
+    pub direction_dependent_viscous: bool,
+    /// Viscous coefficient for `v < 0` (N·s/m).
+    pub sigma2_neg: f64,
+    /// Constant force on the contact (N), at rest and in motion.
+    pub f_offset: f64,
     /// Coulomb level Fc (N), for `v ≥ 0` when direction-dependent.
     pub fc: f64,
     /// Static (break-away) level Fs ≥ Fc (N).
@@ -86,6 +102,9 @@ impl Default for LuGreParams {
             sigma0: 1e5,
             sigma1: 1e5_f64.sqrt(),
             sigma2: 0.4,
+            direction_dependent_viscous: false,
+            sigma2_neg: 0.4,
+            f_offset: 0.0,
             fc: 1.0,
             fs: 1.5,
             vs: 1e-3,
@@ -153,6 +172,10 @@ impl LuGreParams {
         require_positive("sigma0", self.sigma0)?;
         require_non_negative("sigma1", self.sigma1)?;
         require_non_negative("sigma2", self.sigma2)?;
+        if self.direction_dependent_viscous {
+            require_non_negative("sigma2_neg", self.sigma2_neg)?;
+        }
+        crate::error::require_finite("F_offset", self.f_offset)?;
         require_positive("Fc", self.fc)?;
         require_at_least("Fs", self.fs, "Fc", self.fc)?;
         require_positive("vs", self.vs)?;
@@ -506,11 +529,38 @@ impl LuGre {
 
     /// Steady-state (Stribeck) force `Fss = g(v)·sgn v + σ2·v` (σ2 per unit
     /// `Fn` in the normal-force form); Sun et al. 2016 eq. 12.
+    /// The offset `F_offset` is added; at `v = 0`, where a contact at rest
+    /// may carry any force up to its break-away level, the offset alone is
+    /// returned.
     pub fn steady_force(&self, v: f64, x: f64, fn_: f64) -> f64 {
         if v == 0.0 {
-            return 0.0;
+            return self.p.f_offset;
         }
-        (self.g_unit(v.abs(), v, x) * v.signum() + self.p.sigma2 * v) * self.fn_factor(fn_)
+        (self.g_unit(v.abs(), v, x) * v.signum() + self.sigma2_at(v) * v) * self.fn_factor(fn_)
+            + self.p.f_offset
+    }
+
+    /// The viscous coefficient for velocity `v`: `sigma2_neg` for `v < 0`
+    /// when the viscous friction is direction-dependent, else σ2.
+    #[inline(always)]
+    fn sigma2_at(&self, v: f64) -> f64 {
+        if v < 0.0 && self.p.direction_dependent_viscous {
+            self.p.sigma2_neg
+        } else {
+            self.p.sigma2
+        }
+    }
+
+    /// `∂(σ2(v)·v)/∂v`: σ2 of the direction of `v`, and at `v = 0`, where
+    /// a direction-dependent coefficient has a kink, the mean of the two
+    /// one-sided slopes (the limit of central differences).
+    #[inline]
+    fn viscous_slope(&self, v: f64) -> f64 {
+        if v == 0.0 && self.p.direction_dependent_viscous {
+            0.5 * (self.p.sigma2 + self.p.sigma2_neg)
+        } else {
+            self.sigma2_at(v)
+        }
     }
 
     /// `ż = v − σ0·|v|·z/g(v)` at the current state (independent of `Fn`:
@@ -564,10 +614,18 @@ impl LuGre {
         self.force_at_rate(z, v, zd, fn_)
     }
 
-    /// The output equation with the deflection rate `zd` given.
+    /// The output equation with the deflection rate `zd` given:
+    /// `(σ0·z + σ1(v)·ż + σ2(v)·v)·φ(Fn) + F_offset`.
     #[inline]
     fn force_at_rate(&self, z: f64, v: f64, zd: f64, fn_: f64) -> f64 {
-        (self.p.sigma0 * z + self.sigma1_at(v) * zd + self.p.sigma2 * v) * self.fn_factor(fn_)
+        self.force_per_unit(z, v, zd) * self.fn_factor(fn_) + self.p.f_offset
+    }
+
+    /// `σ0·z + σ1(v)·ż + σ2(v)·v`: the force per unit normal force in the
+    /// normal-force form, without the offset.
+    #[inline]
+    fn force_per_unit(&self, z: f64, v: f64, zd: f64) -> f64 {
+        self.p.sigma0 * z + self.sigma1_at(v) * zd + self.sigma2_at(v) * v
     }
 
     /// `true` when moving with the bristles at the sliding level:
@@ -687,15 +745,18 @@ impl LuGre {
     /// ```text
     /// ∂z⁺/∂u = (∂zss/∂u)·(1 − E) − h·(∂λ/∂u)·(z⁺ − zss)
     /// ∂ż⁺/∂u = [u = v] − (∂λ/∂u)·z⁺ − λ·∂z⁺/∂u
-    /// ∂F⁺/∂u = (σ0·∂z⁺/∂u + σ1′(v)·ż⁺·[u = v] + σ1(v)·∂ż⁺/∂u + σ2·[u = v])·φ
+    /// ∂F⁺/∂u = (σ0·∂z⁺/∂u + σ1′(v)·ż⁺·[u = v] + σ1(v)·∂ż⁺/∂u + σ2(v)·[u = v])·φ
     /// ```
     ///
     /// with, for `u = v` (`g′ = ∂g/∂w`, [`LuGre::level_and_slope`]):
     /// `∂zss/∂v = g′/σ0`, `∂λ/∂v = σ0·s·(g − w·g′)/g²`,
     /// `σ1′(v) = −2·v/vd²·σ1(v)`; for `u = x` (`g = scale(x)·G(w)`):
     /// `∂g/∂x = scale′(x)·G`, `∂zss/∂x = s·∂g/∂x/σ0`, `∂λ/∂x = −λ·∂g/∂x/g`;
-    /// for `u = Fn`: `∂z⁺/∂Fn = 0`, `∂F⁺/∂Fn = F⁺/φ` (φ′ = 1 for `Fn > 0`).
-    /// At `v = 0` the step changes nothing and `F = σ0·z·φ`: `∂/∂x` is 0.
+    /// for `u = Fn`: `∂z⁺/∂Fn = 0`, `∂F⁺/∂Fn = (F⁺ − F_offset)/φ` (φ′ = 1
+    /// for `Fn > 0`; the offset is not scaled by `Fn`). σ2(v) is the
+    /// viscous coefficient of the direction of `v` (`sigma2_neg` for
+    /// `v < 0` when direction-dependent). At `v = 0` the step changes
+    /// nothing and `F = σ0·z·φ + F_offset`: `∂/∂x` is 0.
     pub fn held_step_sensitivity(
         &self,
         input: HeldInput,
@@ -719,7 +780,7 @@ impl LuGre {
                 let zd = self.z_rate(z, v, x, fn_);
                 return Some(StepSensitivity {
                     z: 0.0,
-                    force: self.force_at_rate(z, v, zd, 1.0),
+                    force: self.force_per_unit(z, v, zd),
                 });
             }
             HeldInput::V => {
@@ -762,7 +823,7 @@ impl LuGre {
         let mut df = sigma0 * dz + s1 * dzd;
         if by_v {
             let zd = self.z_rate_at_level(z, v, g);
-            df += self.sigma1_slope(v, s1) * zd + p.sigma2;
+            df += self.sigma1_slope(v, s1) * zd + self.sigma2_at(v);
         }
         Some(StepSensitivity {
             z: dz,
@@ -876,7 +937,7 @@ impl LuGre {
         let by_fn = if !p.normal_force_form || fn_ < 0.0 {
             0.0
         } else {
-            let per_unit = self.force_at_rate(z, v, zd, 1.0);
+            let per_unit = self.force_per_unit(z, v, zd);
             if fn_ > 0.0 {
                 per_unit
             } else {
@@ -885,7 +946,7 @@ impl LuGre {
         };
         ForcePartials {
             z: (p.sigma0 + s1 * rate.z) * phi,
-            v: (self.sigma1_slope(v, s1) * zd + s1 * rate.v + p.sigma2) * phi,
+            v: (self.sigma1_slope(v, s1) * zd + s1 * rate.v + self.viscous_slope(v)) * phi,
             x: s1 * rate.x * phi,
             fn_: by_fn,
         }
@@ -1460,6 +1521,73 @@ mod tests {
     /// form, decaying micro-damping, Stribeck exponents 2, 1.4 and 0.6),
     /// stick and slip, both directions; at v = 0, at a table point and at
     /// Fn = 0 (kinks) the mean of the two sides, as the differences give.
+    /// The offset adds a constant to the force, at rest as in motion, and
+    /// leaves the bristle dynamics alone; `sigma2_neg` takes σ2's place for
+    /// v < 0 only. Closed forms: a contact sliding steadily at v carries
+    /// `g(v)·sgn v + σ2(v)·v + F_offset`; at rest with deflection z it
+    /// carries `σ0·z + F_offset`.
+    #[test]
+    fn offset_and_direction_dependent_viscous_friction_in_closed_form() {
+        let plain = LuGreParams::default();
+        let p = LuGreParams {
+            direction_dependent_viscous: true,
+            sigma2_neg: 3.0,
+            f_offset: -0.2,
+            ..plain
+        };
+        for v in [-0.05, -2e-3, 1e-3, 0.05] {
+            let mut a = LuGre::new(p).unwrap();
+            let mut b = LuGre::new(plain).unwrap();
+            // long enough to reach the steady deflection (λ·h ≫ 1)
+            a.step(&inputs(Ramp::constant(v)), 10.0);
+            b.step(&inputs(Ramp::constant(v)), 10.0);
+            assert_eq!(a.z(), b.z(), "the offset and σ2 leave z alone, v {v}");
+            let sigma2 = if v < 0.0 { 3.0 } else { plain.sigma2 };
+            let g = plain.fc + (plain.fs - plain.fc) * (-(v / plain.vs).powi(2)).exp();
+            let expect = g * v.signum() + sigma2 * v - 0.2;
+            assert!(rel(a.force(v, 0.0, 1.0), expect) < 1e-12, "v {v}");
+            assert!(rel(a.steady_force(v, 0.0, 1.0), expect) < 1e-12, "v {v}");
+        }
+        let mut rest = LuGre::new(p).unwrap();
+        rest.set_z(4e-6);
+        let expect = p.sigma0 * 4e-6 - 0.2;
+        assert!(rel(rest.force(0.0, 0.0, 1.0), expect) < 1e-12);
+        assert_eq!(rest.steady_force(0.0, 0.0, 1.0), -0.2);
+        // off, sigma2_neg is not used and not checked
+        let off = LuGreParams {
+            sigma2_neg: -1.0,
+            ..plain
+        };
+        assert!(LuGre::new(off).is_ok());
+        let bad = |q: LuGreParams| LuGre::new(q).unwrap_err().name;
+        assert_eq!(
+            bad(LuGreParams {
+                direction_dependent_viscous: true,
+                ..off
+            }),
+            "sigma2_neg"
+        );
+        for offset in [f64::NAN, f64::INFINITY] {
+            assert_eq!(
+                bad(LuGreParams {
+                    f_offset: offset,
+                    ..plain
+                }),
+                "F_offset"
+            );
+        }
+        // the normal-force form scales the law, not the offset
+        let per_newton = LuGreParams {
+            normal_force_form: true,
+            ..p
+        };
+        let mut l = LuGre::new(per_newton).unwrap();
+        l.step(&inputs(Ramp::constant(-0.05)), 10.0);
+        let f1 = l.force(-0.05, 0.0, 1.0);
+        let f3 = l.force(-0.05, 0.0, 3.0);
+        assert!(rel(f3 + 0.2, 3.0 * (f1 + 0.2)) < 1e-12, "{f1} {f3}");
+    }
+
     #[test]
     fn rate_and_force_partials_match_differences() {
         let options = every_option();
@@ -1474,6 +1602,15 @@ mod tests {
             LuGreParams {
                 stribeck_exponent: 0.6,
                 ..LuGreParams::default()
+            },
+            // direction-dependent viscous friction (a kink of σ2(v)·v at
+            // v = 0, where central differences give the mean slope) and an
+            // offset, which ∂F/∂Fn must leave out
+            LuGreParams {
+                direction_dependent_viscous: true,
+                sigma2_neg: 2.5,
+                f_offset: -0.3,
+                ..options
             },
         ];
         let points = [

@@ -115,6 +115,9 @@ fn varied() -> LuGreParams {
         direction_dependent: true,
         fc_neg: 0.7,
         fs_neg: 1.9,
+        direction_dependent_viscous: true,
+        sigma2_neg: 1.3,
+        f_offset: -0.25,
         stribeck_exponent: 1.4,
         vd: 2e-3,
         normal_force_form: true,
@@ -143,7 +146,8 @@ fn velocity_sensitivity_matches_differences_of_the_step() {
         &SPEEDS,
         &STEPS,
     );
-    // every option: direction-dependent levels, δ = 1.4, σ1(v), Fn = 25,
+    // every option: direction-dependent levels and viscous friction, an
+    // offset, δ = 1.4, σ1(v), Fn = 25,
     // inside a table segment and beyond its ends
     let p = varied();
     for x in [0.05, 0.2, -1.0, 2.0] {
