@@ -75,6 +75,51 @@ fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
         (fc_neg - d.final_model.fc_neg).abs() <= 1e-12 * fc_neg.abs(),
         "{fc_neg}"
     );
+    // the report's rerun command on the held-out file reproduces the
+    // held-out error the report gives for each channel, to 1 %
+    let rerun: Vec<String> = json["rerun"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(rerun.len(), 2, "{rerun:?}");
+    let words: Vec<&str> = rerun[1].split_whitespace().collect();
+    assert_eq!(&words[..2], ["fricsim", "run"], "{}", rerun[1]);
+    super::emps::fricsim_run(&words[2..]);
+    let result = super::emps::read_table(&dir.join("rerun-heldout.csv"));
+    let held = super::emps::read_table(&r.join("examples/data/emps_test_pulses.csv"));
+    for channel in &d.channels {
+        let simulated = super::emps::at_data_times(&result, &channel.name, &held);
+        let measured = super::emps::column(&held, &channel.name);
+        let rms = (measured
+            .iter()
+            .zip(&simulated)
+            .map(|(m, s)| (m - s).powi(2))
+            .sum::<f64>()
+            / measured.len() as f64)
+            .sqrt();
+        assert!(
+            (rms - channel.final_rms).abs() <= 0.01 * channel.final_rms,
+            "{}: the rerun gives {rms}, the report {}",
+            channel.name,
+            channel.final_rms
+        );
+    }
+    // the diagnosed model rerun by `fricsim run` follows the actuator force
+    // on both records at least as closely as the published symmetric model
+    // with its offset (Janot, Gautier, Brunot 2019) run the same way
+    let symmetric = r.join("examples/emps_symmetric_2019.ssd");
+    for record in ["emps_train.csv", "emps_test_pulses.csv"] {
+        let error = |system: &Path| {
+            super::emps::closed_loop_force_error(system, record, "1e-3", &[], out.path())
+        };
+        let (diagnosed, published) = (error(&dir.join("refitted.ssp")), error(&symmetric));
+        assert!(
+            diagnosed <= published,
+            "{record}: diagnosed {diagnosed:.3} %, published symmetric + offset {published:.3} %"
+        );
+    }
 }
 
 /// Thimmalapura's table of break-away levels (71 rows, one block each): every
