@@ -119,6 +119,16 @@ def test_a_dataframe_input_equals_the_command_with_the_csv(tmp_path):
         assert np.ptp(result["friction.F"]) > 0
         for name in expected:
             assert same_bits(result[name], expected[name]), name
+    # held over each step, as the command's --input-hold, and not the same
+    out_held = tmp_path / "alone_held.csv"
+    done = cli("run", system, "--stop", 1.0, "--step", 1e-3, "--input", inputs, "--input-hold",
+               "--out", out_held, "--quiet")
+    assert done.returncode == 0, done.stderr
+    expected_held = read_exact_csv(out_held)
+    held = fricsim.run(system, stop=1.0, step=1e-3, input=table, input_hold=True)
+    for name in expected_held:
+        assert same_bits(held[name], expected_held[name]), name
+    assert not same_bits(held["friction.F"], expected["friction.F"])
 
 
 def test_info_is_the_model_description():

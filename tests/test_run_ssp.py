@@ -251,6 +251,29 @@ def test_fricsim_run_with_an_input_csv_interpolates_it_over_each_step(tmp_path):
     assert np.max(np.abs(held_rows[:, column] - ours[:, column])) > 1e-4 * np.max(np.abs(ours[:, column]))
 
 
+def test_cosim_with_an_input_csv_equals_run(tmp_path):
+    """`fricsim cosim --input` applies the table as `run --input` does,
+    interpolated by default and held with --input-hold."""
+    fmu = fmu_path("LuGre")
+    ssd = tmp_path / "lugre.ssd"
+    ssd.write_text(SINGLE.format(fmu=fmu))
+    _, csv = sampled_velocity(tmp_path)
+    for hold in ([], ["--input-hold"]):
+        run, cosim = tmp_path / "run.csv", tmp_path / "cosim.csv"
+        fricsim("run", ssd, "--input", csv, *hold, "--out", run, "--quiet")
+        # cosim names the columns component.variable
+        named = tmp_path / "named-input.csv"
+        named.write_text(csv.read_text().replace("time,v", "time,friction.v", 1))
+        fricsim("cosim", "--fmu", f"friction={fmu}", "--input", named, *hold, "--step", "1e-3", "--stop", "2",
+                "--out", cosim)
+        header, ours = read_csv(run)
+        cosim_header, theirs = read_csv(cosim)
+        assert ours.shape == theirs.shape
+        for name in ("F", "z"):
+            column = f"friction.{name}"
+            assert_close(column, theirs[:, cosim_header.index(column)], ours[:, header.index(column)], rtol=0.0)
+
+
 def test_fricsim_run_reports_an_incomplete_run(tmp_path):
     """An FMU error mid-run: exit status 1, the rows so far in the CSV with
     an INCOMPLETE comment, the summary says INCOMPLETE. (LuGre refuses a
