@@ -346,6 +346,9 @@ pub struct FoundEffect {
     pub where_: localise::Where,
 }
 
+/// A record's time and its input columns (name, values).
+pub type InputColumns = (Vec<f64>, Vec<(String, Vec<f64>)>);
+
 /// Everything diagnose found.
 #[derive(Clone, Debug, Serialize)]
 pub struct Diagnosis {
@@ -419,11 +422,11 @@ pub struct Diagnosis {
     /// The data file's time and the columns that drive inputs (for the
     /// `inputs.csv` that reruns the refitted system).
     #[serde(skip)]
-    pub measured_inputs: (Vec<f64>, Vec<(String, Vec<f64>)>),
+    pub measured_inputs: InputColumns,
     /// The same of the held-out file, when one was given
     /// (`heldout-inputs.csv`).
     #[serde(skip)]
-    pub heldout_inputs: Option<(Vec<f64>, Vec<(String, Vec<f64>)>)>,
+    pub heldout_inputs: Option<InputColumns>,
     /// The commands that rerun the refitted system on the training data's
     /// inputs and, with a held-out file, on its inputs, with the master
     /// and step the diagnosis co-simulated with: their results are the

@@ -351,7 +351,7 @@ pub fn rerun_commands(d: &Diagnosis, out: &Path) -> Vec<String> {
 
 /// A data file's input columns (what drives the system), for
 /// `fricsim run refitted.ssp --input inputs.csv`.
-fn write_inputs(inputs: &(Vec<f64>, Vec<(String, Vec<f64>)>), path: &Path) -> Result<(), Fail> {
+fn write_inputs(inputs: &super::InputColumns, path: &Path) -> Result<(), Fail> {
     let (time, columns) = inputs;
     let mut text = String::from("time");
     for (name, _) in columns {
