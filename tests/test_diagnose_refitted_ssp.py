@@ -1,7 +1,7 @@
 """`fricsim diagnose` writes the refitted system as an SSP archive that FMPy
 runs as well as `fricsim run` does: FMPy's reader (`fmpy.ssp.ssd.read_ssd`,
 schema-validated) reads it, the friction parameters it binds are the
-report's final model (the direction levels and the position table EMPS
+report's final model (the direction-dependent viscous friction EMPS
 gains), and FMPy driving the archive's FMUs with fricsim's Jacobi loop
 equals `fricsim run refitted.ssp` to 1e-9 relative."""
 
@@ -28,7 +28,7 @@ def test_refitted_emps_system_runs_in_fmpy_with_the_fitted_parameters(tmp_path):
         out,
     )
     report = json.loads((out / "report.json").read_text())
-    assert [e["name"] for e in report["effects"]][:1] == ["direction_dependent"]
+    assert [e["name"] for e in report["effects"]][:1] == ["direction_dependent_viscous"]
     final = report["final_model"]
     ssp = out / "refitted.ssp"
 
@@ -41,15 +41,14 @@ def test_refitted_emps_system_runs_in_fmpy_with_the_fitted_parameters(tmp_path):
         for parameter_set in binding.parameterValues:
             for p in parameter_set.parameters:
                 bound[p.name] = p.value
-    expected = {"Fc": final["fc"], "Fc_neg": final["fc_neg"], "sigma2": final["sigma2"]}
+    expected = {"Fc": final["fc"], "sigma2": final["sigma2"], "sigma2_neg": final["sigma2_neg"]}
     for i, (x, s) in enumerate(zip(final["x_table"], final["scale_pos"])):
         expected[f"x_table[{i + 1}]"] = x
         expected[f"scale_pos[{i + 1}]"] = s
     for name, value in expected.items():
         assert name in bound, f"refitted.ssp binds no {name}"
         assert abs(float(bound[name]) - value) <= 1e-12 * abs(value), (name, bound[name], value)
-    assert bound["direction_dependent"] in ("true", "1", True)
-    assert bound["position_dependent"] in ("true", "1", True)
+    assert bound["direction_dependent_viscous"] in ("true", "1", True)
 
     # the same run in both importers
     run = tmp_path / "run.csv"

@@ -26,6 +26,7 @@ OUT_OF_BOUNDS = [
     ("Dahl", "alpha", -1.0),
     ("LuGre", "sigma0", -1.0),
     ("LuGre", "Fc_neg", -0.5),
+    ("LuGre", "sigma2_neg", -1.0),
     ("LuGre", "scale_neg[3]", -1.0),
     ("ResetIntegrator", "sigma0", -5.0),
     ("Bristle2D", "sigma02", -1.0),

@@ -130,7 +130,7 @@ def test_report_renders_in_chromium_with_every_section(report, tmp_path):
 
 def test_verdict_names_fmu_variables_with_units(emps, hidden):
     emps_html = (emps / "report.html").read_text()
-    assert re.search(r"<code>Fc_neg</code> = [-0-9.e]+ N \(was [-0-9.e]+ N\)", emps_html), "EMPS verdict"
+    assert re.search(r"<code>sigma2_neg</code> = [-0-9.e]+ N.s/m \(was [-0-9.e]+ N.s/m\)", emps_html), "EMPS verdict"
     hidden_html = (hidden / "report.html").read_text()
     assert re.search(r"<code>scale_pos\[1\]</code> = [-0-9.e]+ \(was 1\)", hidden_html), "position verdict"
     # and the refitted system reruns with the command the report gives

@@ -138,14 +138,15 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     );
     for e in &d.effects {
         println!(
-            "  {:<20} {:<8} held-out RMS {:.5} -> {:.5} (p = {:.1e}); where: {} {}",
+            "  {:<20} {:<8} held-out RMS {:.5} -> {:.5} (p = {:.1e}); where: {} {}{}",
             e.name.name(),
             e.action,
             e.rms_before,
             e.rms_after,
             e.p_value,
             e.where_.state,
-            e.where_.bin
+            e.where_.bin,
+            fricsim::diagnose::report::alternatives_line(e)
         );
     }
     println!(

@@ -194,9 +194,10 @@ pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) 
         for e in &d.effects {
             let _ = writeln!(
                 s,
-                "<li><strong>{}</strong>: {}</li>",
+                "<li><strong>{}</strong>: {}{}</li>",
                 escape(e.name.name()),
-                escape(&where_line(&e.where_))
+                escape(&where_line(&e.where_)),
+                escape(&super::report::alternatives_line(e))
             );
         }
         s.push_str("</ol>\n");
@@ -336,7 +337,7 @@ fn candidates(s: &mut String, d: &Diagnosis, min_gain: f64) {
         "<p>Each round fits every candidate (an effect added, or re-sized when the model has it) and scores it on the held-out data against the current model; of those that pass every test, the best is accepted and the next round starts from it.</p>"
     );
     for (r, round) in d.rounds.iter().enumerate() {
-        let threshold = d.alpha / round.len().max(1) as f64;
+        let threshold = d.round_thresholds[r];
         let _ = writeln!(
             s,
             "<h3>Round {} ({} candidates; p must be below {:.2e})</h3>\n<table>\n<tr><th>candidate</th><th>held-out RMS</th><th>drop of the mean square</th><th>p</th><th>outcome</th></tr>",

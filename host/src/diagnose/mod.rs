@@ -344,6 +344,25 @@ pub struct FoundEffect {
     /// Where the improvement is concentrated.
     #[serde(rename = "where")]
     pub where_: localise::Where,
+    /// The other explanations of the same signature, tried in the same
+    /// round ([`Effect::ASYMMETRY`]); empty for an effect of no family.
+    pub alternatives: Vec<Alternative>,
+}
+
+/// Another explanation of an accepted effect's signature, and how strongly
+/// the held-out data separate the two.
+#[derive(Clone, Debug, Serialize)]
+pub struct Alternative {
+    pub name: String,
+    pub heldout_rms: f64,
+    /// One-sided p-value that the accepted effect's held-out squared error
+    /// is below this one's ([`separation_test`]): below `threshold`, the
+    /// data prefer the accepted one.
+    pub p_value: f64,
+    /// Whether this alternative passed the acceptance tests itself.
+    pub passed: bool,
+    /// The data separate the two: p below the round's threshold.
+    pub separated: bool,
 }
 
 /// A record's time and its input columns (name, values).
@@ -372,6 +391,10 @@ pub struct Diagnosis {
     pub effects: Vec<FoundEffect>,
     /// Every candidate tried, per round.
     pub rounds: Vec<Vec<CandidateScore>>,
+    /// The p-value each round's candidates had to beat: α over the
+    /// hypotheses of the round (one per candidate, one per family of
+    /// explanations of one signature).
+    pub round_thresholds: Vec<f64>,
     /// The final error is above [`UNEXPLAINED_FACTOR`] × `floor_rms`.
     pub unexplained: bool,
     /// Held-out RMS of the measurement noise estimated from the data, its
@@ -1019,6 +1042,7 @@ pub fn diagnose(
     let mut current_scored = baseline_scored.clone();
     let mut effects = Vec::new();
     let mut rounds = Vec::new();
+    let mut round_thresholds = Vec::new();
     let (mut polish_seconds, mut polish_runs) = (0.0, 0);
     // the starts of an addition to a model: its first effects added
     // neutrally, the last from a grid
@@ -1093,13 +1117,14 @@ pub fn diagnose(
             }
         }
         let mut accepted = None;
+        let mut alternatives = Vec::new();
         let mut singles_tried = Vec::new();
         for additions in [singles, pairs] {
             if additions.is_empty() {
                 continue;
             }
             let tried = try_round(&current_folds, &additions)?;
-            let threshold = options.alpha / additions.len() as f64;
+            let threshold = options.alpha / hypotheses(&additions) as f64;
             let mut round = Vec::new();
             for t in &tried {
                 let (heldout_rms, gain, p_value, failure) = match &t.scored {
@@ -1160,6 +1185,9 @@ pub fn diagnose(
                 close.extend(far);
                 passing = close;
             }
+            // one signature, several explanations: the one the data prefer
+            // goes first ([`prefer_in_family`])
+            prefer_in_family(&mut passing, &tried, &group, threshold);
             let mut current_fine: Option<Result<Scored, String>> = None;
             let mut chosen = None;
             for k in passing {
@@ -1183,7 +1211,10 @@ pub fn diagnose(
                 }
             }
             rounds.push(round.clone());
+            round_thresholds.push(threshold);
             if let Some(k) = chosen {
+                alternatives =
+                    family_alternatives(k, &tried, &round, &group, threshold, options.min_gain);
                 accepted = Some((tried, k, round[k].p_value, threshold));
                 break;
             }
@@ -1271,6 +1302,7 @@ pub fn diagnose(
                 p_value,
                 threshold,
                 where_,
+                alternatives: std::mem::take(&mut alternatives),
             });
             current = model;
             current_folds = fold_models;
@@ -1348,6 +1380,7 @@ pub fn diagnose(
         baseline_pattern,
         effects,
         rounds,
+        round_thresholds,
         changes: {
             let names: Vec<String> = current.parameters().into_iter().map(|(n, _)| n).collect();
             fmu_values(&setup.friction_fmu, &names, &setup.nominal, &current)
@@ -1532,6 +1565,125 @@ pub fn nested_test(before: &Scored, after: &Scored, scales: &[f64], group: &[usi
         gain,
         grouped_signed_rank_test(&f, &group[..n.min(group.len())]),
     )
+}
+
+/// The number of hypotheses a round of `additions` tests, for its
+/// Bonferroni threshold: one per addition, except that the single
+/// additions of one family ([`Effect::ASYMMETRY`]) test one hypothesis
+/// together (the friction differs between the directions); which of them
+/// explains it is decided among them afterwards ([`prefer_in_family`]).
+fn hypotheses(additions: &[Vec<Effect>]) -> usize {
+    let mut families = Vec::new();
+    let mut n = 0;
+    for added in additions {
+        match added[..] {
+            [e] => match e.family() {
+                Some(f) if families.contains(&f.as_ptr()) => {}
+                Some(f) => {
+                    families.push(f.as_ptr());
+                    n += 1;
+                }
+                None => n += 1,
+            },
+            _ => n += 1,
+        }
+    }
+    n.max(1)
+}
+
+/// One-sided p-value that `better` explains the held-out data better than
+/// `other`, two candidates neither of which is nested in the other (two
+/// explanations of one signature): per held-out sample the difference of
+/// their normalised squared errors `q_other − q_better`, averaged per
+/// group and tested with Wilcoxon's signed-rank test, as the acceptance
+/// test does ([`grouped_signed_rank_test`]). 1 when they were not scored
+/// on the same samples.
+pub fn separation_test(better: &Scored, other: &Scored, group: &[usize]) -> f64 {
+    let n = better.q.len().min(other.q.len());
+    if better.picked[..n] != other.picked[..n] {
+        return 1.0;
+    }
+    let d: Vec<f64> = (0..n).map(|i| other.q[i] - better.q[i]).collect();
+    grouped_signed_rank_test(&d, &group[..n.min(group.len())])
+}
+
+/// Among the passing candidates (best first), when the best is a single
+/// effect of a family ([`Effect::ASYMMETRY`]): the family members that
+/// passed and that the held-out data do not separate from the best
+/// ([`separation_test`] at `threshold`) are equally good explanations of
+/// its signature; the first of them in the family's order is moved to the
+/// front (direction-dependent levels before an offset before
+/// direction-dependent viscous friction). A member the data separate
+/// from the others keeps its place.
+fn prefer_in_family(passing: &mut Vec<usize>, tried: &[Tried], group: &[usize], threshold: f64) {
+    let Some(&best) = passing.first() else {
+        return;
+    };
+    let (Some(family), Ok(best_scored)) = (single_family(&tried[best]), &tried[best].scored) else {
+        return;
+    };
+    let rank = |k: usize| family.iter().position(|e| *e == tried[k].added[0]);
+    let preferred = passing
+        .iter()
+        .copied()
+        .filter(|&k| single_family(&tried[k]) == Some(family))
+        .filter(|&k| {
+            k == best
+                || tried[k]
+                    .scored
+                    .as_ref()
+                    .is_ok_and(|s| separation_test(best_scored, s, group) >= threshold)
+        })
+        .min_by_key(|&k| rank(k));
+    if let Some(p) = preferred {
+        passing.retain(|&k| k != p);
+        passing.insert(0, p);
+    }
+}
+
+/// The family of `t`'s addition when it is one effect of a family.
+fn single_family(t: &Tried) -> Option<&'static [Effect]> {
+    match t.added[..] {
+        [e] => e.family(),
+        _ => None,
+    }
+}
+
+/// The other members of the accepted candidate `k`'s family tried in the
+/// same round, each with how strongly the held-out data separate it from
+/// `k` ([`Alternative`]).
+fn family_alternatives(
+    k: usize,
+    tried: &[Tried],
+    round: &[CandidateScore],
+    group: &[usize],
+    threshold: f64,
+    min_gain: f64,
+) -> Vec<Alternative> {
+    let (Some(family), Ok(chosen)) = (single_family(&tried[k]), &tried[k].scored) else {
+        return Vec::new();
+    };
+    (0..tried.len())
+        .filter(|&j| j != k && single_family(&tried[j]) == Some(family))
+        .map(|j| {
+            let p_value = match &tried[j].scored {
+                Ok(s) => separation_test(chosen, s, group),
+                Err(_) => 0.0,
+            };
+            let c = &round[j];
+            Alternative {
+                name: c.name.clone(),
+                heldout_rms: c.heldout_rms,
+                p_value,
+                passed: c.p_value < threshold
+                    && c.gain >= min_gain
+                    && c.unresolved.is_none()
+                    && c.beyond_step_error
+                    && c.failure.is_none(),
+                separated: p_value < threshold,
+            }
+        })
+        .collect()
 }
 
 /// The means of `d` over its groups (`group[i]` labels `d[i]`; a group is

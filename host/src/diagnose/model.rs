@@ -11,6 +11,16 @@
 //! | `position_dependent` | levels × a piecewise-linear scale of x | the scales at K knots |
 //! | `direction_dependent` | Fc_neg, Fs_neg (and scale_neg) for v < 0 | Fc_neg (or the negative scales) |
 //! | `normal_load` | normal-force form: F ∝ the input Fn | (the levels, per newton of Fn) |
+//! | `offset` | a constant force F_offset on the contact, at rest too | F_offset |
+//! | `direction_dependent_viscous` | sigma2_neg instead of σ2 for v < 0 | σ2, sigma2_neg |
+//!
+//! **One signature, several explanations.** In steady sliding an offset,
+//! direction-dependent levels and direction-dependent viscous friction all
+//! make the friction differ between the two directions (the EMPS models of
+//! Janot, Gautier, Brunot 2019 weigh exactly these): they are the
+//! [`Effect::ASYMMETRY`] family, tried side by side, and the diagnosis
+//! names the one the held-out data prefer, with how strongly they separate
+//! it from the others.
 //!
 //! **Added or re-sized.** Every effect whose nominal can already hold it
 //! (viscous with σ2 > 0, Stribeck with Fs > Fc, presliding with a finite
@@ -48,17 +58,38 @@ pub enum Effect {
     PositionDependent,
     DirectionDependent,
     NormalLoad,
+    Offset,
+    DirectionDependentViscous,
 }
 
 impl Effect {
-    pub const ALL: [Effect; 6] = [
+    pub const ALL: [Effect; 8] = [
         Effect::Viscous,
         Effect::Stribeck,
         Effect::Presliding,
         Effect::PositionDependent,
         Effect::DirectionDependent,
         Effect::NormalLoad,
+        Effect::Offset,
+        Effect::DirectionDependentViscous,
     ];
+
+    /// The effects that explain one signature, a friction that differs
+    /// between the directions of sliding, in the library's order of
+    /// preference when the data do not separate them.
+    pub const ASYMMETRY: [Effect; 3] = [
+        Effect::DirectionDependent,
+        Effect::Offset,
+        Effect::DirectionDependentViscous,
+    ];
+
+    /// The family of explanations `self` belongs to ([`Effect::ASYMMETRY`]),
+    /// if any.
+    pub fn family(self) -> Option<&'static [Effect]> {
+        Effect::ASYMMETRY
+            .contains(&self)
+            .then_some(&Effect::ASYMMETRY[..])
+    }
 
     pub fn name(self) -> &'static str {
         match self {
@@ -68,6 +99,8 @@ impl Effect {
             Effect::PositionDependent => "position_dependent",
             Effect::DirectionDependent => "direction_dependent",
             Effect::NormalLoad => "normal_load",
+            Effect::Offset => "offset",
+            Effect::DirectionDependentViscous => "direction_dependent_viscous",
         }
     }
 
@@ -94,6 +127,10 @@ impl Effect {
             Effect::PositionDependent => "friction levels varying along the travel",
             Effect::DirectionDependent => "different friction levels for the two directions",
             Effect::NormalLoad => "friction levels proportional to the measured normal force",
+            Effect::Offset => "a constant force on the contact, at rest as in motion (F_offset)",
+            Effect::DirectionDependentViscous => {
+                "different viscous friction for the two directions (sigma2_neg for v < 0)"
+            }
         }
     }
 }
@@ -127,6 +164,11 @@ pub struct FrictionModel {
     pub direction_dependent: bool,
     pub normal_force_form: bool,
     pub position_dependent: bool,
+    /// A constant force on the contact (N, not per newton).
+    pub f_offset: f64,
+    /// `sigma2_neg` for v < 0.
+    pub direction_dependent_viscous: bool,
+    pub sigma2_neg: f64,
     /// Table positions (m) and scales (only the first `x_table.len()` are
     /// used; empty when not position-dependent).
     pub x_table: Vec<f64>,
@@ -175,6 +217,11 @@ impl FrictionModel {
             direction_dependent: flag("direction_dependent")?,
             normal_force_form: flag("normal_force_form")?,
             position_dependent: flag("position_dependent")?,
+            f_offset: values.get("F_offset").copied().unwrap_or(0.0),
+            direction_dependent_viscous: values
+                .get("direction_dependent_viscous")
+                .is_some_and(|&x| x != 0.0),
+            sigma2_neg: values.get("sigma2_neg").copied().unwrap_or(0.0),
             x_table: Vec::new(),
             scale_pos: Vec::new(),
             scale_neg: Vec::new(),
@@ -192,6 +239,9 @@ impl FrictionModel {
             m.fc_neg = m.fc;
             m.fs_neg = m.fs;
         }
+        if !m.direction_dependent_viscous {
+            m.sigma2_neg = m.sigma2;
+        }
         Ok(m)
     }
 
@@ -204,6 +254,8 @@ impl FrictionModel {
             Effect::PositionDependent => self.position_dependent,
             Effect::DirectionDependent => self.direction_dependent,
             Effect::NormalLoad => self.normal_force_form,
+            Effect::Offset => self.f_offset != 0.0,
+            Effect::DirectionDependentViscous => self.direction_dependent_viscous,
         }
     }
 
@@ -229,13 +281,18 @@ impl FrictionModel {
     }
 
     /// Whether `effect` can be tried on this model: not yet freed, and for
-    /// the structural effects (position, direction, normal load) not yet
-    /// part of it; viscous, Stribeck and presliding are re-sized when the
-    /// model has them.
+    /// the structural effects (position, direction, normal load, offset,
+    /// direction-dependent viscous friction, the last only where there is
+    /// viscous friction to split) not yet part of it; viscous, Stribeck
+    /// and presliding are re-sized when the model has them.
     pub fn can_try(&self, effect: Effect) -> bool {
         !self.freed.contains(&effect)
             && match effect {
                 Effect::Viscous | Effect::Stribeck | Effect::Presliding => true,
+                // a viscous term to split by direction: without one, the
+                // candidate would be viscous friction and its asymmetry at
+                // once, and win over viscous alone for the viscous part
+                Effect::DirectionDependentViscous => self.has(Effect::Viscous) && !self.has(effect),
                 e => !self.has(e),
             }
     }
@@ -319,6 +376,13 @@ impl FrictionModel {
                 m.scale_neg = m.scale_pos.clone();
             }
             Effect::NormalLoad => m = m.per_newton(context.mean_normal_force),
+            // starts at no offset: the fit finds its sign
+            Effect::Offset => m.f_offset = 0.0,
+            // (tried only on a model with viscous friction, [`Self::can_try`])
+            Effect::DirectionDependentViscous => {
+                m.direction_dependent_viscous = true;
+                m.sigma2_neg = m.sigma2;
+            }
         }
         m
     }
@@ -336,6 +400,7 @@ impl FrictionModel {
             &mut m.sigma0,
             &mut m.sigma1,
             &mut m.sigma2,
+            &mut m.sigma2_neg,
         ] {
             *x /= n;
         }
@@ -374,8 +439,16 @@ impl FrictionModel {
                 f.push(Free::FcNeg);
             }
         }
-        if self.freed.contains(&Effect::Viscous) {
+        // direction-dependent viscous friction frees both coefficients
+        let viscous_asymmetry = self.freed.contains(&Effect::DirectionDependentViscous);
+        if self.freed.contains(&Effect::Viscous) || viscous_asymmetry {
             f.push(Free::Sigma2);
+        }
+        if viscous_asymmetry {
+            f.push(Free::Sigma2Neg);
+        }
+        if self.freed.contains(&Effect::Offset) {
+            f.push(Free::Offset);
         }
         if self.freed.contains(&Effect::Stribeck) {
             f.push(Free::StribeckExcess);
@@ -394,6 +467,9 @@ impl FrictionModel {
                 Free::Fc => self.fc.ln(),
                 Free::FcNeg => self.fc_neg.ln(),
                 Free::Sigma2 => self.sigma2.max(1e-300).ln(),
+                Free::Sigma2Neg => self.sigma2_neg.max(1e-300).ln(),
+                // linear (either sign), in units of this model's Fc
+                Free::Offset => self.f_offset / self.offset_unit(),
                 Free::StribeckExcess => (self.fs / self.fc - 1.0).max(1e-12).ln(),
                 Free::Vs => self.vs.ln(),
                 Free::Sigma0 => self.sigma0.ln(),
@@ -411,6 +487,8 @@ impl FrictionModel {
         for (p, &t) in free.iter().zip(theta) {
             let x = t.clamp(-700.0, 700.0).exp();
             match p {
+                Free::Offset => m.f_offset = t * self.offset_unit(),
+                Free::Sigma2Neg => m.sigma2_neg = x,
                 Free::Fc => m.fc = x,
                 Free::FcNeg => m.fc_neg = x,
                 Free::Sigma2 => m.sigma2 = x,
@@ -427,9 +505,18 @@ impl FrictionModel {
         if !m.direction_dependent {
             m.fc_neg = m.fc;
         }
+        if !m.direction_dependent_viscous {
+            m.sigma2_neg = m.sigma2;
+        }
         m.fs = m.fc * (1.0 + new_excess);
         m.fs_neg = m.fc_neg * (1.0 + new_excess);
         m
+    }
+
+    /// The unit of the offset's fitted coordinate: the Coulomb level in
+    /// newtons (at the mean normal force of 1 N in the normal-force form).
+    fn offset_unit(&self) -> f64 {
+        self.fc.abs().max(1e-12)
     }
 
     /// `(variable, value)` of the LuGre FMU for this model.
@@ -457,6 +544,12 @@ impl FrictionModel {
                 f64::from(u8::from(self.position_dependent)),
             ),
         ];
+        p.push(("F_offset".to_string(), self.f_offset));
+        p.push((
+            "direction_dependent_viscous".to_string(),
+            f64::from(u8::from(self.direction_dependent_viscous)),
+        ));
+        p.push(("sigma2_neg".to_string(), self.sigma2_neg));
         if self.position_dependent {
             p.push(("n_table".to_string(), self.x_table.len() as f64));
             for i in 0..self.x_table.len() {
@@ -482,6 +575,10 @@ impl FrictionModel {
         };
         match effect {
             Effect::Viscous => names(&["sigma2"]),
+            Effect::Offset => names(&["F_offset"]),
+            Effect::DirectionDependentViscous => {
+                names(&["direction_dependent_viscous", "sigma2", "sigma2_neg"])
+            }
             Effect::Stribeck => {
                 let mut v = with_neg("Fs", "Fs_neg");
                 v.extend(names(&["Fc", "vs"]));
@@ -548,13 +645,31 @@ impl FrictionModel {
                 ("Fc_per_N".into(), self.fc, "N/N"),
                 ("Fc_neg_per_N".into(), self.fc_neg, "N/N"),
             ],
+            Effect::Offset => vec![("F_offset".into(), self.f_offset, "N")],
+            Effect::DirectionDependentViscous => {
+                let unit = if self.normal_force_form {
+                    "s/m"
+                } else {
+                    "N.s/m"
+                };
+                vec![
+                    ("sigma2".into(), self.sigma2, unit),
+                    ("sigma2_neg".into(), self.sigma2_neg, unit),
+                    (
+                        "sigma2_neg_minus_sigma2".into(),
+                        self.sigma2_neg - self.sigma2,
+                        unit,
+                    ),
+                ]
+            }
         }
     }
 
     /// The steady sliding force's magnitude at velocity `v`, position `x`
-    /// and normal force `fn_`: LuGre's g(v) + σ2·|v| with its levels for
-    /// that direction and position (docs/models.md, "LuGre"), times `fn_`
-    /// in the normal-force form. What an effect changes in it is the
+    /// and normal force `fn_`: LuGre's g(v) + σ2(v)·|v| with its levels and
+    /// viscous coefficient for that direction and position (docs/models.md,
+    /// "LuGre"), the level times `fn_` in the normal-force form, plus the offset
+    /// along the direction of motion (the force is sgn(v)·that). What an effect changes in it is the
     /// effect's signature along the states ([`super::localise::attribute`]).
     pub fn sliding_level(&self, v: f64, x: f64, fn_: f64) -> f64 {
         let positive = v >= 0.0;
@@ -567,7 +682,13 @@ impl FrictionModel {
         let decay = (-(v.abs() / self.vs.max(1e-300)).powf(self.stribeck_exponent)).exp();
         let g = self.level(positive, x) * (1.0 + (ratio - 1.0) * decay);
         let n = if self.normal_force_form { fn_ } else { 1.0 };
-        g * n + self.sigma2 * v.abs()
+        let sigma2 = if positive || !self.direction_dependent_viscous {
+            self.sigma2
+        } else {
+            self.sigma2_neg
+        };
+        let along = if positive { 1.0 } else { -1.0 };
+        g * n + sigma2 * v.abs() + along * self.f_offset
     }
 
     /// Coulomb level for direction `positive` at position `x` (per unit Fn
@@ -601,6 +722,10 @@ pub enum Free {
     Sigma0,
     ScalePos(usize),
     ScaleNeg(usize),
+    /// The viscous coefficient for v < 0 (ln).
+    Sigma2Neg,
+    /// The offset, linear in units of the start's Fc.
+    Offset,
 }
 
 /// What the neutral starts of the effects depend on: the data's ranges.

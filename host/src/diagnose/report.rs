@@ -206,6 +206,25 @@ pub fn markdown(d: &Diagnosis) -> String {
             e.threshold
         );
         let _ = writeln!(s, "{}\n", where_line(&e.where_));
+        if !e.alternatives.is_empty() {
+            let _ = writeln!(
+                s,
+                "Other explanations of the same signature, fitted in the same round (p: one-sided, that `{}` explains the held-out data better, by the signed-rank test of their squared errors per group):\n\n| explanation | held-out RMS | p | separated | passed itself |\n| --- | --- | --- | --- | --- |",
+                e.name.name()
+            );
+            for a in &e.alternatives {
+                let _ = writeln!(
+                    s,
+                    "| `{}` | {:.5} | {:.2e} | {} | {} |",
+                    a.name,
+                    a.heldout_rms,
+                    a.p_value,
+                    if a.separated { "yes" } else { "no" },
+                    if a.passed { "yes" } else { "no" }
+                );
+            }
+            let _ = writeln!(s);
+        }
         let _ = writeln!(
             s,
             "| LuGre variable | unit | before | after |\n| --- | --- | --- | --- |"
@@ -221,7 +240,7 @@ pub fn markdown(d: &Diagnosis) -> String {
     let _ = writeln!(s, "\n## Candidates tried\n");
     let _ = writeln!(
         s,
-        "Each candidate is the current model with one effect added (or, for viscous, Stribeck and presliding when the model has them, re-sized; or two that interact), refitted; p is the one-sided p-value of Clark and West's test for nested models on the held-out samples (per sample 2·e₀·(ŷ₁ − ŷ₀), averaged per group, Student's t), against α = {} divided by the candidates of the round; the mean square must also drop by at least 2 % and by more than the co-simulation's step error squared. A round of pairs follows a round in which no single effect was accepted.\n",
+        "Each candidate is the current model with one effect added (or, for viscous, Stribeck and presliding when the model has them, re-sized; or two that interact), refitted; p is the one-sided p-value of Clark and West's test for nested models on the held-out samples (per sample 2·e₀·(ŷ₁ − ŷ₀), averaged per group, Wilcoxon's signed-rank test), against α = {} divided by the hypotheses of the round (one per candidate; the offset, direction-dependent levels and direction-dependent viscous friction, three explanations of one signature, count as one, and the one the held-out data prefer is named); the mean square must also drop by at least 2 % and by more than the co-simulation's step error squared. A round of pairs follows a round in which no single effect was accepted.\n",
         d.alpha
     );
     for (r, round) in d.rounds.iter().enumerate() {
@@ -230,7 +249,7 @@ pub fn markdown(d: &Diagnosis) -> String {
             "Round {} ({} candidates; p must be below {:.2e}):\n\n| candidate | held-out RMS | drop of the mean square | p | beyond the step error | force RMS (N, training) | fit runs |\n| --- | --- | --- | --- | --- | --- | --- |",
             r + 1,
             round.len(),
-            d.alpha / round.len().max(1) as f64
+            d.round_thresholds[r]
         );
         for c in round {
             if let Some(why) = &c.failure {
@@ -284,6 +303,39 @@ pub fn markdown(d: &Diagnosis) -> String {
     let _ = writeln!(s, "\nThe same with figures: `report.html`; the figures as PNG: `gap.png` (held-out error per round), `fit.png` (measured, given, final and residuals against time), `law.png` (force against velocity), `levels.png` (position dependence), `residual.png` (friction residual binned against the states). The refitted system: `refitted.ssp`, rerun (with the master and step the diagnosis co-simulated with, so that the results are the co-simulations scored here) by");
     for command in &d.rerun {
         let _ = writeln!(s, "\n    {command}");
+    }
+    s
+}
+
+/// `; the data do not separate it from offset (held-out RMS 0.0778, p = 4.0e-1)` and the
+/// like: how the effect stands against the other explanations of its
+/// signature ([`super::Alternative`]), empty when it has none.
+pub fn alternatives_line(e: &super::FoundEffect) -> String {
+    if e.alternatives.is_empty() {
+        return String::new();
+    }
+    let (apart, close): (Vec<_>, Vec<_>) = e.alternatives.iter().partition(|a| a.separated);
+    let list = |v: &[&super::Alternative]| {
+        v.iter()
+            .map(|a| {
+                format!(
+                    "{} (held-out RMS {:.4}, p = {:.1e})",
+                    a.name, a.heldout_rms, a.p_value
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut s = String::new();
+    if !apart.is_empty() {
+        let _ = write!(s, "; the data prefer it to {}", list(&apart));
+    }
+    if !close.is_empty() {
+        let _ = write!(
+            s,
+            "; the data do not separate it from {}: named first in the library's order",
+            list(&close)
+        );
     }
     s
 }
@@ -398,9 +450,10 @@ fn write_ssp(
     }
     for (name, x) in model.parameters() {
         match name.as_str() {
-            "direction_dependent" | "normal_force_form" | "position_dependent" => {
-                put(&name, "Boolean", (x != 0.0).to_string())
-            }
+            "direction_dependent"
+            | "normal_force_form"
+            | "position_dependent"
+            | "direction_dependent_viscous" => put(&name, "Boolean", (x != 0.0).to_string()),
             "n_table" => put(&name, "Integer", (x as i64).to_string()),
             _ => put(&name, "Real", format!("{x:e}")),
         }

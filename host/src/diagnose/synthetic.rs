@@ -115,6 +115,11 @@ fn apply(
             m.fs_neg = m.fs * (1.0 + a);
         }
         Effect::NormalLoad => m = m.per_newton(FN_MEAN),
+        Effect::Offset => m.f_offset = a * m.fc,
+        Effect::DirectionDependentViscous => {
+            m.direction_dependent_viscous = true;
+            m.sigma2_neg = m.sigma2 * (1.0 + a);
+        }
     }
     m
 }
@@ -198,6 +203,8 @@ pub fn generate(
         let (mut lo, mut hi) = match effect {
             Effect::Presliding => (1e-8, 1e-1),
             Effect::Viscous => (1e-6 * fc / speed, 10.0 * fc / speed),
+            // σ2_neg/σ2 − 1: the viscous force may be small beside Fc
+            Effect::DirectionDependentViscous => (1e-6, 1e3),
             _ => (1e-6, 2.0),
         };
         for _ in 0..50 {

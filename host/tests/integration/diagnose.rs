@@ -13,9 +13,14 @@ fn repo() -> PathBuf {
 
 /// EMPS benchmark: from the symmetric Coulomb + viscous model, fitted on
 /// the training file and scored on the pulses file, the first effect named
-/// is the direction dependence and the held-out error does not get worse.
+/// is the direction dependence of the viscous friction, at the published
+/// asymmetric model's coefficients (Janot, Gautier, Brunot 2019: Fv+ =
+/// 166.7, Fv− = 240.4 N·s/m) within 5 %; the data separate it from the two
+/// other explanations of an asymmetric friction (direction-dependent
+/// levels, an offset), which the report gives as alternatives; and the
+/// held-out error does not get worse.
 #[test]
-fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
+fn emps_names_direction_dependent_viscous_friction_as_published() {
     let r = repo();
     let file = SystemFile::open(r.join("examples/emps_nominal.ssd")).unwrap();
     let d = diagnose(
@@ -28,20 +33,41 @@ fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
     let names: Vec<Effect> = d.effects.iter().map(|e| e.name).collect();
     assert_eq!(
         names.first(),
-        Some(&Effect::DirectionDependent),
-        "{names:?}"
+        Some(&Effect::DirectionDependentViscous),
+        "{names:?}, rounds {:#?}",
+        d.rounds
     );
+    let m = &d.final_model;
+    for (fitted, published) in [(m.sigma2, 166.7061), (m.sigma2_neg, 240.4236)] {
+        assert!(
+            (fitted / published - 1.0).abs() < 0.05,
+            "fitted {fitted} N.s/m, published {published}"
+        );
+    }
+    let alternatives: Vec<&str> = d.effects[0]
+        .alternatives
+        .iter()
+        .map(|a| a.name.as_str())
+        .collect();
+    assert_eq!(alternatives, ["direction_dependent", "offset"]);
+    for a in &d.effects[0].alternatives {
+        assert!(
+            a.separated && a.heldout_rms > d.effects[0].rms_after,
+            "{a:?}"
+        );
+    }
     assert!(
         d.final_rms <= d.baseline_rms,
         "{} > {}",
         d.final_rms,
         d.baseline_rms
     );
-    // its change is put on the direction of motion, which explains all of it
+    // its change is put on the direction of motion, which explains most of
+    // it (the rest grows with the speed, within each direction)
     let explained = &d.effects[0].where_.explained_by;
     assert_eq!(explained[0].state, "direction", "{explained:?}");
-    assert!(explained[0].share > 0.95, "{explained:?}");
-    assert!(explained[1].share < 0.5, "{explained:?}");
+    assert!(explained[0].share > 0.75, "{explained:?}");
+    assert!(explained[1].share < 0.25, "{explained:?}");
     // the outputs: a report that parses, plots and a refitted system
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("emps");
@@ -52,28 +78,35 @@ fn emps_names_direction_dependence_and_the_heldout_error_does_not_grow() {
         assert!(json.get(key).is_some(), "report.json lacks {key}");
     }
     let first = &json["effects"][0];
-    for key in ["name", "parameters", "rms_before", "rms_after", "where"] {
+    for key in [
+        "name",
+        "parameters",
+        "rms_before",
+        "rms_after",
+        "where",
+        "alternatives",
+    ] {
         assert!(first.get(key).is_some(), "effect lacks {key}: {first}");
     }
     for f in ["report.md", "fit.png", "residual.png", "refitted.ssp"] {
         assert!(dir.join(f).metadata().unwrap().len() > 0, "{f}");
     }
-    // the refitted system opens, checks, and carries the fitted level
+    // the refitted system opens, checks, and carries the fitted coefficient
     let refitted = SystemFile::open(dir.join("refitted.ssp")).unwrap();
     refitted.check().unwrap();
-    let fc_neg = refitted
+    let sigma2_neg = refitted
         .parameters
         .iter()
         .rev()
-        .find(|p| p.component == "friction" && p.variable == "Fc_neg")
+        .find(|p| p.component == "friction" && p.variable == "sigma2_neg")
         .map(|p| match p.value {
             fricsim::ssp::Value::Real(x) => x,
             _ => f64::NAN,
         })
         .unwrap();
     assert!(
-        (fc_neg - d.final_model.fc_neg).abs() <= 1e-12 * fc_neg.abs(),
-        "{fc_neg}"
+        (sigma2_neg - d.final_model.sigma2_neg).abs() <= 1e-12 * sigma2_neg.abs(),
+        "{sigma2_neg}"
     );
     // the report's rerun command on the held-out file reproduces the
     // held-out error the report gives for each channel, to 1 %

@@ -47,10 +47,24 @@ fn run(hidden: &[Effect], magnitude: f64, seed: u64) -> CaseResult {
 ///
 /// One test per effect (below), so that the test harness runs two cases
 /// at a time on two cores: a case is mostly one thread's work.
+///
+/// An offset is the same force as direction-dependent levels wherever the
+/// contact slides, and on this rig (a PD loop that holds the carriage
+/// stuck between moves) the stick does not show it: the data cannot tell
+/// the two apart, and the diagnosis must say so. For it, "named" is named
+/// within its family ([`fricsim::diagnose::suite::stand_in`]: the effect
+/// named gives the offset as an alternative it is not separated from) and
+/// the size is the directional difference of the sliding force both
+/// produce.
 fn effect_at_ten_percent_is_named_sized_and_removed(effect: Effect) {
     let r = run(&[effect], 0.10, 1);
     let at_noise = r.final_rms <= 1.05 * r.noise_floor_rms;
-    let ok = r.named_right
+    let named = if effect == Effect::Offset {
+        r.named_within_family
+    } else {
+        r.named_right
+    };
+    let ok = named
         && r.sizes_within
         && r.truth_drop >= 2.0
         && (r.heldout_drop >= 2.0 || (at_noise && r.baseline_rms < 2.0 * r.noise_floor_rms));
@@ -97,6 +111,8 @@ effect_tests! {
     position_dependent_at_ten_percent: PositionDependent,
     direction_dependent_at_ten_percent: DirectionDependent,
     normal_load_at_ten_percent: NormalLoad,
+    offset_at_ten_percent: Offset,
+    direction_dependent_viscous_at_ten_percent: DirectionDependentViscous,
 }
 
 /// Nothing hidden: the refitted nominal model is at the noise floor and no
