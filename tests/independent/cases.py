@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 import random
 import subprocess
 import zlib
@@ -79,9 +80,10 @@ def simulator() -> Path:
     src = HERE / "lugre_rig.c"
     if not out.exists() or out.stat().st_mtime < src.stat().st_mtime:
         out.parent.mkdir(parents=True, exist_ok=True)
-        # built beside it and renamed into place: the test workers may
-        # build it at the same time, and none must run a half-written one
-        part = out.with_name(f"{out.name}.{os.getpid()}")
+        # built beside it and renamed into place: the test workers (and
+        # the suite's threads) may build it at the same time, and none must
+        # run a half-written one
+        part = out.with_name(f"{out.name}.{os.getpid()}.{threading.get_ident()}")
         subprocess.run(
             [os.environ.get("CC", "cc"), "-O2", "-o", str(part), str(src), "-lm"],
             check=True,

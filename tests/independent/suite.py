@@ -8,6 +8,8 @@ DATA.csv --out DIR`), and scored from its report.json:
   null case);
 - size: the fitted size of the hidden effect against the truth (relative
   error; presliding: σ0);
+- interval: whether the report's 95 % interval of the hidden effect
+  (what it adds, or presliding's sigma0) holds the truth;
 - never worse: the final held-out RMS against the given model's;
 - a report was written.
 
@@ -127,6 +129,36 @@ def effect_size(case: cases.Case, report: dict, x: list[float], v: list[float]) 
     return None
 
 
+def interval_check(case: cases.Case, report: dict) -> dict | None:
+    """Whether the report's 95 % interval of the hidden effect holds the
+    truth, when the effect was named and has an interval: what the effect
+    adds (viscous: sigma2 over the nominal's; direction dependence:
+    Fc_neg - Fc; Stribeck: Fs - Fc; report.json effects[].change), or for
+    presliding sigma0 (changes[])."""
+    expected = cases.EXPECTED[case.kind]
+    named = [e for e in report["effects"] if e["name"] == expected]
+    if not named:
+        return None
+    nom, tru = case.nominal, case.truth
+    truths = {
+        "viscous": tru["sigma2"] - nom["sigma2"],
+        "direction_dependent": tru.get("Fc_neg", tru["Fc"]) - tru["Fc"],
+        "stribeck": tru["Fs"] - tru["Fc"],
+    }
+    change = named[-1].get("change") or {}
+    if expected in truths and change.get("interval"):
+        quantity, truth, interval = change["quantity"], truths[expected], change["interval"]
+    elif expected == "presliding":
+        interval = next((c["interval"] for c in report["changes"] if c["name"] == "sigma0" and c.get("interval")), None)
+        if interval is None:
+            return None
+        quantity, truth = "sigma0", tru["sigma0"]
+    else:
+        return None
+    low, high = interval
+    return {"quantity": quantity, "truth": truth, "interval": [low, high], "holds": low <= truth <= high}
+
+
 def run_case(case: cases.Case, work: Path, bad_data: bool = False, extra: tuple = ()) -> dict:
     started = time.time()
     data, ssd = cases.make(case, work)
@@ -180,6 +212,9 @@ def run_case(case: cases.Case, work: Path, bad_data: bool = False, extra: tuple 
         q, truth, fitted = size
         row["size"] = {"quantity": q, "truth": truth, "fitted": fitted,
                        "relative_error": abs(fitted - truth) / abs(truth)}
+    interval = interval_check(case, report)
+    if interval:
+        row["interval"] = interval
     if bad_data:
         q = report["data_quality"]["data"]
         flagged = {(f["line"], f["kind"]) for f in q["findings"]}
@@ -222,6 +257,8 @@ def summarise(rows: list[dict]) -> dict:
         "reports_written": share(lambda r: True, "report"),
         "sized_within_10pct": (sum(1 for r in sized if r["size"]["relative_error"] <= 0.1), len(sized)),
         "localised_right": share(lambda r: "localised_right" in r, "localised_right"),
+        "interval_holds_truth": (sum(1 for r in rows if r.get("interval", {}).get("holds")),
+                                 sum(1 for r in rows if "interval" in r)),
     }
 
 
@@ -236,6 +273,10 @@ def table(rows: list[dict], summary: dict) -> str:
             continue
         size = r.get("size")
         s = f"{size['quantity']}: {size['truth']:.4g} → {size['fitted']:.4g} ({100 * size['relative_error']:.1f} %)" if size else ""
+        if "interval" in r:
+            iv = r["interval"]
+            s += (f"; 95 % interval of {iv['quantity']} [{iv['interval'][0]:.4g}, {iv['interval'][1]:.4g}] "
+                  f"{'holds' if iv['holds'] else 'MISSES'} the truth {iv['truth']:.4g}")
         found = ", ".join(r["found"]) or "none"
         if "localised_as" in r:
             found += f" (on {r['localised_as'].replace('_', ' ')})"

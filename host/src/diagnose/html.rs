@@ -194,10 +194,11 @@ pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) 
         for e in &d.effects {
             let _ = writeln!(
                 s,
-                "<li><strong>{}</strong>: {}{}</li>",
+                "<li><strong>{}</strong>: {}{} {}</li>",
                 escape(e.name.name()),
                 escape(&where_line(&e.where_)),
-                escape(&super::report::alternatives_line(e))
+                escape(&super::report::alternatives_line(e)),
+                escape(&super::report::change_line(e).unwrap_or_default())
             );
         }
         s.push_str("</ol>\n");
@@ -405,11 +406,15 @@ fn changes(s: &mut String, d: &Diagnosis, rerun: &[String]) {
         for v in &d.changes {
             let _ = writeln!(
                 s,
-                "<tr><td><code>{}</code></td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+                "<tr><td><code>{}</code></td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}{}</td><td class=\"num\">{}</td></tr>",
                 escape(&v.name),
                 escape(&v.unit),
                 number(v.before),
                 number(v.after),
+                v.interval.map_or(String::new(), |[low, high]| format!(
+                    " ± {}",
+                    number(0.5 * (high - low))
+                )),
                 if v.before != 0.0 {
                     format!("{:+.1} %", 100.0 * (v.after - v.before) / v.before.abs())
                 } else {

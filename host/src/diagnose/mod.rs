@@ -32,6 +32,7 @@ pub mod dahl;
 pub mod figures;
 pub mod fit;
 pub mod html;
+pub mod intervals;
 pub mod localise;
 pub mod model;
 pub mod problem;
@@ -67,7 +68,8 @@ pub struct Options {
     pub alpha: f64,
     /// Smallest relative drop of the held-out mean square to accept.
     pub min_gain: f64,
-    /// Groups of consecutive held-out samples in the paired test.
+    /// Groups of consecutive held-out samples in the paired test, and of
+    /// training samples in the intervals ([`intervals`]).
     pub groups: usize,
     /// At most this many effects.
     pub max_effects: usize,
@@ -286,6 +288,10 @@ pub struct FmuValue {
     pub unit: String,
     pub before: f64,
     pub after: f64,
+    /// The 95 % interval of `after` ([`intervals`]), for the final
+    /// model's fitted parameters; `None` for a value not fitted (or no
+    /// interval could be formed).
+    pub interval: Option<[f64; 2]>,
 }
 
 /// `names` of the friction FMU from `before` to `after`, with the FMU's
@@ -319,6 +325,7 @@ fn fmu_values(
                 // a variable the model did not set had the FMU's start value
                 before: b.get(n).copied().or(start).or(a.get(n).copied())?,
                 after: *a.get(n)?,
+                interval: None,
             })
         })
         .collect()
@@ -347,6 +354,21 @@ pub struct FoundEffect {
     /// The other explanations of the same signature, tried in the same
     /// round ([`Effect::ASYMMETRY`]); empty for an effect of no family.
     pub alternatives: Vec<Alternative>,
+    /// What the effect adds, as one number whose "no change" is 0
+    /// ([`intervals::effect_change`]), in the final model, with its 95 %
+    /// interval; `None` for an effect without such a number.
+    pub change: Option<EffectChange>,
+}
+
+/// [`FoundEffect::change`].
+#[derive(Clone, Debug, Serialize)]
+pub struct EffectChange {
+    pub quantity: &'static str,
+    pub value: f64,
+    pub interval: Option<[f64; 2]>,
+    /// The interval excludes 0: the data resolve the effect. An effect
+    /// whose interval holds 0 is reported as not resolved.
+    pub resolved: Option<bool>,
 }
 
 /// Another explanation of an accepted effect's signature, and how strongly
@@ -428,6 +450,9 @@ pub struct Diagnosis {
     pub heldout_samples: usize,
     /// Family-wise significance level.
     pub alpha: f64,
+    /// The runs of consecutive samples the tests and intervals group the
+    /// residuals into ([`Options::groups`]).
+    pub groups: usize,
     /// Smallest relative drop of the held-out mean square accepted.
     pub min_gain: f64,
     /// Folds scored: 1 (a held-out file or one third of the blocks) or 3
@@ -1303,12 +1328,45 @@ pub fn diagnose(
                 threshold,
                 where_,
                 alternatives: std::mem::take(&mut alternatives),
+                change: None,
             });
             current = model;
             current_folds = fold_models;
             current_scored = scored;
         }
         current_step_error = step_error_of(&mut system, &current_folds, &current_scored);
+    }
+
+    // 95 % intervals of the final model's fitted parameters, from the
+    // output error of the training data it was refined on ([`intervals`])
+    let interval_samples: &Picker = if folds.len() == 1 {
+        &folds[0].train
+    } else {
+        &every_sample
+    };
+    let covariance = {
+        let mut residual = |models: &[FrictionModel]| -> Vec<Option<nalgebra::DVector<f64>>> {
+            models
+                .par_iter()
+                .map(|m| train_residuals(m, interval_samples))
+                .collect()
+        };
+        intervals::theta_covariance(&current, &mut residual, scales.len(), options.groups)
+    };
+    if let Some(cov) = &covariance {
+        for e in &mut effects {
+            e.change = intervals::effect_change(e.name, &setup.nominal, &current).map(|value| {
+                let interval = cov.interval(&current, &|m: &FrictionModel| {
+                    intervals::effect_change(e.name, &setup.nominal, m)
+                });
+                EffectChange {
+                    quantity: intervals::effect_change_name(e.name).unwrap_or(""),
+                    value,
+                    interval,
+                    resolved: interval.map(|[low, high]| !(low <= 0.0 && 0.0 <= high)),
+                }
+            });
+        }
     }
 
     // the remaining discrepancy against what no model can go below: the
@@ -1383,10 +1441,17 @@ pub fn diagnose(
         round_thresholds,
         changes: {
             let names: Vec<String> = current.parameters().into_iter().map(|(n, _)| n).collect();
-            fmu_values(&setup.friction_fmu, &names, &setup.nominal, &current)
-                .into_iter()
-                .filter(|v| v.before != v.after)
-                .collect()
+            let mut changes: Vec<FmuValue> =
+                fmu_values(&setup.friction_fmu, &names, &setup.nominal, &current)
+                    .into_iter()
+                    .filter(|v| v.before != v.after)
+                    .collect();
+            if let Some(cov) = &covariance {
+                for v in &mut changes {
+                    v.interval = cov.parameter_interval(&current, &v.name);
+                }
+            }
+            changes
         },
         nominal_model: setup.nominal.clone(),
         baseline_model,
@@ -1394,6 +1459,7 @@ pub fn diagnose(
         samples: train.time.len(),
         heldout_samples: current_scored.q.len(),
         alpha: options.alpha,
+        groups: options.groups,
         min_gain: options.min_gain,
         folds: folds.len(),
         wall_seconds: started.elapsed().as_secs_f64(),

@@ -206,6 +206,9 @@ pub fn markdown(d: &Diagnosis) -> String {
             e.threshold
         );
         let _ = writeln!(s, "{}\n", where_line(&e.where_));
+        if let Some(line) = change_line(e) {
+            let _ = writeln!(s, "{line}\n");
+        }
         if !e.alternatives.is_empty() {
             let _ = writeln!(
                 s,
@@ -234,6 +237,26 @@ pub fn markdown(d: &Diagnosis) -> String {
                 s,
                 "| `{}` | {} | {} | {} |",
                 v.name, v.unit, v.before, v.after
+            );
+        }
+    }
+    if !d.changes.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n## What changed\n\nThe friction component's parameters in `refitted.ssp` against the nominal file; the 95 % interval of each fitted one from the output error of the training data, its residuals clustered in {} runs of consecutive samples (docs/diagnose.md, \"Intervals\"):\n\n| variable | unit | nominal | refitted | 95 % interval |\n| --- | --- | --- | --- | --- |",
+            d.groups
+        );
+        for v in &d.changes {
+            let _ = writeln!(
+                s,
+                "| `{}` | {} | {} | {} | {} |",
+                v.name,
+                v.unit,
+                v.before,
+                v.after,
+                v.interval.map_or("".to_string(), |[low, high]| format!(
+                    "[{low:.6e}, {high:.6e}]"
+                ))
             );
         }
     }
@@ -305,6 +328,29 @@ pub fn markdown(d: &Diagnosis) -> String {
         let _ = writeln!(s, "\n    {command}");
     }
     s
+}
+
+/// `What it adds: Fc_neg - Fc = 6.37 N, 95 % interval [6.12, 6.62]:
+/// resolved.` for an effect with a change ([`super::FoundEffect::change`]).
+pub fn change_line(e: &super::FoundEffect) -> Option<String> {
+    let c = e.change.as_ref()?;
+    Some(match (c.interval, c.resolved) {
+        (Some([low, high]), Some(resolved)) => format!(
+            "What it adds: {} = {:.4} ± {:.2} (95 % interval [{low:.4}, {high:.4}]): {}.",
+            c.quantity,
+            c.value,
+            0.5 * (high - low),
+            if resolved {
+                "resolved"
+            } else {
+                "NOT RESOLVED, the interval holds no change"
+            }
+        ),
+        _ => format!(
+            "What it adds: {} = {:.4} (no interval could be formed).",
+            c.quantity, c.value
+        ),
+    })
 }
 
 /// `; the data do not separate it from offset (held-out RMS 0.0778, p = 4.0e-1)` and the

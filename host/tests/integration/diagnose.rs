@@ -56,6 +56,31 @@ fn emps_names_direction_dependent_viscous_friction_as_published() {
             "{a:?}"
         );
     }
+    // 95 % intervals: the published asymmetric coefficients (another
+    // estimator, the inverse model's least squares on filtered data) lie
+    // inside ours, and the asymmetry is resolved (its interval excludes 0)
+    let interval = |name: &str| {
+        d.changes
+            .iter()
+            .find(|v| v.name == name)
+            .and_then(|v| v.interval)
+            .unwrap_or_else(|| panic!("no interval for {name}: {:#?}", d.changes))
+    };
+    for (name, published) in [
+        ("sigma2", 166.7061),
+        ("sigma2_neg", 240.4236),
+        ("Fc", 20.1440),
+    ] {
+        let [low, high] = interval(name);
+        assert!(
+            low < published && published < high,
+            "{name}: [{low}, {high}] against the published {published}"
+        );
+        assert!(high - low < 0.1 * published, "{name}: [{low}, {high}]");
+    }
+    let change = d.effects[0].change.as_ref().unwrap();
+    assert_eq!(change.quantity, "sigma2_neg - sigma2");
+    assert_eq!(change.resolved, Some(true), "{change:?}");
     assert!(
         d.final_rms <= d.baseline_rms,
         "{} > {}",
@@ -85,9 +110,17 @@ fn emps_names_direction_dependent_viscous_friction_as_published() {
         "rms_after",
         "where",
         "alternatives",
+        "change",
     ] {
         assert!(first.get(key).is_some(), "effect lacks {key}: {first}");
     }
+    let first_change = &json["changes"][0];
+    assert!(
+        first_change["interval"]
+            .as_array()
+            .is_some_and(|a| a.len() == 2),
+        "{first_change}"
+    );
     for f in ["report.md", "fit.png", "residual.png", "refitted.ssp"] {
         assert!(dir.join(f).metadata().unwrap().len() > 0, "{f}");
     }
