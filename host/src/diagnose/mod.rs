@@ -840,22 +840,36 @@ pub fn diagnose(
     // refine a model on the output error of the training samples `pick`
     // ([`fit::polish`])
     // the normalised output residuals of `m` on the training samples `pick`
-    let train_residuals = |m: &FrictionModel, pick: &Picker| -> Option<nalgebra::DVector<f64>> {
-        // a system of its own (an FMU instance stays on its thread)
-        let mut system = file.build(0.0).ok()?;
-        let params = system_parameters(file, &setup, m);
-        let (r, _) = co_simulate_robust(&mut system, &params, &setup, &train).ok()?;
-        let picked = pick(&r);
-        let channels = scales.len();
-        let norm = ((picked.len() * channels) as f64).sqrt();
-        Some(nalgebra::DVector::from_iterator(
-            picked.len() * channels,
-            picked.iter().flat_map(|&s| {
-                let (r, scales) = (&r, &scales);
-                (0..channels).map(move |c| r.residuals[c][s] / scales[c] / norm)
-            }),
-        ))
-    };
+    // (`step`: at that macro step instead, with the diagnosis's master and
+    // no fallback)
+    let train_residuals_at =
+        |m: &FrictionModel, pick: &Picker, step: Option<f64>| -> Option<nalgebra::DVector<f64>> {
+            // a system of its own (an FMU instance stays on its thread)
+            let mut system = file.build(0.0).ok()?;
+            let params = system_parameters(file, &setup, m);
+            let r = match step {
+                None => {
+                    co_simulate_robust(&mut system, &params, &setup, &train)
+                        .ok()?
+                        .0
+                }
+                Some(h) => co_simulate_with(&mut system, &params, &train, &setup.master, h).ok()?,
+            };
+            if r.incomplete.is_some() {
+                return None;
+            }
+            let picked = pick(&r);
+            let channels = scales.len();
+            let norm = ((picked.len() * channels) as f64).sqrt();
+            Some(nalgebra::DVector::from_iterator(
+                picked.len() * channels,
+                picked.iter().flat_map(|&s| {
+                    let (r, scales) = (&r, &scales);
+                    (0..channels).map(move |c| r.residuals[c][s] / scales[c] / norm)
+                }),
+            ))
+        };
+    let train_residuals = |m: &FrictionModel, pick: &Picker| train_residuals_at(m, pick, None);
     let polish = |model: &FrictionModel, pick: &Picker, iterations: usize| -> fit::Fitted {
         let mut residual = |models: &[FrictionModel]| -> Vec<Option<nalgebra::DVector<f64>>> {
             models
@@ -1351,7 +1365,16 @@ pub fn diagnose(
                 .map(|m| train_residuals(m, interval_samples))
                 .collect()
         };
-        intervals::theta_covariance(&current, &mut residual, scales.len(), options.groups)
+        // the same residuals with the co-simulation 4× finer: what its
+        // step error moves the estimate by
+        let fine = train_residuals_at(&current, interval_samples, Some(fine_step));
+        intervals::theta_covariance(
+            &current,
+            &mut residual,
+            fine.as_ref(),
+            scales.len(),
+            options.groups,
+        )
     };
     if let Some(cov) = &covariance {
         for e in &mut effects {

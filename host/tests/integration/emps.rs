@@ -155,3 +155,92 @@ fn emps_nominal_at_the_data_step_scores_as_at_a_step_100_times_smaller() {
         assert!(held > 3.0 * fine, "{record}: held {held:.3} %, {fine:.3} %");
     }
 }
+
+/// A recorded row holds the inputs of its own time, by default, for an FMU
+/// that interpolates its inputs (LuGre: it moves them along their slopes
+/// itself) and for one that does not (the two-mass drive of the tests, a C
+/// FMU with canInterpolateInputs="false": fricsim sets them at the
+/// communication point before the row is read); held (`--input-hold`), the
+/// row at t holds the inputs of the step that ended there, from t − h.
+#[test]
+fn a_recorded_row_holds_the_inputs_of_its_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let two_mass = super::common::c_fmu(
+        &repository().join("host/tests/c/two_mass_drive"),
+        "two_mass_drive.c",
+        "TwoMassDrive",
+        dir.path(),
+    );
+    let lugre = super::common::lugre_fmu();
+    // a ramp sampled every 0.1 s, stepped at 0.01 s: most points between samples
+    let inputs = dir.path().join("inputs.csv");
+    let mut text = String::from("time,drive.u,friction.v\n");
+    for k in 0..=10 {
+        let t = 0.1 * k as f64;
+        text.push_str(&format!("{t:?},{:?},{:?}\n", 2.0 * t, 1e-3 * t));
+    }
+    std::fs::write(&inputs, text).unwrap();
+    let table = read_table(&inputs);
+    let ssd = dir.path().join("two.ssd");
+    std::fs::write(
+        &ssd,
+        format!(
+            r#"<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription version="1.0" name="two"
+    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
+    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon">
+  <ssd:System name="two">
+    <ssd:Elements>
+      <ssd:Component name="drive" source="{}"/>
+      <ssd:Component name="friction" source="{}"/>
+    </ssd:Elements>
+  </ssd:System>
+  <ssd:DefaultExperiment startTime="0" stopTime="1">
+    <ssd:Annotations>
+      <ssc:Annotation type="org.friction-fmu.fricsim">
+        <fricsim:Simulation xmlns:fricsim="urn:friction-fmu:fricsim:1" stepSize="0.01"/>
+      </ssc:Annotation>
+    </ssd:Annotations>
+  </ssd:DefaultExperiment>
+</ssd:SystemStructureDescription>
+"#,
+            two_mass.display(),
+            lugre.display()
+        ),
+    )
+    .unwrap();
+    for hold in [false, true] {
+        let out = dir.path().join(format!("rows-{hold}.csv"));
+        let mut run = vec![
+            ssd.to_str().unwrap(),
+            "--input",
+            inputs.to_str().unwrap(),
+            "--record",
+            "drive.u",
+            "--record",
+            "friction.v",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if hold {
+            run.push("--input-hold");
+        }
+        fricsim_run(&run);
+        let rows = read_table(&out);
+        assert_eq!(rows.time.len(), 101);
+        for (name, rate) in [("drive.u", 2.0), ("friction.v", 1e-3)] {
+            let recorded = column(&rows, name);
+            for (k, &t) in rows.time.iter().enumerate().skip(1) {
+                // the value of its own time, or of the step before
+                let at = if hold { t - 0.01 } else { t };
+                let expected =
+                    fricsim::inputs::interpolate(at, &table.time, column(&table, name), false);
+                assert!(
+                    (recorded[k] - expected).abs() <= 1e-12 * rate,
+                    "{name} at t = {t} (held: {hold}): {} against {expected}",
+                    recorded[k]
+                );
+            }
+        }
+    }
+}
