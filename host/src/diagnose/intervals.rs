@@ -211,24 +211,9 @@ pub fn effect_change_name(effect: Effect) -> Option<&'static str> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::BTreeMap;
 
     fn model() -> FrictionModel {
-        FrictionModel::from_values(&BTreeMap::from([
-            ("Fc".to_string(), 2.0),
-            ("Fs".to_string(), 2.0),
-            ("vs".to_string(), 0.01),
-            ("sigma0".to_string(), 1e7),
-            ("sigma1".to_string(), 0.0),
-            ("sigma2".to_string(), 0.0),
-            ("stribeck_exponent".to_string(), 2.0),
-            ("Fc_neg".to_string(), 2.0),
-            ("Fs_neg".to_string(), 2.0),
-            ("direction_dependent".to_string(), 0.0),
-            ("normal_force_form".to_string(), 0.0),
-            ("position_dependent".to_string(), 0.0),
-        ]))
-        .unwrap()
+        FrictionModel::coulomb_for_tests(2.0, 1e7, 0.0)
     }
 
     /// A linear model whose residuals are known: y = Fc·u + e, with the

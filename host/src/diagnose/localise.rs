@@ -527,7 +527,6 @@ pub fn where_improved(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::BTreeMap;
 
     /// A minute of a slow sine stroke and a faster one on top, sampled at
     /// 1 kHz: every speed, both directions and the whole travel.
@@ -559,21 +558,7 @@ mod tests {
     }
 
     fn nominal() -> FrictionModel {
-        FrictionModel::from_values(&BTreeMap::from([
-            ("Fc".to_string(), 2.0),
-            ("Fs".to_string(), 2.0),
-            ("vs".to_string(), 0.01),
-            ("sigma0".to_string(), 1e6),
-            ("sigma1".to_string(), 1e3),
-            ("sigma2".to_string(), 0.0),
-            ("stribeck_exponent".to_string(), 2.0),
-            ("Fc_neg".to_string(), 2.0),
-            ("Fs_neg".to_string(), 2.0),
-            ("direction_dependent".to_string(), 0.0),
-            ("normal_force_form".to_string(), 0.0),
-            ("position_dependent".to_string(), 0.0),
-        ]))
-        .unwrap()
+        FrictionModel::coulomb_for_tests(2.0, 1e6, 1e3)
     }
 
     /// The law's force along the data: the steady sliding force with the

@@ -711,6 +711,30 @@ impl FrictionModel {
     }
 }
 
+#[cfg(test)]
+impl FrictionModel {
+    /// For tests: a Coulomb law (Fs = Fc, no viscous term, one level for
+    /// both directions) with bristle stiffness `sigma0` and damping
+    /// `sigma1`, as [`FrictionModel::from_values`] reads it from an FMU.
+    pub fn coulomb_for_tests(fc: f64, sigma0: f64, sigma1: f64) -> FrictionModel {
+        FrictionModel::from_values(&BTreeMap::from([
+            ("Fc".to_string(), fc),
+            ("Fs".to_string(), fc),
+            ("vs".to_string(), 0.01),
+            ("sigma0".to_string(), sigma0),
+            ("sigma1".to_string(), sigma1),
+            ("sigma2".to_string(), 0.0),
+            ("stribeck_exponent".to_string(), 2.0),
+            ("Fc_neg".to_string(), fc),
+            ("Fs_neg".to_string(), fc),
+            ("direction_dependent".to_string(), 0.0),
+            ("normal_force_form".to_string(), 0.0),
+            ("position_dependent".to_string(), 0.0),
+        ]))
+        .expect("every parameter is given")
+    }
+}
+
 /// A free parameter, fitted as θ = ln(value) (or ln(Fs/Fc − 1)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Free {
@@ -758,21 +782,7 @@ mod tests {
 
     #[test]
     fn only_position_and_direction_interact() {
-        let m = FrictionModel::from_values(&BTreeMap::from([
-            ("Fc".to_string(), 5.0),
-            ("Fs".to_string(), 5.0),
-            ("vs".to_string(), 0.01),
-            ("sigma0".to_string(), 1e7),
-            ("sigma1".to_string(), 0.0),
-            ("sigma2".to_string(), 0.0),
-            ("stribeck_exponent".to_string(), 2.0),
-            ("Fc_neg".to_string(), 5.0),
-            ("Fs_neg".to_string(), 5.0),
-            ("direction_dependent".to_string(), 0.0),
-            ("normal_force_form".to_string(), 0.0),
-            ("position_dependent".to_string(), 0.0),
-        ]))
-        .unwrap();
+        let m = FrictionModel::coulomb_for_tests(5.0, 1e7, 0.0);
         let context = Context {
             speed_scale: 0.1,
             x_min: 0.0,

@@ -68,6 +68,23 @@ pub struct SizeError {
     pub relative_error: f64,
 }
 
+impl SizeError {
+    /// `quantity` fitted as `fitted` where the truth is `truth`; the
+    /// absolute error where the truth is 0.
+    pub fn new(quantity: &str, truth: f64, fitted: f64) -> SizeError {
+        SizeError {
+            quantity: quantity.to_string(),
+            truth,
+            fitted,
+            relative_error: if truth != 0.0 {
+                ((fitted - truth) / truth).abs()
+            } else {
+                fitted.abs()
+            },
+        }
+    }
+}
+
 /// What diagnose made of one case.
 #[derive(Clone, Debug, Serialize)]
 pub struct CaseResult {
@@ -121,16 +138,7 @@ pub fn effect_size(
     fitted: &FrictionModel,
     effect: Effect,
 ) -> Vec<SizeError> {
-    let one = |quantity: &str, t: f64, f: f64| SizeError {
-        quantity: quantity.to_string(),
-        truth: t,
-        fitted: f,
-        relative_error: if t != 0.0 {
-            ((f - t) / t).abs()
-        } else {
-            f.abs()
-        },
-    };
+    let one = SizeError::new;
     match effect {
         Effect::Viscous => vec![one("sigma2", truth.sigma2, fitted.sigma2)],
         Effect::Stribeck => vec![
@@ -274,17 +282,11 @@ pub fn asymmetry_size(truth: &FrictionModel, fitted: &FrictionModel) -> SizeErro
     let v = 10.0 * truth.vs;
     let difference =
         |m: &FrictionModel| m.sliding_level(-v, 0.0, 1.0) - m.sliding_level(v, 0.0, 1.0);
-    let (t, f) = (difference(truth), difference(fitted));
-    SizeError {
-        quantity: "directional_difference".into(),
-        truth: t,
-        fitted: f,
-        relative_error: if t != 0.0 {
-            ((f - t) / t).abs()
-        } else {
-            f.abs()
-        },
-    }
+    SizeError::new(
+        "directional_difference",
+        difference(truth),
+        difference(fitted),
+    )
 }
 
 /// What a case's export holds besides its data: for the sparse-regression
