@@ -138,7 +138,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     );
     for e in &d.effects {
         println!(
-            "  {:<20} {:<8} held-out RMS {:.5} -> {:.5} (p = {:.1e}); where: {} {}{}",
+            "  {:<20} {:<8} held-out RMS {:.5} -> {:.5} (p = {:.1e}); where: {} {}.{}",
             e.name.name(),
             e.action,
             e.rms_before,

@@ -353,7 +353,7 @@ pub fn change_line(e: &super::FoundEffect) -> Option<String> {
     })
 }
 
-/// `; the data do not separate it from offset (held-out RMS 0.0778, p = 4.0e-1)` and the
+/// ` The data do not separate it from offset (held-out RMS 0.0778, p = 4.0e-1): …` and the
 /// like: how the effect stands against the other explanations of its
 /// signature ([`super::Alternative`]), empty when it has none.
 pub fn alternatives_line(e: &super::FoundEffect) -> String {
@@ -374,12 +374,12 @@ pub fn alternatives_line(e: &super::FoundEffect) -> String {
     };
     let mut s = String::new();
     if !apart.is_empty() {
-        let _ = write!(s, "; the data prefer it to {}", list(&apart));
+        let _ = write!(s, " The data prefer it to {}.", list(&apart));
     }
     if !close.is_empty() {
         let _ = write!(
             s,
-            "; the data do not separate it from {}: named first in the library's order",
+            " The data do not separate it from {}: named first in the library's order.",
             list(&close)
         );
     }
