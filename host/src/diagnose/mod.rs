@@ -1667,9 +1667,10 @@ fn hypotheses(additions: &[Vec<Effect>]) -> usize {
     for added in additions {
         match added[..] {
             [e] => match e.family() {
-                Some(f) if families.contains(&f.as_ptr()) => {}
+                // a family is known by its first member
+                Some(f) if families.contains(&f[0]) => {}
                 Some(f) => {
-                    families.push(f.as_ptr());
+                    families.push(f[0]);
                     n += 1;
                 }
                 None => n += 1,
