@@ -115,11 +115,26 @@ def test_a_sweep_survives_a_killed_worker(client):
 
 def test_diagnose_many_on_the_cluster_equals_diagnose(client, tmp_path):
     options = {"candidates": ["direction_dependent"], "polish": False}
-    pairs = [(EMPS, EMPS_TRAIN, EMPS_TEST), (EMPS, tmp_path / "missing.csv")]
+    pairs = [
+        (EMPS, EMPS_TRAIN, EMPS_TEST),
+        (EMPS, tmp_path / "missing.csv"),
+        (EMPS, [EMPS_TRAIN, EMPS_TEST]),
+    ]
     (tmp_path / "missing.csv").write_text("time,rig.x\n")
     remote = fricsim.diagnose_many(pairs, client=client, **options)
     alone = fricsim.diagnose(EMPS, EMPS_TRAIN, EMPS_TEST, out=tmp_path / "alone", **options)
-    assert list(remote["data"]) == [str(EMPS_TRAIN), str(tmp_path / "missing.csv")]
+    both = fricsim.diagnose(EMPS, [EMPS_TRAIN, EMPS_TEST], out=tmp_path / "both", **options)
+    assert list(remote["data"]) == [
+        str(EMPS_TRAIN),
+        str(tmp_path / "missing.csv"),
+        f"{EMPS_TRAIN} + {EMPS_TEST}",
+    ]
+    # several records travel to a worker and give the same diagnosis
+    records = remote.iloc[2]
+    assert records["error"] is None and records["report"]["folds"] == 2
+    assert records["final_rms"] == both.final_rms
+    assert records["report"]["effects"] == both.report["effects"]
+    assert records["report"]["data"] == both.report["data"]
     first = remote.iloc[0]
     assert first["error"] is None
     assert first["effects"] == alone.effect_names == ["direction_dependent"]

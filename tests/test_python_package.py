@@ -255,6 +255,30 @@ def test_a_dataframe_to_diagnose_equals_the_csv_path(tmp_path):
     assert len(fricsim.run(by_path.refitted_system, stop=0.5)) > 10
 
 
+def test_several_records_to_diagnose_as_paths_or_dataframes(tmp_path):
+    """fricsim.diagnose(system, [df1, df2]): one model fitted to both EMPS
+    records, each held out in turn; a record given as a DataFrame gives
+    the same report as its CSV path, and the report names both."""
+    by_path = fricsim.diagnose(
+        EMPS, [EMPS_TRAIN, EMPS_TEST], out=tmp_path / "a", **DIAGNOSE_OPTIONS
+    )
+    pulses = pd.read_csv(EMPS_TEST, comment="#")
+    by_frame = fricsim.diagnose(
+        EMPS, (EMPS_TRAIN, pulses), out=tmp_path / "b", **DIAGNOSE_OPTIONS
+    )
+    assert by_path.folds == by_frame.folds == 2
+    assert "each of the 2 records" in by_path.heldout
+    assert str(EMPS_TRAIN) in by_path.data and str(EMPS_TEST) in by_path.data
+    ignore = {"data", "heldout", "wall_seconds", "polish_seconds", "rerun"}
+    a = {k: v for k, v in by_path.report.items() if k not in ignore}
+    b = {k: v for k, v in by_frame.report.items() if k not in ignore}
+    assert a == b
+    assert by_path.final_rms < by_path.nominal_rms
+    assert (tmp_path / "a" / "inputs-1.csv").exists() and (tmp_path / "a" / "inputs-2.csv").exists()
+    with pytest.raises(ValueError, match="no measurements"):
+        fricsim.diagnose(EMPS, [], out=tmp_path / "c")
+
+
 CHILD = textwrap.dedent(
     """
     import sys, fricsim

@@ -199,6 +199,17 @@ def _as_csv_paths(prefix: str, **tables: Any):
         }
 
 
+def _records(tables: Any) -> list:
+    """One record (a path, a DataFrame, a structured array) or a list or
+    tuple of them, as a list; an empty list is refused."""
+    records = list(tables) if isinstance(tables, (list, tuple)) else [tables]
+    if not records:
+        raise ValueError("diagnose: no measurements given (an empty list of records)")
+    if any(r is None for r in records):
+        raise ValueError("diagnose: a record is None")
+    return records
+
+
 class Diagnosis:
     """The result of :func:`diagnose`: the fields of ``report.json`` as
     attributes (``effects``, ``nominal_rms``, ``final_rms``,
@@ -247,14 +258,17 @@ def diagnose(
 ) -> Diagnosis:
     """``fricsim diagnose``: which friction effect the system misses
     against the measurements ``data`` (a CSV path or a DataFrame with
-    ``time`` first and ``component.variable`` columns), scored on
-    ``heldout`` (same kinds) or on held-out blocks of ``data``.
+    ``time`` first and ``component.variable`` columns, or a list of them:
+    several records of the same system, one model fitted to all, each
+    record co-simulated from its own start), scored on ``heldout`` (same
+    kinds) or, without it, on each record in turn (several records) or
+    held-out blocks of ``data``.
 
     ``out`` is the output directory (default
     ``out/<system name>-diagnosis``); ``options`` are those of the command
     with underscores: ``candidates`` (list of effect names),
     ``position_knots``, ``alpha``, ``smooth``, ``blocks``,
-    ``cross_validate`` ("auto", "always", "never"), ``polish``,
+    ``cross_validate`` ("auto", "always", "never", "records"), ``polish``,
     ``master``, ``lugre``."""
     system = Path(system)
     if out is None:
@@ -278,12 +292,16 @@ def diagnose(
         )
     if "lugre" in options and options["lugre"] is not None:
         options["lugre"] = os.fspath(options["lugre"])
-    with _as_csv_paths("fricsim-data-", data=data, heldout=heldout) as paths:
+    data_records = _records(data)
+    heldout_records = [] if heldout is None else _records(heldout)
+    tables = {f"data{i}": t for i, t in enumerate(data_records)}
+    tables.update({f"heldout{i}": t for i, t in enumerate(heldout_records)})
+    with _as_csv_paths("fricsim-data-", **tables) as paths:
         report = _native.diagnose(
             os.fspath(system),
-            paths["data"],
+            [paths[f"data{i}"] for i in range(len(data_records))],
             os.fspath(out),
-            heldout=paths["heldout"],
+            heldout=[paths[f"heldout{i}"] for i in range(len(heldout_records))],
             **options,
         )
     return Diagnosis(json.loads(report), Path(out))

@@ -231,10 +231,10 @@ def _diagnose_task(payload, data, heldout, options: dict) -> dict:
         system = _local_system(payload)
         renames.append((system, payload))
         with tempfile.TemporaryDirectory(prefix="fricsim-diagnose-") as tmp:
-            local_data = _materialise(data, Path(tmp) / "data.csv", renames)
+            local_data = _materialise(data, Path(tmp) / "data", renames)
             local_heldout = None
             if heldout is not None:
-                local_heldout = _materialise(heldout, Path(tmp) / "heldout.csv", renames)
+                local_heldout = _materialise(heldout, Path(tmp) / "heldout", renames)
             d = diagnose(system, local_data, local_heldout, out=Path(tmp) / "out", **options)
             refitted = d.refitted_system.read_bytes()
         report = d.report
@@ -262,10 +262,16 @@ def _renamed(message: str, renames: list) -> str:
     return message
 
 
-def _materialise(table, path: Path, renames: list):
-    """A dataset sent as ``("csv", bytes, name)`` written to ``path``; a
-    DataFrame as it is."""
+def _materialise(table, stem: Path, renames: list):
+    """A dataset sent as ``("csv", bytes, name)`` written to ``STEM.csv``;
+    a DataFrame as it is; a list of records each so (``STEM-1.csv``, ...)."""
+    if isinstance(table, list):
+        return [
+            _materialise(t, stem.with_name(f"{stem.name}-{i + 1}"), renames)
+            for i, t in enumerate(table)
+        ]
     if isinstance(table, tuple) and table[0] == "csv":
+        path = stem.with_suffix(".csv")
         path.write_bytes(table[1])
         renames.append((path, (None, None, table[2], None)))
         return path
@@ -274,10 +280,20 @@ def _materialise(table, path: Path, renames: list):
 
 def _dataset(table):
     """A dataset as it travels: a CSV file's bytes and name, a DataFrame as
-    it is."""
+    it is; several records (a list or tuple of them) as a list."""
+    if isinstance(table, (list, tuple)):
+        return [_dataset(t) for t in table]
     if isinstance(table, (str, os.PathLike)):
         return ("csv", Path(table).read_bytes(), os.fspath(table))
     return table
+
+
+def _label(table) -> str:
+    """A dataset's name in the result: its path, its type, or the names of
+    its records joined by ``+``."""
+    if isinstance(table, (list, tuple)):
+        return " + ".join(_label(t) for t in table)
+    return os.fspath(table) if isinstance(table, (str, os.PathLike)) else type(table).__name__
 
 
 def diagnose_many(
@@ -288,7 +304,7 @@ def diagnose_many(
 ):
     """``fricsim diagnose`` on many datasets: ``pairs`` holds
     ``(system, data)`` or ``(system, data, heldout)``, each dataset a CSV
-    path or a DataFrame; ``options`` as :func:`fricsim.diagnose`. With a
+    path or a DataFrame, or a list of them (several records); ``options`` as :func:`fricsim.diagnose`. With a
     Dask ``client`` each diagnosis is a task on the cluster, else they run
     here one after the other. Returns a DataFrame, one row per pair: the
     system and data, the effects found, the held-out RMS before and after
@@ -320,7 +336,7 @@ def diagnose_many(
         results = client.gather(futures)
     rows = []
     for p, r in zip(pairs, results):
-        label = os.fspath(p[1]) if isinstance(p[1], (str, os.PathLike)) else type(p[1]).__name__
+        label = _label(p[1])
         rows.append({"system": os.fspath(p[0]), "data": label, **r})
     frame = pd.DataFrame(rows)
     # object, so that a diagnosis without error holds None (not NaN)

@@ -15,7 +15,7 @@
 //! KeyboardInterrupt is raised.
 
 use fricsim::diagnose::model::Effect;
-use fricsim::diagnose::{diagnose as run_diagnosis, report, CrossValidate, Options};
+use fricsim::diagnose::{diagnose_records as run_diagnosis, report, CrossValidate, Options};
 use fricsim::fmu::archive::{unpack, UnpackOptions};
 use fricsim::fmu::library::platforms;
 use fricsim::fmu::ModelDescription;
@@ -161,6 +161,10 @@ impl RowSink for Collect {
 /// (instances that refused `fmi2Terminate`).
 type RunResult = (Vec<String>, Vec<f64>, Option<String>, Vec<String>);
 
+/// [`RunResult`] as `fricsim.run` hands it to Python: the rows as the
+/// bytes of their f64 values.
+type PyRunResult = (Vec<String>, Py<PyBytes>, Option<String>, Vec<String>);
+
 /// `fricsim.run`: co-simulate a system file exactly as `fricsim run` does
 /// (one code path: [`fricsim::run::PreparedRun`]), returning the rows
 /// instead of writing a CSV.
@@ -180,7 +184,7 @@ fn run(
     input: Option<PathBuf>,
     step_timeout: Option<f64>,
     input_hold: bool,
-) -> PyResult<(Vec<String>, Py<PyBytes>, Option<String>, Vec<String>)> {
+) -> PyResult<PyRunResult> {
     let call_time_limit = match step_timeout {
         None => None,
         Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
@@ -292,17 +296,17 @@ fn sweep(
 }
 
 /// `fricsim.diagnose`: `fricsim diagnose` on a system and measurement
-/// files, the outputs written into `out`; the report (`report.json`'s
-/// content) as JSON.
+/// files (one record or several), the outputs written into `out`; the
+/// report (`report.json`'s content) as JSON.
 #[pyfunction]
-#[pyo3(signature = (system, data, out, heldout=None, candidates=Vec::new(), position_knots=None, alpha=None, smooth=None, blocks=None, cross_validate=None, polish=true, master=None, lugre=None))]
+#[pyo3(signature = (system, data, out, heldout=Vec::new(), candidates=Vec::new(), position_knots=None, alpha=None, smooth=None, blocks=None, cross_validate=None, polish=true, master=None, lugre=None))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,
     system: PathBuf,
-    data: PathBuf,
+    data: Vec<PathBuf>,
     out: PathBuf,
-    heldout: Option<PathBuf>,
+    heldout: Vec<PathBuf>,
     candidates: Vec<String>,
     position_knots: Option<usize>,
     alpha: Option<f64>,
@@ -326,9 +330,10 @@ fn diagnose(
                 None | Some("auto") => CrossValidate::Auto,
                 Some("always") => CrossValidate::Always,
                 Some("never") => CrossValidate::Never,
+                Some("records") => CrossValidate::Records,
                 Some(other) => {
                     return Err(format!(
-                        "cross_validate `{other}`: one of auto, always, never"
+                        "cross_validate `{other}`: one of auto, always, never, records"
                     ))
                 }
             },
@@ -343,7 +348,7 @@ fn diagnose(
         }
         let mut file = SystemFile::open(&system).map_err(|e| e.to_string())?;
         let moved = fricsim::diagnose::dahl::move_to_lugre(&mut file, lugre.as_deref())?;
-        let mut d = run_diagnosis(&file, &data, heldout.as_deref(), &options)?;
+        let mut d = run_diagnosis(&file, &data, &heldout, &options)?;
         if let Some(note) = moved {
             d.notes.push(note);
         }

@@ -1,10 +1,10 @@
-//! `fricsim diagnose SYSTEM DATA.csv`: find where the system and the
+//! `fricsim diagnose SYSTEM DATA.csv [DATA2.csv ...]`: find where the system and the
 //! measurements disagree, name the missing friction effect from the
 //! library, add it, refit, and show the error on held-out data
 //! ([`fricsim::diagnose`]).
 
 use fricsim::diagnose::model::Effect;
-use fricsim::diagnose::{diagnose, report, CrossValidate, Options};
+use fricsim::diagnose::{diagnose_records, report, CrossValidate, Options};
 
 /// `--cross-validate`.
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -12,6 +12,7 @@ pub enum CrossValidateArg {
     Auto,
     Always,
     Never,
+    Records,
 }
 use fricsim::output_file::same_file;
 use fricsim::ssp::SystemFile;
@@ -24,13 +25,16 @@ pub struct DiagnoseArgs {
     pub system: PathBuf,
     /// Measurements: CSV with `time` first, then `component.variable`
     /// columns, or a .mat result file; unconnected inputs drive the
-    /// system, outputs are compared.
-    pub data: PathBuf,
-    /// Held-out measurements (same channels) to score on [default: every
-    /// third of 30 equal time blocks of DATA, from the second on, is held
-    /// out].
-    #[arg(long)]
-    pub heldout: Option<PathBuf>,
+    /// system, outputs are compared. Several records of the same system
+    /// (the same columns) are fitted together, each co-simulated from its
+    /// own start with its own inputs.
+    #[arg(required = true, num_args = 1..)]
+    pub data: Vec<PathBuf>,
+    /// Held-out records (same channels) to score on [default: with several
+    /// DATA records each held out in turn; with one, every third of 30
+    /// equal time blocks of it, from the second on].
+    #[arg(long, num_args = 1..)]
+    pub heldout: Vec<PathBuf>,
     /// Output directory [default: out/<system name>-diagnosis].
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -50,8 +54,10 @@ pub struct DiagnoseArgs {
     #[arg(long, default_value_t = fricsim::diagnose::SPLIT_BLOCKS)]
     pub blocks: usize,
     /// Without --heldout: score every block by three-fold cross-validation
-    /// (each third of the blocks held out once) or only one third; auto
-    /// cross-validates data of at most 5000 samples.
+    /// (each third of the blocks held out once), only one third, or each
+    /// record in turn (records); auto holds out each record in turn when
+    /// there are several, else cross-validates data of at most 5000
+    /// samples.
     #[arg(long, value_enum, default_value_t = CrossValidateArg::Auto)]
     pub cross_validate: CrossValidateArg,
     /// Smoothing window of the measured position for the inverse dynamics (s).
@@ -84,6 +90,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             CrossValidateArg::Auto => CrossValidate::Auto,
             CrossValidateArg::Always => CrossValidate::Always,
             CrossValidateArg::Never => CrossValidate::Never,
+            CrossValidateArg::Records => CrossValidate::Records,
         },
         ..Options::default()
     };
@@ -101,17 +108,11 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         .unwrap_or_else(|| super::default_out(&a.system, "-diagnosis").with_extension(""));
     // the report directory is written whole (diagnose::report), but never
     // over one of the inputs
-    let inputs = [
-        Some(("the system file", &a.system)),
-        Some(("the measured data", &a.data)),
-        a.heldout.as_ref().map(|p| ("the held-out data", p)),
-        a.lugre.as_ref().map(|p| ("the LuGre FMU", p)),
-    ];
-    if let Some((what, input)) = inputs
-        .into_iter()
-        .flatten()
-        .find(|(_, p)| same_file(&out, p))
-    {
+    let inputs = std::iter::once(("the system file", &a.system))
+        .chain(a.data.iter().map(|p| ("the measured data", p)))
+        .chain(a.heldout.iter().map(|p| ("the held-out data", p)))
+        .chain(a.lugre.iter().map(|p| ("the LuGre FMU", p)));
+    if let Some((what, input)) = inputs.into_iter().find(|(_, p)| same_file(&out, p)) {
         return Err(format!(
             "the report directory {} is {what} {}, an input of the run: choose another --out",
             out.display(),
@@ -120,7 +121,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     }
     let mut file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
     let moved = fricsim::diagnose::dahl::move_to_lugre(&mut file, a.lugre.as_deref())?;
-    let mut d = diagnose(&file, &a.data, a.heldout.as_deref(), &options)?;
+    let mut d = diagnose_records(&file, &a.data, &a.heldout, &options)?;
     if let Some(note) = moved {
         println!("note: {note}");
         d.notes.push(note);
@@ -190,9 +191,14 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         );
     }
     println!(
-        "{:.2} s; wrote {}/report.html (open it in a browser), report.md, report.json, gap.png, fit.png, law.png, residual.png, refitted.ssp, inputs.csv",
+        "{:.2} s; wrote {}/report.html (open it in a browser), report.md, report.json, gap.png, fit.png, law.png, residual.png, refitted.ssp, {}",
         d.wall_seconds,
-        out.display()
+        out.display(),
+        report::input_files(&d)
+            .into_iter()
+            .map(|(_, name, _)| name)
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     Ok(())
 }

@@ -551,6 +551,7 @@ mod tests {
             position_step: None,
             normal_force_measured: false,
             trusted: vec![true; n],
+            record_starts: vec![0],
             t,
             v,
             x,

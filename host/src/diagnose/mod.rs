@@ -89,17 +89,23 @@ pub struct Options {
 
 /// Without a held-out file, whether every block is scored (three-fold
 /// cross-validation: each third of the blocks, `b mod 3`, is held out once,
-/// the others fit) or one third (`b mod 3 = 1`).
+/// the others fit), one third (`b mod 3 = 1`), or, with several records,
+/// each record in turn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CrossValidate {
-    /// Three folds when the data have at most
+    /// With several records, each held out in turn ([`Self::Records`]);
+    /// otherwise three folds when the data have at most
     /// [`CROSS_VALIDATE_MAX_SAMPLES`] samples (three times the fits, cheap
     /// at that size; short records need every sample's evidence), one
     /// third held out otherwise.
     Auto,
     Never,
     Always,
+    /// Leave one record out: as many folds as records, each scoring one
+    /// record with the model fitted on the others (the cross-test of
+    /// Janot, Gautier and Brunot 2019 on EMPS's two records).
+    Records,
 }
 
 /// [`CrossValidate::Auto`] cross-validates data with at most this many
@@ -204,12 +210,16 @@ const HELD_OUT_PHASE: usize = 1;
 const PHASES: usize = 3;
 
 /// A file's time span cut into equal blocks (at least 3), every third held
-/// out ([`held_out_block`]).
-#[derive(Clone, Copy, Debug)]
+/// out ([`held_out_block`]); or, with several records each held out in
+/// turn, one phase per record.
+#[derive(Clone, Debug)]
 pub struct Blocks {
     t0: f64,
     t1: f64,
     pub count: usize,
+    /// Leave one record out: the joined start time of every record after
+    /// the first (the phase of a time is its record).
+    record_starts: Option<Vec<f64>>,
 }
 
 impl Blocks {
@@ -218,7 +228,27 @@ impl Blocks {
             t0: time.first().copied().unwrap_or(0.0),
             t1: time.last().copied().unwrap_or(0.0),
             count: count.max(3),
+            record_starts: None,
         }
+    }
+
+    /// The blocks of `data` whose phases are its records
+    /// ([`CrossValidate::Records`]).
+    pub fn by_records(data: &Measured, count: usize) -> Blocks {
+        Blocks {
+            record_starts: Some(
+                data.records[1..]
+                    .iter()
+                    .map(|r| data.time[r.rows.start])
+                    .collect(),
+            ),
+            ..Blocks::new(&data.time, count)
+        }
+    }
+
+    /// How many phases (folds of a cross-validation) there are.
+    fn phases(&self) -> usize {
+        self.record_starts.as_ref().map_or(PHASES, |s| s.len() + 1)
     }
 
     /// The block (0-based) holding time `t`.
@@ -227,9 +257,13 @@ impl Blocks {
         b.min(self.count - 1)
     }
 
-    /// The phase (`b mod 3`) of the block holding time `t`.
+    /// The phase (`b mod 3`) of the block holding time `t` (its record,
+    /// when the records are the phases).
     pub fn phase(&self, t: f64) -> usize {
-        self.block(t) % PHASES
+        match &self.record_starts {
+            Some(starts) => starts.iter().filter(|&&s| s <= t).count(),
+            None => self.block(t) % PHASES,
+        }
     }
 
     /// Whether the block holding time `t` is held out by a single split.
@@ -239,13 +273,17 @@ impl Blocks {
 
     /// The positions of a co-simulation's samples (of the file with
     /// `time`) in blocks of `phase` (`held`) or of the other phases.
-    fn picker<'a>(self, time: &[f64], phase: usize, held: bool) -> Picker<'a> {
+    fn picker<'a>(&self, time: &[f64], phase: usize, held: bool) -> Picker<'a> {
         let time = time.to_vec();
-        Box::new(move |r: &ChannelResiduals| {
-            (0..r.samples.len())
-                .filter(|&s| (self.phase(time[r.samples[s]]) == phase) == held)
-                .collect()
-        })
+        let blocks = self.clone();
+        Picker {
+            pick: Box::new(move |r: &ChannelResiduals| {
+                (0..r.samples.len())
+                    .filter(|&s| (blocks.phase(time[r.samples[s]]) == phase) == held)
+                    .collect()
+            }),
+            records: None,
+        }
     }
 }
 
@@ -455,8 +493,9 @@ pub struct Diagnosis {
     pub groups: usize,
     /// Smallest relative drop of the held-out mean square accepted.
     pub min_gain: f64,
-    /// Folds scored: 1 (a held-out file or one third of the blocks) or 3
-    /// (cross-validation, [`CrossValidate`]).
+    /// Folds scored: 1 (a held-out file or one third of the blocks), 3
+    /// (cross-validation, [`CrossValidate`]) or one per record (each held
+    /// out in turn).
     pub folds: usize,
     pub wall_seconds: f64,
     /// Of which the output-error refinement of accepted models took this
@@ -467,14 +506,15 @@ pub struct Diagnosis {
     pub master: String,
     #[serde(skip)]
     pub plots: PlotData,
-    /// The data file's time and the columns that drive inputs (for the
-    /// `inputs.csv` that reruns the refitted system).
+    /// Each data record's own time and the columns that drive inputs (for
+    /// the `inputs.csv` that reruns the refitted system; `inputs-1.csv`,
+    /// `inputs-2.csv`, ... for several records).
     #[serde(skip)]
-    pub measured_inputs: InputColumns,
-    /// The same of the held-out file, when one was given
-    /// (`heldout-inputs.csv`).
+    pub measured_inputs: Vec<InputColumns>,
+    /// The same of the held-out records, when given
+    /// (`heldout-inputs.csv`, or numbered likewise).
     #[serde(skip)]
-    pub heldout_inputs: Option<InputColumns>,
+    pub heldout_inputs: Vec<InputColumns>,
     /// The commands that rerun the refitted system on the training data's
     /// inputs and, with a held-out file, on its inputs, with the master
     /// and step the diagnosis co-simulated with: their results are the
@@ -527,7 +567,34 @@ pub struct ChannelSummary {
 pub type ChannelSeries = (String, Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// Which positions of a co-simulation's samples are held out.
-type Picker<'a> = Box<dyn Fn(&ChannelResiduals) -> Vec<usize> + Sync + 'a>;
+/// The positions (into `ChannelResiduals::samples`) a [`Picker`] takes.
+type PickFn<'a> = Box<dyn Fn(&ChannelResiduals) -> Vec<usize> + Sync + 'a>;
+
+/// Which samples of a co-simulation a score or a fit uses (positions into
+/// `ChannelResiduals::samples`), and which records must be co-simulated
+/// for them (`None`: all).
+struct Picker<'a> {
+    pick: PickFn<'a>,
+    records: Option<Vec<usize>>,
+}
+
+impl<'a> Picker<'a> {
+    /// Every sample of every record.
+    fn all() -> Picker<'a> {
+        Picker {
+            pick: Box::new(all_samples),
+            records: None,
+        }
+    }
+
+    /// Every sample of the records `records`.
+    fn records(records: Vec<usize>) -> Picker<'a> {
+        Picker {
+            pick: Box::new(all_samples),
+            records: Some(records),
+        }
+    }
+}
 
 /// Series for the plots.
 #[derive(Clone, Debug, Default)]
@@ -636,8 +703,9 @@ pub fn truth_rms(
             truth.label
         ));
     }
-    let picked =
-        Blocks::new(&measured.time, options.blocks).picker(&truth.time, HELD_OUT_PHASE, true)(&r);
+    let picked = (Blocks::new(&measured.time, options.blocks)
+        .picker(&truth.time, HELD_OUT_PHASE, true)
+        .pick)(&r);
     let q = r.squared(&channel_scales(&measured));
     Ok((picked.iter().map(|&k| q[k]).sum::<f64>() / picked.len().max(1) as f64).sqrt())
 }
@@ -650,12 +718,41 @@ pub fn diagnose(
     heldout_path: Option<&Path>,
     options: &Options,
 ) -> Result<Diagnosis, String> {
+    diagnose_records(
+        file,
+        &[data_path.to_path_buf()],
+        &heldout_path
+            .map(Path::to_path_buf)
+            .into_iter()
+            .collect::<Vec<_>>(),
+        options,
+    )
+}
+
+/// Run the workflow on `system` with one or several records of
+/// measurements `data` (one model fitted to all of them, each record
+/// co-simulated from its own start with its own inputs,
+/// [`problem::Record`]), scored on the records `heldout` or, without
+/// them, on held-out parts of `data` ([`Options::cross_validate`]).
+pub fn diagnose_records(
+    file: &SystemFile,
+    data_paths: &[std::path::PathBuf],
+    heldout_paths: &[std::path::PathBuf],
+    options: &Options,
+) -> Result<Diagnosis, String> {
     let started = Instant::now();
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
-    let train = Measured::read(data_path, &system)?;
-    let heldout_file = match heldout_path {
-        Some(p) => {
-            let h = Measured::read(p, &system)?;
+    let read_all = |paths: &[std::path::PathBuf], system: &crate::system::System| {
+        paths
+            .iter()
+            .map(|p| Measured::read(p, system))
+            .collect::<Result<Vec<_>, _>>()
+            .and_then(Measured::join)
+    };
+    let train = read_all(data_paths, &system)?;
+    let heldout_file = match heldout_paths.is_empty() {
+        false => {
+            let h = read_all(heldout_paths, &system)?;
             let a: Vec<&String> = train.outputs.iter().map(|(n, _)| n).collect();
             let b: Vec<&String> = h.outputs.iter().map(|(n, _)| n).collect();
             if a != b {
@@ -666,7 +763,7 @@ pub fn diagnose(
             }
             Some(h)
         }
-        None => None,
+        true => None,
     };
     let step = step_of(file, &train);
     let master = diagnosis_master(
@@ -696,15 +793,31 @@ pub fn diagnose(
     };
 
     // which samples and intervals train and which are held out
-    let blocks = Blocks::new(&train.time, options.blocks);
+    let by_records = heldout_file.is_none()
+        && train.records.len() > 1
+        && matches!(
+            options.cross_validate,
+            CrossValidate::Auto | CrossValidate::Records
+        );
+    if heldout_file.is_none() && !by_records && options.cross_validate == CrossValidate::Records {
+        return Err(format!(
+            "{}: cross-validation by records needs at least two records (give several data files)",
+            train.label
+        ));
+    }
+    let blocks = if by_records {
+        Blocks::by_records(&train, options.blocks)
+    } else {
+        Blocks::new(&train.time, options.blocks)
+    };
     let trusted =
         |d: &FrictionData| -> Vec<usize> { (0..d.t.len()).filter(|&j| d.trusted[j]).collect() };
     let all_intervals = trusted(&d_train);
     let cross = heldout_file.is_none()
         && match options.cross_validate {
-            CrossValidate::Always => true,
+            CrossValidate::Always | CrossValidate::Records => true,
             CrossValidate::Never => false,
-            CrossValidate::Auto => train.time.len() <= CROSS_VALIDATE_MAX_SAMPLES,
+            CrossValidate::Auto => by_records || train.time.len() <= CROSS_VALIDATE_MAX_SAMPLES,
         };
     let (held, folds): (HeldOut, Vec<Fold>) = match (&heldout_file, &d_held) {
         (Some(h), Some(dh)) => (
@@ -715,13 +828,13 @@ pub fn diagnose(
             },
             vec![Fold {
                 train_intervals: all_intervals.clone(),
-                held: Box::new(all_samples),
-                train: Box::new(all_samples),
+                held: Picker::all(),
+                train: Picker::all(),
             }],
         ),
         _ => {
             let phases: Vec<usize> = if cross {
-                (0..PHASES).collect()
+                (0..blocks.phases()).collect()
             } else {
                 vec![HELD_OUT_PHASE]
             };
@@ -733,8 +846,18 @@ pub fn diagnose(
                         .copied()
                         .filter(|&j| blocks.phase(d_train.t[j]) != phase)
                         .collect(),
-                    held: blocks.picker(&train.time, phase, true),
-                    train: blocks.picker(&train.time, phase, false),
+                    // by records: only the records a fold scores or fits
+                    // are co-simulated for it
+                    held: if by_records {
+                        Picker::records(vec![phase])
+                    } else {
+                        blocks.picker(&train.time, phase, true)
+                    },
+                    train: if by_records {
+                        Picker::records((0..train.records.len()).filter(|&r| r != phase).collect())
+                    } else {
+                        blocks.picker(&train.time, phase, false)
+                    },
                 })
                 .collect();
             let intervals = all_intervals
@@ -784,21 +907,44 @@ pub fn diagnose(
         let mut notes = Vec::new();
         for (fold, model) in folds.iter().zip(models) {
             let params = system_parameters(file, &setup, model);
+            let records = fold.held.records.as_deref();
             let r = match step {
                 None => {
-                    let (r, note) = co_simulate_robust(system, &params, &setup, held.data)?;
+                    let (r, note) =
+                        co_simulate_robust(system, &params, &setup, held.data, records)?;
                     notes.extend(note);
                     r
                 }
                 Some(h) => {
-                    let r = co_simulate_with(system, &params, held.data, &setup.master, h)?;
+                    let r =
+                        co_simulate_with(system, &params, held.data, records, &setup.master, h)?;
                     if let Some(e) = &r.incomplete {
                         return Err(e.clone());
                     }
                     r
                 }
             };
-            let mine = (fold.held)(&r);
+            let mine = (fold.held.pick)(&r);
+            if records.is_some() {
+                // each fold co-simulated its own records, in order: their
+                // samples follow the previous folds'
+                let m = merged.get_or_insert_with(|| ChannelResiduals {
+                    channels: r.channels.clone(),
+                    samples: Vec::new(),
+                    simulated: vec![Vec::new(); r.channels.len()],
+                    residuals: vec![Vec::new(); r.channels.len()],
+                    incomplete: None,
+                });
+                for &k in &mine {
+                    picked.push(m.samples.len());
+                    m.samples.push(r.samples[k]);
+                    for c in 0..m.residuals.len() {
+                        m.simulated[c].push(r.simulated[c][k]);
+                        m.residuals[c].push(r.residuals[c][k]);
+                    }
+                }
+                continue;
+            }
             let m = merged.get_or_insert_with(|| r.clone());
             if m.samples != r.samples {
                 return Err("the folds' co-simulations compared different samples".into());
@@ -847,18 +993,22 @@ pub fn diagnose(
             // a system of its own (an FMU instance stays on its thread)
             let mut system = file.build(0.0).ok()?;
             let params = system_parameters(file, &setup, m);
+            let records = pick.records.as_deref();
             let r = match step {
                 None => {
-                    co_simulate_robust(&mut system, &params, &setup, &train)
+                    co_simulate_robust(&mut system, &params, &setup, &train, records)
                         .ok()?
                         .0
                 }
-                Some(h) => co_simulate_with(&mut system, &params, &train, &setup.master, h).ok()?,
+                Some(h) => {
+                    co_simulate_with(&mut system, &params, &train, records, &setup.master, h)
+                        .ok()?
+                }
             };
             if r.incomplete.is_some() {
                 return None;
             }
-            let picked = pick(&r);
+            let picked = (pick.pick)(&r);
             let channels = scales.len();
             let norm = ((picked.len() * channels) as f64).sqrt();
             Some(nalgebra::DVector::from_iterator(
@@ -896,7 +1046,7 @@ pub fn diagnose(
         fitted.evaluations += starts.len();
         fitted
     };
-    let every_sample: Picker = Box::new(all_samples);
+    let every_sample = Picker::all();
     // the model reported: fitted on every training interval (the fold's
     // own model when there is one fold)
     let fit_whole = |starts: &[FrictionModel],
@@ -1431,6 +1581,11 @@ pub fn diagnose(
         data: train.label.clone(),
         heldout: match &heldout_file {
             Some(h) => h.label.clone(),
+            None if by_records => format!(
+                "each of the {} records ({}) in turn, scored by the model fitted on the others",
+                train.records.len(),
+                train.label
+            ),
             None if cross => format!(
                 "every one of {} equal time blocks of {}, by three-fold cross-validation (blocks 1, 4, 7, ..., then 2, 5, 8, ..., then 3, 6, 9, ... held out, each scored by the model fitted on the others)",
                 blocks.count, train.label
@@ -1491,12 +1646,20 @@ pub fn diagnose(
         step,
         master,
         plots,
-        measured_inputs: (train.time.clone(), train.inputs.clone()),
-        heldout_inputs: heldout_file
-            .as_ref()
-            .map(|h| (h.time.clone(), h.inputs.clone())),
+        measured_inputs: record_inputs(&train),
+        heldout_inputs: heldout_file.as_ref().map(record_inputs).unwrap_or_default(),
         rerun: Vec::new(),
     })
+}
+
+/// Each record's own time and the columns that drive inputs.
+fn record_inputs(data: &Measured) -> Vec<InputColumns> {
+    (0..data.records.len())
+        .map(|i| {
+            let r = data.record(i);
+            (r.time, r.inputs)
+        })
+        .collect()
 }
 
 /// One addition fitted and scored.

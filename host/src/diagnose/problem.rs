@@ -47,6 +47,28 @@ pub struct Measured {
     /// dropouts already repaired in the columns above), and the rows left
     /// out of scores and fits ([`super::quality`]).
     pub quality: Quality,
+    /// The records (files) joined into these rows: one for a single file
+    /// ([`Measured::join`]).
+    pub records: Vec<Record>,
+}
+
+/// One record of several measured on the same system (a training run and
+/// a run with pulses, constant-velocity runs, break-away tests), joined
+/// into one [`Measured`] by [`Measured::join`]: its rows follow the
+/// previous record's after one sample spacing, so that the joined times
+/// increase and every time-based split (held-out blocks, folds) works on
+/// them as on one file, while each record is co-simulated from its own
+/// start, with its own initial state and inputs, in its own time.
+#[derive(Clone, Debug)]
+pub struct Record {
+    pub label: String,
+    /// Its rows in the joined data.
+    pub rows: std::ops::Range<usize>,
+    /// Added to the record's own times to place it on the joined time line.
+    pub offset: f64,
+    /// The record's own times, as read (exactly: the joined times less
+    /// the offset may differ in the last bit).
+    pub time: Vec<f64>,
 }
 
 impl Measured {
@@ -130,12 +152,113 @@ impl Measured {
             ));
         }
         Ok(Measured {
-            label: shown,
+            label: shown.clone(),
+            records: vec![Record {
+                label: shown,
+                rows: 0..table.time.len(),
+                offset: 0.0,
+                time: table.time.clone(),
+            }],
             time: table.time,
             inputs,
             outputs,
             quality,
         })
+    }
+
+    /// Several records of the same system as one: the same input and
+    /// output columns (refused otherwise, naming both files' columns), each
+    /// record's rows after the previous one's, its times shifted to follow
+    /// them by one sample spacing ([`Record`]). One record is returned as
+    /// it is.
+    pub fn join(mut parts: Vec<Measured>) -> Result<Measured, String> {
+        if parts.len() <= 1 {
+            return parts
+                .pop()
+                .ok_or_else(|| "no measurements given".to_string());
+        }
+        let names = |m: &Measured| -> (Vec<String>, Vec<String>) {
+            (
+                m.inputs.iter().map(|(n, _)| n.clone()).collect(),
+                m.outputs.iter().map(|(n, _)| n.clone()).collect(),
+            )
+        };
+        let first = names(&parts[0]);
+        for p in &parts[1..] {
+            let these = names(p);
+            if these != first {
+                return Err(format!(
+                    "{} has the inputs {:?} and outputs {:?}, but {} has the inputs {:?} and outputs {:?}; records diagnosed together must have the same columns",
+                    p.label, these.0, these.1, parts[0].label, first.0, first.1
+                ));
+            }
+        }
+        let mut joined = Measured {
+            label: parts
+                .iter()
+                .map(|p| p.label.as_str())
+                .collect::<Vec<_>>()
+                .join(" + "),
+            time: Vec::new(),
+            inputs: first.0.iter().map(|n| (n.clone(), Vec::new())).collect(),
+            outputs: first.1.iter().map(|n| (n.clone(), Vec::new())).collect(),
+            quality: Quality::default(),
+            records: Vec::new(),
+        };
+        for p in parts {
+            let offset = match joined.time.last() {
+                None => 0.0,
+                Some(&end) => end + median_spacing(&p.time) - p.time[0],
+            };
+            let start = joined.time.len();
+            joined.time.extend(p.time.iter().map(|t| t + offset));
+            for (to, (_, from)) in joined.inputs.iter_mut().zip(&p.inputs) {
+                to.1.extend_from_slice(from);
+            }
+            for (to, (_, from)) in joined.outputs.iter_mut().zip(&p.outputs) {
+                to.1.extend_from_slice(from);
+            }
+            joined.quality.append(p.quality, &p.label);
+            joined.records.push(Record {
+                label: p.label,
+                rows: start..joined.time.len(),
+                offset,
+                time: p.time,
+            });
+        }
+        Ok(joined)
+    }
+
+    /// Record `i` alone, in its own time.
+    pub fn record(&self, i: usize) -> Measured {
+        let r = &self.records[i];
+        let rows = r.rows.clone();
+        let cut = |cols: &[(String, Vec<f64>)]| -> Vec<(String, Vec<f64>)> {
+            cols.iter()
+                .map(|(n, v)| (n.clone(), v[rows.clone()].to_vec()))
+                .collect()
+        };
+        Measured {
+            label: r.label.clone(),
+            time: r.time.clone(),
+            inputs: cut(&self.inputs),
+            outputs: cut(&self.outputs),
+            quality: self.quality.rows(rows.clone()),
+            records: vec![Record {
+                label: r.label.clone(),
+                rows: 0..rows.len(),
+                offset: 0.0,
+                time: r.time.clone(),
+            }],
+        }
+    }
+
+    /// The record holding row `k`.
+    pub fn record_of(&self, k: usize) -> usize {
+        self.records
+            .iter()
+            .position(|r| r.rows.contains(&k))
+            .unwrap_or(self.records.len() - 1)
     }
 
     pub fn column(&self, name: &str) -> Option<&[f64]> {
@@ -251,6 +374,56 @@ pub struct FrictionData {
     /// driven by the (noisy, near-zero) estimated velocity cannot follow it.
     /// The co-simulation scores cover these intervals too.
     pub trusted: Vec<bool>,
+    /// The first interval of each record ([`Record`]): the friction law
+    /// starts again from rest there (`[0]` for one file).
+    pub record_starts: Vec<usize>,
+}
+
+impl FrictionData {
+    /// The friction data of each record of `data`, joined as its rows are
+    /// ([`Measured::join`]): times on the joined time line, sample indices
+    /// into the joined rows.
+    fn join(parts: Vec<FrictionData>, data: &Measured) -> FrictionData {
+        let min = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        let mut joined = FrictionData {
+            t: Vec::new(),
+            h: Vec::new(),
+            end: Vec::new(),
+            v: Vec::new(),
+            x: Vec::new(),
+            fn_: Vec::new(),
+            f: Vec::new(),
+            source: String::new(),
+            position_resolution: None,
+            position_step: None,
+            normal_force_measured: false,
+            trusted: Vec::new(),
+            record_starts: Vec::new(),
+        };
+        for (part, record) in parts.into_iter().zip(&data.records) {
+            joined.record_starts.push(joined.t.len());
+            joined.t.extend(part.t.iter().map(|t| t + record.offset));
+            joined
+                .end
+                .extend(part.end.iter().map(|k| k + record.rows.start));
+            joined.h.extend(part.h);
+            joined.v.extend(part.v);
+            joined.x.extend(part.x);
+            joined.fn_.extend(part.fn_);
+            joined.f.extend(part.f);
+            joined.trusted.extend(part.trusted);
+            if joined.source.is_empty() {
+                joined.source = part.source;
+            }
+            joined.position_resolution = min(joined.position_resolution, part.position_resolution);
+            joined.position_step = min(joined.position_step, part.position_step);
+            joined.normal_force_measured |= part.normal_force_measured;
+        }
+        joined
+    }
 }
 
 /// The system around the friction FMU.
@@ -408,6 +581,23 @@ impl Setup {
         data: &Measured,
         why: &str,
     ) -> Result<FrictionData, String> {
+        if data.records.len() == 1 {
+            return self.record_friction_data_simulated(file, system, data, why);
+        }
+        let parts = (0..data.records.len())
+            .map(|i| self.record_friction_data_simulated(file, system, &data.record(i), why))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(FrictionData::join(parts, data))
+    }
+
+    /// [`Setup::friction_data_simulated`] of one record.
+    fn record_friction_data_simulated(
+        &self,
+        file: &SystemFile,
+        system: &mut System,
+        data: &Measured,
+        why: &str,
+    ) -> Result<FrictionData, String> {
         let params = super::sim::system_parameters(file, self, &self.nominal);
         // tried as every co-simulation of the diagnosis is
         let mut failures = Vec::new();
@@ -482,6 +672,7 @@ impl Setup {
                 && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
                     > fn_.iter().cloned().fold(f64::INFINITY, f64::min),
             trusted: Vec::new(),
+            record_starts: vec![0],
         };
         let mut force_cursor = crate::inputs::Cursor::default();
         for k in 0..n - 1 {
@@ -521,8 +712,30 @@ impl Setup {
         }
     }
 
-    /// The friction force and law inputs the data imply, on every interval.
+    /// The friction force and law inputs the data imply, on every interval
+    /// (of each record on its own: the smoothing and the differences do
+    /// not reach across from one record into the next).
     pub fn friction_data(
+        &self,
+        system: &System,
+        data: &Measured,
+        smooth: f64,
+    ) -> Result<FrictionData, String> {
+        if data.records.len() == 1 {
+            return self.record_friction_data(system, data, smooth);
+        }
+        let parts = (0..data.records.len())
+            .map(|i| {
+                let record = data.record(i);
+                self.record_friction_data(system, &record, smooth)
+                    .map_err(|e| format!("{}: {e}", record.label))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(FrictionData::join(parts, data))
+    }
+
+    /// [`Setup::friction_data`] of one record.
+    fn record_friction_data(
         &self,
         system: &System,
         data: &Measured,
@@ -649,6 +862,7 @@ impl Setup {
             position_step,
             normal_force_measured,
             trusted,
+            record_starts: vec![0],
         })
     }
 

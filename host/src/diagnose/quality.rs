@@ -93,11 +93,16 @@ pub struct Finding {
     pub value: f64,
     /// Samples it covers.
     pub samples: usize,
+    /// The file, when several records were joined ([`Quality::append`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
 }
 
 impl Finding {
-    /// One line: `FILE: line N: ...` (without the file when `file` is empty).
+    /// One line: `FILE: line N: ...` (without the file when `file` is
+    /// empty; the finding's own file when it has one).
     pub fn describe(&self, file: &str) -> String {
+        let file = self.file.as_deref().unwrap_or(file);
         let file = if file.is_empty() {
             String::new()
         } else {
@@ -159,6 +164,38 @@ impl Quality {
 
     pub fn total(&self) -> usize {
         self.spikes + self.dropouts + self.gaps + self.saturated
+    }
+
+    /// Append the findings and rows of another record (`file`), after
+    /// these rows (several records joined, [`super::problem::Measured::join`]).
+    pub fn append(&mut self, other: Quality, file: &str) {
+        self.findings
+            .extend(other.findings.into_iter().map(|mut f| {
+                f.file.get_or_insert_with(|| file.to_string());
+                f
+            }));
+        self.spikes += other.spikes;
+        self.dropouts += other.dropouts;
+        self.gaps += other.gaps;
+        self.saturated += other.saturated;
+        self.excluded_samples += other.excluded_samples;
+        self.excluded.extend(other.excluded);
+        self.after_gap.extend(other.after_gap);
+    }
+
+    /// The per-row flags of `rows` alone (the counts and findings of the
+    /// whole): one record of several.
+    pub fn rows(&self, rows: std::ops::Range<usize>) -> Quality {
+        Quality {
+            findings: self.findings.clone(),
+            spikes: self.spikes,
+            dropouts: self.dropouts,
+            gaps: self.gaps,
+            saturated: self.saturated,
+            excluded_samples: self.excluded_samples,
+            excluded: self.excluded[rows.clone()].to_vec(),
+            after_gap: self.after_gap[rows].to_vec(),
+        }
     }
 }
 
@@ -250,6 +287,7 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                 time: time[k],
                 value: dt,
                 samples: 1,
+                file: None,
             });
         }
     }
@@ -286,6 +324,7 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                     time: time[start],
                     value: y[start],
                     samples: len,
+                    file: None,
                 });
                 for (_, y) in columns.iter_mut() {
                     let (a, b) = (y[start - 1], y[end]);
@@ -352,6 +391,7 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                     time: time[k],
                     value: y[k],
                     samples: 1,
+                    file: None,
                 });
                 let u =
                     (time[k] - time[k - 1]) / (time[k + 1] - time[k - 1]).max(f64::MIN_POSITIVE);
@@ -415,6 +455,7 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
                     time: time[runs[0].0],
                     value: extreme,
                     samples: total,
+                    file: None,
                 });
             }
         }

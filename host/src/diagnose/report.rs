@@ -44,9 +44,8 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
     std::fs::write(dir.join("report.json"), json + "\n").map_err(|e| e.to_string())?;
     std::fs::write(dir.join("report.md"), markdown(d)).map_err(|e| e.to_string())?;
     let figures = super::figures::draw_all(d, dir)?;
-    write_inputs(&d.measured_inputs, &dir.join("inputs.csv"))?;
-    if let Some(held) = &d.heldout_inputs {
-        write_inputs(held, &dir.join("heldout-inputs.csv"))?;
+    for (inputs, name, _) in input_files(d) {
+        write_inputs(inputs, &dir.join(name))?;
     }
     write_ssp(file, friction, &d.final_model, &dir.join("refitted.ssp"))?;
     std::fs::write(
@@ -421,30 +420,54 @@ pub fn where_line(w: &super::localise::Where) -> String {
 
 type Fail = String;
 
-/// `fricsim run DIR/refitted.ssp --input DIR/inputs.csv …` over the
-/// training record and, with a held-out file, the same over
-/// `heldout-inputs.csv`: each with the diagnosis's master, step and the
-/// record's time span, so that the run is the co-simulation the report
-/// scored (the inputs interpolated over each step, as the diagnosis
-/// gives them).
+/// The input files of a report, with the result file of their rerun:
+/// `inputs.csv` (`rerun.csv`) of the training record and
+/// `heldout-inputs.csv` (`rerun-heldout.csv`) of a held-out file; with
+/// several records, numbered in their order (`inputs-1.csv`,
+/// `rerun-1.csv`, ...).
+pub fn input_files(d: &Diagnosis) -> Vec<(&super::InputColumns, String, String)> {
+    let mut files = Vec::new();
+    for (records, inputs, result) in [
+        (&d.measured_inputs, "inputs", "rerun"),
+        (&d.heldout_inputs, "heldout-inputs", "rerun-heldout"),
+    ] {
+        for (i, record) in records.iter().enumerate() {
+            let n = if records.len() == 1 {
+                String::new()
+            } else {
+                format!("-{}", i + 1)
+            };
+            files.push((
+                record,
+                format!("{inputs}{n}.csv"),
+                format!("{result}{n}.csv"),
+            ));
+        }
+    }
+    files
+}
+
+/// `fricsim run DIR/refitted.ssp --input DIR/inputs.csv …` over each
+/// training record and each held-out file ([`input_files`]): each with
+/// the diagnosis's master, step and the record's time span, so that the
+/// run is the co-simulation the report scored (the inputs interpolated
+/// over each step, as the diagnosis gives them).
 pub fn rerun_commands(d: &Diagnosis, out: &Path) -> Vec<String> {
     let ssp = out.join("refitted.ssp");
-    let command = |inputs: &str, time: &[f64], result: &str| {
-        let (start, stop) = (time[0], *time.last().unwrap_or(&time[0]));
-        format!(
-            "fricsim run {} --input {} --master {} --step {:?} --start {start:?} --stop {stop:?} --out {}",
-            ssp.display(),
-            out.join(inputs).display(),
-            d.master,
-            d.step,
-            out.join(result).display()
-        )
-    };
-    let mut commands = vec![command("inputs.csv", &d.measured_inputs.0, "rerun.csv")];
-    if let Some((time, _)) = &d.heldout_inputs {
-        commands.push(command("heldout-inputs.csv", time, "rerun-heldout.csv"));
-    }
-    commands
+    input_files(d)
+        .into_iter()
+        .map(|((time, _), inputs, result)| {
+            let (start, stop) = (time[0], *time.last().unwrap_or(&time[0]));
+            format!(
+                "fricsim run {} --input {} --master {} --step {:?} --start {start:?} --stop {stop:?} --out {}",
+                ssp.display(),
+                out.join(inputs).display(),
+                d.master,
+                d.step,
+                out.join(result).display()
+            )
+        })
+        .collect()
 }
 
 /// A data file's input columns (what drives the system), for

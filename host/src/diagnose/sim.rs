@@ -61,12 +61,30 @@ impl FrictionSim {
     }
 
     /// The friction force after each interval of `d` for `model`; an error
-    /// when the FMU refuses the parameters or a step.
+    /// when the FMU refuses the parameters or a step. The law starts from
+    /// rest at the first interval of each record (`d.record_starts`).
     pub fn run(&mut self, model: &FrictionModel, d: &FrictionData) -> Result<Vec<f64>, String> {
+        let mut out = Vec::with_capacity(d.t.len());
+        for (r, &first) in d.record_starts.iter().enumerate() {
+            let last = d.record_starts.get(r + 1).copied().unwrap_or(d.t.len());
+            self.run_record(model, d, first..last, &mut out)?;
+        }
+        Ok(out)
+    }
+
+    /// [`FrictionSim::run`] over the intervals `range` (one record), from
+    /// rest, appending the forces to `out`.
+    fn run_record(
+        &mut self,
+        model: &FrictionModel,
+        d: &FrictionData,
+        range: std::ops::Range<usize>,
+        out: &mut Vec<f64>,
+    ) -> Result<(), String> {
         let fail = |e: crate::FmuError| e.to_string();
         let i = &mut self.instance;
         i.reset().map_err(fail)?;
-        let t0 = d.t.first().copied().unwrap_or(0.0);
+        let t0 = d.t.get(range.start).copied().unwrap_or(0.0);
         i.setup_experiment(t0, None).map_err(fail)?;
         i.enter_initialization_mode().map_err(fail)?;
         for (name, value) in model.parameters() {
@@ -77,14 +95,14 @@ impl FrictionSim {
             }
             .map_err(fail)?;
         }
-        if !d.t.is_empty() {
-            i.set_real(&self.inputs, &[d.v[0], d.x[0], d.fn_[0]])
+        if !range.is_empty() {
+            let k = range.start;
+            i.set_real(&self.inputs, &[d.v[k], d.x[k], d.fn_[k]])
                 .map_err(fail)?;
         }
         i.exit_initialization_mode().map_err(fail)?;
-        let mut out = Vec::with_capacity(d.t.len());
         let mut f = [0.0];
-        for k in 0..d.t.len() {
+        for k in range {
             i.set_real(&self.inputs, &[d.v[k], d.x[k], d.fn_[k]])
                 .map_err(fail)?;
             i.do_step_with(d.t[k], d.h[k], Rollback::Never)
@@ -94,7 +112,7 @@ impl FrictionSim {
         }
         // the FMI 2.0 end of a run (§4.2.4); the next run resets
         i.terminate().map_err(fail)?;
-        Ok(out)
+        Ok(())
     }
 }
 
@@ -169,7 +187,7 @@ pub fn co_simulate(
     setup: &Setup,
     data: &Measured,
 ) -> Result<ChannelResiduals, String> {
-    co_simulate_with(system, parameters, data, &setup.master, setup.step)
+    co_simulate_with(system, parameters, data, None, &setup.master, setup.step)
 }
 
 /// A co-simulation that did not complete is tried again, in this order:
@@ -184,15 +202,16 @@ pub fn co_simulate_robust(
     parameters: &[(String, ParameterValue)],
     setup: &Setup,
     data: &Measured,
+    records: Option<&[usize]>,
 ) -> Result<(ChannelResiduals, Option<String>), String> {
     let mut failures = Vec::new();
     for (master, step) in &fallback_tries(setup) {
-        let outcome = co_simulate_with(system, parameters, data, master, *step).and_then(|r| {
-            match &r.incomplete {
+        let outcome = co_simulate_with(system, parameters, data, records, master, *step).and_then(
+            |r| match &r.incomplete {
                 Some(e) => Err(format!("stopped early: {e}")),
                 None => Ok(r),
-            }
-        });
+            },
+        );
         match outcome {
             Ok(r) => {
                 let note = (!failures.is_empty()).then(|| {
@@ -252,8 +271,51 @@ pub fn fallback_tries(setup: &Setup) -> Vec<(String, f64)> {
     tries
 }
 
-/// [`co_simulate`] with a given master and macro step.
+/// [`co_simulate`] with a given master and macro step. Several records
+/// ([`Measured::join`]) are co-simulated one after the other, each from
+/// its own start with its own inputs, and their residuals joined (a record
+/// that stops early leaves the records after it out, and says so);
+/// `records`: only these (indices into `data.records`, in order), the
+/// samples still numbered as rows of the whole `data`.
 pub fn co_simulate_with(
+    system: &mut System,
+    parameters: &[(String, ParameterValue)],
+    data: &Measured,
+    records: Option<&[usize]>,
+    master: &str,
+    step: f64,
+) -> Result<ChannelResiduals, String> {
+    if data.records.len() == 1 {
+        return co_simulate_record(system, parameters, data, master, step);
+    }
+    let all: Vec<usize> = (0..data.records.len()).collect();
+    let mut joined: Option<ChannelResiduals> = None;
+    for &i in records.unwrap_or(&all) {
+        let record = &data.records[i];
+        let r = co_simulate_record(system, parameters, &data.record(i), master, step)?;
+        let j = joined.get_or_insert_with(|| ChannelResiduals {
+            channels: r.channels.clone(),
+            samples: Vec::new(),
+            simulated: vec![Vec::new(); r.channels.len()],
+            residuals: vec![Vec::new(); r.channels.len()],
+            incomplete: None,
+        });
+        j.samples
+            .extend(r.samples.iter().map(|k| k + record.rows.start));
+        for c in 0..r.channels.len() {
+            j.simulated[c].extend_from_slice(&r.simulated[c]);
+            j.residuals[c].extend_from_slice(&r.residuals[c]);
+        }
+        if let Some(e) = r.incomplete {
+            j.incomplete = Some(format!("{}: {e}", record.label));
+            break;
+        }
+    }
+    joined.ok_or_else(|| "no record to co-simulate".to_string())
+}
+
+/// [`co_simulate_with`] of one record.
+fn co_simulate_record(
     system: &mut System,
     parameters: &[(String, ParameterValue)],
     data: &Measured,

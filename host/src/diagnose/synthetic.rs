@@ -171,6 +171,7 @@ pub fn generate(
         position_step: None,
         normal_force_measured: true,
         trusted: vec![true; n],
+        record_starts: vec![0],
     };
     let mut truth = setup.nominal.clone();
     let mut amplitudes = Vec::new();

@@ -186,7 +186,7 @@ fn a_failed_co_simulation_falls_back_to_the_next_master_and_says_so() {
     let measured = Measured::read(&data, &system).unwrap();
     let setup = Setup::new(&truth, &mut system, 1e-3, "no-such-master").unwrap();
     let params = system_parameters(&truth, &setup, &setup.nominal);
-    let (r, note) = co_simulate_robust(&mut system, &params, &setup, &measured).unwrap();
+    let (r, note) = co_simulate_robust(&mut system, &params, &setup, &measured, None).unwrap();
     assert!(r.incomplete.is_none());
     assert_eq!(r.samples.len(), measured.time.len());
     let note = note.expect("a fallback was used");

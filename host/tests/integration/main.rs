@@ -28,6 +28,7 @@ mod crash_safe_output;
 mod diagnose;
 mod diagnose_any_plant;
 mod diagnose_hidden_effects;
+mod diagnose_records;
 mod docs;
 mod emps;
 mod fmu_logging;
