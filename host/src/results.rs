@@ -6,7 +6,7 @@
 //! [`ResultWriter`] takes the rows of a run as they are computed
 //! ([`crate::master::simulate_streaming`]) and writes them at once, keeping
 //! only a summary of each column and the columns to be plotted, so that a
-//! run's memory does not grow with its length; [`write_csv`] writes a
+//! run's memory does not grow with its length; [`write_run`] writes a
 //! [`Run`] held in memory as the same file. A path ending in `.mat` gets
 //! a MAT v4 file instead ([`crate::matfile`], [`create`]). Both write
 //! through an [`OutputFile`]: a result is put in place whole (or marked
@@ -188,9 +188,10 @@ fn header(columns: &[String]) -> String {
         .join(",")
 }
 
-/// Write `run` (rows held in memory) as a CSV result file to `out`.
-pub fn write_csv(run: &Run, out: OutputFile) -> Result<(), OutputError> {
-    let mut file = CsvFile::new(out, &run.columns);
+/// Write `run` (rows held in memory) to `out` in the format its path
+/// names ([`create`]: MAT v4 for `.mat`, else CSV).
+pub fn write_run(run: &Run, out: OutputFile) -> Result<(), OutputError> {
+    let mut file = create(out, &run.columns);
     // a write error is reported by finish, with the path
     let _ = file.write_rows(&run.time, &run.rows);
     file.finish(run.error.as_deref())

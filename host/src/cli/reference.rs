@@ -33,7 +33,8 @@ pub struct ReferenceArgs {
     /// annotation].
     #[arg(long)]
     pub step: Option<f64>,
-    /// Result CSV [default: out/<file name>_reference.csv].
+    /// Result file: CSV, or MAT v4 if it ends in .mat (as `fricsim run`)
+    /// [default: out/<file name>_reference.csv].
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Record a Real variable besides the outputs, component.variable
@@ -87,7 +88,7 @@ pub fn run(a: &ReferenceArgs) -> Result<(), String> {
     // The writer of `fricsim run`: the same format to the digit.
     let output = fricsim::output_file::OutputFile::create(&out, &file.files_read())
         .map_err(|e| e.to_string())?;
-    fricsim::results::write_csv(&run, output).map_err(|e| e.to_string())?;
+    fricsim::results::write_run(&run, output).map_err(|e| e.to_string())?;
 
     println!("{}: {}", file.ssd, model.description());
     print!(

@@ -47,6 +47,13 @@ pub fn run(a: &SweepArgs) -> Result<(), String> {
         .out
         .clone()
         .unwrap_or_else(|| super::default_out(&a.system, "-sweep"));
+    if fricsim::matfile::is_mat(&out) {
+        // refused before anything runs: the table has a text column
+        return Err(format!(
+            "--out {}: a sweep's table is written as CSV only (its `status` column is text, which MAT v4 cannot hold); give a .csv name",
+            out.display()
+        ));
+    }
     let output = OutputFile::create(&out, &file.files_read()).map_err(|e| e.to_string())?;
     let mut axes = a
         .params

@@ -186,6 +186,18 @@ fn the_reference_of_the_stick_slip_example_has_the_columns_and_times_of_run() {
         line.contains(&format!("{:.4e}", err("rig.x").relative_rms.unwrap())),
         "{line}"
     );
+    // `--out ref.mat` is a MAT v4 file (not CSV text under that name) with
+    // the same columns, times and values, to the last bit
+    let mat = p(dir.path(), "ref.mat");
+    ok(&["reference", &example, "--stop", "10", "--out", &mat]);
+    assert!(
+        !std::fs::read(&mat).unwrap().starts_with(b"time"),
+        "CSV text"
+    );
+    let m = ResultFile::read(Path::new(&mat)).unwrap();
+    assert_eq!(m.columns, f.columns);
+    assert_eq!(m.time, f.time);
+    assert_eq!(m.values, f.values);
     // Chosen signals only; a coarser result is compared by interpolation.
     let shown = ok(&["compare", &run, &reference, "--signal", "friction.F"]);
     assert!(

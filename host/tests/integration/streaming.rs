@@ -14,7 +14,7 @@ use fricsim::master::{
     CHUNK_STEPS,
 };
 use fricsim::output_file::OutputFile;
-use fricsim::results::{write_csv, ResultWriter};
+use fricsim::results::{write_run, ResultWriter};
 use fricsim::system::System;
 use std::path::{Path, PathBuf};
 
@@ -244,7 +244,7 @@ fn the_csv_written_as_the_rows_come_is_the_whole_runs_byte_for_byte() {
     )
     .unwrap();
     let kept_file = dir.path().join("whole.csv");
-    write_csv(&whole, OutputFile::create(&kept_file, &[]).unwrap()).unwrap();
+    write_run(&whole, OutputFile::create(&kept_file, &[]).unwrap()).unwrap();
 
     let streamed_file = dir.path().join("sub/streamed.csv");
     let mut system = stick_slip();

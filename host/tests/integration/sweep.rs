@@ -216,6 +216,24 @@ fn wrong_axes_are_refused_before_anything_runs() {
         common::assert_message(&String::from_utf8_lossy(&output.stderr), &[message]);
         assert!(!out.exists(), "{all:?} wrote a table");
     }
+    // a table named .mat would be CSV text in a file that claims MAT
+    let mat = dir.path().join("table.mat");
+    let output = fricsim(&[
+        "sweep",
+        "examples/stick_slip.ssd",
+        "--stop",
+        "0.1",
+        "--param",
+        "friction.sigma0=1e5,2e5",
+        "--out",
+        mat.to_str().unwrap(),
+    ]);
+    assert!(!output.status.success());
+    common::assert_message(
+        &String::from_utf8_lossy(&output.stderr),
+        &["table.mat", "written as CSV only"],
+    );
+    assert!(!mat.exists(), "a .mat sweep table was written");
 }
 
 /// The macro step of [`stick_slip`], s.
