@@ -14,11 +14,12 @@ RIGS = ["Rig1D", "Rig2D"]
 
 # the FMUs with a Model Exchange interface: their states, in order, and
 # their number of event indicators
-MODEL_EXCHANGE = {"Dahl": (["F"], 1), "LuGre": (["z"], 1), "ResetIntegrator": (["z"], 2),
+MODEL_EXCHANGE = {"Dahl": (["F_dahl"], 1), "LuGre": (["z"], 1), "ResetIntegrator": (["z"], 2),
                   "Bristle2D": (["z1", "z2"], 1)}
 
 EXPECTED = {
-    "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma", "Fc", "alpha"}},
+    "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma", "Fc", "alpha", "F_offset"},
+             "local": {"F_dahl", "der(F_dahl)"}},
     "LuGre": {"input": {"v", "x", "Fn"}, "output": {"F", "z", "sliding"},
               "parameter": {"sigma0", "sigma1", "sigma2", "Fc", "Fs", "vs", "stribeck_exponent", "vd",
                             "direction_dependent", "Fc_neg", "Fs_neg", "normal_force_form",

@@ -236,8 +236,11 @@ def dahl_closed_form(t, sigma, fc, alpha, v0, t_reversal):
     return np.where(t <= t_reversal, f, f_back)
 
 
-@pytest.mark.parametrize("alpha", [1.0, 2.0])
-def test_dahl_model_exchange_follows_the_closed_form(alpha):
+@pytest.mark.parametrize("alpha,offset", [(1.0, 0.0), (2.0, 0.0), (1.0, -3.1648)])
+def test_dahl_model_exchange_follows_the_closed_form(alpha, offset):
+    """The state is the force of the law F_dahl; the output F = F_dahl +
+    F_offset is the closed form shifted by the offset (from F = F_offset at
+    the start)."""
     sigma, fc, v0, t1 = 87750.0, 2.0, 1e-4, 1.0  # Sun et al. 2016, Table 7; 8.8 Fc/sigma each way
     signal = np.rec.fromarrays([np.array([0.0, t1, t1, 2.0]), np.array([v0, v0, -v0, -v0])],
                                names=["time", "v"])
@@ -245,18 +248,21 @@ def test_dahl_model_exchange_follows_the_closed_form(alpha):
     for rtol in (1e-6, 1e-9):
         r = simulate_fmu(str(fmu_path("Dahl")), fmi_type="ModelExchange", solver="CVode",
                          stop_time=2.0, output_interval=0.01, input=signal, relative_tolerance=rtol,
-                         start_values={"alpha": alpha}, output=["F", "z", "der(F)"])
+                         start_values={"alpha": alpha, "F_offset": offset},
+                         output=["F", "z", "F_dahl", "der(F_dahl)"])
         expected = dahl_closed_form(r["time"], sigma, fc, alpha, v0, t1)
-        errors[rtol] = np.max(np.abs(r["F"] - expected))
-        assert np.allclose(r["z"], r["F"] / sigma, rtol=1e-15, atol=0)
+        errors[rtol] = np.max(np.abs(r["F_dahl"] - expected))
+        assert r["F_dahl"][0] == 0.0 and r["F"][0] == offset
+        assert np.array_equal(r["F"], r["F_dahl"] + offset)
+        assert np.allclose(r["z"], r["F_dahl"] / sigma, rtol=1e-15, atol=0)
     # within 1e-6 of Fc at rtol 1e-9; and the error is the integrator's:
     # it shrinks with the tolerance
     assert errors[1e-9] <= 1e-6 * fc, errors
     assert errors[1e-9] < errors[1e-6] / 100, errors
     # both branches covered: most of the way to +Fc before the reversal
     # (0.998 Fc for alpha = 1, 0.81 Fc for alpha = 2), past -Fc/2 at the end
-    assert r["F"][r["time"] <= t1].max() > 0.8 * fc
-    assert r["F"][-1] < -0.5 * fc
+    assert r["F_dahl"][r["time"] <= t1].max() > 0.8 * fc
+    assert r["F_dahl"][-1] < -0.5 * fc
 
 
 # ---- the LuGre stick-slip benchmark ---------------------------------------------

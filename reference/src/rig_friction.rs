@@ -4,7 +4,7 @@
 //! State `y = (x, ẋ, ξ, s)`: body position and velocity, the controller's
 //! velocity-error integral ξ (constant 0 without controller), and the
 //! friction law's state `s` (LuGre: the bristle deflection `z`; Dahl: the
-//! force `F`). Right-hand side, from the physics crates:
+//! force of the law `F_dahl`). Right-hand side, from the physics crates:
 //!
 //! - friction inputs: `v` = the rig's slip velocity `ẋ − v_s(t)`
 //!   ([`Rig1D::slip_velocity`]) or its body velocity, `x` = its position or
@@ -12,7 +12,8 @@
 //! - LuGre (Sun et al. 2016 eq. 9–11): `ż = v − σ0·|v|·z/g(v)` ([`LuGre::z_rate`]),
 //!   `F = σ0·z + σ1(v)·ż + σ2·v` ([`LuGre::force_of`]);
 //!   Dahl (Sun et al. 2016 eq. 2–3): `dF/dt = σ·|1 − F/Fc·sgn v|^α·sgn(1 − F/Fc·sgn v)·v`
-//!   ([`Dahl::force_rate`]);
+//!   for `F = F_dahl` ([`Dahl::force_rate`]), the force `F_dahl + F_offset`
+//!   ([`Dahl::force_of`]);
 //! - rig (docs/models.md "Rigs", `rig-dynamics/src/rig1d.rs`):
 //!   `m·ẍ = k·(x_a(t) − x) − c·ẋ + F_ext − F + F_d(t) + F_ctrl`, evaluated by
 //!   [`Rig1D::acceleration`] on a copy of the rig set to `(t, x, ẋ, ξ)`, so
@@ -94,7 +95,7 @@ impl RigWithFriction {
         let s = self.rig.state_to_vec();
         let law_state = match &self.law {
             DynamicLaw::LuGre { law, .. } => law.z(),
-            DynamicLaw::Dahl(d) => d.force(),
+            DynamicLaw::Dahl(d) => d.dahl_force(),
         };
         [s[1], s[2], s[3], law_state]
     }
@@ -121,7 +122,7 @@ impl RigWithFriction {
         };
         let force = match &self.law {
             DynamicLaw::LuGre { law, normal_force } => law.force_of(y[3], v, x, *normal_force),
-            DynamicLaw::Dahl(_) => y[3],
+            DynamicLaw::Dahl(d) => d.force_of(y[3]),
         };
         Ok(Coupling { rig, v, x, force })
     }

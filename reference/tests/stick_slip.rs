@@ -184,6 +184,55 @@ fn dahl_reference_equals_the_exact_update_along_its_own_path() {
         .all(|(z, f)| (z * 87_750.0 - f).abs() < 1e-12));
 }
 
+/// Dahl's offset is a constant force on the body: the rig with a Dahl
+/// contact of `F_offset = c` moves as the rig with a plain one and the
+/// external force `F_ext = −c`, and its force column is the plain one's
+/// plus `c` (`z = F_dahl/σ` unchanged), from `F = c` at the start.
+#[test]
+fn dahl_offset_is_a_constant_force_on_the_body() {
+    for c in [0.3, -0.45] {
+        let offset = run(
+            &system(ComponentSpec::new("friction", "Dahl").real("F_offset", c)),
+            1e-3,
+            5.0,
+            RTOL,
+        );
+        let rig = ComponentSpec::new("rig", "Rig1D")
+            .real("m", 1.0)
+            .real("k", 2.0)
+            .real("c", 0.0)
+            .real("v_a", 0.1)
+            .real("F_ext", -c);
+        let pushed = run(
+            &coupled(rig, ComponentSpec::new("friction", "Dahl")),
+            1e-3,
+            5.0,
+            RTOL,
+        );
+        let f = col(&offset, "friction.F");
+        assert_eq!(f[0], c);
+        let shifted: Vec<f64> = col(&pushed, "friction.F").iter().map(|f| f + c).collect();
+        // The two right-hand sides differ in rounding only, which the
+        // solver's steps carry to its tolerance: observed 1.8e-9 N (F),
+        // 1.7e-13 m (x), 2.1e-14 m (z = F_dahl/σ), 5.5e-12 m/s (v).
+        let bounds = [
+            ("friction.F", 1e-8),
+            ("rig.x", 1e-12),
+            ("friction.z", 1e-13),
+            ("rig.v", 1e-10),
+        ];
+        for (column, bound) in bounds {
+            let a = col(&offset, column);
+            let b = match column {
+                "friction.F" => shifted.clone(),
+                _ => col(&pushed, column),
+            };
+            let d = max_diff(&a, &b);
+            assert!(d < bound, "c {c}: {column} differs by {d:e}");
+        }
+    }
+}
+
 #[test]
 fn recorded_inputs_and_parameters_follow_the_outputs_they_are_connected_to() {
     let mut m = ReferenceModel::from_spec(&system(lugre_1995())).unwrap();

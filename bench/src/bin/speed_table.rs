@@ -1229,6 +1229,7 @@ fn appels_herder_curve(repeats: usize) -> Result<Vec<CurveRow>, String> {
         sigma: p.sigma_ini,
         fc: level,
         alpha: 1.0,
+        f_offset: 0.0,
     };
     let dahl = per_call(repeats, || {
         let mut d = Dahl::new(dahl_params).expect("positive parameters");

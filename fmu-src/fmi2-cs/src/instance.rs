@@ -138,9 +138,10 @@ fn type_flag(t: VarType) -> u8 {
 
 fn flags_of(v: &Variable) -> u8 {
     if v.causality == Causality::Local {
-        // A state derivative, computed when read: without its type bit, so
-        // that the hot paths send it to the checks, which compute it
-        // ([`Instance::get_computed`]); never settable.
+        // A state derivative or a local state, computed when read: without
+        // its type bit, so that the hot paths send it to the checks, which
+        // bring the outputs (with the local states) and the derivatives up
+        // to date ([`Instance::refresh_derivatives`]); never settable.
         return 0;
     }
     let mut f = type_flag(v.var_type);
@@ -430,7 +431,8 @@ impl Instance {
             let f = self.flags.get(*vr as usize).copied().unwrap_or(0);
             if f & type_flag(t) == 0 {
                 self.variable_of_type(*vr, t)?;
-                // of type `t` but without its bit: a state derivative
+                // of type `t` but without its bit: a state derivative or
+                // a local state
                 self.refresh_derivatives()?;
             }
             let state_output = flag::OUTPUT | flag::STATE_OUTPUT;
@@ -510,6 +512,7 @@ impl Instance {
                 self.variable_of_type(*vr, t)?;
             }
             // every one of type `t`, but one without its bit: a derivative
+            // or a local state
             self.refresh_derivatives()?;
             return Ok(true);
         }
@@ -524,9 +527,9 @@ impl Instance {
         Ok(outputs)
     }
 
-    /// The outputs and the `der(…)` variables brought up to date, for a
-    /// read of a derivative (which [`Instance::get`] then reads as any
-    /// value).
+    /// The outputs (with the local states) and the `der(…)` variables
+    /// brought up to date, for a read of a derivative or a local state
+    /// (which [`Instance::get`] then reads as any value).
     #[cold]
     #[inline(never)]
     fn refresh_derivatives(&mut self) -> Result<(), String> {

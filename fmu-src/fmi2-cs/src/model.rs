@@ -36,16 +36,17 @@ pub trait Model: Send {
     }
 
     /// Write every output into `values` from the state and the current
-    /// inputs, and nothing else: the layer keeps inputs and parameters in
-    /// `values` across calls.
+    /// inputs, and the value of every continuous state declared as a local
+    /// variable ([`crate::Variable::state`]), and nothing else: the layer
+    /// keeps inputs and parameters in `values` across calls.
     fn compute_outputs(&self, values: &mut Values);
 
     /// Write at least the outputs `outputs` (value references of outputs)
     /// into `values`, each bit for bit as [`Model::compute_outputs`] does,
     /// for directional derivatives and for a read of one output of the
     /// state alone (no `depends_on`), which need only these; the other
-    /// outputs may be left as they are, inputs and parameters must be. By
-    /// default every output.
+    /// outputs (and local states) may be left as they are, inputs and
+    /// parameters must be. By default every output.
     fn compute_outputs_of(&self, values: &mut Values, outputs: &[u32]) {
         let _ = outputs;
         self.compute_outputs(values);

@@ -256,11 +256,15 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
         for s in me.states {
             let i = s.derivative as usize;
             unknown(w, i, &info.variables[i]);
+            // the derivatives and the states, all `initial="calculated"`
+            // (FMI 2.0.4 §2.2.8): a state that is an output is listed as one
             initial_unknowns.push(i);
+            initial_unknowns.push(s.state as usize);
         }
         let _ = writeln!(w, "    </Derivatives>");
     }
     initial_unknowns.sort_unstable();
+    initial_unknowns.dedup();
     let _ = writeln!(w, "    <InitialUnknowns>");
     for i in initial_unknowns {
         let _ = writeln!(w, r#"      <Unknown index="{}"/>"#, i + 1);

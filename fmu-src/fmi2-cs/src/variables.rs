@@ -204,6 +204,24 @@ impl Variable {
         v
     }
 
+    /// A continuous state that is not an output: a local continuous real
+    /// whose value is the state, written by
+    /// [`crate::Model::compute_outputs`] with the outputs (and, as every
+    /// local, computed when read, never set: Model Exchange sets it with
+    /// `fmi2SetContinuousStates`). For a model whose output is a function
+    /// of the state other than the state itself.
+    pub const fn state(
+        vr: u32,
+        name: &'static str,
+        unit: &'static str,
+        description: &'static str,
+    ) -> Self {
+        let mut v = Self::base(vr, name, VarType::Real, Causality::Local);
+        v.unit = if unit.is_empty() { None } else { Some(unit) };
+        v.description = description;
+        v
+    }
+
     /// The continuous states this output depends on (value references of
     /// state variables).
     pub const fn with_state_dependencies(mut self, states: &'static [u32]) -> Self {
@@ -400,13 +418,14 @@ impl ModelInfo {
                 ));
             }
             let is_derivative = self.model_exchange.is_some_and(|me| me.is_derivative(v.vr));
-            if (v.causality == Causality::Local) != is_derivative {
+            let local_kind = is_derivative || is_state(v.vr) && v.causality == Causality::Local;
+            if (v.causality == Causality::Local) != local_kind {
                 return Err(format!(
-                    "{}: {} is {}a local variable but {}a state derivative (the layer computes only derivatives as locals)",
+                    "{}: {} is {}a local variable but {}a state derivative or a state (the layer computes only derivatives and states as locals)",
                     self.model_name,
                     v.name,
                     if v.causality == Causality::Local { "" } else { "not " },
-                    if is_derivative { "" } else { "not " },
+                    if local_kind { "" } else { "not " },
                 ));
             }
         }
@@ -428,5 +447,77 @@ impl ModelInfo {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A table with the state variable `state` (value reference 3), its
+    /// derivative and an output `y` of the state.
+    fn info(state: Variable) -> ModelInfo {
+        let variables = vec![
+            Variable::input(0, "u", 0.0, "", 1.0, "input"),
+            Variable::output(1, "y", "", "s + 1", &[]).with_state_dependencies(&[3]),
+            Variable::derivative(2, "der(s)", "", "-s + u", &[0], &[3]),
+            state,
+        ];
+        ModelInfo {
+            model_name: "LocalState",
+            model_identifier: "LocalState",
+            guid: "{local-state}",
+            description: "test model",
+            source: "test",
+            variables: Box::leak(variables.into_boxed_slice()),
+            default_experiment: DefaultExperiment {
+                start_time: 0.0,
+                stop_time: 1.0,
+                step_size: 0.1,
+            },
+            capabilities: Capabilities::FULL,
+            model_exchange: Some(ModelExchange {
+                states: &[ContinuousState {
+                    state: 3,
+                    derivative: 2,
+                }],
+                event_indicators: 0,
+                states_jump_at_events: false,
+            }),
+        }
+    }
+
+    /// A continuous state may be a local variable (not only an output),
+    /// and is then listed among the initial unknowns with its derivative
+    /// and the outputs (FMI 2.0.4 §2.2.8); a local that is neither a state
+    /// nor a derivative is refused.
+    #[test]
+    fn a_state_may_be_a_local_variable() {
+        let good = info(Variable::state(3, "s", "", "the state"));
+        good.check().unwrap();
+        let xml = crate::model_description::render(&good, "test").unwrap();
+        let var = xml.split("<!-- index 4 -->").nth(1).unwrap();
+        assert!(
+            var.contains(r#"name="s" valueReference="3" description="the state" causality="local" variability="continuous" initial="calculated""#),
+            "{xml}"
+        );
+        assert!(xml.contains(r#"<Real derivative="4"/>"#), "{xml}");
+        let initial = xml.split("<InitialUnknowns>").nth(1).unwrap();
+        let initial = initial.split("</InitialUnknowns>").next().unwrap();
+        let listed: Vec<&str> = initial
+            .split("index=\"")
+            .skip(1)
+            .map(|s| s.split('"').next().unwrap())
+            .collect();
+        assert_eq!(listed, ["2", "3", "4"]);
+        // a local of the table that is not a state: refused, named
+        let mut stray = good.variables.to_vec();
+        stray.push(Variable::state(4, "w", "", "no state"));
+        let stray = ModelInfo {
+            variables: Box::leak(stray.into_boxed_slice()),
+            ..info(Variable::state(3, "s", "", "the state"))
+        };
+        let e = stray.check().unwrap_err();
+        assert!(e.contains("w is a local variable but not"), "{e}");
     }
 }

@@ -1,7 +1,9 @@
 //! `Dahl.fmu`: the Dahl law (Dahl 1968; Sun et al. 2016 eq. 2–3, 16–17;
 //! docs/models.md "Dahl"), integrated exactly in the displacement domain
-//! for every α in Co-Simulation; in Model Exchange the force `F` is the
-//! continuous state and `dF/dt` ([`Dahl::force_rate`]) its derivative.
+//! for every α in Co-Simulation; in Model Exchange the force of the law
+//! `F_dahl` (a local variable) is the continuous state and `dF_dahl/dt`
+//! ([`Dahl::force_rate`]) its derivative. The output is
+//! `F = F_dahl + F_offset`.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
 use fmi2_cs::{
@@ -18,34 +20,39 @@ pub mod vr {
     pub const SIGMA: u32 = 4;
     pub const FC: u32 = 5;
     pub const ALPHA: u32 = 6;
-    pub const DER_F: u32 = 7;
+    /// `der(F_dahl)` (named `der(F)` while the state was the output `F`).
+    pub const DER_F_DAHL: u32 = 7;
+    /// Added after the first version, after the derivative: the state
+    /// `F_dahl` and the parameter `F_offset`.
+    pub const F_DAHL: u32 = 8;
+    pub const F_OFFSET: u32 = 9;
 }
 
-static VARIABLES: [Variable; 8] = [
+static VARIABLES: [Variable; 10] = [
     sliding_velocity_input(vr::V),
     Variable::output(
         vr::F,
         "F",
         "N",
-        "Friction force, resisting positive motion (the rig applies -F)",
+        "Friction force F = F_dahl + F_offset, resisting positive motion (the rig applies -F)",
         &[],
     )
-    .with_state_dependencies(&[vr::F]),
-    Variable::output(vr::Z, "z", "m", "Bristle deflection z = F/sigma", &[])
-        .with_state_dependencies(&[vr::F]),
+    .with_state_dependencies(&[vr::F_DAHL]),
+    Variable::output(vr::Z, "z", "m", "Bristle deflection z = F_dahl/sigma", &[])
+        .with_state_dependencies(&[vr::F_DAHL]),
     Variable::boolean_output(
         vr::SLIDING,
         "sliding",
-        "True when moving and |F| has reached 99 % of Fc",
+        "True when moving and |F_dahl| has reached 99 % of Fc",
         &[vr::V],
     )
-    .with_state_dependencies(&[vr::F]),
+    .with_state_dependencies(&[vr::F_DAHL]),
     Variable::parameter(
         vr::SIGMA,
         "sigma",
         87750.0,
         "N/m",
-        "Rest stiffness dF/dx at F = 0 (Sun et al. 2016, Table 7)",
+        "Rest stiffness dF/dx at F_dahl = 0 (Sun et al. 2016, Table 7)",
     )
     .with_min(0.0),
     Variable::parameter(
@@ -65,12 +72,25 @@ static VARIABLES: [Variable; 8] = [
     )
     .with_min(0.0),
     Variable::derivative(
-        vr::DER_F,
-        "der(F)",
+        vr::DER_F_DAHL,
+        "der(F_dahl)",
         "N/s",
-        "dF/dt = sigma*|y|^alpha*sgn(y)*v, y = 1 - F/Fc*sgn(v): the derivative of the continuous state F (Model Exchange)",
+        "dF_dahl/dt = sigma*|y|^alpha*sgn(y)*v, y = 1 - F_dahl/Fc*sgn(v): the derivative of the continuous state F_dahl (Model Exchange)",
         &[vr::V],
-        &[vr::F],
+        &[vr::F_DAHL],
+    ),
+    Variable::state(
+        vr::F_DAHL,
+        "F_dahl",
+        "N",
+        "Force of the Dahl law, without the offset: the continuous state (Model Exchange); 0 at the start",
+    ),
+    Variable::parameter(
+        vr::F_OFFSET,
+        "F_offset",
+        0.0,
+        "N",
+        "Constant force on the contact, added to F at rest and in motion (as the offset of Janot, Gautier, Brunot 2019); the Dahl law does not see it",
     ),
 ];
 
@@ -78,15 +98,15 @@ pub static INFO: ModelInfo = ModelInfo {
     model_name: "Dahl",
     model_identifier: "Dahl",
     guid: "{a54e3c99-50b7-48eb-af8d-f492d8bea339}",
-    description: "Dahl friction: dF/dx = sigma*|1 - F/Fc*sgn v|^alpha*sgn(1 - F/Fc*sgn v), dF/dt = dF/dx*v; exact update in x for every alpha.",
-    source: "Dahl 1968; Sun et al. 2016 eq. 2-3, 16-17; Thimmalapura 2004 eq. 2.4-2.5. See docs/models.md.",
+    description: "Dahl friction: dF_dahl/dx = sigma*|1 - F_dahl/Fc*sgn v|^alpha*sgn(1 - F_dahl/Fc*sgn v), dF_dahl/dt = dF_dahl/dx*v, F = F_dahl + F_offset; exact update in x for every alpha.",
+    source: "Dahl 1968; Sun et al. 2016 eq. 2-3, 16-17; Thimmalapura 2004 eq. 2.4-2.5; Janot, Gautier, Brunot 2019 (offset). See docs/models.md.",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
     model_exchange: Some(ModelExchange {
         states: &[ContinuousState {
-            state: vr::F,
-            derivative: vr::DER_F,
+            state: vr::F_DAHL,
+            derivative: vr::DER_F_DAHL,
         }],
         event_indicators: 1,
         states_jump_at_events: false,
@@ -112,6 +132,7 @@ impl DahlFmu {
             sigma: values.real(vr::SIGMA),
             fc: values.real(vr::FC),
             alpha: values.real(vr::ALPHA),
+            f_offset: values.real(vr::F_OFFSET),
         }
     }
 }
@@ -126,11 +147,13 @@ impl Model for DahlFmu {
         Ok(())
     }
 
+    /// The outputs, and the local state `F_dahl`.
     fn compute_outputs(&self, values: &mut Values) {
         let v = values.real(vr::V);
         values.set(vr::F, self.law.force());
         values.set(vr::Z, self.law.z());
         values.set_boolean(vr::SLIDING, self.law.sliding(v));
+        values.set(vr::F_DAHL, self.law.dahl_force());
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
@@ -145,34 +168,32 @@ impl Model for DahlFmu {
         false
     }
 
-    /// dF/dt = (dF/dx)·v (Sun et al. 2016 eq. 3); dz/dt = (dF/dt)/σ.
+    /// dF/dt = dF_dahl/dt = (dF_dahl/dx)·v (Sun et al. 2016 eq. 3; the
+    /// offset is constant); dz/dt = (dF_dahl/dt)/σ.
     fn output_derivative(&self, values: &Values, _slopes: &[f64], output: u32) -> Option<f64> {
-        let p = self.law.params();
-        let v = values.real(vr::V);
-        let y = 1.0 - self.law.force() / p.fc * v.signum();
-        let rate = if v == 0.0 {
-            0.0
-        } else {
-            p.sigma * y.abs().powf(p.alpha) * y.signum() * v
-        };
+        let rate = self
+            .law
+            .force_rate(self.law.dahl_force(), values.real(vr::V));
         match output {
             vr::F => Some(rate),
-            vr::Z => Some(rate / p.sigma),
+            vr::Z => Some(rate / self.law.params().sigma),
             _ => None,
         }
     }
 
-    /// `dF/dt` at the current force and velocity: the law's rate, which its
-    /// step integrates exactly.
+    /// `dF_dahl/dt` at the current state and velocity: the law's rate,
+    /// which its step integrates exactly.
     fn derivatives(&self, values: &Values, dx: &mut [f64]) {
-        dx[0] = self.law.force_rate(self.law.force(), values.real(vr::V));
+        dx[0] = self
+            .law
+            .force_rate(self.law.dahl_force(), values.real(vr::V));
     }
 
     fmi2_cs::ode_is_self!();
 }
 
-/// Model Exchange: the state is `F`; the one event indicator is `v`, where
-/// `sgn v` switches the law's branch (the rate has a kink there); no
+/// Model Exchange: the state is `F_dahl`; the one event indicator is `v`,
+/// where `sgn v` switches the law's branch (the rate has a kink there); no
 /// discrete state, so an event changes nothing.
 impl Ode for DahlFmu {
     fmi2_cs::delegate_continuous_states!(law);
@@ -181,7 +202,7 @@ impl Ode for DahlFmu {
         z[0] = values.real(vr::V);
     }
 
-    /// `F` on the scale of `Fc`.
+    /// `F_dahl` on the scale of `Fc`.
     fn nominals(&self, values: &Values, nominal: &mut [f64]) {
         nominal[0] = Self::params(values).fc;
     }
@@ -190,18 +211,19 @@ impl Ode for DahlFmu {
         false
     }
 
-    /// `∂(dF/dt)/∂F`, `∂(dF/dt)/∂v` ([`Dahl::force_rate_partials`]); the
-    /// outputs `F` (the state) and `z = F/σ` do not depend on `v`.
+    /// `∂(dF_dahl/dt)/∂F_dahl`, `∂(dF_dahl/dt)/∂v`
+    /// ([`Dahl::force_rate_partials`]); the outputs `F = F_dahl + F_offset`
+    /// and `z = F_dahl/σ` do not depend on `v` (nor on the offset).
     fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
         let v = values.real(vr::V);
         let (by_f, by_v) = match unknown {
-            vr::DER_F => self.law.force_rate_partials(self.law.force(), v),
+            vr::DER_F_DAHL => self.law.force_rate_partials(self.law.dahl_force(), v),
             vr::F => (1.0, 0.0),
             vr::Z => (1.0 / self.law.params().sigma, 0.0),
             _ => return None,
         };
         match known {
-            vr::F => Some(by_f),
+            vr::F_DAHL => Some(by_f),
             vr::V => Some(by_v),
             _ => None,
         }

@@ -111,6 +111,7 @@ fn directional_derivatives_agree_with_finite_differences() {
         h,
     );
     check_step_sensitivity("Dahl", &[], "F", "v", &[("v", 1e-4)], h);
+    check_step_sensitivity("Dahl", &[("F_offset", -0.4)], "F", "v", &[("v", -1e-4)], h);
     check_step_sensitivity("ResetIntegrator", &[], "F", "v", &[("v", 1e-6)], h);
     check_step_sensitivity(
         "Bristle2D",
@@ -354,6 +355,94 @@ fn output_derivatives_agree_with_a_short_step() {
             (rate - fd).abs() <= 1e-3 * fd.abs().max(1e-9),
             "{model}: dF/dt {rate:e}, short step {fd:e}"
         );
+    }
+}
+
+/// Dahl's offset in Co-Simulation: an instance with `F_offset = c` driven
+/// as one without has the same state (`F_dahl`, `z`, `sliding`, the
+/// derivative) bit for bit and the force shifted by `c` exactly: `F = c`
+/// relaxed at the start, `F_dahl + c` at rest after a load and in motion,
+/// with interpolated inputs too. The force's output derivative and its
+/// step sensitivity are the plain instance's (the offset is constant), and
+/// the output derivative is the slope of a short step. A non-finite offset
+/// is refused when set, named with its value.
+#[test]
+fn dahl_offset_shifts_the_force_and_not_its_derivatives() {
+    let c = -3.1648;
+    let mut plain = Fmu::new("Dahl", &[("alpha", 0.7)]);
+    let mut shifted = Fmu::new("Dahl", &[("alpha", 0.7), ("F_offset", c)]);
+    assert_eq!((shifted.get("F"), shifted.get("F_dahl")), (c, 0.0));
+    let v = |t: f64| 1e-3 * (2.0 * PI * t / 0.02).sin();
+    let h = 1e-4;
+    for k in 0..600 {
+        let t = k as f64 * h;
+        // a sine through two reversals, then at rest from t = 0.03 on
+        let (value, slope) = if t < 0.03 {
+            (v(t), (v(t + h) - v(t)) / h)
+        } else {
+            (0.0, 0.0)
+        };
+        for fmu in [&mut plain, &mut shifted] {
+            fmu.set("v", value);
+            fmu.set_slope("v", slope);
+        }
+        if k % 50 == 7 {
+            let rate = shifted.output_derivative("F");
+            assert_eq!(rate, plain.output_derivative("F"), "t {t}");
+            let f0 = shifted.get("F");
+            let (s0, t0) = (shifted.state(), shifted.t);
+            shifted.step(1e-9);
+            let fd = (shifted.get("F") - f0) / 1e-9;
+            assert!(
+                (rate - fd).abs() <= 1e-3 * fd.abs().max(1e-6),
+                "t {t}: dF/dt {rate:e}, short step {fd:e}"
+            );
+            shifted.restore(s0, t0);
+            shifted.set("v", value);
+            shifted.set_slope("v", slope);
+        }
+        plain.step(h);
+        shifted.step(h);
+        let state = shifted.get("F_dahl");
+        assert_eq!(state.to_bits(), plain.get("F_dahl").to_bits(), "t {t}");
+        assert_eq!(shifted.get("F"), plain.get("F") + c, "t {t}");
+        assert_eq!(shifted.get("F"), state + c, "t {t}");
+        for name in ["z", "der(F_dahl)"] {
+            assert_eq!(
+                shifted.get(name).to_bits(),
+                plain.get(name).to_bits(),
+                "{name}"
+            );
+        }
+        assert_eq!(shifted.get_any("sliding"), plain.get_any("sliding"));
+    }
+    // at rest, loaded: the state plus the offset, and it stays there
+    let state = shifted.get("F_dahl");
+    assert!(state.abs() > 0.1, "loaded: {state}");
+    shifted.step(0.5);
+    assert_eq!(shifted.get("F"), state + c);
+    // the step sensitivity after a held step: the offset cancels (to the
+    // rounding of the layer's differences of a force shifted by c)
+    for fmu in [&mut plain, &mut shifted] {
+        fmu.set("v", -2e-4);
+    }
+    let (j, fd) = shifted.step_sensitivity("F", "v", 1e-3);
+    let (j0, _) = plain.step_sensitivity("F", "v", 1e-3);
+    assert!((j - j0).abs() <= 1e-8 * j0.abs(), "{j:e} {j0:e}");
+    assert!((j - fd).abs() <= 1e-4 * fd.abs(), "{j:e} {fd:e}");
+    // not finite: refused when set, named
+    for bad in [f64::NAN, f64::INFINITY] {
+        let fmu = Fmu::instantiated("Dahl", &[]);
+        assert_eq!(
+            fmu.set_any("F_offset", bad),
+            fmi2_cs::ffi::fmi2Status::fmi2Error
+        );
+        let m = common::last_error();
+        assert!(
+            m.contains("F_offset (value reference 9) must be finite but was"),
+            "{m}"
+        );
+        assert_eq!(fmu.get("F_offset"), 0.0);
     }
 }
 

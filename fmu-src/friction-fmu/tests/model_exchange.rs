@@ -201,29 +201,77 @@ fn check_partials(
     }
 }
 
+/// The state is the force of the law `F_dahl`, the output
+/// `F = F_dahl + F_offset`: with an offset too.
 #[test]
 fn dahl_partials_match_differences() {
     for alpha in [1.0, 0.6, 2.5] {
-        let me = Me::new("Dahl", &[("alpha", alpha)]);
-        for (f, v) in [
-            (0.0, 1e-3),
-            (0.8, 2e-3),
-            (1.5, -1e-3),
-            (-1.9, 4e-4),
-            (0.6, 0.0),
-        ] {
-            me.set_states(&[f]);
-            me.set("v", v);
-            let context = format!("Dahl alpha {alpha} at F {f}, v {v}");
-            check_partials(
-                &me,
-                &[("der(F)", 87750.0 * 1e-3), ("F", 1.0), ("z", 1e-5)],
-                &[("F", 1e-7), ("v", 1e-9)],
-                1e-6,
-                &context,
-            );
+        for offset in [0.0, -0.4] {
+            let me = Me::new("Dahl", &[("alpha", alpha), ("F_offset", offset)]);
+            for (f, v) in [
+                (0.0, 1e-3),
+                (0.8, 2e-3),
+                (1.5, -1e-3),
+                (-1.9, 4e-4),
+                (0.6, 0.0),
+            ] {
+                me.set_states(&[f]);
+                me.set("v", v);
+                assert_eq!((me.get("F_dahl"), me.get("F")), (f, f + offset));
+                let context = format!("Dahl alpha {alpha}, F_offset {offset} at F_dahl {f}, v {v}");
+                check_partials(
+                    &me,
+                    &[("der(F_dahl)", 87750.0 * 1e-3), ("F", 1.0), ("z", 1e-5)],
+                    &[("F_dahl", 1e-7), ("v", 1e-9)],
+                    1e-6,
+                    &context,
+                );
+            }
         }
     }
+}
+
+/// Dahl's offset in Model Exchange: two instances, with `F_offset = c` and
+/// without, integrated alike by an importer's solver (explicit Euler here,
+/// through a reversal and a rest), keep the same state bit for bit and
+/// the same derivatives, `z` and `sliding`, and their forces differ by `c`
+/// exactly: `F = c` relaxed at the start, `F_dahl + c` at rest and in
+/// motion.
+#[test]
+fn dahl_offset_shifts_the_output_in_model_exchange() {
+    let c = 3.1648;
+    let plain = Me::new("Dahl", &[("alpha", 1.5)]);
+    let shifted = Me::new("Dahl", &[("alpha", 1.5), ("F_offset", c)]);
+    assert_eq!(shifted.states(), [0.0]);
+    assert_eq!((shifted.get("F_dahl"), shifted.get("F")), (0.0, c));
+    let h = 1e-5;
+    for k in 0..2000 {
+        let t = k as f64 * h;
+        // forward, back, then at rest from t = 0.015 on
+        let v = if t < 0.015 {
+            2e-3 * (2.0 * std::f64::consts::PI * t / 0.01).sin()
+        } else {
+            0.0
+        };
+        plain.set("v", v);
+        shifted.set("v", v);
+        let (x, dx) = (shifted.states(), shifted.derivatives());
+        assert_eq!(x[0].to_bits(), plain.states()[0].to_bits(), "t {t}");
+        assert_eq!(dx[0].to_bits(), plain.derivatives()[0].to_bits(), "t {t}");
+        assert_eq!(shifted.get("F"), plain.get("F") + c, "t {t}");
+        assert_eq!(shifted.get("F"), x[0] + c, "t {t}");
+        assert_eq!(shifted.get("F_dahl"), x[0], "t {t}");
+        assert_eq!(shifted.get("z"), plain.get("z"), "t {t}");
+        if v == 0.0 {
+            assert_eq!(dx[0], 0.0, "at rest the state stays: t {t}");
+        }
+        plain.set_states(&[x[0] + h * dx[0]]);
+        shifted.set_states(&[x[0] + h * dx[0]]);
+    }
+    // loaded, then at rest: the state plus the offset
+    let f_rest = shifted.states()[0];
+    assert!(f_rest.abs() > 0.1, "loaded: {f_rest}");
+    assert_eq!(shifted.get("F"), f_rest + c);
 }
 
 /// LuGre with each option: the benchmark's parameters, direction- and
@@ -377,7 +425,7 @@ type Case = (
 #[test]
 fn the_right_hand_side_is_the_one_the_step_integrates() {
     let cases: [Case; 4] = [
-        ("Dahl", &[("v", 3e-4)], &["F"], &["F", "z"]),
+        ("Dahl", &[("v", 3e-4)], &["F_dahl"], &["F", "z"]),
         ("LuGre", &[("v", 2e-3)], &["z"], &["F", "z"]),
         ("ResetIntegrator", &[("v", 1e-3)], &["z"], &["F", "z"]),
         (

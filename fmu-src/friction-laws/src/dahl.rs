@@ -8,19 +8,27 @@
 //! `Δx = ∫ v dt` is exact for a ramped `v`, and with `y = 1 − F·s/Fc`,
 //! `u = |Δx|`, the ODE `d|y|/du = −(σ/Fc)·|y|^α` (sign of `y` preserved) has
 //! the closed-form solution used by [`Dahl::step`] for every `α > 0`.
+//!
+//! `F_offset` is a constant force on the contact (0 by default), which
+//! acts at rest as in motion: the output is `F = F_dahl + F_offset`, with
+//! `F_dahl` the state of the law above (the `F` of Dahl 1968). The law
+//! does not see it: the levels it saturates at become `F_offset ± Fc`.
+//! The same term as LuGre's offset (Janot, Gautier, Brunot 2019).
 
-use crate::error::require_positive;
+use crate::error::{require_finite, require_positive};
 use crate::interval::{displacement, one_sign_pieces, sign_on};
 use crate::state::one_value_state;
 use crate::{ParamError, Ramp};
 
 /// Dahl parameters: rest stiffness `sigma` (N/m), Coulomb level `fc` (N),
-/// shape exponent `alpha` (–).
+/// shape exponent `alpha` (–), constant offset force `f_offset` (N).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DahlParams {
     pub sigma: f64,
     pub fc: f64,
     pub alpha: f64,
+    /// Constant force added to the output, at rest and in motion (0: none).
+    pub f_offset: f64,
 }
 
 impl Default for DahlParams {
@@ -30,21 +38,25 @@ impl Default for DahlParams {
             sigma: 87_750.0,
             fc: 2.0,
             alpha: 1.0,
+            f_offset: 0.0,
         }
     }
 }
 
 impl DahlParams {
-    /// All three parameters must be finite and > 0.
+    /// `sigma`, `Fc` and `alpha` must be finite and > 0, `F_offset`
+    /// finite (any sign).
     pub fn validate(&self) -> Result<(), ParamError> {
         require_positive("sigma", self.sigma)?;
         require_positive("Fc", self.fc)?;
         require_positive("alpha", self.alpha)?;
+        require_finite("F_offset", self.f_offset)?;
         Ok(())
     }
 }
 
-/// Dahl friction state: the force `F` itself (N).
+/// Dahl friction state: the force of the law `F_dahl` (N), without the
+/// offset.
 #[derive(Clone, Debug)]
 pub struct Dahl {
     p: DahlParams,
@@ -52,7 +64,8 @@ pub struct Dahl {
 }
 
 impl Dahl {
-    /// A relaxed contact (`F = 0`) with validated parameters.
+    /// A relaxed contact (`F_dahl = 0`, so `F = F_offset`) with validated
+    /// parameters.
     pub fn new(p: DahlParams) -> Result<Self, ParamError> {
         p.validate()?;
         Ok(Dahl { p, f: 0.0 })
@@ -62,19 +75,37 @@ impl Dahl {
         &self.p
     }
 
-    /// The friction force `F` (the state; Dahl has no direct feedthrough).
+    /// The friction force `F = F_dahl + F_offset` (Dahl has no direct
+    /// feedthrough).
+    #[inline]
     pub fn force(&self) -> f64 {
+        self.force_of(self.f)
+    }
+
+    /// The force of the law `F_dahl`: the state, without the offset.
+    #[inline]
+    pub fn dahl_force(&self) -> f64 {
         self.f
     }
 
-    /// Equivalent bristle deflection `z = F/σ` (m).
+    /// The friction force for the state `f_dahl`: `f_dahl + F_offset`
+    /// (the output equation, for integrating the law with other
+    /// equations).
+    #[inline]
+    pub fn force_of(&self, f_dahl: f64) -> f64 {
+        f_dahl + self.p.f_offset
+    }
+
+    /// Equivalent bristle deflection `z = F_dahl/σ` (m).
     pub fn z(&self) -> f64 {
         self.f / self.p.sigma
     }
 
-    /// The right-hand side of the law in time for any force `f`:
+    /// The right-hand side of the law in time for any state `f`
+    /// (`F_dahl`, without the offset):
     /// `dF/dt = σ·|1 − (F/Fc)·sgn v|^α·sgn(1 − (F/Fc)·sgn v)·v` (Sun et al.
-    /// 2016 eq. 2–3; docs/models.md "Dahl"). A pure function, for
+    /// 2016 eq. 2–3; docs/models.md "Dahl"); the offset being constant,
+    /// also the rate of the output. A pure function, for
     /// integrating the law together with other equations (the monolithic
     /// reference solutions); [`Dahl::step`] integrates it exactly in
     /// displacement instead.
@@ -97,7 +128,8 @@ impl Dahl {
     }
 
     /// The partial derivatives `(∂Ḟ/∂F, ∂Ḟ/∂v)` of [`Dahl::force_rate`]
-    /// at `(f, v)`, in closed form: with `s = sgn v`, `y = 1 − F·s/Fc`,
+    /// at `(f, v)` (`f` the state `F_dahl`; the offset, constant, changes
+    /// neither), in closed form: with `s = sgn v`, `y = 1 − F·s/Fc`,
     /// `Ḟ = σ·|y|^α·sgn(y)·v`, so `∂Ḟ/∂F = −σ·α·|y|^(α−1)·|v|/Fc` and,
     /// `y` being constant in `v` for one sign, `∂Ḟ/∂v = σ·|y|^α·sgn(y)`.
     /// At `v = 0` the rate is 0 for every `F` (`∂Ḟ/∂F = 0`) and has a kink
@@ -121,7 +153,7 @@ impl Dahl {
         (-p.sigma * slope * v.abs() / p.fc, p.sigma * self.shape(y))
     }
 
-    /// `true` when moving (`v ≠ 0`) with `sgn(v)·F ≥ 0.99·Fc`.
+    /// `true` when moving (`v ≠ 0`) with `sgn(v)·F_dahl ≥ 0.99·Fc`.
     pub fn sliding(&self, v: f64) -> bool {
         v != 0.0 && v.signum() * self.f >= 0.99 * self.p.fc
     }
@@ -151,11 +183,11 @@ impl Dahl {
         }
     }
 
-    // The state: the force F, any finite value.
-    one_value_state!("Dahl", "F", f);
+    // The state: the force of the law F_dahl, any finite value.
+    one_value_state!("Dahl", "F_dahl", f);
 }
 
-/// Exact Dahl update of `F` over a displacement `u ≥ 0` in direction `s = ±1`.
+/// Exact Dahl update of `F_dahl` over a displacement `u ≥ 0` in direction `s = ±1`.
 fn advance(p: &DahlParams, f: f64, s: f64, u: f64) -> f64 {
     let y = 1.0 - f * s / p.fc;
     if y == 0.0 || u <= 0.0 {
@@ -209,6 +241,73 @@ mod tests {
             ..p
         })
         .is_err());
+    }
+
+    /// The offset shifts the output and nothing else: driven alike, a law
+    /// with `F_offset = c` has the state of one without, bit for bit, and
+    /// the force `F_dahl + c`, at rest (`F = c` relaxed, `F_dahl + c` once
+    /// loaded and stopped) as in motion, for every α and both directions;
+    /// the rate, its partials and `sliding` are those of the state. A
+    /// non-finite offset is refused, named.
+    #[test]
+    fn offset_shifts_the_force_and_leaves_the_law_alone() {
+        assert_eq!(DahlParams::default().f_offset, 0.0);
+        for alpha in [0.5, 1.0, 2.5] {
+            let plain = DahlParams {
+                alpha,
+                ..DahlParams::default()
+            };
+            for c in [-0.7, 3.1648] {
+                let p = DahlParams {
+                    f_offset: c,
+                    ..plain
+                };
+                let mut a = Dahl::new(p).unwrap();
+                let mut b = Dahl::new(plain).unwrap();
+                // relaxed at rest: the offset alone
+                assert_eq!((a.force(), a.dahl_force()), (c, 0.0));
+                let x_sat = 4.0 * p.fc / p.sigma;
+                for (v, h) in [
+                    (Ramp::constant(1e-3), 0.3 * x_sat / 1e-3),
+                    (Ramp::new(2e-3, -5e-3), 1.0),
+                    (Ramp::constant(0.0), 0.5),
+                    (Ramp::constant(-1e-4), 10.0 * x_sat / 1e-4),
+                ] {
+                    a.step(v, h);
+                    b.step(v, h);
+                    assert_eq!(a.dahl_force().to_bits(), b.force().to_bits());
+                    assert_eq!(a.force(), b.force() + c, "alpha {alpha}, c {c}");
+                    assert_eq!(a.force_of(a.dahl_force()), a.force());
+                    assert_eq!(a.z(), b.z());
+                    for w in [-1e-3, 0.0, 2e-3] {
+                        assert_eq!(a.sliding(w), b.sliding(w));
+                        let f = a.dahl_force();
+                        assert_eq!(a.force_rate(f, w), b.force_rate(f, w));
+                        assert_eq!(a.force_rate_partials(f, w), b.force_rate_partials(f, w));
+                    }
+                }
+                // saturated backward (α ≤ 1 gets there within the
+                // distance; α > 1 only approaches it): the level -Fc moved
+                // by the offset
+                if alpha <= 1.0 {
+                    assert!((a.force() - (c - p.fc)).abs() < 1e-12 * p.fc);
+                    assert!(a.sliding(-1.0));
+                }
+                // stopped, loaded: state plus offset, and it stays there
+                a.state_from_slice(&[0.8]).unwrap();
+                a.step(Ramp::constant(0.0), 1.0);
+                assert_eq!(a.force(), 0.8 + c);
+            }
+        }
+        for offset in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let e = Dahl::new(DahlParams {
+                f_offset: offset,
+                ..DahlParams::default()
+            })
+            .unwrap_err();
+            assert_eq!(e.name, "F_offset");
+            assert!(e.to_string().contains("F_offset"), "{e}");
+        }
     }
 
     #[test]
@@ -455,7 +554,7 @@ mod tests {
     fn refused_states_are_named_and_written_states_agree() {
         let mut d = Dahl::new(DahlParams::default()).unwrap();
         let err = d.state_from_slice(&[f64::INFINITY]).unwrap_err();
-        assert_eq!(err, "Dahl state F = inf is not finite");
+        assert_eq!(err, "Dahl state F_dahl = inf is not finite");
         let err = d.state_from_slice(&[1.0, 2.0]).unwrap_err();
         assert_eq!(err, "Dahl state has 1 value, got 2");
         d.state_from_slice(&[0.25]).unwrap();

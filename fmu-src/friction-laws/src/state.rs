@@ -1,4 +1,4 @@
-//! The state of a law whose state is one value (Dahl's `F`, the `z` of
+//! The state of a law whose state is one value (Dahl's `F_dahl`, the `z` of
 //! LuGre and of the reset integrator): the methods the FMU layer saves and
 //! restores it with, written once.
 
@@ -6,8 +6,8 @@
 /// `$field`: `state_len` (1), `write_state_into`, `state_is_finite`,
 /// `state_to_vec` and `state_from_slice` (any finite value), inside the law's `impl`. `$law`
 /// and `$name` are the law and the variable as the messages name them:
-/// `one_value_state!("Dahl", "F", f)` refuses with
-/// "Dahl state F = inf is not finite" or "Dahl state has 1 value, got 2".
+/// `one_value_state!("Dahl", "F_dahl", f)` refuses with
+/// "Dahl state F_dahl = inf is not finite" or "Dahl state has 1 value, got 2".
 macro_rules! one_value_state {
     ($law:literal, $name:literal, $field:ident) => {
         /// The number of values of the state (1).

@@ -174,7 +174,7 @@ fn a_valid_description_is_read() {
 fn the_shipped_descriptions_with_model_exchange_are_read() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
     for (name, states, indicators) in [
-        ("Dahl", &["F"][..], 1),
+        ("Dahl", &["F_dahl"][..], 1),
         ("LuGre", &["z"][..], 1),
         ("ResetIntegrator", &["z"][..], 2),
         ("Bristle2D", &["z1", "z2"][..], 1),
