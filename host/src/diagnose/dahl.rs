@@ -6,7 +6,9 @@
 //! stiffness), `σ1 = σ2 = 0`. With Dahl's shape exponent α = 1 this LuGre
 //! is Dahl's law exactly (both are `ż = v − σ·|v|·z/Fc`, `F = σ·z`; Dahl
 //! 1968, Canudas de Wit et al. 1995); with another α the presliding curve's
-//! shape differs, and the report says so.
+//! shape differs, and the report says so. Dahl's offset force `F_offset`
+//! (on its output, the Dahl state starting at 0) is LuGre's `F_offset`
+//! (added to its force, z starting at 0): the same.
 
 use crate::ssp::{ParameterDef, SystemFile, Value};
 use std::path::{Path, PathBuf};
@@ -42,6 +44,11 @@ pub fn move_to_lugre(
     let mut value =
         |v: &str| super::problem::read_value(&mut system.components[i].instance, &fmu, v);
     let (sigma, fc, alpha) = (value("sigma")?, value("Fc")?, value("alpha")?);
+    // (a Dahl FMU built before the offset existed has none)
+    let offset = match fmu.variable("F_offset") {
+        Ok(_) => value("F_offset")?,
+        Err(_) => 0.0,
+    };
     let def = file
         .components
         .iter_mut()
@@ -61,7 +68,8 @@ pub fn move_to_lugre(
     def.source_text = path.display().to_string();
     def.source = path.clone();
     file.parameters.retain(|p| {
-        !(p.component == name && ["sigma", "alpha", "Fc"].contains(&p.variable.as_str()))
+        !(p.component == name
+            && ["sigma", "alpha", "Fc", "F_offset"].contains(&p.variable.as_str()))
     });
     for (variable, x) in [
         ("Fc", fc),
@@ -69,6 +77,7 @@ pub fn move_to_lugre(
         ("sigma0", sigma),
         ("sigma1", 0.0),
         ("sigma2", 0.0),
+        ("F_offset", offset),
     ] {
         file.parameters.push(ParameterDef {
             component: name.clone(),
@@ -86,7 +95,7 @@ pub fn move_to_lugre(
         )
     };
     Ok(Some(format!(
-        "the nominal friction `{name}` is a Dahl FMU (sigma = {sigma} N/m, Fc = {fc} N); the effects it cannot express are added by moving it to LuGre ({}) with Dahl's levels as the start: Fc = {fc} N, Fs = Fc, sigma0 = sigma, sigma1 = sigma2 = 0, {shape}",
+        "the nominal friction `{name}` is a Dahl FMU (sigma = {sigma} N/m, Fc = {fc} N, F_offset = {offset} N); the effects it cannot express are added by moving it to LuGre ({}) with Dahl's levels as the start: Fc = {fc} N, Fs = Fc, sigma0 = sigma, sigma1 = sigma2 = 0, F_offset = {offset} N, {shape}",
         path.display()
     )))
 }

@@ -342,3 +342,58 @@ fn bad_measurement_files_are_refused_with_the_problem_named() {
         "{e}"
     );
 }
+
+/// A Dahl nominal with an offset force (`F_offset`) is moved to LuGre
+/// with the offset kept: with α = 1 the moved system is Dahl's law exactly
+/// (Dahl 1968; Canudas de Wit et al. 1995), so the two co-simulations of
+/// the Sun et al. (2016) velocity trial give the same friction force, to
+/// 1e-6 of Fc; dropping the 1.5 N offset would put them 1.5 N apart.
+#[test]
+fn a_dahl_nominal_moves_to_lugre_with_its_offset() {
+    let r = repo();
+    let text = std::fs::read_to_string(r.join("examples/dahl_velocity.ssd"))
+        .unwrap()
+        .replace("../dist/", &format!("{}/", r.join("dist").display()))
+        .replace(
+            r#"<ssv:Parameter name="alpha"><ssv:Real value="1"/></ssv:Parameter>"#,
+            r#"<ssv:Parameter name="alpha"><ssv:Real value="1"/></ssv:Parameter>
+               <ssv:Parameter name="F_offset"><ssv:Real value="1.5" unit="N"/></ssv:Parameter>"#,
+        );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dahl_offset.ssd");
+    std::fs::write(&path, text).unwrap();
+    let dahl = SystemFile::open(&path).unwrap();
+    let mut lugre = SystemFile::open(&path).unwrap();
+    let note = fricsim::diagnose::dahl::move_to_lugre(&mut lugre, None)
+        .unwrap()
+        .unwrap();
+    assert!(note.contains("F_offset = 1.5 N"), "{note}");
+    let force = |file: &SystemFile| -> Vec<f64> {
+        let mut system = file.build(0.0).unwrap();
+        let mut master = fricsim::master::by_name("gauss-seidel-interpolated").unwrap();
+        let run = fricsim::master::simulate_with(
+            &mut system,
+            master.as_mut(),
+            0.0,
+            1e-4,
+            2.0,
+            &mut fricsim::master::NoObserver,
+        )
+        .unwrap();
+        let c = run.columns.iter().position(|c| c == "friction.F").unwrap();
+        run.rows.iter().map(|row| row[c]).collect()
+    };
+    let (a, b) = (force(&dahl), force(&lugre));
+    assert_eq!(a.len(), b.len());
+    assert!(
+        (a[0] - 1.5).abs() < 1e-12,
+        "Dahl starts at its offset: {}",
+        a[0]
+    );
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 2e-6, "Dahl and the moved LuGre differ by {worst} N");
+}
