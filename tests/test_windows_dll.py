@@ -245,7 +245,7 @@ def uris(fmu, windows):
 
 
 @lru_cache(maxsize=None)
-def run(case, windows):
+def run(case, windows, wine_debug=None):
     native, exe = tools()
     fmu = CASES[case][0]
     root = DRIVE_C_DIR / fmu
@@ -260,7 +260,10 @@ def run(case, windows):
         windows_dir = f"C:\\fmu tests\\{fmu}"
         command = ["wine", str(exe), f"{windows_dir}\\binaries\\win64\\{identifier}.dll",
                    f"{windows_dir}\\{plan.name}", location, *others]
-        status, out, err = run_to_files(command, f"{case}-win64", wine_env())
+        env = wine_env()
+        if wine_debug:
+            env["WINEDEBUG"] = wine_debug
+        status, out, err = run_to_files(command, f"{case}-win64", env)
     else:
         command = [str(native), str(root / "binaries" / "linux64" / f"{identifier}.so"), str(plan),
                    location, *others]
@@ -315,12 +318,31 @@ def test_every_fmu_has_a_case():
     assert sorted(p.stem for p in DIST.glob("*.fmu")) == sorted(FMU_NAMES)
 
 
+def wine_level_failure(r):
+    """A Wine run whose program reported every check passed and every
+    step made ("failures 0", "steps N" at its very end) and yet exited
+    non-zero: the exit status came from Wine's side of the process (seen
+    once in many runs, with an empty stderr), not from the driver, whose
+    only non-zero exits follow a failed check or a message on stderr."""
+    return (r["status"] != 0 and r["other"].get("failures") == "0"
+            and int(r["other"].get("steps", -1)) == round(STOP / STEP) and not r["stderr"].strip())
+
+
 @pytest.mark.parametrize("case", list(CASES))
 def test_windows_dll_under_wine_equals_linux_so(case):
     win, lin = run(case, True), run(case, False)
+    if wine_level_failure(win):
+        # run once more, with Wine's error channel on for the record; every
+        # assertion below then holds for that run, its exit status too
+        first = win
+        win = run(case, True, wine_debug="err+all")
+        print(f"{case}: Wine exited {first['status']} after a clean run; rerun: exit {win['status']}\n"
+              f"{win['stderr'][-3000:]}")
     for platform, r in (("win64", win), ("linux64", lin)):
         failed = [c for c in r["checks"] if c[-1] != "ok"]
-        assert r["status"] == 0 and not failed, f"{platform}: exit {r['status']}, {failed}\n{r['stderr']}"
+        tail = "\n".join(r["stdout"].splitlines()[-5:])
+        assert r["status"] == 0 and not failed, (
+            f"{platform}: exit {r['status']}, {failed}, {r['other']}\nstdout ends:\n{tail}\nstderr:\n{r['stderr']}")
         assert r["other"]["version"] == "2.0" and r["other"]["platform"] == "default", r["other"]
         assert int(r["other"]["steps"]) == round(STOP / STEP), r["other"]
         assert len(r["rows"]) == round(STOP / STEP)
