@@ -73,6 +73,15 @@ EXPECTED = {
 SAMPLE = 1e-3
 RESOLUTION = 1e-6
 
+#: Coarse data: 200 Hz through a 10 µm encoder, where a Stribeck curve and
+#: presliding leave overlapping signatures (the diagnosis must name the
+#: right one or none, never the other).
+COARSE_SAMPLE = 5e-3
+COARSE_RESOLUTION = 1e-5
+
+#: The kinds of the coarse rows.
+COARSE_KINDS = ("none", "stribeck", "presliding_stiff_nominal", "presliding_soft_nominal")
+
 
 def simulator() -> Path:
     """Build the simulator (once) and return its path."""
@@ -106,15 +115,32 @@ class Case:
     truth: dict = field(default_factory=dict)
     #: position table of the truth (x, scale), when position-dependent
     table: tuple = ()
+    #: sampling period (s) and encoder step (m) of the data
+    sample: float = SAMPLE
+    resolution: float = RESOLUTION
+
+    @property
+    def coarse(self) -> bool:
+        return self.sample != SAMPLE or self.resolution != RESOLUTION
 
     @property
     def name(self) -> str:
-        return f"{self.kind}-{round(self.magnitude * 100)}pct-s{self.seed}"
+        rate = f"-{round(1 / self.sample)}hz-{round(self.resolution * 1e6)}um" if self.coarse else ""
+        return f"{self.kind}-{round(self.magnitude * 100)}pct-s{self.seed}{rate}"
 
 
-def draw(kind: str, magnitude: float, seed: int, duration: float = 40.0) -> Case:
+def draw(kind: str, magnitude: float, seed: int, duration: float = 40.0, coarse: bool = False) -> Case:
     """A case's rig, drive and nominal friction, drawn from its seed (the
-    hidden effect is sized later, along the effect-free trajectory)."""
+    hidden effect is sized later, along the effect-free trajectory);
+    `coarse`: sampled as [`COARSE_SAMPLE`], [`COARSE_RESOLUTION`] (the
+    same rig and drive as the fine case of that seed)."""
+    case = _draw(kind, magnitude, seed, duration)
+    if coarse:
+        case.sample, case.resolution = COARSE_SAMPLE, COARSE_RESOLUTION
+    return case
+
+
+def _draw(kind: str, magnitude: float, seed: int, duration: float) -> Case:
     rng = random.Random(zlib.crc32(f"{kind}/{seed}".encode()))
     m = rng.uniform(0.5, 4.0)
     k = rng.uniform(300.0, 3000.0)
@@ -169,7 +195,7 @@ def run_simulator(case: Case, params: dict, out: Path, truth: bool = False, tabl
     args = [str(simulator())]
     args += [f"{k}={v!r}" for k, v in {**case.rig, **params}.items()]
     args += [f"{k}={v}" for k, v in case.drive.items()]
-    args += [f"duration={case.duration}", f"sample={SAMPLE}", f"resolution={RESOLUTION}"]
+    args += [f"duration={case.duration}", f"sample={case.sample}", f"resolution={case.resolution}"]
     args += [f"seed={case.seed}", f"truth={int(truth)}"]
     if table:
         xs, scales = table
@@ -219,7 +245,7 @@ def size_hidden_effect(case: Case, work: Path) -> None:
     run_simulator(case, p, free, truth=True)
     d = read_columns(free)
     x = d["true_x"]
-    v = [(b - a) / SAMPLE for a, b in zip(x, x[1:])]
+    v = [(b - a) / case.sample for a, b in zip(x, x[1:])]
     xm = [0.5 * (a + b) for a, b in zip(x, x[1:])]
     free.unlink()
 

@@ -122,6 +122,9 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     let mut file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
     let moved = fricsim::diagnose::dahl::move_to_lugre(&mut file, a.lugre.as_deref())?;
     let mut d = diagnose_records(&file, &a.data, &a.heldout, &options)?;
+    for note in &d.notes {
+        println!("note: {note}");
+    }
     if let Some(note) = moved {
         println!("note: {note}");
         d.notes.push(note);

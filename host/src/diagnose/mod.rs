@@ -392,6 +392,11 @@ pub struct FoundEffect {
     /// The other explanations of the same signature, tried in the same
     /// round ([`Effect::ASYMMETRY`]); empty for an effect of no family.
     pub alternatives: Vec<Alternative>,
+    /// When the other effect of an overlapping pair ([`Effect::OVERLAPPING`])
+    /// passed in the same round: how the data separate the two, and what
+    /// each adds to the other when fitted together.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overlap: Option<OverlapCheck>,
     /// What the effect adds, as one number whose "no change" is 0
     /// ([`intervals::effect_change`]), in the final model, with its 95 %
     /// interval; `None` for an effect without such a number.
@@ -423,6 +428,79 @@ pub struct Alternative {
     pub passed: bool,
     /// The data separate the two: p below the round's threshold.
     pub separated: bool,
+}
+
+/// An effect and the other of its overlapping pair ([`Effect::OVERLAPPING`]),
+/// both passing in one round: the one with the smaller held-out error is
+/// named only when the held-out data separate it from the other
+/// ([`separation_test`], the test that chooses within a family of
+/// explanations); the two are also fitted together, and the joint model
+/// tested against each alone ([`nested_test`]), for the report: whether
+/// the other adds to it (then a later round can take it too).
+#[derive(Clone, Debug, Serialize)]
+pub struct OverlapCheck {
+    /// The other effect of the pair.
+    pub other: String,
+    /// This effect added to the other (the joint model against the other
+    /// alone): the relative drop of the held-out mean square and its
+    /// p-value.
+    pub gain_after_other: f64,
+    pub p_after_other: f64,
+    /// The other added to this effect.
+    pub other_gain_after: f64,
+    pub other_p_after: f64,
+    /// One-sided p-value that this effect's held-out squared error is
+    /// below the other's, each alone ([`separation_test`]): it is named
+    /// only when this is below the round's threshold (the data prefer
+    /// it); otherwise neither is.
+    pub p_separated: f64,
+}
+
+/// Fit the effects of candidates `k` and `j` together, by output error,
+/// from each one's fitted model (in parallel; the fit with the smaller
+/// training error is the joint model), and test the joint model against
+/// each alone on the held-out data ([`OverlapCheck`]): what `k`'s effect
+/// adds to `j`'s, and `j`'s to `k`'s. Both candidates are output-error
+/// fits here (see the round in [`diagnose_records`]), so the joint model
+/// is compared with fits of its own kind. A joint fit whose co-simulation
+/// fails counts as adding nothing.
+fn overlap_check<F>(
+    tried: &[Tried],
+    k: usize,
+    j: usize,
+    try_round: &F,
+    scales: &[f64],
+    group: &[usize],
+) -> Result<OverlapCheck, String>
+where
+    F: Fn(&[FrictionModel], &[Vec<Effect>], bool) -> Result<Vec<Tried>, String> + Sync,
+{
+    let after =
+        |base: usize, added: &[Effect]| try_round(&tried[base].models, &[added.to_vec()], true);
+    let (from_k, from_j) = rayon::join(|| after(k, &tried[j].added), || after(j, &tried[k].added));
+    let joint = from_k?
+        .into_iter()
+        .chain(from_j?)
+        .filter(|t| t.scored.is_ok())
+        .min_by(|a, b| a.force_rms.total_cmp(&b.force_rms));
+    let adds_to = |single: usize| match (&tried[single].scored, joint.as_ref().map(|t| &t.scored)) {
+        (Ok(before), Some(Ok(after))) => nested_test(before, after, scales, group),
+        _ => (f64::NEG_INFINITY, 1.0),
+    };
+    let ((gain_after_other, p_after_other), (other_gain_after, other_p_after)) =
+        (adds_to(j), adds_to(k));
+    let p_separated = match (&tried[k].scored, &tried[j].scored) {
+        (Ok(better), Ok(other)) => separation_test(better, other, group),
+        _ => 1.0,
+    };
+    Ok(OverlapCheck {
+        other: label(&tried[j].added),
+        gain_after_other,
+        p_after_other,
+        other_gain_after,
+        other_p_after,
+        p_separated,
+    })
 }
 
 /// A record's time and its input columns (name, values).
@@ -1116,13 +1194,17 @@ pub fn diagnose_records(
     // or is not estimated at all (another plant), else on the force
     let by_output_error =
         |added: &[Effect]| output_error_only.is_some() || added.contains(&Effect::Presliding);
+    // (`oe`: by output error whatever the addition, the force fit's result
+    // as a start: an effect fitted to compete with one fitted so, see
+    // [`Effect::OVERLAPPING`])
     let fit_folds_any = |starts: &(dyn Fn(&FrictionModel) -> Vec<FrictionModel> + Sync),
                          base: &[FrictionModel],
-                         added: &[Effect]|
+                         added: &[Effect],
+                         oe: bool|
      -> Result<(Vec<FrictionModel>, f64, usize), String> {
         if output_error_only.is_some() {
             Ok(fit_folds_output_error(starts, base, &[]))
-        } else if by_output_error(added) {
+        } else if oe || by_output_error(added) {
             // the force fit's result as one more start: what the force
             // shows of the effect outside the stick
             let (forced, _, n) = fit_folds(starts, base)?;
@@ -1134,9 +1216,10 @@ pub fn diagnose_records(
     };
     let fit_whole_any = |starts: &[FrictionModel],
                          fold_models: &[FrictionModel],
-                         added: &[Effect]|
+                         added: &[Effect],
+                         oe: bool|
      -> Result<FrictionModel, String> {
-        if by_output_error(added) && folds.len() > 1 {
+        if (oe || by_output_error(added)) && folds.len() > 1 {
             Ok(fit_output_error(starts, &every_sample).model)
         } else {
             fit_whole(starts, fold_models)
@@ -1177,8 +1260,9 @@ pub fn diagnose_records(
     let level_starts = |m: &FrictionModel| -> Vec<FrictionModel> {
         [1.0, 0.8, 1.25].map(|f| m.scaled_levels(f)).to_vec()
     };
-    let (refit_folds, refit_force_rms, _) = fit_folds_any(&level_starts, &nominal_folds, &[])?;
-    let refit_model = fit_whole_any(&level_starts(&setup.nominal), &refit_folds, &[])?;
+    let (refit_folds, refit_force_rms, _) =
+        fit_folds_any(&level_starts, &nominal_folds, &[], false)?;
+    let refit_model = fit_whole_any(&level_starts(&setup.nominal), &refit_folds, &[], false)?;
     let refit_scored = score(&mut system, &refit_folds);
     let refit_threshold = options.alpha;
     let nominal_step_error = step_error_of(&mut system, &nominal_folds, &nominal_scored);
@@ -1232,6 +1316,7 @@ pub fn diagnose_records(
     let mut effects = Vec::new();
     let mut rounds = Vec::new();
     let mut round_thresholds = Vec::new();
+    let mut notes: Vec<String> = Vec::new();
     let (mut polish_seconds, mut polish_runs) = (0.0, 0);
     // the starts of an addition to a model: its first effects added
     // neutrally, the last from a grid
@@ -1258,19 +1343,22 @@ pub fn diagnose_records(
         }
     };
     // one round: fit and score each addition (one effect, or two at once)
+    // (`oe`: each fitted by output error, [`fit_folds_any`])
     let try_round = |current_folds: &[FrictionModel],
-                     additions: &[Vec<Effect>]|
+                     additions: &[Vec<Effect>],
+                     oe: bool|
      -> Result<Vec<Tried>, String> {
         additions
             .par_iter()
             .map(|added| {
                 let (models, force_rms, evaluations) =
-                    fit_folds_any(&addition_starts(added), current_folds, added)?;
+                    fit_folds_any(&addition_starts(added), current_folds, added, oe)?;
                 let mut system = file.build(0.0).map_err(|e| e.to_string())?;
                 // a candidate whose co-simulation fails is rejected, not fatal
                 let scored = score(&mut system, &models);
                 Ok(Tried {
                     added: added.clone(),
+                    by_output_error: oe || by_output_error(added),
                     models,
                     force_rms,
                     evaluations,
@@ -1307,13 +1395,47 @@ pub fn diagnose_records(
         }
         let mut accepted = None;
         let mut alternatives = Vec::new();
+        let mut overlap: Option<OverlapCheck> = None;
+        let mut undecided = false;
         let mut singles_tried = Vec::new();
         for additions in [singles, pairs] {
             if additions.is_empty() {
                 continue;
             }
-            let tried = try_round(&current_folds, &additions)?;
+            let mut tried = try_round(&current_folds, &additions, false)?;
             let threshold = options.alpha / hypotheses(&additions) as f64;
+            // overlapping explanations compete on equal terms: when one
+            // fitted by output error (presliding, which the force the data
+            // imply cannot show) passes the round's test, the other of its
+            // pair is fitted by output error too (the force fit's result
+            // one of its starts). On coarse data the force shows little of
+            // a Stribeck curve (the stick-to-slip transition is a few
+            // samples, differenced twice), and its force fit gained
+            // nothing where its output-error fit gains most.
+            for &(a, b) in &Effect::OVERLAPPING {
+                for (fitted_oe, other) in [(a, b), (b, a)] {
+                    let find = |e: Effect, oe: bool| {
+                        tried
+                            .iter()
+                            .position(|t| t.added == [e] && t.by_output_error == oe)
+                    };
+                    let (Some(i), Some(j)) = (find(fitted_oe, true), find(other, false)) else {
+                        continue;
+                    };
+                    let passes = tried[i].scored.as_ref().is_ok_and(|scored| {
+                        let (gain, p) = nested_test(&current_scored, scored, &scales, &group);
+                        p < threshold && gain >= options.min_gain
+                    });
+                    if passes {
+                        if let Some(mut refit) =
+                            try_round(&current_folds, &[vec![other]], true)?.pop()
+                        {
+                            refit.evaluations += tried[j].evaluations;
+                            tried[j] = refit;
+                        }
+                    }
+                }
+            }
             let mut round = Vec::new();
             for t in &tried {
                 let (heldout_rms, gain, p_value, failure) = match &t.scored {
@@ -1378,12 +1500,12 @@ pub fn diagnose_records(
             // goes first ([`prefer_in_family`])
             prefer_in_family(&mut passing, &tried, &group, threshold);
             let mut current_fine: Option<Result<Scored, String>> = None;
-            let mut chosen = None;
-            for k in passing {
+            // whether candidate k's gain survives a finer co-simulation step
+            let mut survives = |k: usize, round: &mut Vec<CandidateScore>| -> bool {
                 let fine_current = current_fine
                     .get_or_insert_with(|| scored_at_step(&mut system, &current_folds, fine_step));
                 // without a finer co-simulation the check cannot be made
-                let survives = match fine_current {
+                match fine_current {
                     Err(_) => true,
                     Ok(cur) => match scored_at_step(&mut system, &tried[k].models, fine_step) {
                         Err(_) => true,
@@ -1393,11 +1515,56 @@ pub fn diagnose_records(
                             p < threshold && gain >= options.min_gain
                         }
                     },
+                }
+            };
+            let passes = |c: &CandidateScore| c.p_value < threshold && c.gain >= options.min_gain;
+            let mut chosen = None;
+            for k in passing {
+                if !survives(k, &mut round) {
+                    continue;
+                }
+                // an overlapping explanation that passes too: this one is
+                // accepted only when the data separate it from that one
+                let partner = match tried[k].added[..] {
+                    [e] => e.overlapping().and_then(|o| {
+                        (0..tried.len()).find(|&j| tried[j].added == [o] && passes(&round[j]))
+                    }),
+                    _ => None,
                 };
-                if survives {
+                let Some(j) = partner else {
+                    chosen = Some(k);
+                    break;
+                };
+                let check = overlap_check(&tried, k, j, &try_round, &scales, &group)?;
+                if check.p_separated < threshold {
+                    overlap = Some(check);
                     chosen = Some(k);
                     break;
                 }
+                notes.push(format!(
+                    "{} and {} both lower the held-out error in round {} (held-out RMS {:.4} and {:.4}), and the data do not separate them (p = {:.1e}, not below {:.1e}): neither is named. Fitted together, {} adds {:.1} % to {} (p = {:.1e}) and {} adds {:.1} % to {} (p = {:.1e}).",
+                    label(&tried[k].added),
+                    label(&tried[j].added),
+                    rounds.len() + 1,
+                    round[k].heldout_rms,
+                    round[j].heldout_rms,
+                    check.p_separated,
+                    threshold,
+                    label(&tried[k].added),
+                    100.0 * check.gain_after_other,
+                    label(&tried[j].added),
+                    check.p_after_other,
+                    label(&tried[j].added),
+                    100.0 * check.other_gain_after,
+                    label(&tried[k].added),
+                    check.other_p_after,
+                ));
+                // the strongest evidence is one of two explanations the
+                // data cannot tell apart: a weaker candidate (or a pair of
+                // them) accepted now would only stand in for it, so the
+                // search ends here
+                undecided = true;
+                break;
             }
             rounds.push(round.clone());
             round_thresholds.push(threshold);
@@ -1405,6 +1572,9 @@ pub fn diagnose_records(
                 alternatives =
                     family_alternatives(k, &tried, &round, &group, threshold, options.min_gain);
                 accepted = Some((tried, k, round[k].p_value, threshold));
+                break;
+            }
+            if undecided {
                 break;
             }
             singles_tried = tried;
@@ -1417,7 +1587,12 @@ pub fn diagnose_records(
             Ok(s) => (t.models, s),
             Err(e) => return Err(format!("accepted {} without a score: {e}", label(&t.added))),
         };
-        let mut whole = fit_whole_any(&addition_starts(&t.added)(&current), &models, &t.added)?;
+        let mut whole = fit_whole_any(
+            &addition_starts(&t.added)(&current),
+            &models,
+            &t.added,
+            t.by_output_error,
+        )?;
         // refine the accepted models on the output error of their training data
         let polish_started = Instant::now();
         if options.polish {
@@ -1453,6 +1628,7 @@ pub fn diagnose_records(
                         &addition_starts(&single.added)(&current),
                         &single.models,
                         &single.added,
+                        single.by_output_error,
                     )?;
                     steps.push((
                         t.added[0],
@@ -1492,6 +1668,7 @@ pub fn diagnose_records(
                 threshold,
                 where_,
                 alternatives: std::mem::take(&mut alternatives),
+                overlap: overlap.take(),
                 change: None,
             });
             current = model;
@@ -1611,7 +1788,7 @@ pub fn diagnose_records(
             heldout: heldout_file.as_ref().map(|h| h.quality.clone()),
         },
         fallbacks,
-        notes: Vec::new(),
+        notes,
         residual_pattern,
         baseline_pattern,
         effects,
@@ -1664,6 +1841,8 @@ fn record_inputs(data: &Measured) -> Vec<InputColumns> {
 
 /// One addition fitted and scored.
 struct Tried {
+    /// Fitted by output error (else on the force the data imply).
+    by_output_error: bool,
     added: Vec<Effect>,
     /// One per fold.
     models: Vec<FrictionModel>,

@@ -83,6 +83,31 @@ impl Effect {
         Effect::DirectionDependentViscous,
     ];
 
+    /// Effects whose signatures overlap without being one force: a
+    /// Stribeck curve (a level that is higher just out of the stick and
+    /// falls with speed) and presliding (a contact of another stiffness,
+    /// which takes the force over another travel after each reversal)
+    /// both change how the contact leaves the stick, and on coarse data
+    /// either can take much of the other's gain. Before one of such a pair
+    /// is accepted while the other also passes the round's test, each is
+    /// fitted after the other, and the one that still adds is kept
+    /// (`diagnose::OverlapCheck`).
+    pub const OVERLAPPING: [(Effect, Effect); 1] = [(Effect::Stribeck, Effect::Presliding)];
+
+    /// The effect whose signature overlaps `self`'s
+    /// ([`Effect::OVERLAPPING`]), if any.
+    pub fn overlapping(self) -> Option<Effect> {
+        Effect::OVERLAPPING.iter().find_map(|&(a, b)| {
+            if a == self {
+                Some(b)
+            } else if b == self {
+                Some(a)
+            } else {
+                None
+            }
+        })
+    }
+
     /// The family of explanations `self` belongs to ([`Effect::ASYMMETRY`]),
     /// if any.
     pub fn family(self) -> Option<&'static [Effect]> {

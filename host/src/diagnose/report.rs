@@ -356,8 +356,9 @@ pub fn change_line(e: &super::FoundEffect) -> Option<String> {
 /// like: how the effect stands against the other explanations of its
 /// signature ([`super::Alternative`]), empty when it has none.
 pub fn alternatives_line(e: &super::FoundEffect) -> String {
+    let mut s = overlap_line(e);
     if e.alternatives.is_empty() {
-        return String::new();
+        return s;
     }
     let (apart, close): (Vec<_>, Vec<_>) = e.alternatives.iter().partition(|a| a.separated);
     let list = |v: &[&super::Alternative]| {
@@ -371,7 +372,6 @@ pub fn alternatives_line(e: &super::FoundEffect) -> String {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let mut s = String::new();
     if !apart.is_empty() {
         let _ = write!(s, " The data prefer it to {}.", list(&apart));
     }
@@ -383,6 +383,23 @@ pub fn alternatives_line(e: &super::FoundEffect) -> String {
         );
     }
     s
+}
+
+/// The overlap check of an effect in words ([`super::OverlapCheck`]), or
+/// nothing.
+fn overlap_line(e: &super::FoundEffect) -> String {
+    let Some(o) = &e.overlap else {
+        return String::new();
+    };
+    format!(
+        " {other} passed too, and the two overlap: the data prefer this one (p = {:.1e}); fitted together, it adds {:.1} % to {other} (p = {:.1e}) and {other} adds {:.1} % to it (p = {:.1e}).",
+        o.p_separated,
+        100.0 * o.gain_after_other,
+        o.p_after_other,
+        100.0 * o.other_gain_after,
+        o.other_p_after,
+        other = o.other
+    )
 }
 
 /// The "Where" of an effect in words: the state its change depends on,
