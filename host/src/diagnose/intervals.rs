@@ -261,6 +261,31 @@ mod tests {
         FrictionModel::coulomb_for_tests(2.0, 1e7, 0.0)
     }
 
+    /// The least-squares Fc of y = Fc·u and the 95 % interval
+    /// [`theta_covariance`] gives it, the residuals clustered into `runs`
+    /// equal runs.
+    fn fitted_interval(u: &[f64], y: &[f64], runs: usize) -> (f64, [f64; 2]) {
+        let fc =
+            y.iter().zip(u).map(|(y, u)| y * u).sum::<f64>() / u.iter().map(|u| u * u).sum::<f64>();
+        let mut m = model();
+        m.fc = fc;
+        m.fs = fc;
+        let n = (u.len() as f64).sqrt();
+        let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
+            models
+                .iter()
+                .map(|m| {
+                    Some(DVector::from_iterator(
+                        u.len(),
+                        (0..u.len()).map(|i| (y[i] - m.fc * u[i]) / n),
+                    ))
+                })
+                .collect()
+        };
+        let cov = theta_covariance(&m, &mut residual, None, 1, runs).unwrap();
+        (fc, cov.parameter_interval(&m, "Fc").unwrap())
+    }
+
     /// A linear model whose residuals are known: y = Fc·u + e, with the
     /// noise e correlated within runs of 50 samples (a constant per run),
     /// fitted through the transform θ = ln Fc. The sandwich's interval of
@@ -283,26 +308,7 @@ mod tests {
             let y: Vec<f64> = (0..u.len())
                 .map(|i| truth * u[i] + offsets[i / per_run] + 0.01 * rng.random_range(-1.0..1.0))
                 .collect();
-            // least squares of y = Fc·u
-            let fc = y.iter().zip(&u).map(|(y, u)| y * u).sum::<f64>()
-                / u.iter().map(|u| u * u).sum::<f64>();
-            let mut m = model();
-            m.fc = fc;
-            m.fs = fc;
-            let n = (u.len() as f64).sqrt();
-            let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
-                models
-                    .iter()
-                    .map(|m| {
-                        Some(DVector::from_iterator(
-                            u.len(),
-                            (0..u.len()).map(|i| (y[i] - m.fc * u[i]) / n),
-                        ))
-                    })
-                    .collect()
-            };
-            let cov = theta_covariance(&m, &mut residual, None, 1, runs).unwrap();
-            let [low, high] = cov.parameter_interval(&m, "Fc").unwrap();
+            let (fc, [low, high]) = fitted_interval(&u, &y, runs);
             assert!(low < fc && fc < high);
             if (low..=high).contains(&truth) {
                 covered += 1;
@@ -347,24 +353,7 @@ mod tests {
             let y: Vec<f64> = (0..u.len())
                 .map(|i| truth * u[i] + offsets[i / per_run])
                 .collect();
-            let fc = y.iter().zip(&u).map(|(y, u)| y * u).sum::<f64>() / uu;
-            let mut m = model();
-            m.fc = fc;
-            m.fs = fc;
-            let n = (u.len() as f64).sqrt();
-            let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
-                models
-                    .iter()
-                    .map(|m| {
-                        Some(DVector::from_iterator(
-                            u.len(),
-                            (0..u.len()).map(|i| (y[i] - m.fc * u[i]) / n),
-                        ))
-                    })
-                    .collect()
-            };
-            let cov = theta_covariance(&m, &mut residual, None, 1, runs).unwrap();
-            let [low, high] = cov.parameter_interval(&m, "Fc").unwrap();
+            let (fc, [low, high]) = fitted_interval(&u, &y, runs);
             if (low..=high).contains(&truth) {
                 covered += 1;
             }

@@ -1006,13 +1006,7 @@ pub fn diagnose_records(
             if records.is_some() {
                 // each fold co-simulated its own records, in order: their
                 // samples follow the previous folds'
-                let m = merged.get_or_insert_with(|| ChannelResiduals {
-                    channels: r.channels.clone(),
-                    samples: Vec::new(),
-                    simulated: vec![Vec::new(); r.channels.len()],
-                    residuals: vec![Vec::new(); r.channels.len()],
-                    incomplete: None,
-                });
+                let m = merged.get_or_insert_with(|| ChannelResiduals::empty(&r.channels));
                 for &k in &mine {
                     picked.push(m.samples.len());
                     m.samples.push(r.samples[k]);

@@ -380,6 +380,25 @@ pub struct FrictionData {
 }
 
 impl FrictionData {
+    /// No interval yet, of one record, obtained as `source` says.
+    fn empty(source: String) -> FrictionData {
+        FrictionData {
+            t: Vec::new(),
+            h: Vec::new(),
+            end: Vec::new(),
+            v: Vec::new(),
+            x: Vec::new(),
+            fn_: Vec::new(),
+            f: Vec::new(),
+            source,
+            position_resolution: None,
+            position_step: None,
+            normal_force_measured: false,
+            trusted: Vec::new(),
+            record_starts: vec![0],
+        }
+    }
+
     /// The friction data of each record of `data`, joined as its rows are
     /// ([`Measured::join`]): times on the joined time line, sample indices
     /// into the joined rows.
@@ -388,21 +407,8 @@ impl FrictionData {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         };
-        let mut joined = FrictionData {
-            t: Vec::new(),
-            h: Vec::new(),
-            end: Vec::new(),
-            v: Vec::new(),
-            x: Vec::new(),
-            fn_: Vec::new(),
-            f: Vec::new(),
-            source: String::new(),
-            position_resolution: None,
-            position_step: None,
-            normal_force_measured: false,
-            trusted: Vec::new(),
-            record_starts: Vec::new(),
-        };
+        let mut joined = FrictionData::empty(String::new());
+        joined.record_starts.clear();
         for (part, record) in parts.into_iter().zip(&data.records) {
             joined.record_starts.push(joined.t.len());
             joined.t.extend(part.t.iter().map(|t| t + record.offset));
@@ -650,16 +656,6 @@ impl Setup {
             .ok_or_else(|| format!("the co-simulation does not record `{f}.F`"))?;
         let n = data.time.len();
         let mut d = FrictionData {
-            t: Vec::new(),
-            h: Vec::new(),
-            end: Vec::new(),
-            v: Vec::new(),
-            x: Vec::new(),
-            fn_: Vec::new(),
-            f: Vec::new(),
-            source: format!(
-                "not estimated ({why}): every fit is by output error through co-simulation of the whole system"
-            ),
             position_resolution: self
                 .input_source(system, "x")
                 .and_then(|src| data.column(&src))
@@ -671,8 +667,9 @@ impl Setup {
             normal_force_measured: data.column(&format!("{f}.Fn")).is_some()
                 && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
                     > fn_.iter().cloned().fold(f64::INFINITY, f64::min),
-            trusted: Vec::new(),
-            record_starts: vec![0],
+            ..FrictionData::empty(format!(
+                "not estimated ({why}): every fit is by output error through co-simulation of the whole system"
+            ))
         };
         let mut force_cursor = crate::inputs::Cursor::default();
         for k in 0..n - 1 {

@@ -133,6 +133,17 @@ pub struct ChannelResiduals {
 }
 
 impl ChannelResiduals {
+    /// No sample yet of the channels `channels` (to append to).
+    pub fn empty(channels: &[String]) -> ChannelResiduals {
+        ChannelResiduals {
+            channels: channels.to_vec(),
+            samples: Vec::new(),
+            simulated: vec![Vec::new(); channels.len()],
+            residuals: vec![Vec::new(); channels.len()],
+            incomplete: None,
+        }
+    }
+
     /// Per sample: mean over channels of (residual / scale)².
     pub fn squared(&self, scales: &[f64]) -> Vec<f64> {
         (0..self.samples.len())
@@ -293,13 +304,7 @@ pub fn co_simulate_with(
     for &i in records.unwrap_or(&all) {
         let record = &data.records[i];
         let r = co_simulate_record(system, parameters, &data.record(i), master, step)?;
-        let j = joined.get_or_insert_with(|| ChannelResiduals {
-            channels: r.channels.clone(),
-            samples: Vec::new(),
-            simulated: vec![Vec::new(); r.channels.len()],
-            residuals: vec![Vec::new(); r.channels.len()],
-            incomplete: None,
-        });
+        let j = joined.get_or_insert_with(|| ChannelResiduals::empty(&r.channels));
         j.samples
             .extend(r.samples.iter().map(|k| k + record.rows.start));
         for c in 0..r.channels.len() {
