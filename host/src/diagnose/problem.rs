@@ -69,6 +69,8 @@ pub struct Record {
     /// The record's own times, as read (exactly: the joined times less
     /// the offset may differ in the last bit).
     pub time: Vec<f64>,
+    /// What the inspection found in the record ([`super::quality`]).
+    pub quality: Quality,
 }
 
 impl Measured {
@@ -158,6 +160,7 @@ impl Measured {
                 rows: 0..table.time.len(),
                 offset: 0.0,
                 time: table.time.clone(),
+                quality: quality.clone(),
             }],
             time: table.time,
             inputs,
@@ -218,12 +221,13 @@ impl Measured {
             for (to, (_, from)) in joined.outputs.iter_mut().zip(&p.outputs) {
                 to.1.extend_from_slice(from);
             }
-            joined.quality.append(p.quality, &p.label);
+            joined.quality.append(p.quality.clone(), &p.label);
             joined.records.push(Record {
                 label: p.label,
                 rows: start..joined.time.len(),
                 offset,
                 time: p.time,
+                quality: p.quality,
             });
         }
         Ok(joined)
@@ -243,12 +247,13 @@ impl Measured {
             time: r.time.clone(),
             inputs: cut(&self.inputs),
             outputs: cut(&self.outputs),
-            quality: self.quality.rows(rows.clone()),
+            quality: r.quality.clone(),
             records: vec![Record {
                 label: r.label.clone(),
                 rows: 0..rows.len(),
                 offset: 0.0,
                 time: r.time.clone(),
+                quality: r.quality.clone(),
             }],
         }
     }
@@ -397,6 +402,24 @@ impl FrictionData {
             trusted: Vec::new(),
             record_starts: vec![0],
         }
+    }
+
+    /// `one` of each record of `data` (of `data` itself when it is one
+    /// record), joined ([`FrictionData::join`]); an error names its record.
+    fn per_record(
+        data: &Measured,
+        mut one: impl FnMut(&Measured) -> Result<FrictionData, String>,
+    ) -> Result<FrictionData, String> {
+        if data.records.len() == 1 {
+            return one(data);
+        }
+        let parts = (0..data.records.len())
+            .map(|i| {
+                let record = data.record(i);
+                one(&record).map_err(|e| format!("{}: {e}", record.label))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(FrictionData::join(parts, data))
     }
 
     /// The friction data of each record of `data`, joined as its rows are
@@ -587,13 +610,9 @@ impl Setup {
         data: &Measured,
         why: &str,
     ) -> Result<FrictionData, String> {
-        if data.records.len() == 1 {
-            return self.record_friction_data_simulated(file, system, data, why);
-        }
-        let parts = (0..data.records.len())
-            .map(|i| self.record_friction_data_simulated(file, system, &data.record(i), why))
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(FrictionData::join(parts, data))
+        FrictionData::per_record(data, |record| {
+            self.record_friction_data_simulated(file, system, record, why)
+        })
     }
 
     /// [`Setup::friction_data_simulated`] of one record.
@@ -718,17 +737,9 @@ impl Setup {
         data: &Measured,
         smooth: f64,
     ) -> Result<FrictionData, String> {
-        if data.records.len() == 1 {
-            return self.record_friction_data(system, data, smooth);
-        }
-        let parts = (0..data.records.len())
-            .map(|i| {
-                let record = data.record(i);
-                self.record_friction_data(system, &record, smooth)
-                    .map_err(|e| format!("{}: {e}", record.label))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(FrictionData::join(parts, data))
+        FrictionData::per_record(data, |record| {
+            self.record_friction_data(system, record, smooth)
+        })
     }
 
     /// [`Setup::friction_data`] of one record.

@@ -182,21 +182,6 @@ impl Quality {
         self.excluded.extend(other.excluded);
         self.after_gap.extend(other.after_gap);
     }
-
-    /// The per-row flags of `rows` alone (the counts and findings of the
-    /// whole): one record of several.
-    pub fn rows(&self, rows: std::ops::Range<usize>) -> Quality {
-        Quality {
-            findings: self.findings.clone(),
-            spikes: self.spikes,
-            dropouts: self.dropouts,
-            gaps: self.gaps,
-            saturated: self.saturated,
-            excluded_samples: self.excluded_samples,
-            excluded: self.excluded[rows.clone()].to_vec(),
-            after_gap: self.after_gap[rows].to_vec(),
-        }
-    }
 }
 
 fn median(mut x: Vec<f64>) -> f64 {

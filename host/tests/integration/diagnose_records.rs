@@ -99,6 +99,19 @@ fn records_with_other_columns_are_refused() {
         "{stderr}"
     );
     assert!(!out.exists());
+    // holding out each record in turn needs two of them
+    let result = Command::new(env!("CARGO_BIN_EXE_fricsim"))
+        .arg("diagnose")
+        .arg(repository().join("examples/emps_nominal.ssd"))
+        .arg(emps("emps_train.csv"))
+        .args(["--cross-validate", "records", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(!result.status.success());
+    assert!(stderr.contains("needs at least two records"), "{stderr}");
+    assert!(!out.exists());
 }
 
 /// EMPS with both records, each held out in turn (the model fitted on
