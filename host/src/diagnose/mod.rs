@@ -403,6 +403,30 @@ pub struct FoundEffect {
     pub change: Option<EffectChange>,
 }
 
+/// An effect accepted in an earlier round and taken out again once later
+/// effects explained its gain: with them in the model, taking it out and
+/// refitting the rest no longer loses what the test that admitted it asks
+/// for (p below its threshold and a drop of at least `--min-gain`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Withdrawn {
+    pub name: Effect,
+    /// The round that accepted it (1-based, as in `rounds`).
+    pub accepted_in_round: usize,
+    /// The round after whose acceptance it was re-examined and taken out.
+    pub withdrawn_after_round: usize,
+    /// The effects accepted in that round.
+    pub explained_by: Vec<Effect>,
+    /// Held-out RMS of the model with it and without it (refitted).
+    pub heldout_rms_with: f64,
+    pub heldout_rms_without: f64,
+    /// What keeping it gains over the model without it, and the p of that
+    /// gain ([`nested_test`]).
+    pub gain: f64,
+    pub p_value: f64,
+    /// The threshold it passed when it was accepted.
+    pub threshold: f64,
+}
+
 /// [`FoundEffect::change`].
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectChange {
@@ -527,6 +551,9 @@ pub struct Diagnosis {
     /// Held-out RMS of the final model.
     pub final_rms: f64,
     pub effects: Vec<FoundEffect>,
+    /// Effects accepted and later taken out because effects accepted after
+    /// them explained their gain ([`Withdrawn`]).
+    pub withdrawn: Vec<Withdrawn>,
     /// Every candidate tried, per round.
     pub rounds: Vec<Vec<CandidateScore>>,
     /// The p-value each round's candidates had to beat: α over the
@@ -1307,11 +1334,14 @@ pub fn diagnose_records(
     let mut current = baseline_model.clone();
     let mut current_folds = baseline_folds;
     let mut current_scored = baseline_scored.clone();
-    let mut effects = Vec::new();
+    let mut effects: Vec<FoundEffect> = Vec::new();
+    // per accepted effect: its round, the model it was added to, and
+    // whether it was fitted by output error
+    let mut accepted_as: Vec<(usize, FrictionModel, bool)> = Vec::new();
+    let mut withdrawn: Vec<Withdrawn> = Vec::new();
     let mut rounds = Vec::new();
     let mut round_thresholds = Vec::new();
     let mut notes: Vec<String> = Vec::new();
-    let (mut polish_seconds, mut polish_runs) = (0.0, 0);
     // the starts of an addition to a model: its first effects added
     // neutrally, the last from a grid
     // (and the same from the levels as given, when the baseline's refit
@@ -1361,6 +1391,48 @@ pub fn diagnose_records(
             })
             .collect()
     };
+    // refine accepted fold models and the reported model on the output
+    // error of their training data ([`fit::polish`]); the fold models are
+    // kept unrefined if a refined one's co-simulation fails, or if the
+    // refinement raises the held-out error (it fits the training samples'
+    // noise): a reference worse than the fits it came from would let
+    // every candidate of the next round pass for undoing it. The reported
+    // model is refined too, unless its folds' refinement was not kept.
+    let polish_runs = std::cell::Cell::new(0usize);
+    let polish_seconds = std::cell::Cell::new(0.0f64);
+    let refine = |system: &mut crate::system::System,
+                  models: Vec<FrictionModel>,
+                  scored: Scored,
+                  whole: FrictionModel|
+     -> (Vec<FrictionModel>, Scored, FrictionModel) {
+        let started = Instant::now();
+        let polished: Vec<fit::Fitted> = folds
+            .iter()
+            .zip(&models)
+            .map(|(fold, m)| polish(m, &fold.train, POLISH_ITERATIONS))
+            .collect();
+        polish_runs.set(polish_runs.get() + polished.iter().map(|p| p.evaluations).sum::<usize>());
+        let refined: Vec<FrictionModel> = polished.into_iter().map(|p| p.model).collect();
+        let (models, scored, kept) = if refined == models {
+            (models, scored, true)
+        } else {
+            match score(system, &refined) {
+                Ok(s) if mean(&s.q) <= mean(&scored.q) => (refined, s, true),
+                _ => (models, scored, false),
+            }
+        };
+        let whole = if folds.len() == 1 {
+            models[0].clone()
+        } else if !kept {
+            whole
+        } else {
+            let p = polish(&whole, &every_sample, POLISH_ITERATIONS);
+            polish_runs.set(polish_runs.get() + p.evaluations);
+            p.model
+        };
+        polish_seconds.set(polish_seconds.get() + started.elapsed().as_secs_f64());
+        (models, scored, whole)
+    };
     while effects.len() < options.max_effects {
         let missing: Vec<Effect> = options
             .candidates
@@ -1369,6 +1441,7 @@ pub fn diagnose_records(
             .filter(|&e| current.can_try(e))
             .filter(|&e| e != Effect::NormalLoad || d_train.normal_force_measured)
             .filter(|&e| e != Effect::PositionDependent || context.travel > 1e-9)
+            .filter(|&e| withdrawn.iter().all(|w| w.name != e))
             .collect();
         if missing.is_empty() {
             break;
@@ -1577,6 +1650,8 @@ pub fn diagnose_records(
             break;
         };
         let t = tried.swap_remove(k);
+        let fitted_by_output_error = t.by_output_error;
+        let mut earlier = effects.len();
         let (mut models, mut scored) = match t.scored {
             Ok(s) => (t.models, s),
             Err(e) => return Err(format!("accepted {} without a score: {e}", label(&t.added))),
@@ -1588,31 +1663,9 @@ pub fn diagnose_records(
             t.by_output_error,
         )?;
         // refine the accepted models on the output error of their training data
-        let polish_started = Instant::now();
         if options.polish {
-            let polished: Vec<fit::Fitted> = folds
-                .iter()
-                .zip(&models)
-                .map(|(fold, m)| polish(m, &fold.train, POLISH_ITERATIONS))
-                .collect();
-            polish_runs += polished.iter().map(|p| p.evaluations).sum::<usize>();
-            let refined: Vec<FrictionModel> = polished.into_iter().map(|p| p.model).collect();
-            if refined != models {
-                // kept unrefined if a refined model's co-simulation fails
-                if let Ok(s) = score(&mut system, &refined) {
-                    models = refined;
-                    scored = s;
-                }
-            }
-            whole = if folds.len() == 1 {
-                models[0].clone()
-            } else {
-                let p = polish(&whole, &every_sample, POLISH_ITERATIONS);
-                polish_runs += p.evaluations;
-                p.model
-            };
+            (models, scored, whole) = refine(&mut system, models, scored, whole);
         }
-        polish_seconds += polish_started.elapsed().as_secs_f64();
         // the intermediate model of a pair: its first effect alone, as fitted in the singles round
         let mut steps: Vec<(Effect, FrictionModel, Vec<FrictionModel>, Scored)> = Vec::new();
         if t.added.len() == 2 {
@@ -1665,9 +1718,82 @@ pub fn diagnose_records(
                 overlap: overlap.take(),
                 change: None,
             });
+            accepted_as.push((rounds.len(), current.clone(), fitted_by_output_error));
             current = model;
             current_folds = fold_models;
             current_scored = scored;
+        }
+        // re-examine the effects accepted before this round: one whose
+        // gain the new effects explain (taken out, the rest refitted, the
+        // model loses no more than the test that admitted it asks for)
+        // is taken out, so that a greedy early choice (one of two
+        // explanations of a signature, taken before the better one could
+        // be tried) does not stay in the model beside the better one
+        let mut i = 0;
+        while i < earlier {
+            let effect = effects[i].name;
+            let before = &accepted_as[i].1;
+            let reduced: Option<Vec<FrictionModel>> = current_folds
+                .iter()
+                .map(|m| m.without(effect, before, &context))
+                .collect();
+            let (Some(reduced), Some(reduced_whole)) =
+                (reduced, current.without(effect, before, &context))
+            else {
+                i += 1;
+                continue;
+            };
+            let rest: Vec<Effect> = reduced_whole.freed.iter().copied().collect();
+            let oe = accepted_as.iter().enumerate().any(|(j, a)| j != i && a.2);
+            let from_itself = |m: &FrictionModel| vec![m.clone()];
+            let (refitted, _, _) = fit_folds_any(&from_itself, &reduced, &rest, oe)?;
+            let Ok(reduced_scored) = score(&mut system, &refitted) else {
+                i += 1;
+                continue;
+            };
+            let (gain, p_value) = nested_test(&reduced_scored, &current_scored, &scales, &group);
+            if p_value < effects[i].threshold && gain >= options.min_gain {
+                i += 1;
+                continue;
+            }
+            let mut whole = fit_whole_any(&[reduced_whole], &refitted, &rest, oe)?;
+            let (mut refitted, mut reduced_scored) = (refitted, reduced_scored);
+            let w = Withdrawn {
+                name: effect,
+                accepted_in_round: accepted_as[i].0,
+                withdrawn_after_round: rounds.len(),
+                explained_by: effects[earlier..].iter().map(|e| e.name).collect(),
+                heldout_rms_with: mean(&current_scored.q).sqrt(),
+                heldout_rms_without: mean(&reduced_scored.q).sqrt(),
+                gain,
+                p_value,
+                threshold: effects[i].threshold,
+            };
+            notes.push(format!(
+                "{} (accepted in round {}) was taken out after round {}: with {} in the model, keeping it gains {:.1} % of the held-out mean square (p = {:.1e}, it needed p below {:.1e} and {:.1} %), held-out RMS {:.4} with it and {:.4} without",
+                effect.name(),
+                w.accepted_in_round,
+                w.withdrawn_after_round,
+                label(&w.explained_by),
+                100.0 * gain,
+                p_value,
+                w.threshold,
+                100.0 * options.min_gain,
+                w.heldout_rms_with,
+                w.heldout_rms_without,
+            ));
+            withdrawn.push(w);
+            // the model without it refined as an accepted one is
+            if options.polish {
+                (refitted, reduced_scored, whole) =
+                    refine(&mut system, refitted, reduced_scored, whole);
+            }
+            effects.remove(i);
+            accepted_as.remove(i);
+            earlier -= 1;
+            current = whole;
+            current_folds = refitted;
+            current_scored = reduced_scored;
         }
         current_step_error = step_error_of(&mut system, &current_folds, &current_scored);
     }
@@ -1786,6 +1912,7 @@ pub fn diagnose_records(
         residual_pattern,
         baseline_pattern,
         effects,
+        withdrawn,
         rounds,
         round_thresholds,
         changes: {
@@ -1812,8 +1939,8 @@ pub fn diagnose_records(
         min_gain: options.min_gain,
         folds: folds.len(),
         wall_seconds: started.elapsed().as_secs_f64(),
-        polish_seconds,
-        polish_cosimulations: polish_runs,
+        polish_seconds: polish_seconds.get(),
+        polish_cosimulations: polish_runs.get(),
         step,
         master,
         plots,

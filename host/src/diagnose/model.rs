@@ -205,6 +205,14 @@ pub struct FrictionModel {
     pub freed: BTreeSet<Effect>,
 }
 
+/// The largest factor a position table's scale may take the level by,
+/// up or down (a level 100 times another along one travel is no
+/// position dependence of one contact). Unbounded, a knot that few
+/// samples reach was fitted to 6e-8 on one record, a level of nothing
+/// there, and the LuGre FMU took its largest number of sub-steps on every
+/// step of each co-simulation of it (minutes for a 16 s record).
+pub const MAX_SCALE: f64 = 100.0;
+
 /// The LuGre parameter names diagnose reads from the nominal FMU.
 pub const READ_PARAMETERS: [&str; 9] = [
     "Fc",
@@ -412,6 +420,72 @@ impl FrictionModel {
         m
     }
 
+    /// The model with `effect` taken out again: its parameters as they
+    /// were in `before` (the model it was added to), its switch off, and
+    /// its parameters no longer fitted; the levels keep what they carried
+    /// (a position table's mean scale, the normal force it was per
+    /// newton of). `None` when a later effect rests on it (viscous
+    /// friction under direction-dependent viscous friction) or it is not
+    /// part of the model.
+    pub fn without(
+        &self,
+        effect: Effect,
+        before: &FrictionModel,
+        context: &Context,
+    ) -> Option<FrictionModel> {
+        if !self.freed.contains(&effect)
+            || (effect == Effect::Viscous && self.direction_dependent_viscous)
+        {
+            return None;
+        }
+        let mut m = self.clone();
+        m.freed.remove(&effect);
+        match effect {
+            Effect::Viscous => {
+                m.sigma2 = before.sigma2;
+                m.sigma2_neg = before.sigma2_neg;
+            }
+            Effect::Stribeck => {
+                m.fs = m.fc * before.fs / before.fc;
+                m.fs_neg = m.fc_neg * before.fs_neg / before.fc_neg;
+                m.vs = before.vs;
+            }
+            Effect::Presliding => {
+                m.sigma0 = before.sigma0;
+                m.sigma1 = before.sigma1;
+            }
+            Effect::PositionDependent => {
+                let mean = |s: &[f64]| s.iter().sum::<f64>() / s.len().max(1) as f64;
+                let (pos, neg) = (mean(&m.scale_pos), mean(&m.scale_neg));
+                m.fc *= pos;
+                m.fs *= pos;
+                m.fc_neg *= neg;
+                m.fs_neg *= neg;
+                m.position_dependent = false;
+                m.x_table.clear();
+                m.scale_pos.clear();
+                m.scale_neg.clear();
+            }
+            Effect::DirectionDependent => {
+                m.direction_dependent = false;
+                m.fc_neg = m.fc;
+                m.fs_neg = m.fs;
+                m.scale_neg = m.scale_pos.clone();
+            }
+            Effect::NormalLoad => {
+                let n = context.mean_normal_force;
+                m = m.per_newton(1.0 / n);
+                m.normal_force_form = false;
+            }
+            Effect::Offset => m.f_offset = before.f_offset,
+            Effect::DirectionDependentViscous => {
+                m.direction_dependent_viscous = false;
+                m.sigma2_neg = m.sigma2;
+            }
+        }
+        Some(m)
+    }
+
     /// The normal-force form with the same force at a normal force `n`:
     /// every level and coefficient per newton of the input Fn.
     pub fn per_newton(&self, n: f64) -> FrictionModel {
@@ -523,8 +597,8 @@ impl FrictionModel {
                     m.sigma1 = self.sigma1 * (x / self.sigma0).sqrt();
                     m.sigma0 = x;
                 }
-                Free::ScalePos(i) => m.scale_pos[*i] = x,
-                Free::ScaleNeg(i) => m.scale_neg[*i] = x,
+                Free::ScalePos(i) => m.scale_pos[*i] = x.clamp(1.0 / MAX_SCALE, MAX_SCALE),
+                Free::ScaleNeg(i) => m.scale_neg[*i] = x.clamp(1.0 / MAX_SCALE, MAX_SCALE),
             }
         }
         if !m.direction_dependent {

@@ -89,7 +89,7 @@ pub fn markdown(d: &Diagnosis) -> String {
     );
     let _ = writeln!(s, "## Result\n");
     for note in &d.notes {
-        let _ = writeln!(s, "Note: {note}.\n");
+        let _ = writeln!(s, "Note: {}.\n", note.trim_end_matches('.'));
     }
     if d.effects.is_empty() {
         let _ = writeln!(

@@ -29,6 +29,7 @@ mod diagnose;
 mod diagnose_any_plant;
 mod diagnose_hidden_effects;
 mod diagnose_records;
+mod diagnose_reexamine;
 mod docs;
 mod emps;
 mod fmu_logging;
