@@ -20,7 +20,7 @@ the clock starts, as the host builds its system before its own), the
 number of steps, the final value of every recorded output, and, for
 newton, the iteration and Jacobian counts.
 
-Masters, as host/src/master/ implements them, with the same FMI calls in
+Masters, as host/core/src/master/ implements them, with the same FMI calls in
 the same order as the host makes them, so that the comparison is of the
 two callers, not of two call sequences:
 

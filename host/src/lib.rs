@@ -1,12 +1,24 @@
 //! `fricsim`: a co-simulation host for FMI 2.0 Co-Simulation FMUs.
 //!
-//! The host imports FMUs that anyone built — it does not link against the
-//! FMUs of this repository, only against the FMI 2.0 C ABI. Importing is
-//! [`fmu`]: the `.fmu` archive is unpacked with limits and path checks, its
+//! The host imports FMUs that anyone built. Importing is [`fmu`], the
+//! crate `fricsim-fmi` (`host/fmi`), which links against no FMU of this
+//! repository, only against the FMI 2.0 C ABI (the types of `fmi2-types`):
+//! the `.fmu` archive is unpacked with limits and path checks, its
 //! `modelDescription.xml` is parsed and validated, its `linux64` binary is
 //! loaded and every FMI function resolved, and each [`fmu::Instance`] wraps
 //! the C API in safe methods that turn every non-OK status into an
-//! [`FmuError`] carrying what the FMU logged.
+//! [`FmuError`] carrying what the FMU logged. (`fricsim-core` links the
+//! laws through `fricsim-reference`, for the monolithic reference
+//! solutions of `fricsim reference`, never to co-simulate.)
+//!
+//! The crates, each usable on its own:
+//!
+//! - `fricsim-fmi` (`host/fmi`): the importer, here [`fmu`];
+//! - `fricsim-core` (`host/core`): systems, masters, inputs, result files,
+//!   isolation, sweeps, plots ([`system`], [`master`], [`results`], ...);
+//! - this crate, `fricsim`: the diagnosis ([`diagnose`]), the `fricsim`
+//!   binary, and the modules of the crates above under the paths they had
+//!   when they were one crate.
 //!
 //! ```no_run
 //! use fricsim::fmu::Fmu;
@@ -23,25 +35,9 @@
 //! # Ok::<(), fricsim::FmuError>(())
 //! ```
 
-pub mod compare;
-pub mod error;
-pub mod fmu;
-pub mod inputs;
-pub mod isolate;
-pub mod master;
-pub mod matfile;
-pub mod output_file;
-pub mod plot;
-pub mod reference;
-pub mod results;
-pub mod rows;
-pub mod run;
-pub mod signals;
-pub mod ssp;
-pub mod stale;
-pub mod sweep;
-pub mod system;
-pub mod writer_thread;
-
-pub use error::{ArchiveProblem, FmuError};
+pub use fricsim_core::{
+    compare, error, fmu, inputs, isolate, master, matfile, output_file, plot, reference, results,
+    rows, run, signals, ssp, stale, sweep, system, writer_thread,
+};
+pub use fricsim_core::{ArchiveProblem, FmuError};
 pub mod diagnose;

@@ -12,14 +12,20 @@
 //! that crate alone, not on the exporter.
 
 pub mod archive;
+pub mod blackbox;
+pub mod error;
 pub mod instance;
 pub mod library;
 pub mod logger;
 pub mod model_description;
+pub mod shared_memory;
+pub mod stale;
 mod status;
 pub mod watchdog;
+pub mod xml_text;
 
 pub use archive::UnpackOptions;
+pub use error::{ArchiveProblem, FmuError};
 pub use instance::{Fmu, FmuState, Instance, Rollback};
 pub use library::Library;
 pub use logger::{Log, LogMessage};

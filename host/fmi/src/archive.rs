@@ -11,7 +11,7 @@
 //! link is ever created, so no write can leave it.
 
 use crate::error::{ArchiveProblem, FmuError};
-use crate::fmu::library::PLATFORM;
+use crate::library::PLATFORM;
 use std::collections::HashSet;
 use std::fs::{self, File};
 use std::io::{self, BufReader, Read, Seek, SeekFrom, Write};
@@ -46,7 +46,7 @@ pub struct UnpackOptions {
     /// our FMUs carry a Windows DLL beside the Linux library, and inflating
     /// it was half the time spent opening one.
     ///
-    /// [`Fmu::open`]: crate::fmu::Fmu::open
+    /// [`Fmu::open`]: crate::Fmu::open
     pub skip_unused: bool,
     /// Write the model description only, every other entry checked but
     /// not written (their folders are made, as with `skip_unused`):

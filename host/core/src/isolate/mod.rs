@@ -30,11 +30,10 @@
 //!
 //! Linux only (`mmap`, `prctl(PR_SET_PDEATHSIG)`), as is the host.
 
-pub mod blackbox;
+pub use fricsim_fmi::blackbox;
 pub mod child;
 pub mod parent;
 pub mod ring;
-mod shared;
 
 use serde::{Deserialize, Serialize};
 

@@ -1,10 +1,10 @@
-//! Compiles the variadic FMI logger callback (`src/fmu/logger.c`): stable
+//! Compiles the variadic FMI logger callback (`src/logger.c`): stable
 //! Rust cannot define a C-variadic function, so this one lives in C.
 
 fn main() {
-    println!("cargo:rerun-if-changed=src/fmu/logger.c");
+    println!("cargo:rerun-if-changed=src/logger.c");
     cc::Build::new()
-        .file("src/fmu/logger.c")
+        .file("src/logger.c")
         .warnings(true)
         .extra_warnings(true)
         .compile("fricsim_logger");

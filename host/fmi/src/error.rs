@@ -2,11 +2,11 @@
 //! variant carries the values needed to say what failed and where; the
 //! message is written once, here.
 
-use crate::fmu::Status;
+use crate::Status;
 use std::path::PathBuf;
 use thiserror::Error;
 
-/// Why an archive was refused (see [`crate::fmu::archive`]).
+/// Why an archive was refused (see [`crate::archive`]).
 #[derive(Debug, Error)]
 pub enum ArchiveProblem {
     #[error("not a readable zip archive: {0}")]
@@ -134,7 +134,7 @@ pub enum FmuError {
     },
 
     /// A call took longer than the limit set with
-    /// [`Instance::set_call_time_limit`](crate::fmu::Instance::set_call_time_limit)
+    /// [`Instance::set_call_time_limit`](crate::Instance::set_call_time_limit)
     /// (`--step-timeout`); its result is not used.
     #[error(
         "{function} for instance \"{instance}\" took {elapsed:.3} s, longer than the limit of {limit} s (--step-timeout); its result is not used"

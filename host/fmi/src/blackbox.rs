@@ -1,6 +1,6 @@
 //! The black box: which FMI call the isolated child is in.
 //!
-//! Before each FMI call the child's [`Instance`](crate::fmu::Instance)
+//! Before each FMI call the child's [`Instance`](crate::Instance)
 //! stores the instance's index, the function's name and a call count, and
 //! after it clears the index; `fmi2DoStep` also stores its communication
 //! point. These are a few stores into shared memory, no system call. When
@@ -8,7 +8,7 @@
 //! parent reads how long the current call has lasted (the call count
 //! unchanged since it first saw it) to stop a call that hangs.
 
-use super::shared::Mapping;
+use crate::shared_memory::Mapping;
 use std::path::Path;
 use std::sync::atomic::Ordering::{Acquire, Relaxed, Release};
 use std::sync::Arc;
@@ -86,7 +86,7 @@ impl BlackBox {
     }
 }
 
-/// One instance's view of the black box (see [`crate::fmu::Instance::set_black_box`]).
+/// One instance's view of the black box (see [`crate::Instance::set_black_box`]).
 pub struct CallRecorder {
     map: Arc<Mapping>,
     /// The instance's index + 1 (0 means "in no call").

@@ -2,9 +2,9 @@
 //!
 //! A run killed with SIGKILL, or one whose process crashes, runs no
 //! destructor: its temporary result file (`.<name>.fricsim-partial-<pid>`,
-//! [`crate::output_file`]) and the folders its FMUs were unpacked into
+//! the host's result files (`fricsim::output_file`)) and the folders its FMUs were unpacked into
 //! (`fricsim-fmu-<pid>-XXXXXX` in the temporary directory,
-//! [`crate::fmu::archive`]) stay. Both names carry the pid of the process
+//! [`crate::archive`]) stay. Both names carry the pid of the process
 //! that made them, so a later run can tell which ones belong to a process
 //! that no longer runs and remove them. A process that still runs, or
 //! whose pid cannot be checked (another user's: `kill` answers `EPERM`),

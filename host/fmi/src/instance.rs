@@ -15,8 +15,8 @@ use super::logger::{fricsim_fmi2_logger, Log, Sink};
 use super::model_description::{ModelDescription, ScalarVariable, ValueReference};
 use super::watchdog::Watched;
 use super::Status;
+use crate::blackbox::CallRecorder;
 use crate::error::FmuError;
-use crate::isolate::blackbox::CallRecorder;
 use fmi2_types::*;
 use std::ffi::CString;
 use std::mem::ManuallyDrop;
@@ -354,7 +354,7 @@ impl Instance {
 
     /// Record every later FMI call of this instance in an isolated run's
     /// black box (`None`: no longer), so that the parent process can name
-    /// the call the FMU crashed or hung in ([`crate::isolate::blackbox`]).
+    /// the call the FMU crashed or hung in ([`crate::blackbox`]).
     pub fn set_black_box(&mut self, recorder: Option<CallRecorder>) {
         self.black_box = recorder;
         self.guarded = self.fatal || self.limit.is_some() || self.black_box.is_some();

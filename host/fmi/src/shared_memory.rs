@@ -9,7 +9,7 @@ use std::path::Path;
 use std::sync::atomic::AtomicU64;
 
 /// A file of `words` 64-bit words mapped into this process.
-pub(crate) struct Mapping {
+pub struct Mapping {
     pointer: *mut AtomicU64,
     words: usize,
 }
@@ -22,7 +22,7 @@ unsafe impl Sync for Mapping {}
 impl Mapping {
     /// Map the file `path`, creating it and setting its length to
     /// `words` × 8 bytes if `create` (new pages read as zeros).
-    pub(crate) fn open(path: &Path, words: usize, create: bool) -> std::io::Result<Mapping> {
+    pub fn open(path: &Path, words: usize, create: bool) -> std::io::Result<Mapping> {
         let file = OpenOptions::new()
             .read(true)
             .write(true)
@@ -64,7 +64,7 @@ impl Mapping {
 
     /// Word `i` (panics past the end: a bug of this module, never input).
     #[inline(always)]
-    pub(crate) fn word(&self, i: usize) -> &AtomicU64 {
+    pub fn word(&self, i: usize) -> &AtomicU64 {
         assert!(i < self.words, "word {i} of {}", self.words);
         // SAFETY: in bounds (checked), page-aligned base, live mapping.
         unsafe { &*self.pointer.add(i) }

@@ -2,7 +2,7 @@
 //! (plotters' bitmap backend) or SVG, chosen by the file's extension.
 //!
 //! Text is drawn with DejaVu Sans, compiled into the binary
-//! (`host/assets/DejaVuSans.ttf`, Bitstream Vera licence beside it) and
+//! (`host/core/assets/DejaVuSans.ttf`, Bitstream Vera licence beside it) and
 //! registered with plotters' pure-Rust `ab_glyph` renderer, so a plot looks
 //! the same on every machine and needs no system font library.
 
@@ -15,7 +15,7 @@ use std::sync::OnceLock;
 const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// Register the font under "sans-serif" once per process.
-pub(crate) fn register_font() -> Result<(), String> {
+pub fn register_font() -> Result<(), String> {
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {
@@ -113,7 +113,7 @@ fn draw<DB: DrawingBackend>(
 /// any scale (plotters' default prints `0.0` for every tick of a signal in
 /// micrometres): decimals for magnitudes from 1e-3 to 1e5, scientific
 /// notation otherwise, with digits down to a twentieth of the range.
-pub(crate) fn tick_label(y: f64, lo: f64, hi: f64) -> String {
+pub fn tick_label(y: f64, lo: f64, hi: f64) -> String {
     if y == 0.0 || !y.is_finite() {
         return format!("{y}");
     }

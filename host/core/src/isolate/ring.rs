@@ -3,8 +3,8 @@
 //! has stored is the parent's even if the child dies the next instant, and
 //! no system call is made per row. The child waits while the ring is full.
 
-use super::shared::Mapping;
 use crate::rows::Rows;
+use fricsim_fmi::shared_memory::Mapping;
 use std::path::Path;
 use std::sync::atomic::Ordering::{Acquire, Relaxed, Release};
 use std::time::Duration;

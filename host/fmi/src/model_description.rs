@@ -15,7 +15,7 @@
 //! names, units declared in `UnitDefinitions`, `ModelStructure` indices).
 
 use crate::error::FmuError;
-use crate::ssp::xml::{double_hyphen_offset, line_column};
+use crate::xml_text::{double_hyphen_offset, line_column};
 use quick_xml::events::Event;
 use std::collections::HashMap;
 use std::fmt;
