@@ -86,13 +86,6 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     }
-    // a result file that replaces one leaves freeing the old one's blocks
-    // to a child once the command is done (`free_replaced_in_background`
-    // below): on some disks that is as long as the run
-    let writes_results = matches!(args.command, Command::Run(_) | Command::Cosim(_));
-    if writes_results {
-        fricsim::output_file::defer_freeing_replaced();
-    }
     let result = match args.command {
         Command::Info { fmu } => cli::info::run(&fmu).map_err(|e| e.to_string()),
         Command::Cosim(args) => cli::cosim::run(&args),
@@ -106,9 +99,6 @@ fn main() -> ExitCode {
         Command::Sweep(args) => cli::sweep::run(&args),
         Command::IsolatedChild(args) => cli::isolated::child(&args),
     };
-    if writes_results {
-        fricsim::output_file::free_replaced_in_background();
-    }
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -1623,7 +1623,7 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
     let against = |t: f64| fmpy_jacobi.map_or("–".to_string(), |f| format!("{:.0}×", f / t));
     let _ = writeln!(
         s,
-        "\n**The whole `fricsim run {STICK_SLIP} --out FILE`** ({} s), a fresh process each time (start, unpacking the FMUs, the run, writing the file and `fsync`, exit), CSV and MAT v4 in turns, against FMPy's Jacobi loop run in the same turns as the new-file runs ({}; its own clock, without the interpreter's start), writing a new file (a path no run has written) and replacing the previous result (the rename that puts the new file in place then has the file system free the old one's blocks, as `rm` would; a child process does that after fricsim exits), the replacing runs back to back and {} ms apart (when the runs follow each other at once, each starts while the file system frees the file the run before it replaced):\n",
+        "\n**The whole `fricsim run {STICK_SLIP} --out FILE`** ({} s), a fresh process each time (start, unpacking the FMUs, the run, writing the file and `fsync`, exit), CSV and MAT v4 in turns, against FMPy's Jacobi loop run in the same turns as the new-file runs ({}; its own clock, without the interpreter's start), writing a new file (a path no run has written) and replacing the previous result (the rename that puts the new file in place then has the file system free the old one's blocks, as `rm` would), the replacing runs back to back and {} ms apart (when the runs follow each other at once, each starts while the file system frees the file the run before it replaced):\n",
         h.stop,
         p.fmpy.as_ref().map_or_else(
             |e| format!("not measured: {e}"),

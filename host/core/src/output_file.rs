@@ -127,19 +127,7 @@ impl OutputFile {
         let out = self.out().map_err(io)?;
         out.flush().map_err(io)?;
         out.get_ref().file.sync_all().map_err(io)?;
-        // the file being replaced, held open past the rename when its
-        // freeing is to be left to the end (see `defer_freeing_replaced`)
-        let replaced = match DEFER_FREEING.load(std::sync::atomic::Ordering::Relaxed) {
-            true => hold(&self.path),
-            false => None,
-        };
         std::fs::rename(&self.partial, &self.path).map_err(io)?;
-        if let Some(file) = replaced {
-            REPLACED
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .push(file);
-        }
         self.out = None;
         // the rename is durable once the directory is (fsync(2))
         // (the temporary file's directory: `.` for a bare file name)
@@ -266,124 +254,6 @@ impl Seek for Writeback {
         self.unsent = self.unsent.min(self.position);
         Ok(self.position)
     }
-}
-
-/// Whether [`OutputFile::commit`] holds the file it replaces open
-/// ([`defer_freeing_replaced`]).
-static DEFER_FREEING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// The replaced files held open ([`defer_freeing_replaced`]).
-static REPLACED: std::sync::Mutex<Vec<File>> = std::sync::Mutex::new(Vec::new());
-
-/// From now on, a result that replaces a file leaves freeing the old
-/// file's blocks to [`free_replaced_in_background`]: for a command that
-/// is about to exit. Freeing them is the file system's work when the last
-/// link and the last open file of the old file go: at the rename that
-/// puts the result in place, unless the file is still open. On an ext4
-/// mounted with `discard` that work waits for the disk to discard every
-/// block, about 35 ms for the 22 MB MAT file of the stick-slip benchmark
-/// (`perf trace`: the rename), the time of the whole run again.
-pub fn defer_freeing_replaced() {
-    DEFER_FREEING.store(true, std::sync::atomic::Ordering::Relaxed);
-}
-
-/// `path` opened without reading anything (`O_PATH` on Linux), to keep its
-/// file alive after the rename over it; `None` if there is no file.
-fn hold(path: &Path) -> Option<File> {
-    let mut options = OpenOptions::new();
-    options.read(true);
-    #[cfg(target_os = "linux")]
-    {
-        use std::os::unix::fs::OpenOptionsExt;
-        options.custom_flags(libc::O_PATH | libc::O_NOFOLLOW);
-    }
-    options.open(path).ok()
-}
-
-/// Let a child process drop the files replaced by results since
-/// [`defer_freeing_replaced`], so that this process can exit at once and
-/// the file system frees their blocks while the child ends. The child
-/// closes every other descriptor first (a pipe reading this process's
-/// output sees its end when this process exits), waits until this
-/// process has closed its own copies (else the last close, and the work,
-/// would be this process's), closes them and exits; it runs nothing but
-/// system calls. Without replaced files, or if the child cannot be
-/// started, nothing happens: the files are closed at exit, as always.
-///
-/// For a process about to exit: the child is left to the system to reap.
-/// Returns the child's pid, if one was started.
-pub fn free_replaced_in_background() -> Option<i32> {
-    let files = std::mem::take(&mut *REPLACED.lock().unwrap_or_else(|e| e.into_inner()));
-    if files.is_empty() {
-        return None;
-    }
-    free_in_child(files)
-}
-
-#[cfg(target_os = "linux")]
-fn free_in_child(files: Vec<File>) -> Option<i32> {
-    use std::os::fd::AsRawFd;
-    // Every descriptor the child must close, found before the fork (the
-    // child must not allocate): all but the files and the pipe's end.
-    let mut pipe = [0; 2];
-    // SAFETY: a valid array of two descriptors
-    if unsafe { libc::pipe2(pipe.as_mut_ptr(), libc::O_CLOEXEC) } != 0 {
-        return None;
-    }
-    let [read_end, write_end] = pipe;
-    let keep: Vec<i32> = files.iter().map(|f| f.as_raw_fd()).collect();
-    let others: Vec<i32> = std::fs::read_dir("/proc/self/fd")
-        .map(|entries| {
-            entries
-                .filter_map(|e| e.ok()?.file_name().to_str()?.parse().ok())
-                .filter(|fd| *fd != read_end && !keep.contains(fd))
-                .collect()
-        })
-        .unwrap_or_default();
-    // SAFETY: the child calls only async-signal-safe functions (close,
-    // read, _exit) on memory allocated before the fork
-    match unsafe { libc::fork() } {
-        -1 => {
-            // SAFETY: the two ends of the pipe made above
-            unsafe {
-                libc::close(read_end);
-                libc::close(write_end);
-            }
-            None
-        }
-        0 => {
-            // SAFETY: descriptors of this process; read into a local byte
-            unsafe {
-                for &fd in &others {
-                    libc::close(fd);
-                }
-                let mut byte = 0u8;
-                // until the parent has closed its end (or exited)
-                while libc::read(read_end, (&raw mut byte).cast(), 1) < 0 {}
-                for &fd in &keep {
-                    libc::close(fd);
-                }
-                libc::_exit(0)
-            }
-        }
-        child => {
-            // this process's copies first, then the pipe: the child's
-            // close is the last one
-            drop(files);
-            // SAFETY: the two ends of the pipe made above
-            unsafe {
-                libc::close(read_end);
-                libc::close(write_end);
-            }
-            Some(child)
-        }
-    }
-}
-
-#[cfg(not(target_os = "linux"))]
-fn free_in_child(files: Vec<File>) -> Option<i32> {
-    drop(files);
-    None
 }
 
 /// Temporary files `<prefix><pid>` of processes that no longer run. Called
@@ -535,41 +405,6 @@ fn absolute(path: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// With freeing deferred, the file a result replaces stays open in
-    /// this process after the rename (so the rename does not free it),
-    /// until a child takes it over: then this process holds it no longer,
-    /// the child exits cleanly, and nothing is left to free.
-    #[cfg(target_os = "linux")]
-    #[test]
-    fn a_replaced_file_is_freed_by_a_child_not_at_the_rename() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("r.csv");
-        std::fs::write(&path, "old\n").unwrap();
-        let old = std::fs::metadata(&path).unwrap();
-        // an open descriptor of this process on the old file
-        let held = || {
-            std::fs::read_dir("/proc/self/fd").unwrap().any(|e| {
-                std::fs::metadata(e.unwrap().path())
-                    .is_ok_and(|m| m.ino() == old.ino() && m.dev() == old.dev())
-            })
-        };
-        assert!(!held());
-        defer_freeing_replaced();
-        let mut out = OutputFile::create(&path, &[]).unwrap();
-        out.write_all(b"new\n").unwrap();
-        out.commit().unwrap();
-        assert_eq!(std::fs::read_to_string(&path).unwrap(), "new\n");
-        assert!(held(), "the replaced file is still open");
-        let child = free_replaced_in_background().expect("a child started");
-        assert!(!held(), "this process's copy is closed");
-        let mut status = 0;
-        // SAFETY: waiting for this process's own child
-        assert_eq!(unsafe { libc::waitpid(child, &mut status, 0) }, child);
-        assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0);
-        assert_eq!(free_replaced_in_background(), None, "nothing left");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
-    }
 
     #[test]
     fn a_committed_file_replaces_the_previous_one_and_leaves_nothing_beside_it() {
