@@ -19,7 +19,8 @@ if [ "${NO_VALGRIND:-0}" = 1 ] || ! command -v valgrind > /dev/null; then
     echo "valgrind not used: native cycles only"
 fi
 status=0
-for name in Dahl LuGre ResetIntegrator Bristle Bristle2D Rig1D Rig2D; do
+# every shipped FMU, from the one list (modelDescription/shipped.txt)
+for name in $(grep -v '^#' modelDescription/shipped.txt | cut -d' ' -f1); do
     fmu="dist/$name.fmu"
     [ -f "$fmu" ] || { echo "$fmu missing: run ./build-fmu.sh"; exit 2; }
     mkdir -p "$work/$name"

@@ -16,10 +16,13 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
 from fmpy.simulation import Input
 
+import shipped
+
 ROOT = Path(__file__).resolve().parent.parent
 DIST = ROOT / "dist"
 RUN_LAW = ROOT / "target" / "release" / "run-law"
-MODELS = ["Dahl", "LuGre", "ResetIntegrator", "Bristle", "Bristle2D"]
+#: the friction laws (modelDescription/shipped.txt, through tests/shipped.py)
+MODELS = shipped.LAWS
 
 
 def fmu_path(name):

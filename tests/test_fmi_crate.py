@@ -23,6 +23,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
+import shipped
 from conftest import ROOT, fmu_path
 
 DRIVE = ROOT / "target" / "fmi-crate" / "debug" / "fmi-crate-drive"
@@ -179,3 +180,7 @@ def test_fmi_crate_refuses_what_it_should(tmp_path):
                                 capture_output=True, text=True)
         assert result.returncode != 0
         assert message in result.stderr, result.stderr
+
+
+def test_every_shipped_fmu_has_a_case():
+    shipped.covers({fmu for fmu, _, _ in CASES.values()}, shipped.SHIPPED, "CASES")

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
+import shipped
 from conftest import applied_inputs, fmu_path, run_in_process
 
 STOP = 2.0
@@ -126,3 +127,7 @@ def test_interpolated_inputs_change_the_result():
     held, _ = applied_inputs(sig, times, False)
     _, slopes = applied_inputs(sig, times, True)
     assert max(abs(s) for s in slopes["v"]) > 0
+
+
+def test_every_shipped_law_has_a_case():
+    shipped.covers(CASES, shipped.LAWS, "CASES")

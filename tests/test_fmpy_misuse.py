@@ -14,7 +14,8 @@ import math
 import pytest
 from fmpy.fmi1 import FMICallException
 
-SHIPPED = ["Dahl", "LuGre", "ResetIntegrator", "Bristle", "Bristle2D", "Rig1D", "Rig2D"]
+from shipped import SHIPPED
+
 STATES = ["Instantiated", "InitializationMode", "StepComplete", "Terminated"]
 # The calls that take each fresh instance to a state.
 TO_STATE = {

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-SHIPPED = ["Dahl", "LuGre", "ResetIntegrator", "Bristle", "Bristle2D", "Rig1D", "Rig2D"]
+from shipped import SHIPPED
 PROBE = Path(__file__).resolve().parent / "concurrent_probe.py"
 
 

@@ -7,14 +7,15 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
+import shipped
 from conftest import MODELS, fmu_path
 
 # the rig FMUs (the mechanical side), validated like the friction laws
-RIGS = ["Rig1D", "Rig2D"]
+RIGS = shipped.RIGS
 
 # the FMUs with a Model Exchange interface: their states, in order, and
 # their number of event indicators
-MODEL_EXCHANGE = {"Dahl": (["F_dahl"], 1), "LuGre": (["z"], 1), "ResetIntegrator": (["z"], 2),
+MODEL_EXCHANGE_STATES = {"Dahl": (["F_dahl"], 1), "LuGre": (["z"], 1), "ResetIntegrator": (["z"], 2),
                   "Bristle2D": (["z1", "z2"], 1)}
 
 EXPECTED = {
@@ -41,6 +42,11 @@ EXPECTED = {
               "parameter": {"m", "k1", "k2", "c1", "c2", "x1_0", "x2_0", "v1_0", "v2_0", "vs1", "vs2",
                             "dither_amp1", "dither_freq1", "dither_amp2", "dither_freq2"}},
 }
+
+
+def test_the_tables_cover_every_shipped_fmu():
+    shipped.covers(EXPECTED, shipped.SHIPPED, "EXPECTED")
+    shipped.covers(MODEL_EXCHANGE_STATES, shipped.MODEL_EXCHANGE, "MODEL_EXCHANGE_STATES")
 
 
 @pytest.mark.parametrize("name", MODELS + RIGS)
@@ -70,8 +76,8 @@ def test_declared_variables_and_capabilities(name):
     # Model Exchange beside Co-Simulation, same binary, for the laws that
     # are ODEs (issue 22); the bristle law and the rigs are Co-Simulation only
     me = md.modelExchange
-    if name in MODEL_EXCHANGE:
-        states, indicators = MODEL_EXCHANGE[name]
+    if name in shipped.MODEL_EXCHANGE:
+        states, indicators = MODEL_EXCHANGE_STATES[name]
         assert me is not None and me.modelIdentifier == name
         assert me.canGetAndSetFMUstate and me.canSerializeFMUstate and me.providesDirectionalDerivative
         assert [d.variable.derivative.name for d in md.derivatives] == states

@@ -31,6 +31,8 @@ from urllib.parse import quote
 import numpy as np
 import pytest
 
+import shipped
+
 ROOT = Path(__file__).resolve().parent.parent
 DIST = ROOT / "dist"
 DRIVER_SOURCE = ROOT / "tests" / "windows" / "fmi_driver.c"
@@ -38,7 +40,7 @@ WORK = ROOT / "target" / "windows-test"
 PREFIX = WORK / "wine-prefix"
 # the FMUs are unpacked here, C:\fmu tests\<Name>\ under Wine
 DRIVE_C_DIR = PREFIX / "drive_c" / "fmu tests"
-FMU_NAMES = ["Dahl", "LuGre", "ResetIntegrator", "Bristle", "Bristle2D", "Rig1D", "Rig2D"]
+FMU_NAMES = shipped.SHIPPED
 
 # What a DLL of ours may import: Windows' own DLLs, present on every
 # installation (API sets api-ms-win-* are Windows' too). Anything else,
@@ -420,3 +422,7 @@ def test_resource_locations(fmu):
                 f'fmuResourceLocation "{d}" is not a file: URI; accepted: this model uses no resources',
             ]
         assert messages == [f"fmi2Instantiate: {m}" for m in expected], messages
+
+
+def test_every_shipped_fmu_has_a_case():
+    shipped.covers({fmu for fmu, _, _ in CASES.values()}, shipped.SHIPPED, "CASES")

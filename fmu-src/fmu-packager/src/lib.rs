@@ -27,6 +27,39 @@ pub fn all_models() -> Vec<&'static ModelInfo> {
         .collect()
 }
 
+/// The list of shipped models, `modelDescription/shipped.txt`: one line per
+/// FMU, its name, `law` or `rig`, and its interfaces (`cs`, and `me` for
+/// the models offered for Model Exchange too), from the registries. Every
+/// test and script that goes over the shipped FMUs reads it.
+pub fn shipped_list() -> String {
+    let mut s = String::from(
+        "# The FMUs this project ships: name, kind (law or rig), interfaces (cs: Co-Simulation,\n\
+         # me: Model Exchange). Rendered from the registries by `cargo run -p fmu-packager -- render`;\n\
+         # every test and script that goes over the shipped FMUs reads this list.\n",
+    );
+    let kinds = [
+        ("law", friction_fmu::REGISTRY.iter()),
+        ("rig", rig_fmu::REGISTRY.iter()),
+    ];
+    for (kind, factories) in kinds {
+        for f in factories {
+            let me = if f.create_model_exchange.is_some() {
+                " me"
+            } else {
+                ""
+            };
+            s.push_str(&format!("{} {kind} cs{me}\n", f.info.model_name));
+        }
+    }
+    s
+}
+
+/// Where [`shipped_list`] is checked in, under the model descriptions'
+/// directory.
+pub fn shipped_list_path(dir: &Path) -> PathBuf {
+    dir.join("shipped.txt")
+}
+
 /// The library crate that holds `info`.
 pub fn library_of(info: &ModelInfo) -> &'static str {
     libraries()

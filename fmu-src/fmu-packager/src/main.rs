@@ -15,12 +15,14 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Write <dir>/<Name>.xml for every model from its variable table.
+    /// Write <dir>/<Name>.xml for every model from its variable table, and
+    /// <dir>/shipped.txt, the list of shipped models.
     Render {
         #[arg(default_value = "modelDescription")]
         dir: PathBuf,
     },
-    /// Fail if any checked-in <dir>/<Name>.xml differs from the rendering.
+    /// Fail if any checked-in <dir>/<Name>.xml or <dir>/shipped.txt differs
+    /// from the rendering.
     Check {
         #[arg(default_value = "modelDescription")]
         dir: PathBuf,
@@ -55,6 +57,10 @@ fn run(cli: Cli) -> Result<(), String> {
                     .map_err(|e| format!("{}: {e}", path.display()))?;
                 println!("wrote {}", path.display());
             }
+            let path = fmu_packager::shipped_list_path(&dir);
+            std::fs::write(&path, fmu_packager::shipped_list())
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            println!("wrote {}", path.display());
         }
         Command::Check { dir } => {
             let mut stale = Vec::new();
@@ -64,6 +70,10 @@ fn run(cli: Cli) -> Result<(), String> {
                 if on_disk != render(info)? {
                     stale.push(path.display().to_string());
                 }
+            }
+            let path = fmu_packager::shipped_list_path(&dir);
+            if std::fs::read_to_string(&path).unwrap_or_default() != fmu_packager::shipped_list() {
+                stale.push(path.display().to_string());
             }
             if !stale.is_empty() {
                 return Err(format!(

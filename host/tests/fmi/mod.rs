@@ -645,16 +645,29 @@ pub fn check_state_table<S: Copy + PartialEq + std::fmt::Debug>(
 
 // ---- the shipped FMUs ------------------------------------------------------
 
-/// The FMUs `build-fmu.sh` writes into `dist/`.
-pub const SHIPPED: [&str; 7] = [
-    "Dahl",
-    "LuGre",
-    "ResetIntegrator",
-    "Bristle",
-    "Bristle2D",
-    "Rig1D",
-    "Rig2D",
-];
+/// The FMUs `build-fmu.sh` writes into `dist/`: the one list of them,
+/// `modelDescription/shipped.txt` (rendered from the registries; checked
+/// against them by fmu-packager's tests).
+pub static SHIPPED: std::sync::LazyLock<Vec<&'static str>> =
+    std::sync::LazyLock::new(|| shipped_where(|_| true));
+
+/// The shipped FMUs offered for Model Exchange too.
+pub static SHIPPED_MODEL_EXCHANGE: std::sync::LazyLock<Vec<&'static str>> =
+    std::sync::LazyLock::new(|| shipped_where(|interfaces| interfaces.contains(&"me")));
+
+/// The names of `modelDescription/shipped.txt` whose interfaces pass `keep`.
+fn shipped_where(keep: impl Fn(&[&str]) -> bool) -> Vec<&'static str> {
+    let path = repository().join("modelDescription").join("shipped.txt");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let text: &'static str = Box::leak(text.into_boxed_str());
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .filter_map(|l| {
+            let fields: Vec<&str> = l.split_whitespace().collect();
+            keep(fields.get(2..).unwrap_or(&[])).then_some(fields[0])
+        })
+        .collect()
+}
 
 /// A shipped FMU unpacked by the host's importer and its binary loaded.
 pub struct Loaded {

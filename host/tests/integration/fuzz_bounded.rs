@@ -115,7 +115,7 @@ fn random_call_sequences_against_every_shipped_fmu() {
     let mut rng = Rng(SEED);
     let start = Instant::now();
     let mut calls = 0;
-    for name in SHIPPED {
+    for &name in SHIPPED.iter() {
         let loaded = load_shipped(name);
         for iteration in 0..1000 {
             let len = 16 + rng.below(600);
@@ -137,7 +137,7 @@ fn random_call_sequences_against_every_shipped_fmu() {
 #[test]
 fn mutated_serialized_states_are_refused() {
     let mut rng = Rng(SEED + 1);
-    for name in SHIPPED {
+    for &name in SHIPPED.iter() {
         let loaded = load_shipped(name);
         let i = loaded.instance("states");
         assert_eq!(i.initialize(), OK);

@@ -96,9 +96,6 @@ const ALLOWED: &[(&str, &[St])] = &[
     ("fmi2GetRealStatus", &[]),
 ];
 
-/// The FMUs with a Model Exchange interface.
-const ME_FMUS: [&str; 4] = ["Dahl", "LuGre", "ResetIntegrator", "Bristle2D"];
-
 struct Fixture {
     loaded: Loaded,
 }
@@ -251,10 +248,14 @@ impl Fixture {
 
 #[test]
 fn exactly_the_ode_laws_offer_model_exchange() {
-    for name in SHIPPED {
+    for &name in SHIPPED.iter() {
         let f = Fixture::new(name);
         let me = f.loaded.model_exchange.as_deref();
-        assert_eq!(me, ME_FMUS.contains(&name).then_some(name), "{name}");
+        assert_eq!(
+            me,
+            SHIPPED_MODEL_EXCHANGE.contains(&name).then_some(name),
+            "{name}"
+        );
         let expected_states = match name {
             "Bristle2D" => 2,
             "Dahl" | "LuGre" | "ResetIntegrator" => 1,
@@ -268,7 +269,7 @@ fn exactly_the_ode_laws_offer_model_exchange() {
 #[test]
 fn every_function_in_every_model_exchange_state_follows_the_standard_table() {
     let (mut refused, mut accepted) = (0, 0);
-    for name in ME_FMUS {
+    for &name in SHIPPED_MODEL_EXCHANGE.iter() {
         let (r, a) = check_state_table(&Fixture::new(name), ALLOWED, &STATES);
         refused += r;
         accepted += a;
@@ -410,7 +411,7 @@ fn nulls_wrong_lengths_and_nan_are_refused_and_change_nothing() {
             "neither a state derivative nor an output",
         ),
     ];
-    for name in ME_FMUS {
+    for &name in SHIPPED_MODEL_EXCHANGE.iter() {
         let f = Fixture::new(name);
         let i = f.instance_in(ContinuousTimeMode);
         // a state of its own, to see it kept
@@ -444,7 +445,7 @@ fn nulls_wrong_lengths_and_nan_are_refused_and_change_nothing() {
 
 #[test]
 fn a_null_foreign_or_freed_component_is_refused_by_every_model_exchange_function() {
-    for name in ME_FMUS {
+    for &name in SHIPPED_MODEL_EXCHANGE.iter() {
         let f = Fixture::new(name);
         let m = f.loaded.me_api;
         let freed = f.instance_in(ContinuousTimeMode);
@@ -494,7 +495,7 @@ fn a_null_foreign_or_freed_component_is_refused_by_every_model_exchange_function
 fn co_simulation_instances_refuse_the_model_exchange_functions() {
     let model_exchange_only = &ALLOWED[..10];
     assert_eq!(model_exchange_only[0].0, "fmi2EnterEventMode");
-    for name in SHIPPED {
+    for &name in SHIPPED.iter() {
         let f = Fixture::new(name);
         let i = f.loaded.instance("cs");
         assert_eq!(i.initialize(), OK);

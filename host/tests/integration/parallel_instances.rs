@@ -74,7 +74,7 @@ impl<'a> Run<'a> {
 
 #[test]
 fn instances_in_one_thread_and_across_threads_equal_one_alone() {
-    for name in SHIPPED {
+    for &name in SHIPPED.iter() {
         let loaded = load_shipped(name);
         let mut alone = Run::new(&loaded, "alone");
         for _ in 0..STEPS {
