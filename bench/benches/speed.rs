@@ -11,8 +11,8 @@
 //!   curve with one reversal ([`bristle_curve`]), 10 to 100 000 bristles.
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
-use fricsim::fmu::Fmu;
 use fricsim_bench::{bristle_curve, FmuStepper, FRICTION_FMUS};
+use fricsim_fmi::Fmu;
 use friction_laws::bristle::{Bristle, BristleParams};
 use std::path::Path;
 

@@ -10,16 +10,16 @@
 //! `fmi2GetInteger` and its Boolean ones in one `fmi2GetBoolean` (where it
 //! has any), as whole numbers.
 //!
-//! The scheme is the host's Jacobi (`fricsim::master::jacobi`): at each
+//! The scheme is the host's Jacobi (`fricsim_core::master::jacobi`): at each
 //! communication point every component gets its connected inputs from the
 //! row recorded there, then steps; the row at the next point is read from
-//! every output. Rows go into a buffer of [`fricsim::master::CHUNK_STEPS`]
+//! every output. Rows go into a buffer of [`fricsim_core::master::CHUNK_STEPS`]
 //! rows used again once full, as `fricsim run` hands its rows on.
 
 use fmi2_types::*;
-use fricsim::fmu::model_description::{Causality, VariableKind};
-use fricsim::fmu::Fmu;
-use fricsim::master::{step_count, CHUNK_STEPS};
+use fricsim_core::master::{step_count, CHUNK_STEPS};
+use fricsim_fmi::model_description::{Causality, VariableKind};
+use fricsim_fmi::Fmu;
 use std::ffi::CString;
 use std::time::Instant;
 

@@ -183,10 +183,10 @@ pub const FRICTION_FMUS: &[DrivenFmu] = &[
 /// resolved value references: [`FmuStepper::step`] is one communication
 /// step through the C ABI (`fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal`).
 pub struct FmuStepper {
-    instance: fricsim::fmu::Instance,
+    instance: fricsim_fmi::Instance,
     inputs: &'static [Sinusoid],
-    input_vrs: Vec<fricsim::fmu::ValueReference>,
-    output_vrs: Vec<fricsim::fmu::ValueReference>,
+    input_vrs: Vec<fricsim_fmi::ValueReference>,
+    output_vrs: Vec<fricsim_fmi::ValueReference>,
     u: Vec<f64>,
     /// The outputs after the last step.
     pub y: Vec<f64>,
@@ -195,7 +195,7 @@ pub struct FmuStepper {
 impl FmuStepper {
     /// Instantiate the `index`-th model of [`FRICTION_FMUS`] from `fmu`,
     /// initialised at t = 0 with its default parameters.
-    pub fn new(fmu: &fricsim::fmu::Fmu, index: usize) -> Result<FmuStepper, String> {
+    pub fn new(fmu: &fricsim_fmi::Fmu, index: usize) -> Result<FmuStepper, String> {
         let (model, inputs, outputs) = FRICTION_FMUS[index];
         let vr = |name: &str| {
             fmu.variable(name)
@@ -224,7 +224,7 @@ impl FmuStepper {
     }
 
     /// Set the inputs at `t`, step to `t + h`, read the outputs.
-    pub fn step(&mut self, t: f64, h: f64) -> Result<(), fricsim::FmuError> {
+    pub fn step(&mut self, t: f64, h: f64) -> Result<(), fricsim_fmi::FmuError> {
         for (x, (_, a, phase)) in self.u.iter_mut().zip(self.inputs) {
             *x = a * (std::f64::consts::TAU * t + phase).sin();
         }

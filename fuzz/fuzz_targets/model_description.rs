@@ -5,7 +5,7 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {
-        if let Err(e) = fricsim::fmu::ModelDescription::parse(text) {
+        if let Err(e) = fricsim_fmi::ModelDescription::parse(text) {
             assert!(!e.to_string().is_empty());
         }
     }

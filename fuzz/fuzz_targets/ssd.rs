@@ -22,7 +22,7 @@ static DIR: LazyLock<(tempfile::TempDir, PathBuf)> = LazyLock::new(|| {
 fuzz_target!(|data: &[u8]| {
     let ssd = &DIR.1;
     std::fs::write(ssd, data).unwrap();
-    if let Err(e) = fricsim::ssp::SystemFile::open(ssd) {
+    if let Err(e) = fricsim_core::ssp::SystemFile::open(ssd) {
         assert!(!e.to_string().is_empty());
     }
 });

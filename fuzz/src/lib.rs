@@ -63,7 +63,7 @@ pub static MODELS: LazyLock<Vec<fmi::Model>> = LazyLock::new(|| {
             let path = fmi::repository()
                 .join("modelDescription")
                 .join(format!("{name}.xml"));
-            let md = fricsim::fmu::ModelDescription::from_file(&path).unwrap();
+            let md = fricsim_fmi::ModelDescription::from_file(&path).unwrap();
             fmi::Model::from_description(&md)
         })
         .collect()

@@ -16,9 +16,13 @@
 //! - `fricsim-fmi` (`host/fmi`): the importer, here [`fmu`];
 //! - `fricsim-core` (`host/core`): systems, masters, inputs, result files,
 //!   isolation, sweeps, plots ([`system`], [`master`], [`results`], ...);
-//! - this crate, `fricsim`: the diagnosis ([`diagnose`]), the `fricsim`
-//!   binary, and the modules of the crates above under the paths they had
-//!   when they were one crate.
+//! - `fricsim-diagnose` (`host/diagnose`): the diagnosis, here
+//!   [`diagnose`];
+//! - this crate, `fricsim`: the `fricsim` binary, and the modules of the
+//!   crates above under the paths they had when they were one crate.
+//!
+//! The diagnosis's generated test data are `fricsim-hidden-effects`
+//! (`host/hidden-effects`), which the binary does not contain.
 //!
 //! ```no_run
 //! use fricsim::fmu::Fmu;
@@ -40,4 +44,5 @@ pub use fricsim_core::{
     rows, run, signals, ssp, stale, sweep, system, writer_thread,
 };
 pub use fricsim_core::{ArchiveProblem, FmuError};
-pub mod diagnose;
+/// The diagnosis, the crate `fricsim-diagnose` (`host/diagnose`).
+pub use fricsim_diagnose as diagnose;

@@ -7,25 +7,25 @@
 //! carrying the host's message: the file and line, the instance, the call.
 //!
 //! Ctrl-C: Python's signal handler only sets a flag while Rust runs. A run
-//! hands its rows on in chunks ([`fricsim::master::simulate_streaming`]);
+//! hands its rows on in chunks ([`fricsim_core::master::simulate_streaming`]);
 //! between chunks it takes the GIL for a moment and calls
 //! `Python::check_signals` (PyErr_CheckSignals), and on KeyboardInterrupt
 //! asks the run to stop ([`RowSink::stop_requested`]): the instances are
 //! freed and the unpacked FMUs removed as on any early stop, then the
 //! KeyboardInterrupt is raised.
 
-use fricsim::diagnose::model::Effect;
-use fricsim::diagnose::{diagnose_records as run_diagnosis, report, CrossValidate, Options};
-use fricsim::fmu::archive::{unpack, UnpackOptions};
-use fricsim::fmu::library::platforms;
-use fricsim::fmu::ModelDescription;
-use fricsim::inputs::InputTable;
-use fricsim::master::{by_name, RowSink};
-use fricsim::rows::Rows;
-use fricsim::run::{time_grid, PreparedRun, RunOptions, StartValue};
-use fricsim::ssp::SystemFile;
-use fricsim::sweep::{check_axes, run_all, Axis, Plan};
-use fricsim::FmuError;
+use fricsim_diagnose::model::Effect;
+use fricsim_diagnose::{diagnose_records as run_diagnosis, report, CrossValidate, Options};
+use fricsim_fmi::archive::{unpack, UnpackOptions};
+use fricsim_fmi::library::platforms;
+use fricsim_fmi::ModelDescription;
+use fricsim_core::inputs::InputTable;
+use fricsim_core::master::{by_name, RowSink};
+use fricsim_core::rows::Rows;
+use fricsim_core::run::{time_grid, PreparedRun, RunOptions, StartValue};
+use fricsim_core::ssp::SystemFile;
+use fricsim_core::sweep::{check_axes, run_all, Axis, Plan};
+use fricsim_fmi::FmuError;
 use pyo3::create_exception;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
@@ -48,7 +48,7 @@ fn host_error(message: impl Into<String>) -> PyErr {
 
 /// A start value from Python, typed as Python types it: `bool`, `int`,
 /// `float`, `str` (checked against the variable's type by
-/// [`fricsim::run::check_start_value`]).
+/// [`fricsim_core::run::check_start_value`]).
 #[derive(FromPyObject)]
 enum Value {
     Boolean(bool),
@@ -166,7 +166,7 @@ type RunResult = (Vec<String>, Vec<f64>, Option<String>, Vec<String>);
 type PyRunResult = (Vec<String>, Py<PyBytes>, Option<String>, Vec<String>);
 
 /// `fricsim.run`: co-simulate a system file exactly as `fricsim run` does
-/// (one code path: [`fricsim::run::PreparedRun`]), returning the rows
+/// (one code path: [`fricsim_core::run::PreparedRun`]), returning the rows
 /// instead of writing a CSV.
 #[pyfunction]
 #[pyo3(signature = (system, start=None, stop=None, step=None, master=None, start_values=Vec::new(), output_interval=None, record=Vec::new(), input=None, step_timeout=None, input_hold=false))]
@@ -347,7 +347,7 @@ fn diagnose(
                 .collect::<Result<_, _>>()?;
         }
         let mut file = SystemFile::open(&system).map_err(|e| e.to_string())?;
-        let moved = fricsim::diagnose::dahl::move_to_lugre(&mut file, lugre.as_deref())?;
+        let moved = fricsim_diagnose::dahl::move_to_lugre(&mut file, lugre.as_deref())?;
         let mut d = run_diagnosis(&file, &data, &heldout, &options)?;
         if let Some(note) = moved {
             d.notes.push(note);
@@ -364,7 +364,7 @@ fn diagnose(
 fn seed_ports(py: Python<'_>, system: PathBuf) -> PyResult<Vec<String>> {
     py.allow_threads(|| {
         let file = SystemFile::open(&system).map_err(|e| e.to_string())?;
-        fricsim::sweep::seed_ports(&file)
+        fricsim_core::sweep::seed_ports(&file)
     })
     .map_err(host_error)
 }
@@ -373,16 +373,16 @@ fn seed_ports(py: Python<'_>, system: PathBuf) -> PyResult<Vec<String>> {
 /// (what travels to the workers of a Dask cluster).
 #[pyfunction]
 fn pack(py: Python<'_>, ssd: PathBuf, out: PathBuf) -> PyResult<()> {
-    py.allow_threads(|| fricsim::ssp::pack(Path::new(&ssd), &out))
+    py.allow_threads(|| fricsim_core::ssp::pack(Path::new(&ssd), &out))
         .map_err(|e| host_error(e.to_string()))
 }
 
 /// The folders `<prefix><pid>-…` in `dir` whose process no longer runs,
-/// removed ([`fricsim::stale`], as `fricsim run` removes the FMU folders
+/// removed ([`fricsim_core::stale`], as `fricsim run` removes the FMU folders
 /// of a killed run): the folders of killed Dask workers.
 #[pyfunction]
 fn remove_folders_of_gone_processes(dir: PathBuf, prefix: &str) {
-    fricsim::stale::remove_left_by_gone_processes(&dir, prefix, |p| std::fs::remove_dir_all(p));
+    fricsim_core::stale::remove_left_by_gone_processes(&dir, prefix, |p| std::fs::remove_dir_all(p));
 }
 
 #[pymodule]

@@ -4,7 +4,7 @@
 //! file is co-simulated exactly as `fricsim run FILE --master M --step H`
 //! does it (same [`SystemFile::build`], [`by_name`], [`simulate_with`]),
 //! its monolithic reference solved exactly as `fricsim reference FILE
-//! --step H` does it (same [`fricsim::reference::spec`], tolerance
+//! --step H` does it (same [`fricsim_core::reference::spec`], tolerance
 //! [`RTOL`]), and the friction force compared as `fricsim compare` does it
 //! ([`compare`]): relative RMS error over the communication points. All in
 //! one process, so that no CSV of millions of rows is written and read
@@ -34,12 +34,12 @@
 //! wall times and the "Generated" line are not compared.
 
 use clap::Parser;
-use fricsim::compare::{compare, ResultFile};
-use fricsim::master::{by_name, simulate_with, NoObserver, Run};
-use fricsim::ssp::SystemFile;
 use fricsim_bench::{
     command_line, exit_code, generated_part, machine, splice, today, TableFileArgs,
 };
+use fricsim_core::compare::{compare, ResultFile};
+use fricsim_core::master::{by_name, simulate_with, NoObserver, Run};
+use fricsim_core::ssp::SystemFile;
 use fricsim_reference::{ReferenceModel, RTOL};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -264,10 +264,10 @@ fn run_row(
     masters: &[String],
 ) -> Result<Row, String> {
     let start = file.start_time.unwrap_or(0.0);
-    let n = fricsim::master::step_count(start, step, stop);
+    let n = fricsim_core::master::step_count(start, step, stop);
     let times: Vec<f64> = (0..=n).map(|i| start + i as f64 * step).collect();
     let clock = Instant::now();
-    let spec = fricsim::reference::spec(file)?;
+    let spec = fricsim_core::reference::spec(file)?;
     let mut model = ReferenceModel::from_spec(&spec)
         .map_err(|e| format!("{}: no monolithic reference: {e}", file.ssd))?;
     let (table, _) = model
@@ -277,7 +277,7 @@ fn run_row(
     let reference = as_result_file(
         "reference",
         Run {
-            rows: fricsim::master::Rows::from_rows(table.columns.len(), &table.rows),
+            rows: fricsim_core::master::Rows::from_rows(table.columns.len(), &table.rows),
             columns: table.columns,
             time: table.time,
             error: None,

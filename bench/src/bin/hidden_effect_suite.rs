@@ -1,5 +1,5 @@
 //! `hidden-effect-suite`: run `fricsim diagnose` on cases that hide known
-//! effects ([`fricsim::diagnose::suite`]) and print, per case and in sum,
+//! effects ([`fricsim_hidden_effects::suite`]) and print, per case and in sum,
 //! how often the right effect is named, how close its fitted size is to
 //! the truth and how far the held-out error drops.
 //!
@@ -9,9 +9,9 @@
 //! ```
 
 use clap::Parser;
-use fricsim::diagnose::model::Effect;
-use fricsim::diagnose::suite::{export_case, run_case, CaseResult, CaseSpec, SIZE_TOLERANCE};
-use fricsim::diagnose::Options;
+use fricsim_diagnose::model::Effect;
+use fricsim_diagnose::Options;
+use fricsim_hidden_effects::suite::{export_case, run_case, CaseResult, CaseSpec, SIZE_TOLERANCE};
 use std::path::PathBuf;
 
 #[derive(Parser)]

@@ -3,7 +3,7 @@
 //! one machine at one time).
 //!
 //! 1. **One communication step of each friction FMU** through the C ABI
-//!    ([`fricsim::fmu::Instance`]: `fmi2SetReal`, `fmi2DoStep`,
+//!    ([`fricsim_fmi::Instance`]: `fmi2SetReal`, `fmi2DoStep`,
 //!    `fmi2GetReal`), ns per step, at a small (1e-5 s) and a large
 //!    (1e-2 s) step, the inputs a 1 Hz sinusoid through stick and slip.
 //! 2. **The LuGre stick-slip benchmark** (`examples/stick_slip.ssd`, 20 s at
@@ -41,7 +41,7 @@
 //!    reversal (0 → 3·δmax → −3·δmax), per-increment cost, of the law and,
 //!    in turns with it, through `Bristle.fmu`'s C ABI (the same forces, bit
 //!    for bit).
-//! 5. **`fricsim sweep`** ([`fricsim::sweep::run_all`]) on one thread and
+//! 5. **`fricsim sweep`** ([`fricsim_core::sweep::run_all`]) on one thread and
 //!    on every core: runs per second.
 //! 6. **`fricsim diagnose`** on the EMPS data: the command, timed.
 //!
@@ -58,14 +58,14 @@
 //! builds everything and updates BENCHMARKS.md.
 
 use clap::Parser;
-use fricsim::fmu::Fmu;
-use fricsim::master::{by_name, simulate_streaming, step_count, NoObserver, RowSink, Rows};
-use fricsim::ssp::{SystemFile, Value};
-use fricsim::sweep::{grid, run_all, Axis, Plan};
 use fricsim_bench::{
     bristle_curve, bristle_curve_point, command_line, exit_code, load_average, machine, splice,
     today, FmuStepper, TableFileArgs, FRICTION_FMUS, INCREMENTS,
 };
+use fricsim_core::master::{by_name, simulate_streaming, step_count, NoObserver, RowSink, Rows};
+use fricsim_core::ssp::{SystemFile, Value};
+use fricsim_core::sweep::{grid, run_all, Axis, Plan};
+use fricsim_fmi::Fmu;
 use friction_laws::bristle::{Bristle, BristleParams};
 use friction_laws::dahl::{Dahl, DahlParams};
 use friction_laws::lugre::{HeldInput, LuGre, LuGreInputs, LuGreParams};
@@ -331,7 +331,7 @@ fn law_table(root: &Path, sizes: &Sizes) -> Result<Vec<LawRow>, String> {
 
 const STICK_SLIP: &str = "examples/stick_slip.ssd";
 const STICK_SLIP_STEP: f64 = 1e-4;
-/// Strong coupling's tolerances, as [`fricsim::master::strong`] has them.
+/// Strong coupling's tolerances, as [`fricsim_core::master::strong`] has them.
 const RTOL: f64 = 1e-8;
 const ATOL: f64 = 1e-10;
 
@@ -432,7 +432,7 @@ fn host_run(
     master: &str,
     h: f64,
     stop: f64,
-) -> Result<(f64, f64, Box<dyn fricsim::master::MasterAlgorithm>), String> {
+) -> Result<(f64, f64, Box<dyn fricsim_core::master::MasterAlgorithm>), String> {
     let mut algorithm = by_name(master)?;
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
     // every output, as `fricsim run` records them (LuGre's Boolean
@@ -882,7 +882,7 @@ fn fmpy_run(
 /// The nominal of input `variable` of component `name` (1 if none), the
 /// scale of strong coupling's absolute tolerance.
 fn input_nominal(fmus: &[(String, Fmu)], name: &str, variable: &str) -> f64 {
-    use fricsim::fmu::model_description::VariableKind;
+    use fricsim_fmi::model_description::VariableKind;
     fmus.iter()
         .find(|(n, _)| n == name)
         .and_then(|(_, f)| f.variable(variable).ok())
@@ -902,7 +902,7 @@ fn input_nominal(fmus: &[(String, Fmu)], name: &str, variable: &str) -> f64 {
 const RECORDED: usize = 13;
 
 /// What a run of a monolithic loop records, as a host run does
-/// ([`fricsim::master::Run`]): the time of each communication point and a
+/// ([`fricsim_core::master::Run`]): the time of each communication point and a
 /// row of outputs there.
 #[derive(Default)]
 struct Recording {
@@ -982,7 +982,7 @@ impl StickSlipModel {
 
     /// The outputs the FMUs record (Rig1D's ten, LuGre's F, z and sliding) at time
     /// `t`, one row per communication point in the host's format
-    /// ([`fricsim::master::Run`]: the time, and a [`Rows`] of [`RECORDED`]
+    /// ([`fricsim_core::master::Run`]: the time, and a [`Rows`] of [`RECORDED`]
     /// columns written in place), so that only the FMI boundary differs
     /// between the two loops.
     /// `friction_force` is LuGre's output F at its input, computed once by
@@ -1311,7 +1311,7 @@ struct ScalingRow {
 /// of the forces, which must equal [`bristle_curve`]'s bit for bit.
 fn bristle_curve_through_fmu(fmu: &Fmu, count: usize) -> Result<(f64, f64), String> {
     let vr = |name: &str| fmu.variable(name).map(|v| v.value_reference);
-    let e = |e: fricsim::FmuError| e.to_string();
+    let e = |e: fricsim_fmi::FmuError| e.to_string();
     let (x, f) = (vr("x").map_err(e)?, vr("F").map_err(e)?);
     let n_bristles = vr("n_bristles").map_err(e)?;
     let count_from_load = vr("count_from_load").map_err(e)?;
@@ -1558,7 +1558,7 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
 
     let _ = writeln!(
         s,
-        "**One communication step of each friction FMU** through the C ABI (`fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal` from `fricsim::fmu::Instance`), ns per step, {} steps, inputs a 1 Hz sinusoid through stick and slip:\n",
+        "**One communication step of each friction FMU** through the C ABI (`fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal` from `fricsim_fmi::Instance`), ns per step, {} steps, inputs a 1 Hz sinusoid through stick and slip:\n",
         sizes.law_steps
     );
     let _ = writeln!(
@@ -1691,7 +1691,7 @@ fn render(r: &Report, sizes: &Sizes, command: &str, total: f64) -> String {
 
     let _ = writeln!(
         s,
-        "\n**Bristle count**: the bristle law (`friction-laws`) over a {INCREMENTS}-increment curve with one reversal (0 → 3·δmax in 500 increments, back to −3·δmax in 500), Appels and Herder's σ_ini and δmax; the placement (`Bristle::new`, once per realisation) apart. The last two columns run the same curve through `Bristle.fmu` (`fmi2SetReal` x, `fmi2DoStep`, `fmi2GetReal` F per increment, the FMU loaded by `fricsim::fmu`), in turns with the law; its forces equal the law's bit for bit:\n"
+        "\n**Bristle count**: the bristle law (`friction-laws`) over a {INCREMENTS}-increment curve with one reversal (0 → 3·δmax in 500 increments, back to −3·δmax in 500), Appels and Herder's σ_ini and δmax; the placement (`Bristle::new`, once per realisation) apart. The last two columns run the same curve through `Bristle.fmu` (`fmi2SetReal` x, `fmi2DoStep`, `fmi2GetReal` F per increment, the FMU loaded by `fricsim_fmi`), in turns with the law; its forces equal the law's bit for bit:\n"
     );
     let _ = writeln!(
         s,

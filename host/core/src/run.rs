@@ -8,10 +8,10 @@
 //! [`RowSink`] as they are computed, and returns the [`RunOutcome`].
 //!
 //! ```no_run
-//! use fricsim::output_file::OutputFile;
-//! use fricsim::results::ResultWriter;
-//! use fricsim::run::{PreparedRun, RunOptions, StartValue};
-//! use fricsim::ssp::SystemFile;
+//! use fricsim_core::output_file::OutputFile;
+//! use fricsim_core::results::ResultWriter;
+//! use fricsim_core::run::{PreparedRun, RunOptions, StartValue};
+//! use fricsim_core::ssp::SystemFile;
 //! let file = SystemFile::open("dist/stick_slip.ssp").map_err(|e| e.to_string())?;
 //! let options = RunOptions {
 //!     stop: Some(5.0),

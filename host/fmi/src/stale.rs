@@ -2,7 +2,7 @@
 //!
 //! A run killed with SIGKILL, or one whose process crashes, runs no
 //! destructor: its temporary result file (`.<name>.fricsim-partial-<pid>`,
-//! the host's result files (`fricsim::output_file`)) and the folders its FMUs were unpacked into
+//! the host's result files, `fricsim_core::output_file`) and the folders its FMUs were unpacked into
 //! (`fricsim-fmu-<pid>-XXXXXX` in the temporary directory,
 //! [`crate::archive`]) stay. Both names carry the pid of the process
 //! that made them, so a later run can tell which ones belong to a process

@@ -15,7 +15,7 @@
 //! unknown state). A call that never returns keeps fricsim waiting until it
 //! is interrupted (Ctrl-C), and the results of that run are then lost.
 //! `--isolate` runs the FMUs in a child process, which the parent kills
-//! when a call passes the limit (the host's process isolation (`fricsim::isolate`)).
+//! when a call passes the limit (the host's process isolation, `fricsim_core::isolate`).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock, Weak};
@@ -30,7 +30,7 @@ static REPORT: AtomicBool = AtomicBool::new(true);
 
 /// Report a call still running past its limit on stderr (the default), or
 /// not: in an isolated run the parent process stops such a call and says
-/// so itself (the host's process isolation (`fricsim::isolate`)).
+/// so itself (the host's process isolation, `fricsim_core::isolate`).
 pub fn report_on_stderr(on: bool) {
     REPORT.store(on, Ordering::Relaxed);
 }

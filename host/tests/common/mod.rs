@@ -73,9 +73,9 @@ pub fn stub_fmu_dir(capabilities: &str, flags: &[&str]) -> TempDir {
 /// The FMU `dist/<name>.fmu` of this repository with `edit` applied to its
 /// model description, zipped into `out`. The edit must change something.
 pub fn repacked(name: &str, out: &Path, edit: impl Fn(&str) -> String) -> PathBuf {
-    let unpacked = fricsim::fmu::archive::unpack(
+    let unpacked = fricsim_fmi::archive::unpack(
         &repository().join("dist").join(format!("{name}.fmu")),
-        &fricsim::fmu::archive::UnpackOptions::default(),
+        &fricsim_fmi::archive::UnpackOptions::default(),
     )
     .unwrap();
     let md = unpacked.path().join("modelDescription.xml");

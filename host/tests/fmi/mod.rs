@@ -169,8 +169,8 @@ pub struct Model {
 
 impl Model {
     /// From a `modelDescription.xml` (parsed by the host's parser).
-    pub fn from_description(md: &fricsim::fmu::ModelDescription) -> Model {
-        use fricsim::fmu::VariableKind as K;
+    pub fn from_description(md: &fricsim_fmi::ModelDescription) -> Model {
+        use fricsim_fmi::VariableKind as K;
         Model {
             name: md.model_name.clone(),
             guid: md.guid.clone(),
@@ -693,9 +693,9 @@ pub fn load_shipped(name: &str) -> Loaded {
         "{} is missing: run ./build-fmu.sh first",
         fmu.display()
     );
-    let dir = fricsim::fmu::archive::unpack(&fmu, &Default::default()).unwrap();
-    let md = fricsim::fmu::ModelDescription::from_file(&dir.path().join("modelDescription.xml"))
-        .unwrap();
+    let dir = fricsim_fmi::archive::unpack(&fmu, &Default::default()).unwrap();
+    let md =
+        fricsim_fmi::ModelDescription::from_file(&dir.path().join("modelDescription.xml")).unwrap();
     let identifier = &md.co_simulation.model_identifier;
     let so = dir
         .path()

@@ -1,4 +1,4 @@
-//! `fricsim diagnose` (host/src/diagnose/): the real-data case it must
+//! `fricsim diagnose` (host/diagnose/): the real-data case it must
 //! get right (EMPS) and the bad inputs it must refuse with a message,
 //! writing nothing.
 

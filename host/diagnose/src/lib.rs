@@ -1,4 +1,4 @@
-//! `fricsim diagnose`: where simulation and measurement disagree, which
+//! `fricsim-diagnose`, the diagnosis of `fricsim diagnose`: where simulation and measurement disagree, which
 //! physical effect is missing, the model with it added and refitted, and
 //! the error on data the fit did not see.
 //!
@@ -39,8 +39,10 @@ pub mod problem;
 pub mod quality;
 pub mod report;
 pub mod sim;
-pub mod suite;
-pub mod synthetic;
+
+// the co-simulation core's modules under the paths the diagnosis names
+// them by
+use fricsim_core::{fmu, inputs, master, plot, ssp, system, FmuError};
 
 use model::{Effect, FrictionModel};
 use problem::{FrictionData, Measured, Setup};

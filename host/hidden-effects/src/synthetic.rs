@@ -21,12 +21,12 @@
 //! effort u_ctrl + N(0, 0.02 V) quantised to 10 V/2048 (a 12-bit DAC); Fn
 //! + N(0, 0.2 N). 1 kHz samples.
 
-use super::model::{Effect, FrictionModel};
-use super::problem::{FrictionData, Setup};
-use super::sim::{system_parameters, FrictionSim};
-use crate::inputs::{ExternalInputs, InputTable};
-use crate::master::{by_name, simulate_with};
-use crate::ssp::{ParameterDef, SystemFile, Value};
+use fricsim_core::inputs::{ExternalInputs, InputTable};
+use fricsim_core::master::{by_name, simulate_with};
+use fricsim_core::ssp::{ParameterDef, SystemFile, Value};
+use fricsim_diagnose::model::{Effect, FrictionModel};
+use fricsim_diagnose::problem::{FrictionData, Setup};
+use fricsim_diagnose::sim::{system_parameters, FrictionSim};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::f64::consts::TAU;
@@ -138,9 +138,9 @@ pub fn generate(
 ) -> Result<Case, String> {
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
     // the data come from the system file's master with its inputs
-    // interpolated (second order, [`super::diagnosis_master`]): as close
+    // interpolated (second order, [`fricsim_diagnose::diagnosis_master`]): as close
     // to the continuous system as the co-simulation gets at this step
-    let master_name = super::diagnosis_master(&file.settings.master_or_default(), None);
+    let master_name = fricsim_diagnose::diagnosis_master(&file.settings.master_or_default(), None);
     let setup = Setup::new(file, &mut system, SAMPLE, &master_name)?;
     let n = (duration / SAMPLE).round() as usize;
     let time: Vec<f64> = (0..=n).map(|k| k as f64 * SAMPLE).collect();

@@ -28,9 +28,9 @@
 //! the table of BENCHMARKS.md; `host/tests/integration/diagnose_hidden_effects.rs`
 //! runs a few.
 
-use super::model::{Effect, FrictionModel};
-use super::synthetic;
-use super::{diagnose, Options};
+use crate::synthetic;
+use fricsim_diagnose::model::{Effect, FrictionModel};
+use fricsim_diagnose::{diagnose, Options};
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -106,7 +106,7 @@ pub struct CaseResult {
     /// baseline_rms / final_rms.
     pub heldout_drop: f64,
     /// Held-out RMS of the refitted nominal system against the noise-free
-    /// truth (normalised like the others, [`super::truth_rms`]): the model
+    /// truth (normalised like the others, [`fricsim_diagnose::truth_rms`]): the model
     /// error without the measurement noise.
     pub truth_baseline_rms: f64,
     /// The same for the final model.
@@ -212,8 +212,9 @@ pub fn run_case(
     )?;
     let d = diagnose(&nominal, &csv, None, options)?;
     let truth_baseline_rms =
-        super::truth_rms(&nominal, &csv, &truth_csv, &d.baseline_model, options)?;
-    let truth_final_rms = super::truth_rms(&nominal, &csv, &truth_csv, &d.final_model, options)?;
+        fricsim_diagnose::truth_rms(&nominal, &csv, &truth_csv, &d.baseline_model, options)?;
+    let truth_final_rms =
+        fricsim_diagnose::truth_rms(&nominal, &csv, &truth_csv, &d.final_model, options)?;
     let _ = std::fs::remove_file(&csv);
     let _ = std::fs::remove_file(&truth_csv);
     let found: Vec<Effect> = d.effects.iter().map(|e| e.name).collect();
@@ -259,7 +260,7 @@ pub fn run_case(
 /// `h` itself when found, else a found effect of `h`'s family whose
 /// alternatives give `h` as not separated from it (the data could not tell
 /// the two apart, and the report says so).
-pub fn stand_in(h: Effect, d: &super::Diagnosis) -> Option<Effect> {
+pub fn stand_in(h: Effect, d: &fricsim_diagnose::Diagnosis) -> Option<Effect> {
     if d.effects.iter().any(|e| e.name == h) {
         return Some(h);
     }
@@ -308,7 +309,7 @@ struct ExportedCase<'a> {
 /// derives from it (`<label>-<magnitude>-<seed>.friction.csv`: interval
 /// start `t`, velocity `v`, position `x`, normal force `Fn`, the friction
 /// force the data imply `F`, `trusted` (1/0, see
-/// [`super::problem::FrictionData::trusted`]) and `heldout` (1 in the
+/// [`fricsim_diagnose::problem::FrictionData::trusted`]) and `heldout` (1 in the
 /// blocks diagnose holds out)) and a JSON of the case and its truth. The
 /// baseline sees the same preprocessed data as diagnose's fits.
 pub fn export_case(
@@ -318,7 +319,7 @@ pub fn export_case(
     options: &Options,
     dir: &Path,
 ) -> Result<(), String> {
-    use super::problem::{Measured, Setup};
+    use fricsim_diagnose::problem::{Measured, Setup};
     use std::fmt::Write as _;
     let nominal_file = synthetic::nominal_file(example, &case.hidden)?;
     let stem = format!("{}-{}-{}", case.label(), case.magnitude, case.seed);
@@ -341,7 +342,7 @@ pub fn export_case(
         &nominal_file.settings.master_or_default(),
     )?;
     let d = setup.friction_data(&system, &data, options.smooth)?;
-    let blocks = super::Blocks::new(&data.time, options.blocks);
+    let blocks = fricsim_diagnose::Blocks::new(&data.time, options.blocks);
     let mut text = String::from("t,v,x,Fn,F,trusted,heldout\n");
     for j in 0..d.t.len() {
         let _ = writeln!(
