@@ -46,6 +46,9 @@ scripts/setup-windows.sh
 start browser-and-fmi-crate bash -c 'scripts/setup-browser.sh && scripts/setup-fmi-crate.sh'
 ./build-fmu.sh
 cargo test --workspace --profile release-test
+# the host's library crates document their public API without a broken link
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p fricsim-fmi -p fricsim-core \
+    -p fricsim-diagnose -p fricsim-hidden-effects -p fricsim
 finish venv
 finish browser-and-fmi-crate
 scripts/setup-python-package.sh

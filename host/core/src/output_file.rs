@@ -15,7 +15,7 @@
 //!   that runs its code to the end (one left by a killed run is reused);
 //! * writes to the temporary file `.<name>.fricsim-partial-<pid>` in the
 //!   same directory (starting the disk writing every MiB as it goes,
-//!   [`Writeback`]) and, once complete, flushes it to the disk
+//!   `Writeback`) and, once complete, flushes it to the disk
 //!   (`fsync`), renames it over the path (atomic on POSIX: a reader sees
 //!   the previous file or the new one, never a mix) and flushes the
 //!   directory, so that the rename itself survives a power loss;

@@ -301,7 +301,7 @@ pub struct CandidateScore {
     /// One-sided p-value of the paired test against the current model.
     pub p_value: f64,
     /// Why the data cannot tell the candidate from the current model, when
-    /// they cannot ([`unresolved_presliding`]); then it is not accepted.
+    /// they cannot (`unresolved_presliding`); then it is not accepted.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub unresolved: Option<String>,
     /// Drop of the mean square and p-value when the current model and the
@@ -310,7 +310,7 @@ pub struct CandidateScore {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fine_step: Option<(f64, f64)>,
     /// Whether the held-out mean square drops by more than the current
-    /// model's step error squared ([`drop_beyond_step_error`]).
+    /// model's step error squared (`drop_beyond_step_error`).
     pub beyond_step_error: bool,
     /// RMS of the law's force against the force the data imply (N), training.
     pub force_rms: f64,
@@ -2431,15 +2431,15 @@ fn unmoved_resize(
     })
 }
 
-/// See [`unmoved_resize`].
+/// See `unmoved_resize`.
 pub const RESIZE_MIN_CHANGE: f64 = 0.05;
 
 /// A change of the presliding displacement at a reversal below this many
-/// encoder steps is not resolved by the data ([`unresolved_presliding`]).
+/// encoder steps is not resolved by the data (`unresolved_presliding`).
 pub const PRESLIDING_RESOLVED: f64 = 1.0;
 
 /// The presliding displacement at a reversal, in presliding distances
-/// Fc/σ0: the bristles go from −Fc/σ0 to +Fc/σ0 ([`unresolved_presliding`]).
+/// Fc/σ0: the bristles go from −Fc/σ0 to +Fc/σ0 (`unresolved_presliding`).
 pub const PRESLIDING_SWING: f64 = 2.0;
 
 /// Whether a candidate of held-out RMS `candidate_rms` lowers the mean
