@@ -53,6 +53,10 @@ pub const SATURATION_RUN_FACTOR: f64 = 5.0;
 /// A saturated run is reached or left by a step of at least this many
 /// resolutions of the column (its quantisation step, twice its noise).
 pub const SATURATION_KINK: f64 = 5.0;
+/// A column whose resolution (quantisation step, noise) is at most this
+/// fraction of its range has neither: it is computed, not measured, and
+/// is not checked for saturation.
+pub const NOISE_FREE: f64 = 1e-12;
 /// Share of the samples at the extreme for a column to be saturated.
 pub const SATURATION_SHARE: f64 = 0.005;
 /// At most this share of a file's samples may be flagged.
@@ -396,7 +400,15 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
         if lo >= hi {
             continue; // a constant column is a setting, not a clipped one
         }
-        let kink = SATURATION_KINK * resolution(y).max(f64::MIN_POSITIVE);
+        // a column without noise or quantisation (a computed command: the
+        // reference a controller followed) sits at its extreme because it
+        // was told to, a constant-velocity run (the standard friction
+        // experiment) reached by a ramp, not because a converter clipped it
+        let res = resolution(y);
+        if res <= NOISE_FREE * (hi - lo) {
+            continue;
+        }
+        let kink = SATURATION_KINK * res.max(f64::MIN_POSITIVE);
         // a column held in steps (a table, a setting) sits at every value
         // for a while: a clipped signal sits at its extreme far longer
         // than at its other values
@@ -560,6 +572,51 @@ mod tests {
         let mut cols = vec![("rig.x_act_in".to_string(), y)];
         let q = inspect(&time, &mut cols, &[]);
         assert_eq!(q.saturated, 0, "{:?}", q.findings);
+    }
+
+    /// A computed velocity reference of constant-velocity plateaus joined
+    /// by linear ramps (as a test rig's motion controller commands them)
+    /// is not clipped, though it reaches its extremes with a kink; the same
+    /// reference measured (quantised) and clipped below its plateau is.
+    #[test]
+    fn a_computed_reference_at_its_extreme_is_not_saturated() {
+        let n = 16000;
+        let time: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let plateaus = [(1.0, 0.05), (0.5, 0.15), (0.5, -0.15), (1.0, -0.05)];
+        let v_ref = |t: f64| {
+            let tau = t.rem_euclid(3.0);
+            let mut t0 = 0.0;
+            for (i, &(length, v)) in plateaus.iter().enumerate() {
+                if tau < t0 + length {
+                    let previous = plateaus[(i + 3) % 4].1;
+                    return previous + (v - previous) * ((tau - t0) / 0.05).min(1.0);
+                }
+                t0 += length;
+            }
+            plateaus[3].1
+        };
+        let v: Vec<f64> = time.iter().map(|&t| v_ref(t)).collect();
+        // with the position measured through a 1 µm encoder beside it
+        let mut x = vec![0.1];
+        for k in 1..n {
+            x.push(x[k - 1] + 0.5e-3 * (v[k - 1] + v[k]));
+        }
+        let encoder: Vec<f64> = x.iter().map(|&x| (x / 1e-6).round() * 1e-6).collect();
+        let mut cols = vec![
+            ("rig.v_ref".to_string(), v.clone()),
+            ("rig.x".to_string(), encoder),
+        ];
+        let q = inspect(&time, &mut cols, &[]);
+        assert_eq!(q.total(), 0, "{:?}", q.findings);
+        assert_eq!(cols[0].1, v, "nothing repaired");
+        // measured through a converter of 1e-4 m/s that clips at 0.12
+        let clipped: Vec<f64> = v
+            .iter()
+            .map(|&x| (x.clamp(-0.12, 0.12) / 1e-4).round() * 1e-4)
+            .collect();
+        let mut cols = vec![("rig.v".to_string(), clipped)];
+        let q = inspect(&time, &mut cols, &[]);
+        assert!(q.saturated >= 1, "{:?}", q.findings);
     }
 
     #[test]
