@@ -1748,8 +1748,8 @@ pub fn diagnose_records(
             let rest: Vec<Effect> = reduced_whole.freed.iter().copied().collect();
             let oe = accepted_as.iter().enumerate().any(|(j, a)| j != i && a.2);
             let from_itself = |m: &FrictionModel| vec![m.clone()];
-            let (refitted, _, _) = fit_folds_any(&from_itself, &reduced, &rest, oe)?;
-            let Ok(reduced_scored) = score(&mut system, &refitted) else {
+            let (mut refitted, _, _) = fit_folds_any(&from_itself, &reduced, &rest, oe)?;
+            let Ok(mut reduced_scored) = score(&mut system, &refitted) else {
                 i += 1;
                 continue;
             };
@@ -1759,7 +1759,6 @@ pub fn diagnose_records(
                 continue;
             }
             let mut whole = fit_whole_any(&[reduced_whole], &refitted, &rest, oe)?;
-            let (mut refitted, mut reduced_scored) = (refitted, reduced_scored);
             let w = Withdrawn {
                 name: effect,
                 accepted_in_round: accepted_as[i].0,
