@@ -14,7 +14,7 @@
 //! - [`spec`]: a system as plain data (components with model names, GUIDs
 //!   and parameter values; connections), and [`ReferenceModel`], which
 //!   recognises one of the couplings above in it;
-//! - [`metrics`]: the stick-slip figures of MODELS.md.
+//! - [`metrics`]: the stick-slip figures of docs/models.md, "Reference figures".
 //!
 //! Parameters are interpreted, and output columns named and computed from
 //! a state, by the FMU adapters' own variable tables and `compute_outputs`
@@ -49,7 +49,7 @@ use spec::Component;
 pub use spec::{ComponentSpec, MapError, SystemSpec, Value};
 use std::fmt;
 
-/// The relative tolerance of the reference solutions (MODELS.md: "Radau
+/// The relative tolerance of the reference solutions (docs/models.md, "Reference figures": "Radau
 /// IIA, rtol 1e-10").
 pub const RTOL: f64 = 1e-10;
 

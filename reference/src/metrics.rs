@@ -1,5 +1,5 @@
-//! Figures of a stick-slip run, as MODELS.md "Reference results to
-//! reproduce" states them for the LuGre benchmark: the first time the
+//! Figures of a stick-slip run, as docs/models.md ("Reference figures")
+//! states them for the LuGre benchmark: the first time the
 //! velocity exceeds 0.05 m/s (the first slip), the period (between the last
 //! two such instants), and the peaks of the friction force and the
 //! velocity.

@@ -9,7 +9,7 @@
 //!   ([`Rig2D::axis`]) set to `(t, x_i, ẋ_i)`, whose
 //!   [`Rig1D::acceleration`] and [`Rig1D::slip_velocity`]
 //!   (`v_i = ẋ_i − v_s,i(t)`, surface speed and dither) are used;
-//! - 2-D bristle (MODELS.md "Two-dimensional bristle", derived from Wijata
+//! - 2-D bristle (docs/models.md, "Two-dimensional bristle", derived from Wijata
 //!   et al. 2016): `ż = v − [on the boundary and z·v > 0]·(z·v)·z/|z|²`
 //!   ([`Bristle2D::z_rate`]), `F_i = (1 + a_i)·σ0i·z_i + σ1i(|v|)·ż_i`
 //!   inside the disc `|z| < z0`, without the `a_i` on its boundary

@@ -1,5 +1,5 @@
 //! The monolithic reference of Rig1D (m > 0) with LuGre and Dahl: the LuGre
-//! stick-slip benchmark against MODELS.md "Reference results to reproduce",
+//! stick-slip benchmark against docs/models.md, "Reference figures",
 //! convergence in the tolerance, consistency of the output columns, and the
 //! Dahl coupling against the law's exact update in displacement.
 
@@ -67,7 +67,7 @@ fn lugre_benchmark_reproduces_the_reference_results_to_the_digits_given() {
     let s = metrics::stick_slip(&t.time, &col(&t, "rig.v"), &col(&t, "friction.F"), 0.05)
         .expect("periodic stick-slip");
     eprintln!("reference figures: {s:?}");
-    // MODELS.md: first slip 7.540 s, period 6.3627 s, peak friction
+    // docs/models.md, "Reference figures": first slip 7.540 s, period 6.3627 s, peak friction
     // 1.4766 N, peak velocity 0.3698 m/s: each within half a unit of the
     // last digit given. Observed 7.5403975, 6.3627198, 1.4765729, 0.3698160.
     assert!((s.first_slip - 7.540).abs() <= 5e-4, "{s:?}");
@@ -262,7 +262,7 @@ fn recorded_inputs_and_parameters_follow_the_outputs_they_are_connected_to() {
 
 #[test]
 fn lugre_pre_sliding_settles_with_the_bristles_at_f_over_sigma0() {
-    // MODELS.md: with Sun et al. 2016's parameters a step force below break-away
+    // docs/models.md, "Reference figures": with Sun et al. 2016's parameters a step force below break-away
     // settles at x = F/σ0 (14.9 µm at 1 N). At rest the LuGre force is
     // σ0·z, so the bristle deflection z settles at F/σ0 exactly; the
     // body's x equals it only while F ≪ Fs: on the way, ż = v − σ0·|v|·z/g

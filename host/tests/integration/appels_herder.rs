@@ -4,7 +4,7 @@
 //! `examples/piezo_push.ssd` and `examples/piezo_relaxation.ssd`
 //! through the host.
 //!
-//! The paper's results (MODELS.md "Reference results", "Bristle"): sliding
+//! The paper's results (docs/models.md, "Reference figures" and "Pre-sliding bristle model"): sliding
 //! at σ_ini·δmax = μc·m·g; the transition to sliding completed within
 //! 2·δmax of body displacement; after the load is removed the block is
 //! pulled back (relaxation), by at most one bristle's largest deflection,

@@ -163,7 +163,7 @@ fn the_reference_of_the_stick_slip_example_has_the_columns_and_times_of_run() {
     assert_eq!(r.columns[..f.columns.len()], f.columns[..]);
     assert_eq!(r.columns[f.columns.len()..], ["friction.sliding"]);
     assert_eq!(r.time, f.time, "same times, bit for bit");
-    // The reference slips first at 7.540 s (MODELS.md).
+    // The reference slips first at 7.540 s (docs/models.md, "Reference figures").
     let v = &f.values[f.columns.iter().position(|c| c == "rig.v").unwrap()];
     let i = v.iter().position(|&v| v > 0.05).unwrap();
     assert!((f.time[i] - 7.540).abs() <= 5e-4, "{}", f.time[i]);

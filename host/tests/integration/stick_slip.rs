@@ -1,7 +1,7 @@
 //! The main job's scenario: the 1995 LuGre stick-slip benchmark
 //! (m = 1 kg, k = 2 N/m, pulled at 0.1 m/s; Canudas de Wit parameters) as
 //! Rig1D.fmu + LuGre.fmu under the Jacobi master at 1e-4 s, against the
-//! reference results of MODELS.md (Radau IIA, rtol 1e-10): period 6.3627 s,
+//! reference figures of docs/models.md (Radau IIA, rtol 1e-10): period 6.3627 s,
 //! peak friction 1.4766 N, peak velocity 0.3698 m/s, each within 0.5 %;
 //! velocity first above 0.05 m/s at t = 7.540 s.
 

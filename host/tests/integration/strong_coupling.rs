@@ -87,7 +87,7 @@ fn newton_reproduces_the_stick_slip_benchmark_at_a_millisecond_step() {
     let mut master = newton();
     let run = simulate(&mut system, &mut master, 1e-3, 12.0).unwrap();
     assert!(run.error.is_none(), "{:?}", run.error);
-    // MODELS.md reference results (Radau IIA, rtol 1e-10), within 0.5 %.
+    // docs/models.md "Reference figures" (Radau IIA, rtol 1e-10), within 0.5 %.
     let peak_force = max(&column(&run, "friction.F"));
     let peak_velocity = max(&column(&run, "rig.v"));
     assert!(

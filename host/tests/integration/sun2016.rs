@@ -3,7 +3,7 @@
 //! steps) and `examples/dahl_velocity.ssd` (Dahl, velocity
 //! control on v = 1e-3·sin(t/k)) through the host.
 //!
-//! MODELS.md "Reference results": a step force below break-away settles at
+//! docs/models.md, "Reference figures": a step force below break-away settles at
 //! x = F/σ0; Dahl follows its closed form. The second holds to 1e-4 of Fc.
 //! The first holds for LuGre's bristle deflection z, not for the position
 //! x: z lags x by ∫σ0·|v|·z/g(v) dt, so x exceeds F/σ0 by 13–183 % after

@@ -2,7 +2,7 @@
 //! two-dimensional bristle friction, as the example system files
 //! `examples/planar_*.ssd` (Rig2D.fmu + Bristle2D.fmu, the paper's
 //! numerical set from `examples/bristle2d_wijata2016.ssv`) run through the
-//! host, against the behaviours MODELS.md ("Two-dimensional bristle")
+//! host, against the behaviours docs/models.md ("Two-dimensional bristle")
 //! says the paper reports, and against closed forms where one exists:
 //!
 //! 1. planar oscillator: straight-line decay envelopes (R² > 0.99 of a line
