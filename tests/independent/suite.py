@@ -323,12 +323,13 @@ def main() -> int:
         help="run nothing: render OUT/suite.json (of an earlier run with the same --seeds) again",
     )
     ap.add_argument("--diagnose-arg", action="append", default=[], help="passed on to fricsim diagnose (repeat)")
-    ap.add_argument("--fricsim", type=Path, default=FRICSIM, help="the fricsim binary to diagnose with (default: this build's)")
+    ap.add_argument("--fricsim", type=Path, help="the fricsim binary to diagnose with (default: this build's)")
     ap.add_argument("--no-coarse", action="store_true", help="leave out the 200 Hz / 10 µm rows")
     ap.add_argument("--coarse-only", action="store_true", help="only the 200 Hz / 10 µm rows")
     args = ap.parse_args()
     global FRICSIM
-    FRICSIM = args.fricsim.resolve()
+    if args.fricsim:
+        FRICSIM = args.fricsim.resolve()
     todo = grid(args.seeds, args.quick, coarse=not args.no_coarse)
     if args.only:
         keep = args.only.split(",")
