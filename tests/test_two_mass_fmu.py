@@ -12,14 +12,12 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import add_logger_proxy
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, calloc, free
+from plant_fmus import open_plant
+from plant_fmus import jacobian as plant_jacobian
+from plant_fmus import stepped_outputs as plant_stepped_outputs
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "independent"))
 import cases  # noqa: E402
-import two_mass_fmu  # noqa: E402
 
 OUTPUTS = ["x_m", "x_l", "v", "a"]
 INPUTS = ["u", "F"]
@@ -27,39 +25,15 @@ INPUTS = ["u", "F"]
 
 @pytest.fixture
 def drive(tmp_path):
-    fmu = two_mass_fmu.build(tmp_path)
-    md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    messages = []
-
-    def logger(env, instance, status, category, message):
-        messages.append((status, message.decode()))
-
-    callbacks = fmi2CallbackFunctions()
-    callbacks.logger = fmi2CallbackLoggerTYPE(logger)
-    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-    add_logger_proxy(callbacks)
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=str(tmp_path / "unzipped")),
-                      modelIdentifier="TwoMassDrive", instanceName="drive")
-    slave.instantiate(callbacks=callbacks)
-    slave.setupExperiment(startTime=0.0)
-    slave.enterInitializationMode()
-    slave.exitInitializationMode()
-    yield slave, vr, messages, md
-    slave.terminate()
-    slave.freeInstance()
+    yield from open_plant(tmp_path, "two_mass")
 
 
 def jacobian(slave, vr):
-    return {(o, i): slave.getDirectionalDerivative([vr[o]], [vr[i]], [1.0])[0] for o in OUTPUTS for i in INPUTS}
+    return plant_jacobian(slave, vr, OUTPUTS, INPUTS)
 
 
 def stepped_outputs(slave, vr, state, t, h, inputs):
-    slave.setFMUstate(state)
-    slave.setReal([vr[n] for n in INPUTS], [inputs[n] for n in INPUTS])
-    slave.doStep(t, h)
-    return dict(zip(OUTPUTS, slave.getReal([vr[o] for o in OUTPUTS])))
+    return plant_stepped_outputs(slave, vr, state, t, h, {n: inputs[n] for n in INPUTS}, OUTPUTS)
 
 
 def test_directional_derivatives_are_the_step_sensitivity_after_a_step(drive):

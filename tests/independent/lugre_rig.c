@@ -32,10 +32,27 @@
  * a2·cos(ω2·t)] (the load's mean speed stays zero), both positions read
  * through the encoder. Output: time,drive.u,drive.x_m,drive.x_l[,...].
  *
+ * plant=servo: the same drive train (k, c the belt's stiffness and
+ * damping) under a PD position controller on the motor, which tracks the
+ * reference r(t) of `drive` (the actuator motion above: sines, a rounded
+ * triangle or ramped steps, the mass's speed crossing zero):
+ *
+ *   u         = Kp·(r(t) − x_m) − Kd·x_m'
+ *   m_m·x_m'' = u − k·(x_m − x) − c·(x_m' − x') − c_m·x_m'
+ *   m·x''     = k·(x_m − x) + c·(x_m' − x') − F
+ *
+ * both masses at rest at r(0) to start. The controller reads the true motor
+ * position and velocity (a continuous-time controller, as the nominal
+ * model has it); r and the controller's force u are written as computed,
+ * the two positions through the encoder. Output:
+ * time,drive.r,drive.x_m,drive.x_l,drive.u[,true_x,true_F] (true_x: the
+ * carriage's noise-free position, as for every plant).
+ *
  * Usage: lugre_rig key=value ... > data.csv
  *   keys: m c k Fc Fs Fc_neg Fs_neg vs sigma0 sigma1 sigma2 duration
  *         sample resolution noise seed drive (sines|triangle|steps)
  *         amp period  n_table x_table scale (comma lists)
+ *         plant (rig|two_mass|servo)  m_m c_m (two_mass, servo)  Kp Kd (servo)
  *         truth=1 (also write the noise-free x and the friction force)
  * Output: time,rig.x_act_in,rig.x[,true_x,true_F]
  */
@@ -56,8 +73,9 @@ static char drive[32] = "sines";
 static int n_table = 0;
 static double x_table[MAX_TABLE], scale_tab[MAX_TABLE];
 static int write_truth = 0;
-static int two_mass = 0;
+static int two_mass = 0, servo = 0; /* plant=two_mass, plant=servo */
 static double m_m = 0.5, c_m = 1.0;
+static double Kp = 4000, Kd = 140;
 static double step_fraction = 0.5; /* of the stiffest time scale */
 
 /* splitmix64 */
@@ -133,6 +151,11 @@ static double motor_force(double t) {
     return amp * ((1 - a2) * cos(2 * M_PI * f1 * t) + a2 * cos(2 * M_PI * f2 * t));
 }
 
+/* the servo's controller force: PD on the motor, tracking actuator(t) */
+static double servo_force(double t, const double *y) {
+    return Kp * (actuator(t) - y[3]) - Kd * y[4];
+}
+
 /* state y = (x, v, z[, x_m, v_m]); returns the friction force */
 static double rhs(double t, const double *y, double *dy) {
     double x = y[0], v = y[1], z = y[2];
@@ -140,11 +163,12 @@ static double rhs(double t, const double *y, double *dy) {
     double F = sigma0 * z + sigma1 * zd + sigma2 * v;
     dy[0] = v;
     dy[2] = zd;
-    if (two_mass) {
+    if (two_mass || servo) {
         double belt = k * (y[3] - x) + c * (y[4] - v);
+        double u = servo ? servo_force(t, y) : motor_force(t);
         dy[1] = (belt - F) / m;
         dy[3] = y[4];
-        dy[4] = (motor_force(t) - belt - c_m * y[4]) / m_m;
+        dy[4] = (u - belt - c_m * y[4]) / m_m;
     } else {
         dy[1] = (k * (actuator(t) - x) - c * v - F) / m;
         dy[3] = dy[4] = 0;
@@ -186,8 +210,15 @@ int main(int argc, char **argv) {
         KEY("duration", duration) KEY("sample", sample)
         KEY("resolution", resolution) KEY("noise", noise) KEY("amp", amp)
         KEY("period", period) KEY("step_fraction", step_fraction)
-        KEY("m_m", m_m) KEY("c_m", c_m)
-        else if (strcmp(key, "plant") == 0) two_mass = strcmp(val, "two_mass") == 0;
+        KEY("m_m", m_m) KEY("c_m", c_m) KEY("Kp", Kp) KEY("Kd", Kd)
+        else if (strcmp(key, "plant") == 0) {
+            two_mass = strcmp(val, "two_mass") == 0;
+            servo = strcmp(val, "servo") == 0;
+            if (!two_mass && !servo && strcmp(val, "rig") != 0) {
+                fprintf(stderr, "lugre_rig: unknown plant `%s`\n", val);
+                return 2;
+            }
+        }
         else if (strcmp(key, "seed") == 0) seed = strtoull(val, NULL, 10);
         else if (strcmp(key, "truth") == 0) write_truth = atoi(val);
         else if (strcmp(key, "drive") == 0) snprintf(drive, sizeof drive, "%s", val);
@@ -214,18 +245,24 @@ int main(int argc, char **argv) {
     if (sigma1 > 0) h_cap = fmin(h_cap, step_fraction * m / sigma1);
 
     /* start at rest, the spring relaxed, no bristle deflection */
-    double y[5] = {two_mass ? 0.0 : actuator(0.0), 0, 0, 0, 0}, k1[5], k2[5], k3[5], k4[5], yt[5];
-    if (two_mass) h_cap = fmin(h_cap, step_fraction * sqrt(fmin(m, m_m) / (k + 1e-300)));
+    double y[5] = {two_mass ? 0.0 : actuator(0.0), 0, 0, servo ? actuator(0.0) : 0.0, 0};
+    double k1[5], k2[5], k3[5], k4[5], yt[5];
+    if (two_mass || servo) h_cap = fmin(h_cap, step_fraction * sqrt(fmin(m, m_m) / (k + 1e-300)));
+    /* the controller: its stiffness on the motor, and its damping */
+    if (servo) h_cap = fmin(h_cap, step_fraction * fmin(sqrt(m_m / (Kp + 1e-300)), m_m / (Kd + 1e-300)));
     long n = (long)llround(duration / sample);
     if (two_mass)
         printf("time,drive.u,drive.x_m,drive.x_l%s\n", write_truth ? ",true_x,true_F" : "");
+    else if (servo)
+        printf("time,drive.r,drive.x_m,drive.x_l,drive.u%s\n", write_truth ? ",true_x,true_F" : "");
     else
         printf("time,rig.x_act_in,rig.x%s\n", write_truth ? ",true_x,true_F" : "");
     for (long s = 0; s <= n; s++) {
         double t = s * sample;
         double F = rhs(t, y, k1);
-        if (two_mass) {
-            printf("%.6f,%.9g,%.9g,%.9g", t, motor_force(t), quantise(y[3]), quantise(y[0]));
+        if (two_mass || servo) {
+            if (two_mass) printf("%.6f,%.9g,%.9g,%.9g", t, motor_force(t), quantise(y[3]), quantise(y[0]));
+            else printf("%.6f,%.12g,%.9g,%.9g,%.9g", t, actuator(t), quantise(y[3]), quantise(y[0]), servo_force(t, y));
             if (write_truth) printf(",%.12g,%.9g", y[0], F);
             printf("\n");
         } else if (write_truth)
