@@ -18,6 +18,19 @@ is tuned to one rig.
 
 The magnitude ε of an effect is the RMS, along the effect-free trajectory,
 of the change of the friction level it makes, as a fraction of Fc.
+
+Any-plant cases (`<plant>_<effect>`, PLANT_KINDS): the same effects on a
+plant that is not Rig1D, so that the diagnosis has no inverse dynamics
+and fits by output error alone (issue 43). Two plants, different in
+structure, each a hand-written C FMU (host/tests/c/, built by
+two_mass_fmu.py) and a mode of the simulator:
+
+- `two_mass`: TwoMassDrive, a motor driving a load through a belt spring,
+  friction on the load, driven by a measured motor force (`drive.u`;
+  measured: `drive.x_m`, `drive.x_l`);
+- `servo`: ServoAxis, the same drive train under a PD position controller
+  on the motor, driven by a position reference (`drive.r`; measured: both
+  positions and the controller's force `drive.u`).
 """
 
 from __future__ import annotations
@@ -45,10 +58,16 @@ KINDS = (
     "presliding_soft_nominal",
 )
 
-#: Cases on a plant that is not Rig1D (a two-mass drive, the friction on
-#: the load, driven by a measured motor force): diagnose has no inverse
-#: dynamics for it and fits by output error alone.
-TWO_MASS_KINDS = ("two_mass_none", "two_mass_viscous")
+#: The plants that are not Rig1D (cases.py's docstring): diagnose has no
+#: inverse dynamics for them and fits by output error alone.
+PLANTS = ("two_mass", "servo")
+
+#: Every any-plant kind: each plant with each kind of KINDS.
+PLANT_KINDS = tuple(f"{plant}_{kind}" for plant in PLANTS for kind in KINDS)
+
+#: The any-plant kinds in the suite's default grid (its rows from before
+#: there were more; their names and draws are kept).
+GRID_PLANT_KINDS = ("two_mass_none", "two_mass_viscous")
 
 #: Cases whose nominal friction is a Dahl FMU (the truth: LuGre with
 #: Dahl's levels, Fs = Fc, σ1 = 0, plus the hidden effect): diagnose moves
@@ -56,7 +75,7 @@ TWO_MASS_KINDS = ("two_mass_none", "two_mass_viscous")
 DAHL_KINDS = ("dahl_none", "dahl_viscous")
 
 #: The effect a kind should be diagnosed as (None: nothing to find).
-EXPECTED = {
+EXPECTED: dict[str, str | None] = {
     "none": None,
     "viscous": "viscous",
     "stribeck": "stribeck",
@@ -64,11 +83,25 @@ EXPECTED = {
     "position_dependent": "position_dependent",
     "presliding_stiff_nominal": "presliding",
     "presliding_soft_nominal": "presliding",
-    "two_mass_none": None,
-    "two_mass_viscous": "viscous",
     "dahl_none": None,
     "dahl_viscous": "viscous",
 }
+EXPECTED.update({f"{plant}_{kind}": EXPECTED[kind] for plant in PLANTS for kind in KINDS})
+
+
+def plant_of(kind: str) -> str | None:
+    """The plant of an any-plant kind (PLANTS), None for Rig1D."""
+    return next((p for p in PLANTS if kind.startswith(p + "_")), None) if kind in PLANT_KINDS else None
+
+
+def effect_of(kind: str) -> str:
+    """The kind of KINDS a kind is on its plant or nominal law:
+    `servo_stribeck` → `stribeck`, `dahl_viscous` → `viscous`."""
+    for prefix in (*PLANTS, "dahl"):
+        if kind.startswith(prefix + "_") and kind[len(prefix) + 1:] in KINDS:
+            return kind[len(prefix) + 1:]
+    return kind
+
 
 SAMPLE = 1e-3
 RESOLUTION = 1e-6
@@ -162,16 +195,17 @@ def _draw(kind: str, magnitude: float, seed: int, duration: float) -> Case:
         "sigma1": 2 * zeta * math.sqrt(sigma0 * m),
         "sigma2": rng.choice([0.0, fc / peak_speed * rng.uniform(0.05, 0.3)]),
     }
-    if kind == "presliding_soft_nominal":
+    effect, plant = effect_of(kind), plant_of(kind)
+    if effect == "presliding_soft_nominal":
         # a nominal presliding distance of 0.3-1 mm against a stiff truth
         nominal["sigma0"] = fc / rng.uniform(3e-4, 1e-3)
         nominal["sigma1"] = 2 * zeta * math.sqrt(nominal["sigma0"] * m)
-    if kind == "presliding_stiff_nominal":
+    if effect == "presliding_stiff_nominal":
         nominal["sigma0"] = 1e6
         nominal["sigma1"] = 2 * zeta * math.sqrt(1e6 * m)
     if kind in DAHL_KINDS:
         nominal.update(Fs=fc, sigma1=0.0, sigma2=0.0)
-    if kind in TWO_MASS_KINDS:
+    if plant == "two_mass":
         # motor 0.2-1 kg, load 1-4 kg, belt 1e4-5e4 N/m; the motor force
         # 3-6 times the friction level
         m_m = rng.uniform(0.2, 1.0)
@@ -183,6 +217,16 @@ def _draw(kind: str, magnitude: float, seed: int, duration: float) -> Case:
         peak_speed = drive["amp"] / ((m + m_m) * 2 * math.pi / drive["period"])
         nominal["vs"] = peak_speed * rng.uniform(0.1, 0.3)
         nominal["sigma2"] = 0.0
+    elif plant == "servo":
+        # the rig's drive as the reference of a PD loop on a motor of
+        # 0.2-1 kg, belt 1e4-5e4 N/m to the carriage (the mass m); the
+        # loop's bandwidth 4-10 Hz, damping ratio 0.5-1 on the total mass,
+        # so a carriage held by friction sits Fc/Kp (50 µm to 11 mm) off
+        m_m = rng.uniform(0.2, 1.0)
+        w = 2 * math.pi * rng.uniform(4.0, 10.0)
+        rig = {"m": m, "k": rng.uniform(1e4, 5e4), "c": rng.uniform(5.0, 30.0), "m_m": m_m,
+               "c_m": rng.uniform(0.5, 2.0), "Kp": (m + m_m) * w * w, "Kd": 2 * rng.uniform(0.5, 1.0) * (m + m_m) * w}
+        case = Case(kind, magnitude, seed, min(duration, 20.0), rig, {"plant": "servo", **drive}, nominal)
     else:
         case = Case(kind, magnitude, seed, duration, {"m": m, "k": k, "c": c}, drive, nominal)
     case.truth = dict(nominal)
@@ -227,19 +271,20 @@ def size_hidden_effect(case: Case, work: Path) -> None:
     eps, p = case.magnitude, case.nominal
     fc = p["Fc"]
     t = case.truth
-    if case.kind == "presliding_stiff_nominal":
+    effect = effect_of(case.kind)
+    if effect == "presliding_stiff_nominal":
         # 0.3-1.7 mm of presliding displacement, the damping ratio kept
         d = rng.uniform(3e-4, 1.7e-3)
         t["sigma0"] = fc / d
         t["sigma1"] = 2 * case._zeta * math.sqrt(t["sigma0"] * case.rig["m"])  # type: ignore[attr-defined]
         return
-    if case.kind == "presliding_soft_nominal":
+    if effect == "presliding_soft_nominal":
         # a stiff truth: 5-50 µm of presliding, 5 to 50 encoder steps (a
         # contact stiffer than the encoder resolves can be bounded, not sized)
         t["sigma0"] = fc / rng.uniform(5e-6, 5e-5)
         t["sigma1"] = 2 * case._zeta * math.sqrt(t["sigma0"] * case.rig["m"])  # type: ignore[attr-defined]
         return
-    if case.kind in ("none", "two_mass_none", "dahl_none"):
+    if effect == "none":
         return
     free = work / f"{case.name}.effect-free.csv"
     run_simulator(case, p, free, truth=True)
@@ -252,9 +297,9 @@ def size_hidden_effect(case: Case, work: Path) -> None:
     def level(vv: float) -> float:
         return p["Fc"] + (p["Fs"] - p["Fc"]) * math.exp(-((vv / p["vs"]) ** 2))
 
-    if case.kind in ("viscous", "two_mass_viscous", "dahl_viscous"):
+    if effect == "viscous":
         t["sigma2"] = p["sigma2"] + eps * fc / rms(v)
-    elif case.kind == "stribeck":
+    elif effect == "stribeck":
         vs = p["vs"] if p["Fs"] > p["Fc"] else rms(v) * rng.uniform(0.2, 0.5)
         base = (p["Fs"] - p["Fc"]) * 0 + 0.0
         shape = rms(math.exp(-((vv / vs) ** 2)) for vv in v)
@@ -265,12 +310,12 @@ def size_hidden_effect(case: Case, work: Path) -> None:
             t["Fs"] = p["Fs"] + eps * fc / shape
         else:
             t["Fs"] = fc + eps * fc / shape + base
-    elif case.kind == "direction_dependent":
+    elif effect == "direction_dependent":
         neg = rms((level(vv) / fc if vv < 0 else 0.0) for vv in v)
         a = eps / neg
         t["Fc_neg"] = p["Fc"] * (1 + a)
         t["Fs_neg"] = p["Fs"] * (1 + a)
-    elif case.kind == "position_dependent":
+    elif effect == "position_dependent":
         lo, hi = min(xm), max(xm)
         knots = 5
         xs = [lo + (hi - lo) * i / (knots - 1) for i in range(knots)]
@@ -308,10 +353,12 @@ def make(case: Case, work: Path) -> tuple[Path, Path]:
         for row in zip(*(d[c] for c in columns)):
             f.write(f"{row[0]:.6f}," + ",".join(f"{x:.9g}" for x in row[1:]) + "\n")
     ssd = work / f"{case.name}.ssd"
-    if case.kind in TWO_MASS_KINDS:
+    plant = plant_of(case.kind)
+    if plant:
         import two_mass_fmu
 
-        ssd.write_text(two_mass_ssd(case, two_mass_fmu.build(ROOT / "target" / "independent")))
+        fmu = two_mass_fmu.build(ROOT / "target" / "independent", plant)
+        ssd.write_text((two_mass_ssd if plant == "two_mass" else servo_ssd)(case, fmu, x0=d["true_x"][0]))
     else:
         ssd.write_text(nominal_ssd(case, d["true_x"][0]))
     return data, ssd
@@ -369,26 +416,41 @@ def _lugre(case: Case, dist: Path) -> str:
     return _component("friction", dist / "LuGre.fmu", [("v", "input", "m/s"), ("x", "input", "m"), ("F", "output", "N")], fr)
 
 
-def two_mass_ssd(case: Case, plant_fmu: Path, dist: Path | None = None) -> str:
-    """The nominal system of a two-mass case: TwoMassDrive (motor force u
-    from the data) with LuGre on the load."""
-    dist = dist or ROOT / "dist"
-    r = case.rig
-    plant = "".join(
-        _real(n, v)
-        for n, v in [("m_m", r["m_m"]), ("m_l", r["m"]), ("k_b", r["k"]), ("c_b", r["c"]), ("c_m", r["c_m"]), ("x0", 0.0), ("h_max", 1e-4)]
-    )
-    drive = _component(
-        "drive",
-        plant_fmu,
-        [("u", "input", "N"), ("F", "input", "N"), ("x_m", "output", "m"), ("x_l", "output", "m"), ("v", "output", "m/s")],
-        plant,
-    )
+def _plant_ssd(case: Case, plant_fmu: Path, parameters: list, connectors: list, dist: Path | None) -> str:
+    """The nominal system of an any-plant case: the plant FMU as `drive`
+    (its parameters, connectors) with LuGre on the load, connected v, x_l
+    and F."""
+    drive = _component("drive", plant_fmu, connectors, "".join(_real(n, v) for n, v in parameters))
     return _ssd(
         case,
-        drive + _lugre(case, dist),
+        drive + _lugre(case, dist or ROOT / "dist"),
         [("drive", "v", "friction", "v"), ("drive", "x_l", "friction", "x"), ("friction", "F", "drive", "F")],
     )
+
+
+#: The outputs both plants share (their carriage or load).
+_PLANT_OUTPUTS = [("x_m", "output", "m"), ("x_l", "output", "m"), ("v", "output", "m/s")]
+
+
+def two_mass_ssd(case: Case, plant_fmu: Path, dist: Path | None = None, x0: float = 0.0) -> str:
+    """The nominal system of a two-mass case: TwoMassDrive (motor force u
+    from the data) with LuGre on the load."""
+    r = case.rig
+    parameters = [("m_m", r["m_m"]), ("m_l", r["m"]), ("k_b", r["k"]), ("c_b", r["c"]), ("c_m", r["c_m"]),
+                  ("x0", x0), ("h_max", 1e-4)]
+    connectors = [("u", "input", "N"), ("F", "input", "N"), *_PLANT_OUTPUTS]
+    return _plant_ssd(case, plant_fmu, parameters, connectors, dist)
+
+
+def servo_ssd(case: Case, plant_fmu: Path, dist: Path | None = None, x0: float = 0.0) -> str:
+    """The nominal system of a servo case: ServoAxis (position reference r
+    from the data; the controller's force u an output, compared with the
+    data's) with LuGre on the carriage."""
+    r = case.rig
+    parameters = [("m_m", r["m_m"]), ("m_l", r["m"]), ("k_g", r["k"]), ("c_g", r["c"]), ("c_m", r["c_m"]),
+                  ("Kp", r["Kp"]), ("Kd", r["Kd"]), ("x0", x0), ("h_max", 1e-4)]
+    connectors = [("r", "input", "m"), ("F", "input", "N"), *_PLANT_OUTPUTS, ("u", "output", "N")]
+    return _plant_ssd(case, plant_fmu, parameters, connectors, dist)
 
 
 def nominal_ssd(case: Case, x0: float, dist: Path | None = None) -> str:
