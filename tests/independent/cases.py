@@ -226,7 +226,10 @@ def _draw(kind: str, magnitude: float, seed: int, duration: float) -> Case:
         w = 2 * math.pi * rng.uniform(4.0, 10.0)
         rig = {"m": m, "k": rng.uniform(1e4, 5e4), "c": rng.uniform(5.0, 30.0), "m_m": m_m,
                "c_m": rng.uniform(0.5, 2.0), "Kp": (m + m_m) * w * w, "Kd": 2 * rng.uniform(0.5, 1.0) * (m + m_m) * w}
-        case = Case(kind, magnitude, seed, min(duration, 20.0), rig, {"plant": "servo", **drive}, nominal)
+        # the controller's force measured as a drive's current is, in
+        # steps of 1 mN
+        drive = {"plant": "servo", **drive, "force_resolution": 1e-3}
+        case = Case(kind, magnitude, seed, min(duration, 20.0), rig, drive, nominal)
     else:
         case = Case(kind, magnitude, seed, duration, {"m": m, "k": k, "c": c}, drive, nominal)
     case.truth = dict(nominal)

@@ -43,8 +43,9 @@
  *
  * both masses at rest at r(0) to start. The controller reads the true motor
  * position and velocity (a continuous-time controller, as the nominal
- * model has it); r and the controller's force u are written as computed,
- * the two positions through the encoder. Output:
+ * model has it); r is written as computed, the controller's force u as a
+ * drive's current measurement reads it (rounded to force_resolution N, 0:
+ * exact), the two positions through the encoder. Output:
  * time,drive.r,drive.x_m,drive.x_l,drive.u[,true_x,true_F] (true_x: the
  * carriage's noise-free position, as for every plant).
  *
@@ -52,7 +53,8 @@
  *   keys: m c k Fc Fs Fc_neg Fs_neg vs sigma0 sigma1 sigma2 duration
  *         sample resolution noise seed drive (sines|triangle|steps)
  *         amp period  n_table x_table scale (comma lists)
- *         plant (rig|two_mass|servo)  m_m c_m (two_mass, servo)  Kp Kd (servo)
+ *         plant (rig|two_mass|servo)  m_m c_m (two_mass, servo)  Kp Kd
+ *         force_resolution (servo)
  *         truth=1 (also write the noise-free x and the friction force)
  * Output: time,rig.x_act_in,rig.x[,true_x,true_F]
  */
@@ -75,7 +77,7 @@ static double x_table[MAX_TABLE], scale_tab[MAX_TABLE];
 static int write_truth = 0;
 static int two_mass = 0, servo = 0; /* plant=two_mass, plant=servo */
 static double m_m = 0.5, c_m = 1.0;
-static double Kp = 4000, Kd = 140;
+static double Kp = 4000, Kd = 140, force_resolution = 0;
 static double step_fraction = 0.5; /* of the stiffest time scale */
 
 /* splitmix64 */
@@ -211,6 +213,7 @@ int main(int argc, char **argv) {
         KEY("resolution", resolution) KEY("noise", noise) KEY("amp", amp)
         KEY("period", period) KEY("step_fraction", step_fraction)
         KEY("m_m", m_m) KEY("c_m", c_m) KEY("Kp", Kp) KEY("Kd", Kd)
+        KEY("force_resolution", force_resolution)
         else if (strcmp(key, "plant") == 0) {
             two_mass = strcmp(val, "two_mass") == 0;
             servo = strcmp(val, "servo") == 0;
@@ -262,7 +265,11 @@ int main(int argc, char **argv) {
         double F = rhs(t, y, k1);
         if (two_mass || servo) {
             if (two_mass) printf("%.6f,%.9g,%.9g,%.9g", t, motor_force(t), quantise(y[3]), quantise(y[0]));
-            else printf("%.6f,%.12g,%.9g,%.9g,%.9g", t, actuator(t), quantise(y[3]), quantise(y[0]), servo_force(t, y));
+            else {
+                double u = servo_force(t, y);
+                if (force_resolution > 0) u = force_resolution * nearbyint(u / force_resolution);
+                printf("%.6f,%.12g,%.9g,%.9g,%.9g", t, actuator(t), quantise(y[3]), quantise(y[0]), u);
+            }
             if (write_truth) printf(",%.12g,%.9g", y[0], F);
             printf("\n");
         } else if (write_truth)
