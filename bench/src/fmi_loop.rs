@@ -1,7 +1,8 @@
 //! The smallest Jacobi co-simulation of two FMUs one could write by hand:
-//! the FMUs' libraries opened with `dlopen` (`libloading`), their FMI 2.0
-//! functions called straight through the C ABI, no checks but each call's
-//! status, every output recorded at every step. It is what the host's
+//! the FMUs' FMI 2.0 functions called straight through the C ABI, from the
+//! importer's raw table ([`fricsim_fmi::fmi2::Functions`] of the binary
+//! the [`Fmu`] loaded: plain function pointers, as `dlsym` gives them), no
+//! checks but each call's status, every output recorded at every step. It is what the host's
 //! stepping is measured against in BENCHMARKS.md: the same FMUs, the same
 //! scheme and calls, without the host's bookkeeping.
 //!
@@ -16,60 +17,12 @@
 //! every output. Rows go into a buffer of [`fricsim_core::master::CHUNK_STEPS`]
 //! rows used again once full, as `fricsim run` hands its rows on.
 
-use fmi2_types::*;
 use fricsim_core::master::{step_count, CHUNK_STEPS};
+use fricsim_fmi::fmi2::*;
 use fricsim_fmi::model_description::{Causality, VariableKind};
 use fricsim_fmi::Fmu;
 use std::ffi::CString;
 use std::time::Instant;
-
-/// The FMI functions the loop calls, from one library.
-struct Functions {
-    _library: libloading::Library,
-    instantiate: fmi2InstantiateTYPE,
-    setup_experiment: fmi2SetupExperimentTYPE,
-    enter_initialization_mode: fmi2ComponentTYPE,
-    exit_initialization_mode: fmi2ComponentTYPE,
-    free_instance: fmi2FreeInstanceTYPE,
-    get_real: fmi2GetRealTYPE,
-    get_integer: fmi2GetIntegerTYPE,
-    get_boolean: fmi2GetBooleanTYPE,
-    set_real: fmi2SetRealTYPE,
-    do_step: fmi2DoStepTYPE,
-}
-
-impl Functions {
-    fn open(fmu: &Fmu) -> Result<Functions, String> {
-        let path = fmu.library().path();
-        let shown = path.display();
-        // SAFETY: the FMU's own library, already loaded by `fmu` (this
-        // takes a second reference to it); its exports have the FMI 2.0
-        // signatures of fmi2-types.
-        unsafe {
-            let library = libloading::Library::new(path).map_err(|e| format!("{shown}: {e}"))?;
-            macro_rules! get {
-                ($name:literal) => {
-                    *library
-                        .get(concat!($name, "\0").as_bytes())
-                        .map_err(|e| format!("{shown}: {}: {e}", $name))?
-                };
-            }
-            Ok(Functions {
-                instantiate: get!("fmi2Instantiate"),
-                setup_experiment: get!("fmi2SetupExperiment"),
-                enter_initialization_mode: get!("fmi2EnterInitializationMode"),
-                exit_initialization_mode: get!("fmi2ExitInitializationMode"),
-                free_instance: get!("fmi2FreeInstance"),
-                get_real: get!("fmi2GetReal"),
-                get_integer: get!("fmi2GetInteger"),
-                get_boolean: get!("fmi2GetBoolean"),
-                set_real: get!("fmi2SetReal"),
-                do_step: get!("fmi2DoStep"),
-                _library: library,
-            })
-        }
-    }
-}
 
 /// The logger's five fixed arguments (see [`print_message`]).
 type FixedArgumentsLogger =
@@ -147,15 +100,15 @@ pub fn jacobi_run(
     h: f64,
     stop: f64,
 ) -> Result<(f64, Vec<(String, f64)>), String> {
-    let callbacks = fmi2CallbackFunctions {
+    let callbacks = CallbackFunctions {
         // SAFETY: see `print_message`
         logger: Some(unsafe {
             std::mem::transmute::<FixedArgumentsLogger, VariadicLogger>(print_message)
         }),
-        allocateMemory: Some(libc_calloc),
-        freeMemory: Some(libc_free),
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
+        allocate_memory: Some(libc_calloc),
+        free_memory: Some(libc_free),
+        step_finished: None,
+        component_environment: std::ptr::null_mut(),
     };
     let mut units = Vec::new();
     let mut width = 0;
@@ -192,7 +145,9 @@ pub fn jacobi_run(
         let guid = CString::new(d.guid.as_str()).map_err(|e| e.to_string())?;
         let resources = CString::new(format!("file://{}/resources", fmu.dir().display()))
             .map_err(|e| e.to_string())?;
-        let f = Functions::open(fmu)?;
+        // (`components` borrow the FMUs, which keep their binaries loaded
+        // for the whole run)
+        let f = *fmu.library().functions();
         // SAFETY: valid C strings and callbacks that outlive the instance
         let c = unsafe {
             (f.instantiate)(

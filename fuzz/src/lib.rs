@@ -35,10 +35,12 @@ macro_rules! lookup {
     };
 }
 
-/// The exports above as an [`fmi::Api`].
+/// The exports above as an [`fmi::Api`], the importer's raw FMI 2.0 table
+/// (`fricsim_fmi::fmi2::Functions`) filled from the exports linked in.
 pub fn api() -> fmi::Api {
-    // SAFETY: each name maps to the export of that name.
-    unsafe {
+    // SAFETY: each name maps to the export of that name, linked into this
+    // program for as long as it runs.
+    let api = unsafe {
         fmi::Api::from_lookup(|name| {
             lookup!(name;
                 fmi2GetTypesPlatform, fmi2GetVersion, fmi2SetDebugLogging, fmi2Instantiate,
@@ -52,7 +54,8 @@ pub fn api() -> fmi::Api {
                 fmi2CancelStep, fmi2GetStatus, fmi2GetRealStatus, fmi2GetIntegerStatus,
                 fmi2GetBooleanStatus, fmi2GetStringStatus)
         })
-    }
+    };
+    api.unwrap_or_else(|missing| panic!("not linked: {missing:?}"))
 }
 
 /// The seven models, from `modelDescription/<Name>.xml`.

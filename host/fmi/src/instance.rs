@@ -10,14 +10,14 @@
 //! value-access and step functions do not allocate unless they fail.
 
 use super::archive::{unpack, UnpackOptions};
-use super::library::{c_text, Functions, Library};
+use super::library::{c_text, Declared, Library};
 use super::logger::{fricsim_fmi2_logger, Log, Sink};
 use super::model_description::{ModelDescription, ScalarVariable, ValueReference};
 use super::watchdog::Watched;
 use super::Status;
 use crate::blackbox::CallRecorder;
 use crate::error::FmuError;
-use fmi2_types::*;
+use crate::fmi2::*;
 use std::ffi::CString;
 use std::mem::ManuallyDrop;
 use std::os::raw::c_void;
@@ -182,14 +182,18 @@ static NEXT_INSTANCE_ID: AtomicU64 = AtomicU64::new(1);
 /// §2.1.3 allows no further call and the instance is leaked.
 pub struct Instance {
     fmu: Fmu,
+    /// FMI 2.0's raw table, copied from the library: each call is one
+    /// indirect call through it.
     functions: Functions,
+    /// The optional groups the FMU declares: the others are refused.
+    declared: Declared,
     component: fmi2Component,
     name: String,
     id: u64,
     /// The logger's environment and the callbacks: the FMU may keep pointers
     /// to both until it is freed (and forever after `fmi2Fatal`).
     sink: ManuallyDrop<Box<Sink>>,
-    callbacks: ManuallyDrop<Box<fmi2CallbackFunctions>>,
+    callbacks: ManuallyDrop<Box<CallbackFunctions>>,
     states: Vec<fmi2FMUstate>,
     fatal: bool,
     /// A call returned `fmi2Error` or `fmi2Fatal` since instantiation or
@@ -281,14 +285,15 @@ impl Instance {
         )?;
         let id = NEXT_INSTANCE_ID.fetch_add(1, Ordering::Relaxed);
         let sink = Box::new(Sink::new(fmu.log().clone(), name, id));
-        let callbacks = Box::new(fmi2CallbackFunctions {
+        let callbacks = Box::new(CallbackFunctions {
             logger: Some(fricsim_fmi2_logger),
-            allocateMemory: Some(allocate_memory),
-            freeMemory: Some(free_memory),
-            stepFinished: None,
-            componentEnvironment: &*sink as *const Sink as *mut c_void,
+            allocate_memory: Some(allocate_memory),
+            free_memory: Some(free_memory),
+            step_finished: None,
+            component_environment: &*sink as *const Sink as *mut c_void,
         });
         let functions = fmu.shared.library.functions;
+        let declared = fmu.shared.library.declared;
         // SAFETY: all strings are NUL-terminated and outlive the call; the
         // callbacks and their environment live as long as the instance.
         let component = unsafe {
@@ -311,6 +316,7 @@ impl Instance {
         Ok(Instance {
             fmu: fmu.clone(),
             functions,
+            declared,
             component,
             name: name.to_string(),
             id,
@@ -891,9 +897,10 @@ impl Instance {
         values: &[f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2SetRealInputDerivatives";
-        let Some(f) = self.functions.set_real_input_derivatives else {
+        if !self.declared.input_derivatives {
             return Err(not_supported(F, "canInterpolateInputs=\"true\""));
-        };
+        }
+        let f = self.functions.set_real_input_derivatives;
         let mark = self.begin(F)?;
         same_length(F, "orders", vrs.len(), orders.len())?;
         same_length(F, "values", vrs.len(), values.len())?;
@@ -918,9 +925,10 @@ impl Instance {
         values: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetRealOutputDerivatives";
-        let Some(f) = self.functions.get_real_output_derivatives else {
+        if !self.declared.output_derivatives {
             return Err(not_supported(F, "maxOutputDerivativeOrder > 0"));
-        };
+        }
+        let f = self.functions.get_real_output_derivatives;
         let mark = self.begin(F)?;
         same_length(F, "orders", vrs.len(), orders.len())?;
         same_length(F, "values", vrs.len(), values.len())?;
@@ -947,9 +955,10 @@ impl Instance {
         out: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi2GetDirectionalDerivative";
-        let Some(f) = self.functions.get_directional_derivative else {
+        if !self.declared.directional_derivative {
             return Err(not_supported(F, "providesDirectionalDerivative=\"true\""));
-        };
+        }
+        let f = self.functions.get_directional_derivative;
         self.call(F, |component| {
             same_length(F, "seed", knowns.len(), seed.len())?;
             same_length(F, "out", unknowns.len(), out.len())?;
@@ -979,15 +988,18 @@ impl Instance {
         }
     }
 
+    /// `f` if its group is `declared`, else [`FmuError::NotSupported`].
     fn state_function<T>(
         &self,
         function: &'static str,
-        f: Option<T>,
+        f: T,
+        declared: bool,
         capability: &'static str,
     ) -> Result<T, FmuError> {
-        match f {
-            Some(f) => Ok(f),
-            None => Err(not_supported(function, capability)),
+        if declared {
+            Ok(f)
+        } else {
+            Err(not_supported(function, capability))
         }
     }
 
@@ -997,6 +1009,7 @@ impl Instance {
         let f = self.state_function(
             F,
             self.functions.get_fmu_state,
+            self.declared.fmu_state,
             "canGetAndSetFMUstate=\"true\"",
         )?;
         let mark = self.begin(F)?;
@@ -1025,6 +1038,7 @@ impl Instance {
         let f = self.state_function(
             F,
             self.functions.get_fmu_state,
+            self.declared.fmu_state,
             "canGetAndSetFMUstate=\"true\"",
         )?;
         self.own(F, state)?;
@@ -1064,6 +1078,7 @@ impl Instance {
         let f = self.state_function(
             F,
             self.functions.set_fmu_state,
+            self.declared.fmu_state,
             "canGetAndSetFMUstate=\"true\"",
         )?;
         self.own(F, state)?;
@@ -1080,6 +1095,7 @@ impl Instance {
         let f = self.state_function(
             F,
             self.functions.free_fmu_state,
+            self.declared.fmu_state,
             "canGetAndSetFMUstate=\"true\"",
         )?;
         self.own(F, &state)?;
@@ -1098,9 +1114,18 @@ impl Instance {
         const CAPABILITY: &str = "canSerializeFMUstate=\"true\"";
         const SIZE: &str = "fmi2SerializedFMUstateSize";
         const F: &str = "fmi2SerializeFMUstate";
-        let size_f =
-            self.state_function(SIZE, self.functions.serialized_fmu_state_size, CAPABILITY)?;
-        let f = self.state_function(F, self.functions.serialize_fmu_state, CAPABILITY)?;
+        let size_f = self.state_function(
+            SIZE,
+            self.functions.serialized_fmu_state_size,
+            self.declared.serialize_fmu_state,
+            CAPABILITY,
+        )?;
+        let f = self.state_function(
+            F,
+            self.functions.serialize_fmu_state,
+            self.declared.serialize_fmu_state,
+            CAPABILITY,
+        )?;
         self.own(F, state)?;
         let mark = self.begin(SIZE)?;
         let mut size = 0usize;
@@ -1128,6 +1153,7 @@ impl Instance {
         let f = self.state_function(
             F,
             self.functions.deserialize_fmu_state,
+            self.declared.serialize_fmu_state,
             "canSerializeFMUstate=\"true\"",
         )?;
         let mark = self.begin(F)?;
@@ -1174,7 +1200,8 @@ impl Drop for Instance {
             // sink, so both are leaked with it.
             return;
         }
-        if let Some(free_state) = self.functions.free_fmu_state {
+        if self.declared.fmu_state {
+            let free_state = self.functions.free_fmu_state;
             for mut pointer in self.states.drain(..) {
                 // SAFETY: each pointer is a live state of this instance.
                 unsafe { free_state(self.component, &mut pointer) };

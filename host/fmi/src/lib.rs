@@ -2,6 +2,9 @@
 //!
 //! - [`archive`]: the `.fmu` zip unpacked safely into a temporary directory;
 //! - [`model_description`]: `modelDescription.xml` parsed and validated;
+//! - [`fmi2`]: FMI 2.0's raw layer, the binary's functions as a table of
+//!   typed pointers with no checks (also used by the misuse tests, the
+//!   fuzz targets and the benchmarks' hand-written loop);
 //! - [`library`]: the `linux64` binary loaded and its functions resolved;
 //! - [`logger`]: the FMU's log messages (callback in `logger.c`);
 //! - [`instance`]: [`Fmu`] and its [`Instance`]s, the safe API;
@@ -14,6 +17,7 @@
 pub mod archive;
 pub mod blackbox;
 pub mod error;
+pub mod fmi2;
 pub mod instance;
 pub mod library;
 pub mod logger;

@@ -2,107 +2,46 @@
 //! <modelIdentifier>.so`) loaded with libloading, and its FMI 2.0
 //! Co-Simulation functions (§2.1, §4.2) resolved into typed pointers.
 //!
-//! Every function of the common and co-simulation API is required; the
-//! optional groups (FMU state §2.1.8, directional derivatives §2.1.9, input
-//! and output derivatives §4.2.1) are resolved only when the model
-//! description declares the capability, and then they must be there.
+//! The functions are looked up into FMI 2.0's raw table
+//! ([`crate::fmi2::Functions`]). Every function of the common and
+//! co-simulation API is required; the optional groups (FMU state §2.1.8,
+//! directional derivatives §2.1.9, input and output derivatives §4.2.1)
+//! are used only when the model description declares the capability, and
+//! then they must be there.
 
 use super::model_description::ModelDescription;
 use crate::error::FmuError;
-use fmi2_types::*;
+use crate::fmi2::{fmi2Version, Functions};
 use std::ffi::CStr;
 use std::path::{Path, PathBuf};
 
 /// The only platform this host loads.
 pub const PLATFORM: &str = "linux64";
 
-macro_rules! functions {
-    (
-        required { $($field:ident: $ty:ty = $symbol:literal,)* }
-        optional { $($ofield:ident: $oty:ty = $osymbol:literal,)* }
-    ) => {
-        /// The FMI functions of one loaded binary. The optional ones are
-        /// `None` when the model description does not declare them.
-        /// (`fmi2GetStatus` & co. are required by the standard but only
-        /// meaningful for asynchronous steps, which this host does not use.)
-        #[derive(Clone, Copy)]
-        #[allow(dead_code)]
-        pub(crate) struct Functions {
-            $(pub $field: $ty,)*
-            $(pub $ofield: Option<$oty>,)*
-        }
-
-        impl Functions {
-            /// Resolve all functions, or name every missing required one.
-            fn resolve(library: &libloading::Library) -> Result<Functions, Vec<&'static str>> {
-                $(let $field = lookup::<$ty>(library, $symbol);)*
-                let missing: Vec<&'static str> =
-                    [$(($symbol, $field.is_none()),)*].into_iter().filter(|(_, m)| *m).map(|(s, _)| s).collect();
-                if !missing.is_empty() {
-                    return Err(missing);
-                }
-                Ok(Functions {
-                    $($field: $field.expect("checked above"),)*
-                    $($ofield: lookup::<$oty>(library, $osymbol),)*
-                })
-            }
-        }
-    };
-}
-
-functions! {
-    required {
-        get_types_platform: fmi2GetTypesPlatformTYPE = "fmi2GetTypesPlatform",
-        get_version: fmi2GetVersionTYPE = "fmi2GetVersion",
-        set_debug_logging: fmi2SetDebugLoggingTYPE = "fmi2SetDebugLogging",
-        instantiate: fmi2InstantiateTYPE = "fmi2Instantiate",
-        free_instance: fmi2FreeInstanceTYPE = "fmi2FreeInstance",
-        setup_experiment: fmi2SetupExperimentTYPE = "fmi2SetupExperiment",
-        enter_initialization_mode: fmi2ComponentTYPE = "fmi2EnterInitializationMode",
-        exit_initialization_mode: fmi2ComponentTYPE = "fmi2ExitInitializationMode",
-        terminate: fmi2ComponentTYPE = "fmi2Terminate",
-        reset: fmi2ComponentTYPE = "fmi2Reset",
-        get_real: fmi2GetRealTYPE = "fmi2GetReal",
-        get_integer: fmi2GetIntegerTYPE = "fmi2GetInteger",
-        get_boolean: fmi2GetBooleanTYPE = "fmi2GetBoolean",
-        get_string: fmi2GetStringTYPE = "fmi2GetString",
-        set_real: fmi2SetRealTYPE = "fmi2SetReal",
-        set_integer: fmi2SetIntegerTYPE = "fmi2SetInteger",
-        set_boolean: fmi2SetBooleanTYPE = "fmi2SetBoolean",
-        set_string: fmi2SetStringTYPE = "fmi2SetString",
-        do_step: fmi2DoStepTYPE = "fmi2DoStep",
-        cancel_step: fmi2ComponentTYPE = "fmi2CancelStep",
-        get_status: fmi2GetStatusTYPE = "fmi2GetStatus",
-        get_real_status: fmi2GetRealStatusTYPE = "fmi2GetRealStatus",
-        get_integer_status: fmi2GetIntegerStatusTYPE = "fmi2GetIntegerStatus",
-        get_boolean_status: fmi2GetBooleanStatusTYPE = "fmi2GetBooleanStatus",
-        get_string_status: fmi2GetStringStatusTYPE = "fmi2GetStringStatus",
-    }
-    optional {
-        get_fmu_state: fmi2GetFMUstateTYPE = "fmi2GetFMUstate",
-        set_fmu_state: fmi2SetFMUstateTYPE = "fmi2SetFMUstate",
-        free_fmu_state: fmi2FreeFMUstateTYPE = "fmi2FreeFMUstate",
-        serialized_fmu_state_size: fmi2SerializedFMUstateSizeTYPE = "fmi2SerializedFMUstateSize",
-        serialize_fmu_state: fmi2SerializeFMUstateTYPE = "fmi2SerializeFMUstate",
-        deserialize_fmu_state: fmi2DeSerializeFMUstateTYPE = "fmi2DeSerializeFMUstate",
-        get_directional_derivative: fmi2GetDirectionalDerivativeTYPE = "fmi2GetDirectionalDerivative",
-        set_real_input_derivatives: fmi2SetRealInputDerivativesTYPE = "fmi2SetRealInputDerivatives",
-        get_real_output_derivatives: fmi2GetRealOutputDerivativesTYPE = "fmi2GetRealOutputDerivatives",
-    }
-}
-
-/// The address of `symbol`, if the library exports it.
-fn lookup<T: Copy>(library: &libloading::Library, symbol: &str) -> Option<T> {
-    // SAFETY: `T` is the function type the FMI standard gives this symbol;
-    // the pointer is only used while `library` is loaded (`Library` keeps
-    // both together).
-    unsafe { library.get::<T>(symbol) }.ok().map(|s| *s)
+/// The optional groups of functions the model description declares
+/// (and which the binary therefore exports): a function of a group not
+/// declared is refused by the instance, [`FmuError::NotSupported`], even
+/// if the binary has it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Declared {
+    /// `canGetAndSetFMUstate`: `fmi2GetFMUstate`, `fmi2SetFMUstate`, `fmi2FreeFMUstate`.
+    pub fmu_state: bool,
+    /// `canSerializeFMUstate`: `fmi2SerializedFMUstateSize`, `fmi2SerializeFMUstate`,
+    /// `fmi2DeSerializeFMUstate`.
+    pub serialize_fmu_state: bool,
+    /// `providesDirectionalDerivative`: `fmi2GetDirectionalDerivative`.
+    pub directional_derivative: bool,
+    /// `canInterpolateInputs`: `fmi2SetRealInputDerivatives`.
+    pub input_derivatives: bool,
+    /// `maxOutputDerivativeOrder > 0`: `fmi2GetRealOutputDerivatives`.
+    pub output_derivatives: bool,
 }
 
 /// A loaded FMU binary. The function pointers stay valid as long as this
 /// value lives.
 pub struct Library {
     pub(crate) functions: Functions,
+    pub(crate) declared: Declared,
     path: PathBuf,
     version: String,
     types_platform: String,
@@ -150,12 +89,14 @@ impl Library {
                     message: with_execution_tool_hint(error_chain(&e), description),
                 })?
                 .into();
-        let mut functions =
-            Functions::resolve(&library).map_err(|symbols| FmuError::MissingFunctions {
+        // SAFETY: an FMI 2.0 binary (its version is checked below), kept
+        // loaded with the table in this `Library`.
+        let functions =
+            unsafe { Functions::load(&library) }.map_err(|symbols| FmuError::MissingFunctions {
                 path: path.to_path_buf(),
                 symbols,
             })?;
-        check_capabilities(&mut functions, description, path)?;
+        let declared = check_capabilities(&functions, description, path)?;
 
         // SAFETY: both functions take no arguments and return a static string.
         let version = unsafe { c_text((functions.get_version)()) };
@@ -168,6 +109,7 @@ impl Library {
         let types_platform = unsafe { c_text((functions.get_types_platform)()) };
         Ok(Library {
             functions,
+            declared,
             path: path.to_path_buf(),
             version,
             types_platform,
@@ -177,6 +119,16 @@ impl Library {
 
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// The binary's functions, raw: FMI 2.0's table, valid as long as
+    /// this `Library` lives. Calling them is unchecked and `unsafe`; the
+    /// safe way is an [`Instance`](crate::Instance). (The hand-written
+    /// FMI loop of the benchmarks calls them.) An optional function the
+    /// model description does not declare may be a stand-in
+    /// ([`Functions::exports`]).
+    pub fn functions(&self) -> &Functions {
+        &self.functions
     }
 
     /// What `fmi2GetVersion()` returned ("2.0").
@@ -190,69 +142,56 @@ impl Library {
     }
 }
 
-/// Each optional group must be exported if its capability is declared, and
-/// is not used (set to `None`) if it is not.
+/// Each optional group must be exported if its capability is declared;
+/// the groups declared.
 fn check_capabilities(
-    f: &mut Functions,
+    f: &Functions,
     d: &ModelDescription,
     path: &Path,
-) -> Result<(), FmuError> {
+) -> Result<Declared, FmuError> {
     let cs = &d.co_simulation;
-    // (capability, declared, [(function, exported)])
-    type Group = (&'static str, bool, Vec<(&'static str, bool)>);
-    let groups: [Group; 5] = [
+    let declared = Declared {
+        fmu_state: cs.can_get_and_set_fmu_state,
+        serialize_fmu_state: cs.can_serialize_fmu_state,
+        directional_derivative: cs.provides_directional_derivative,
+        input_derivatives: cs.can_interpolate_inputs,
+        output_derivatives: cs.max_output_derivative_order > 0,
+    };
+    // (capability, declared, its functions)
+    let groups: [(&'static str, bool, &[&'static str]); 5] = [
         (
             "canGetAndSetFMUstate=\"true\"",
-            cs.can_get_and_set_fmu_state,
-            vec![
-                ("fmi2GetFMUstate", f.get_fmu_state.is_some()),
-                ("fmi2SetFMUstate", f.set_fmu_state.is_some()),
-                ("fmi2FreeFMUstate", f.free_fmu_state.is_some()),
-            ],
+            declared.fmu_state,
+            &["fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate"],
         ),
         (
             "canSerializeFMUstate=\"true\"",
-            cs.can_serialize_fmu_state,
-            vec![
-                (
-                    "fmi2SerializedFMUstateSize",
-                    f.serialized_fmu_state_size.is_some(),
-                ),
-                ("fmi2SerializeFMUstate", f.serialize_fmu_state.is_some()),
-                ("fmi2DeSerializeFMUstate", f.deserialize_fmu_state.is_some()),
+            declared.serialize_fmu_state,
+            &[
+                "fmi2SerializedFMUstateSize",
+                "fmi2SerializeFMUstate",
+                "fmi2DeSerializeFMUstate",
             ],
         ),
         (
             "providesDirectionalDerivative=\"true\"",
-            cs.provides_directional_derivative,
-            vec![(
-                "fmi2GetDirectionalDerivative",
-                f.get_directional_derivative.is_some(),
-            )],
+            declared.directional_derivative,
+            &["fmi2GetDirectionalDerivative"],
         ),
         (
             "canInterpolateInputs=\"true\"",
-            cs.can_interpolate_inputs,
-            vec![(
-                "fmi2SetRealInputDerivatives",
-                f.set_real_input_derivatives.is_some(),
-            )],
+            declared.input_derivatives,
+            &["fmi2SetRealInputDerivatives"],
         ),
         (
             "maxOutputDerivativeOrder > 0",
-            cs.max_output_derivative_order > 0,
-            vec![(
-                "fmi2GetRealOutputDerivatives",
-                f.get_real_output_derivatives.is_some(),
-            )],
+            declared.output_derivatives,
+            &["fmi2GetRealOutputDerivatives"],
         ),
     ];
     for (capability, declared, symbols) in groups {
-        let missing: Vec<&'static str> = symbols
-            .iter()
-            .filter(|(_, present)| !present)
-            .map(|(s, _)| *s)
-            .collect();
+        let missing: Vec<&'static str> =
+            symbols.iter().copied().filter(|s| !f.exports(s)).collect();
         if declared && !missing.is_empty() {
             return Err(FmuError::MissingCapabilityFunctions {
                 path: path.to_path_buf(),
@@ -261,26 +200,7 @@ fn check_capabilities(
             });
         }
     }
-    if !cs.can_get_and_set_fmu_state {
-        (f.get_fmu_state, f.set_fmu_state, f.free_fmu_state) = (None, None, None);
-    }
-    if !cs.can_serialize_fmu_state {
-        (
-            f.serialized_fmu_state_size,
-            f.serialize_fmu_state,
-            f.deserialize_fmu_state,
-        ) = (None, None, None);
-    }
-    if !cs.provides_directional_derivative {
-        f.get_directional_derivative = None;
-    }
-    if !cs.can_interpolate_inputs {
-        f.set_real_input_derivatives = None;
-    }
-    if cs.max_output_derivative_order == 0 {
-        f.get_real_output_derivatives = None;
-    }
-    Ok(())
+    Ok(declared)
 }
 
 /// An error and its sources, e.g. "dlopen failed: <dlerror text>".

@@ -1,5 +1,6 @@
 //! Raw access to the FMI 2.0 C functions of an FMU binary (Co-Simulation,
-//! and Model Exchange in [`MeApi`]), for
+//! and Model Exchange in [`MeApi`]: the importer's raw layer,
+//! `fricsim_fmi::fmi2`), for
 //! tests that misuse them on purpose (`misuse.rs`, `fuzz_bounded.rs`,
 //! `parallel_instances.rs`) and for the fuzz targets in `fuzz/` (which
 //! include this file with `#[path]` and fill [`Api`] from the exports linked
@@ -11,134 +12,45 @@
 
 pub mod sequence;
 
+use fricsim_fmi::fmi2;
 use std::ffi::{c_void, CStr, CString};
-use std::os::raw::{c_char, c_int, c_uint};
+use std::os::raw::{c_char, c_int};
 use std::path::Path;
 use std::ptr::{null, null_mut};
 use std::sync::Mutex;
 
-pub type Component = *mut c_void;
-pub type FmuState = *mut c_void;
-pub type Vr = c_uint;
+pub type Component = fmi2::fmi2Component;
+pub type FmuState = fmi2::fmi2FMUstate;
+pub type Vr = fmi2::fmi2ValueReference;
 /// `fmi2Status` as the C `int` it is.
-pub type Status = c_int;
+pub type Status = fmi2::fmi2Status;
 
-pub const OK: Status = 0;
-pub const WARNING: Status = 1;
-pub const DISCARD: Status = 2;
-pub const ERROR: Status = 3;
-pub const FATAL: Status = 4;
+pub const OK: Status = fmi2::fmi2OK;
+pub const WARNING: Status = fmi2::fmi2Warning;
+pub const DISCARD: Status = fmi2::fmi2Discard;
+pub const ERROR: Status = fmi2::fmi2Error;
+pub const FATAL: Status = fmi2::fmi2Fatal;
+
+/// `fmi2CallbackFunctions`, any field of which may be null.
+pub type Callbacks = fmi2::CallbackFunctions;
+/// `fmi2EventInfo`.
+pub type EventInfo = fmi2::fmi2EventInfo;
+
+/// Every function of the FMI 2.0 Co-Simulation API (FMI 2.0.4 §2.1,
+/// §4.2) as a typed pointer: the importer's raw table.
+pub type Api = fmi2::Functions;
+
+/// The functions Model Exchange adds (FMI 2.0.4 §3.2) as typed pointers.
+pub type MeApi = fmi2::ModelExchangeFunctions;
 
 /// The importer's logger, declared without the variadic tail: the FMUs
 /// call it with a format and no arguments, so the ABI is the same on
 /// x86-64 (as with ctypes loggers).
-pub type LoggerFn =
+type LoggerFn =
     unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char);
-
-/// `fmi2CallbackFunctions`.
-#[repr(C)]
-pub struct Callbacks {
-    pub logger: Option<LoggerFn>,
-    pub allocate_memory: Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>,
-    pub free_memory: Option<unsafe extern "C" fn(*mut c_void)>,
-    pub step_finished: Option<unsafe extern "C" fn(*mut c_void, c_int)>,
-    pub component_environment: *mut c_void,
-}
-
-macro_rules! api {
-    ($(#[$doc:meta])* $name:ident; $($field:ident: fn($($arg:ty),*) $(-> $ret:ty)? = $symbol:literal,)*) => {
-        $(#[$doc])*
-        #[derive(Clone, Copy)]
-        pub struct $name {
-            $(pub $field: unsafe extern "C" fn($($arg),*) $(-> $ret)?,)*
-        }
-
-        impl $name {
-            /// Resolve every function with `lookup` (symbol name → address).
-            ///
-            /// # Safety
-            /// Each address must be the function the standard gives that name.
-            pub unsafe fn from_lookup(lookup: impl Fn(&str) -> *const c_void) -> $name {
-                $name {
-                    $($field: {
-                        let address = lookup($symbol);
-                        assert!(!address.is_null(), "{} is missing", $symbol);
-                        // SAFETY: the caller's contract.
-                        unsafe { std::mem::transmute::<*const c_void, unsafe extern "C" fn($($arg),*) $(-> $ret)?>(address) }
-                    },)*
-                }
-            }
-        }
-    };
-}
-
-api! {
-    /// Every function of the FMI 2.0 Co-Simulation API (FMI 2.0.4 §2.1,
-    /// §4.2) as a typed pointer.
-    Api;
-    get_types_platform: fn() -> *const c_char = "fmi2GetTypesPlatform",
-    get_version: fn() -> *const c_char = "fmi2GetVersion",
-    set_debug_logging: fn(Component, c_int, usize, *const *const c_char) -> Status = "fmi2SetDebugLogging",
-    instantiate: fn(*const c_char, c_int, *const c_char, *const c_char, *const Callbacks, c_int, c_int) -> Component = "fmi2Instantiate",
-    free_instance: fn(Component) = "fmi2FreeInstance",
-    setup_experiment: fn(Component, c_int, f64, f64, c_int, f64) -> Status = "fmi2SetupExperiment",
-    enter_initialization_mode: fn(Component) -> Status = "fmi2EnterInitializationMode",
-    exit_initialization_mode: fn(Component) -> Status = "fmi2ExitInitializationMode",
-    terminate: fn(Component) -> Status = "fmi2Terminate",
-    reset: fn(Component) -> Status = "fmi2Reset",
-    get_real: fn(Component, *const Vr, usize, *mut f64) -> Status = "fmi2GetReal",
-    get_integer: fn(Component, *const Vr, usize, *mut c_int) -> Status = "fmi2GetInteger",
-    get_boolean: fn(Component, *const Vr, usize, *mut c_int) -> Status = "fmi2GetBoolean",
-    get_string: fn(Component, *const Vr, usize, *mut *const c_char) -> Status = "fmi2GetString",
-    set_real: fn(Component, *const Vr, usize, *const f64) -> Status = "fmi2SetReal",
-    set_integer: fn(Component, *const Vr, usize, *const c_int) -> Status = "fmi2SetInteger",
-    set_boolean: fn(Component, *const Vr, usize, *const c_int) -> Status = "fmi2SetBoolean",
-    set_string: fn(Component, *const Vr, usize, *const *const c_char) -> Status = "fmi2SetString",
-    get_fmu_state: fn(Component, *mut FmuState) -> Status = "fmi2GetFMUstate",
-    set_fmu_state: fn(Component, FmuState) -> Status = "fmi2SetFMUstate",
-    free_fmu_state: fn(Component, *mut FmuState) -> Status = "fmi2FreeFMUstate",
-    serialized_fmu_state_size: fn(Component, FmuState, *mut usize) -> Status = "fmi2SerializedFMUstateSize",
-    serialize_fmu_state: fn(Component, FmuState, *mut c_char, usize) -> Status = "fmi2SerializeFMUstate",
-    deserialize_fmu_state: fn(Component, *const c_char, usize, *mut FmuState) -> Status = "fmi2DeSerializeFMUstate",
-    get_directional_derivative: fn(Component, *const Vr, usize, *const Vr, usize, *const f64, *mut f64) -> Status = "fmi2GetDirectionalDerivative",
-    set_real_input_derivatives: fn(Component, *const Vr, usize, *const c_int, *const f64) -> Status = "fmi2SetRealInputDerivatives",
-    get_real_output_derivatives: fn(Component, *const Vr, usize, *const c_int, *mut f64) -> Status = "fmi2GetRealOutputDerivatives",
-    do_step: fn(Component, f64, f64, c_int) -> Status = "fmi2DoStep",
-    cancel_step: fn(Component) -> Status = "fmi2CancelStep",
-    get_status: fn(Component, c_int, *mut c_int) -> Status = "fmi2GetStatus",
-    get_real_status: fn(Component, c_int, *mut f64) -> Status = "fmi2GetRealStatus",
-    get_integer_status: fn(Component, c_int, *mut c_int) -> Status = "fmi2GetIntegerStatus",
-    get_boolean_status: fn(Component, c_int, *mut c_int) -> Status = "fmi2GetBooleanStatus",
-    get_string_status: fn(Component, c_int, *mut *const c_char) -> Status = "fmi2GetStringStatus",
-}
-
-/// `fmi2EventInfo`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default)]
-pub struct EventInfo {
-    pub new_discrete_states_needed: c_int,
-    pub terminate_simulation: c_int,
-    pub nominals_of_continuous_states_changed: c_int,
-    pub values_of_continuous_states_changed: c_int,
-    pub next_event_time_defined: c_int,
-    pub next_event_time: f64,
-}
-
-api! {
-    /// The functions Model Exchange adds (FMI 2.0.4 §3.2) as typed
-    /// pointers.
-    MeApi;
-    enter_event_mode: fn(Component) -> Status = "fmi2EnterEventMode",
-    new_discrete_states: fn(Component, *mut EventInfo) -> Status = "fmi2NewDiscreteStates",
-    enter_continuous_time_mode: fn(Component) -> Status = "fmi2EnterContinuousTimeMode",
-    completed_integrator_step: fn(Component, c_int, *mut c_int, *mut c_int) -> Status = "fmi2CompletedIntegratorStep",
-    set_time: fn(Component, f64) -> Status = "fmi2SetTime",
-    set_continuous_states: fn(Component, *const f64, usize) -> Status = "fmi2SetContinuousStates",
-    get_derivatives: fn(Component, *mut f64, usize) -> Status = "fmi2GetDerivatives",
-    get_event_indicators: fn(Component, *mut f64, usize) -> Status = "fmi2GetEventIndicators",
-    get_continuous_states: fn(Component, *mut f64, usize) -> Status = "fmi2GetContinuousStates",
-    get_nominals_of_continuous_states: fn(Component, *mut f64, usize) -> Status = "fmi2GetNominalsOfContinuousStates",
-}
+/// The logger as FMI 2.0 declares it, variadic.
+type VariadicLogger =
+    unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char, ...);
 
 // ---- the model description, reduced to what the probes need ---------------
 
@@ -324,7 +236,8 @@ impl Instance {
     ) -> Result<Instance, Box<Log>> {
         let log = Box::<Log>::default();
         let callbacks = Box::new(Callbacks {
-            logger: Some(record),
+            // SAFETY: see `LoggerFn`
+            logger: Some(unsafe { std::mem::transmute::<LoggerFn, VariadicLogger>(record) }),
             allocate_memory: None,
             free_memory: None,
             step_finished: None,
@@ -703,14 +616,20 @@ pub fn load_shipped(name: &str) -> Loaded {
         .join(format!("{identifier}.so"));
     // SAFETY: our own FMU binary.
     let library = unsafe { libloading::Library::new(&so) }.unwrap();
-    let lookup = |symbol: &str| {
-        // SAFETY: looked up as an address only
-        unsafe { library.get::<*const c_void>(symbol.as_bytes()) }
-            .map(|s| *s)
-            .unwrap_or(null())
+    // SAFETY: an FMI 2.0 binary, kept loaded in `Loaded` with the tables.
+    let (api, me_api) = unsafe { (Api::load(&library), MeApi::load(&library)) };
+    let (api, me_api) = match (api, me_api) {
+        (Ok(api), Ok(me_api)) => (api, me_api),
+        (api, me_api) => panic!(
+            "{}: missing {:?} {:?}",
+            so.display(),
+            api.err(),
+            me_api.err()
+        ),
     };
-    // SAFETY: the symbols are the standard's functions.
-    let (api, me_api) = unsafe { (Api::from_lookup(lookup), MeApi::from_lookup(lookup)) };
+    for symbol in Api::OPTIONAL {
+        assert!(api.exports(symbol), "{}: {symbol} missing", so.display());
+    }
     Loaded {
         model: Model::from_description(&md),
         api,
