@@ -1,6 +1,7 @@
 //! An imported FMU ([`Fmu`]: unpacked files, model description, loaded
 //! binary) and its instances ([`Instance`]: the FMI 2.0 Co-Simulation API of
-//! FMI 2.0.4 §2.1 and §4.2 as safe methods).
+//! FMI 2.0.4 §2.1 and §4.2 as safe methods, each a call through FMI 2.0's
+//! raw table, [`crate::fmi2::Functions`], with the checks around it).
 //!
 //! Every FMU call returns `Result<Status, FmuError>`: `fmi2OK` and
 //! `fmi2Warning` are `Ok` (a warning is in the log), `fmi2Discard`,
