@@ -162,16 +162,21 @@ def interval_check(case: cases.Case, report: dict) -> dict | None:
     return {"quantity": quantity, "truth": truth, "interval": [low, high], "holds": low <= truth <= high}
 
 
-def run_case(case: cases.Case, work: Path, bad_data: bool = False, extra: tuple = ()) -> dict:
+def run_case(
+    case: cases.Case, work: Path, bad_data: bool = False, extra: tuple = (), timeout: float | None = None
+) -> dict:
+    """Make, diagnose and score one case; `timeout`: seconds after which
+    the diagnosis is stopped and the case recorded as timed out."""
     started = time.time()
     data, ssd = cases.make(case, work)
     marks = corrupt(data) if bad_data else []
     out = work / f"out-{case.name}{'-bad' if bad_data else ''}"
-    proc = subprocess.run(
-        [str(FRICSIM), "diagnose", str(ssd), str(data), "--out", str(out), *extra],
-        capture_output=True,
-        text=True,
-    )
+    (out / "report.json").unlink(missing_ok=True)  # none left from an earlier run
+    argv = [str(FRICSIM), "diagnose", str(ssd), str(data), "--out", str(out), *extra]
+    try:
+        proc = subprocess.run(argv, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc = subprocess.CompletedProcess(argv, None, "", f"stopped after {timeout:g} s (--case-timeout)")
     row = {
         "case": case.name + (" (spikes, dropout)" if bad_data else ""),
         "kind": case.kind,
@@ -186,6 +191,7 @@ def run_case(case: cases.Case, work: Path, bad_data: bool = False, extra: tuple 
         "report": (out / "report.json").exists(),
         "exit": proc.returncode,
         "stderr": proc.stderr[-2000:],
+        "timed_out": proc.returncode is None,
     }
     if not row["report"]:
         row["seconds"] = time.time() - started
@@ -348,6 +354,9 @@ def main() -> int:
     )
     ap.add_argument("--diagnose-arg", action="append", default=[], help="passed on to fricsim diagnose (repeat)")
     ap.add_argument("--fricsim", type=Path, help="the fricsim binary to diagnose with (default: this build's)")
+    ap.add_argument(
+        "--case-timeout", type=float, help="stop a diagnosis after this many seconds (recorded as timed out, no report)"
+    )
     ap.add_argument("--no-coarse", action="store_true", help="leave out the 200 Hz / 10 µm rows")
     ap.add_argument("--coarse-only", action="store_true", help="only the 200 Hz / 10 µm rows")
     ap.add_argument(
@@ -372,7 +381,10 @@ def main() -> int:
     else:
         with ThreadPoolExecutor(args.jobs) as pool:
             rows = list(
-                pool.map(lambda cb: run_case(cb[0], args.out / "cases", cb[1], tuple(args.diagnose_arg)), todo)
+                pool.map(
+                    lambda cb: run_case(cb[0], args.out / "cases", cb[1], tuple(args.diagnose_arg), args.case_timeout),
+                    todo,
+                )
             )
     for r in rows:
         print(r["case"], r.get("found"), r.get("size", {}).get("relative_error"), r.get("final_rms", 0) / max(r.get("given_rms", 1), 1e-300), file=sys.stderr)
