@@ -61,7 +61,7 @@ enum Command {
     Sweep(cli::sweep::SweepArgs),
     /// The child process of `run --isolate` (started by fricsim itself).
     #[command(name = "isolated-child", hide = true)]
-    IsolatedChild(cli::isolated::ChildArgs),
+    IsolatedChild(cli::child::ChildArgs),
 }
 
 fn main() -> ExitCode {
@@ -97,7 +97,7 @@ fn main() -> ExitCode {
         Command::Reference(args) => cli::reference::run(&args),
         Command::Diagnose(args) => cli::diagnose::run(&args),
         Command::Sweep(args) => cli::sweep::run(&args),
-        Command::IsolatedChild(args) => cli::isolated::child(&args),
+        Command::IsolatedChild(args) => cli::child::child(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

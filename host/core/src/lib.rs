@@ -1,7 +1,8 @@
 //! `fricsim-core`: the co-simulation core of `fricsim`. A system of FMUs
 //! read from an SSP file ([`ssp`]) and built with checked connections
 //! ([`system`]), stepped by a master algorithm ([`master`]: Jacobi,
-//! Gauss–Seidel, strong coupling) with inputs from a table ([`inputs`]),
+//! Gauss–Seidel, strong coupling) on the communication points of
+//! [`time_grid`], with inputs from a table ([`inputs`]),
 //! its rows recorded ([`rows`]) and written as CSV or MAT files
 //! ([`results`], [`matfile`], [`output_file`], on a second core:
 //! [`writer_thread`]), a run stopped cleanly by a signal ([`signals`]) or
@@ -29,6 +30,7 @@ pub mod ssp;
 pub use fricsim_fmi::stale;
 pub mod sweep;
 pub mod system;
+pub mod time_grid;
 pub mod writer_thread;
 
 pub use error::{ArchiveProblem, FmuError};

@@ -1,5 +1,10 @@
 //! A co-simulated system: named FMU instances, parameter values and
 //! connections from outputs to inputs, checked when built.
+//!
+//! Uses the importer ([`crate::fmu`]), [`crate::rows`] and
+//! [`crate::time_grid`]; it knows nothing of the masters, which step it
+//! through its public fields and methods (the master module uses this
+//! one, never the reverse).
 
 use crate::fmu::model_description::{Causality, VariableKind};
 use crate::fmu::{Fmu, Instance, Rollback, ValueReference};
@@ -377,16 +382,16 @@ impl From<f64> for Experiment {
 
 impl Experiment {
     /// A run from `start` in macro steps of `step` towards `stop`, as the
-    /// masters step it ([`crate::master::step_count`]): its stop time is
+    /// masters step it ([`crate::time_grid::step_count`]): its stop time is
     /// the last communication point, `start + n·step`, which the last
     /// step reaches exactly (FMPy tells the FMUs its stop time too; a
     /// `stop` that is not a whole number of steps from `start` would
     /// otherwise be short of the last point or past it).
     pub fn stepped(start: f64, step: f64, stop: f64) -> Experiment {
-        let n = crate::master::step_count(start, step, stop);
+        let n = crate::time_grid::step_count(start, step, stop);
         Experiment {
             start,
-            stop: Some(crate::master::communication_time(start, step, n)),
+            stop: Some(crate::time_grid::communication_time(start, step, n)),
         }
     }
 }
@@ -855,7 +860,7 @@ impl System {
 
     /// [`System::start_recording`] of every row, whatever
     /// [`System::keep_last_rows`] says: for a run that hands its rows on
-    /// as it goes ([`crate::master::simulate_streaming`]).
+    /// as it goes (the masters' `simulate_streaming`).
     pub(crate) fn start_streamed_recording(&mut self, rows: usize) {
         let width = self.recording.rows.width();
         self.recording.rows = Rows::with_capacity(width, rows);
@@ -879,7 +884,7 @@ impl System {
     /// `window` rows (at least 2), the others summed into
     /// [`Rows::square_sums`] and counted in [`Rows::rows_pushed`]: for runs
     /// of which only a summary is kept (`fricsim sweep`). Such a run keeps
-    /// the times of those rows only ([`crate::master::Run::time`]). `None`
+    /// the times of those rows only (a run's `time`). `None`
     /// (the default): every row is kept.
     ///
     /// # Panics

@@ -1,34 +1,14 @@
-//! `fricsim run --isolate` and `cosim --isolate`: the FMUs in a child
-//! process ([`fricsim::isolate`]). The parent claims the result file
-//! before the child starts, writes the rows, the plot and the summary as
-//! the command does in-process; the child (the hidden subcommand
-//! `isolated-child`) builds the system and runs it (`run::child`,
-//! `cosim::child`).
+//! `fricsim run --isolate` and `cosim --isolate`, the parent's side and
+//! what both sides share: the FMUs in a child process
+//! ([`fricsim::isolate`]). The parent claims the result file before the
+//! child starts, writes the rows, the plot and the summary as the command
+//! does in-process; the child (the hidden subcommand `isolated-child`,
+//! the module `child`) builds the system and runs it. Used by `run` and
+//! `cosim`; names neither of them.
 
-use super::cosim::CosimArgs;
-use super::run::RunArgs;
-use fricsim::isolate::child::Child;
 use fricsim::isolate::parent;
 use fricsim::master::{Ended, RowSink};
 use serde::{de::DeserializeOwned, Serialize};
-use std::path::PathBuf;
-
-/// The hidden subcommand: `fricsim isolated-child --run-dir DIR <command>`.
-#[derive(clap::Args)]
-pub struct ChildArgs {
-    /// The run's directory, made by the parent (black box, row ring).
-    #[arg(long = "run-dir")]
-    pub run_dir: PathBuf,
-    #[command(subcommand)]
-    pub command: ChildCommand,
-}
-
-/// The commands that can run isolated, with their own options.
-#[derive(clap::Subcommand)]
-pub enum ChildCommand {
-    Run(RunArgs),
-    Cosim(CosimArgs),
-}
 
 /// What the child adds when the run ends.
 #[derive(serde::Serialize, serde::Deserialize, Default)]
@@ -105,20 +85,6 @@ pub fn run_isolated<P: DeserializeOwned, S: RowSink>(
         error,
         ending,
     })
-}
-
-/// The child: run as the command does in-process, the rows and the
-/// outcome going to the parent.
-pub fn child(a: &ChildArgs) -> Result<(), String> {
-    let mut link = Child::connect(&a.run_dir)?;
-    let ran = match &a.command {
-        ChildCommand::Run(args) => super::run::child(args, &mut link),
-        ChildCommand::Cosim(args) => super::cosim::child(args, &mut link),
-    };
-    match ran {
-        Ok(()) => Ok(()),
-        Err(e) => link.failed(e),
-    }
 }
 
 /// `value` as the JSON of a message to the parent.

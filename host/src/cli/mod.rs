@@ -1,5 +1,11 @@
-//! The subcommands of the `fricsim` binary (not part of the library).
+//! The subcommands of the `fricsim` binary (not part of the library): one
+//! module per subcommand, and here the options and helpers they share.
+//! The dependencies go one way: [`isolated`] (what `run --isolate` and
+//! `cosim --isolate` share) is below [`run`] and [`cosim`], which use it;
+//! [`child`] (the hidden `isolated-child`) is above them, and only `main`
+//! uses it.
 
+pub mod child;
 pub mod compare;
 pub mod cosim;
 pub mod diagnose;

@@ -1,4 +1,8 @@
 //! Master algorithms: how a macro step advances the connected FMUs.
+//!
+//! Uses [`crate::system`] (the components and connections it steps),
+//! [`crate::rows`] and [`crate::time_grid`] (the communication points,
+//! re-exported here); the system uses nothing of this module.
 
 pub mod gauss_seidel;
 pub mod jacobi;
@@ -6,6 +10,8 @@ pub mod strong;
 
 pub use crate::rows::Rows;
 use crate::system::System;
+use crate::time_grid::counted;
+pub use crate::time_grid::{communication_time, step_count};
 use crate::FmuError;
 
 pub trait MasterAlgorithm {
@@ -227,33 +233,6 @@ pub fn simulate(
     stop: f64,
 ) -> Result<Run, FmuError> {
     simulate_with(system, master, 0.0, h, stop, &mut NoObserver)
-}
-
-/// Number of macro steps of `h` from `start` to `stop`: the nearest whole
-/// number, so that a stop time that is a multiple of the step up to rounding
-/// (20 / 1e-4) is reached exactly.
-pub fn step_count(start: f64, h: f64, stop: f64) -> usize {
-    ((stop - start) / h).round().max(0.0) as usize
-}
-
-/// The time of communication point `j` of a run from `start` in steps of
-/// `h`: `start + j·h`, counted from the start (never summed), as
-/// [`simulate_with`] steps; point 0 is `start` itself.
-pub fn communication_time(start: f64, h: f64, j: usize) -> f64 {
-    if j == 0 {
-        start
-    } else {
-        counted(start, h, j)
-    }
-}
-
-/// `start + j·h`: where step `j` of [`simulate_with`] starts (and step
-/// `j - 1` ends).
-#[inline(always)]
-fn counted(start: f64, h: f64, j: usize) -> f64 {
-    // `j` converted as a signed integer (one instruction; without the
-    // sign, several): the same number, a count being far below 2⁶³
-    start + j as i64 as f64 * h
 }
 
 /// Leave initialization mode at `start`: external inputs set, the
