@@ -40,8 +40,8 @@
 //! ```
 
 pub use fricsim_core::{
-    compare, error, fmu, inputs, isolate, master, matfile, output_file, plot, reference, results,
-    rows, run, signals, ssp, stale, sweep, system, writer_thread,
+    compare, csvfile, error, fmu, formats, inputs, isolate, master, matfile, output_file, plot,
+    reference, results, rows, run, signals, ssp, stale, sweep, system, time_grid, writer_thread,
 };
 pub use fricsim_core::{ArchiveProblem, FmuError};
 /// The diagnosis, the crate `fricsim-diagnose` (`host/diagnose`).

@@ -10,6 +10,7 @@
 //! occurs. When the time grids differ the reference is interpolated
 //! linearly onto the result's times (it must cover them).
 
+use crate::formats::ResultFormat;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -76,14 +77,16 @@ impl ResultFile {
     /// A path ending in `.mat` is read as a MAT v4 result file
     /// ([`crate::matfile::read`]), with the same checks.
     pub fn read(path: &Path) -> Result<ResultFile, CompareError> {
-        if crate::matfile::is_mat(path) {
-            return Self::read_mat(path);
+        match ResultFormat::from_path(path) {
+            ResultFormat::Mat => Self::read_mat(path),
+            ResultFormat::Csv => {
+                let text = std::fs::read_to_string(path).map_err(|e| CompareError::Read {
+                    path: path.to_path_buf(),
+                    message: e.to_string(),
+                })?;
+                Self::parse(path, &text)
+            }
         }
-        let text = std::fs::read_to_string(path).map_err(|e| CompareError::Read {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
-        Self::parse(path, &text)
     }
 
     /// A MAT v4 result file: the variables of its `data_2`, time strictly
@@ -246,18 +249,20 @@ impl ResultFile {
         let col = self.column(name).unwrap_or(&[]);
         match col.iter().position(|x| !x.is_finite()) {
             None => Ok(()),
-            Some(i) if crate::matfile::is_mat(&self.path) => Err(CompareError::Read {
-                path: self.path.clone(),
-                message: format!(
-                    "time point {}: {name} = {} is not a finite number",
-                    self.lines[i], col[i]
-                ),
-            }),
-            Some(i) => Err(CompareError::NotFinite {
-                path: self.path.clone(),
-                line: self.lines[i],
-                column: name.to_string(),
-                value: col[i],
+            Some(i) => Err(match ResultFormat::from_path(&self.path) {
+                ResultFormat::Mat => CompareError::Read {
+                    path: self.path.clone(),
+                    message: format!(
+                        "time point {}: {name} = {} is not a finite number",
+                        self.lines[i], col[i]
+                    ),
+                },
+                ResultFormat::Csv => CompareError::NotFinite {
+                    path: self.path.clone(),
+                    line: self.lines[i],
+                    column: name.to_string(),
+                    value: col[i],
+                },
             }),
         }
     }

@@ -18,6 +18,7 @@
 
 use crate::fmu::model_description::{Causality, Variability, VariableKind};
 use crate::fmu::ValueReference;
+use crate::formats::ResultFormat;
 use crate::master::Observer;
 use crate::system::System;
 use crate::FmuError;
@@ -42,9 +43,14 @@ impl InputTable {
     /// MAT v4 result file ([`crate::matfile::read`]), with the same checks
     /// (its time points counted as lines: the first is 2).
     pub fn read(path: &Path) -> Result<InputTable, String> {
-        if crate::matfile::is_mat(path) {
-            return Self::read_mat(path);
+        match ResultFormat::from_path(path) {
+            ResultFormat::Mat => Self::read_mat(path),
+            ResultFormat::Csv => Self::read_csv(path),
         }
+    }
+
+    /// [`InputTable::read`] of a CSV file.
+    fn read_csv(path: &Path) -> Result<InputTable, String> {
         let shown = path.display();
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)

@@ -3,8 +3,9 @@
 //! ([`system`]), stepped by a master algorithm ([`master`]: Jacobi,
 //! Gauss–Seidel, strong coupling) on the communication points of
 //! [`time_grid`], with inputs from a table ([`inputs`]),
-//! its rows recorded ([`rows`]) and written as CSV or MAT files
-//! ([`results`], [`matfile`], [`output_file`], on a second core:
+//! its rows recorded ([`rows`]) and written as CSV or MAT files, the
+//! format chosen in one place ([`formats`]; [`results`], [`csvfile`],
+//! [`matfile`], [`output_file`], on a second core:
 //! [`writer_thread`]), a run stopped cleanly by a signal ([`signals`]) or
 //! isolated in a child process ([`isolate`]); sweeps ([`sweep`]), plots
 //! ([`plot`]), comparisons of result files ([`compare`]) and the monolithic
@@ -12,9 +13,11 @@
 //! `fricsim-fmi`, here [`fmu`].
 
 pub mod compare;
+pub mod csvfile;
 /// The FMU importer, the crate `fricsim-fmi` (`host/fmi`).
 pub use fricsim_fmi as fmu;
 pub use fricsim_fmi::error;
+pub mod formats;
 pub mod inputs;
 pub mod isolate;
 pub mod master;

@@ -32,12 +32,6 @@ use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom, Write};
 use std::path::Path;
 
-/// Whether `path` names a MAT file (extension `.mat`, any case).
-pub fn is_mat(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mat"))
-}
-
 /// Element types (the P digit of a header's type).
 const DOUBLE: i32 = 0;
 const FLOAT: i32 = 1;
@@ -89,7 +83,7 @@ fn text_columns(out: &mut impl Write, name: &str, strings: &[&str]) -> std::io::
 
 /// A MAT result file written row by row ([module docs](self)) to an
 /// [`OutputFile`] (put in place whole, or marked incomplete, or not at
-/// all), as [`crate::results::CsvFile`].
+/// all), as [`crate::csvfile::CsvFile`].
 pub struct MatFile {
     out: OutputFile,
     columns: Vec<String>,
@@ -514,7 +508,6 @@ mod tests {
     fn a_run_that_stopped_early_says_why() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("r.MAT");
-        assert!(is_mat(&path) && !is_mat(Path::new("r.csv")));
         let mut file = MatFile::new(
             OutputFile::create(&path, &[]).unwrap(),
             &["a.y".to_string()],

@@ -230,7 +230,7 @@ impl PreparedRun {
 
     /// The type of each column of [`PreparedRun::columns`]: Integer and
     /// Boolean columns hold whole numbers (see
-    /// [`crate::results::CsvFile::whole_number_columns`]).
+    /// [`crate::csvfile::CsvFile::whole_number_columns`]).
     pub fn column_types(&self) -> Vec<RecordedType> {
         self.system.column_types()
     }

@@ -10,6 +10,7 @@
 //! time. Runs share nothing but the parsed file, so they scale with the
 //! cores; a run that fails is a row that says so, not the end of the sweep.
 
+use crate::csvfile::push_number;
 use crate::master::{by_name, simulate_with, NoObserver};
 use crate::output_file::{OutputError, OutputFile};
 use crate::ssp::{CheckedSystem, SystemFile};
@@ -243,16 +244,21 @@ pub fn run_all(file: &SystemFile, plan: &Plan, threads: usize) -> Result<Vec<Out
 
 /// The table: `run`, one column per swept variable, `status` (`ok` or the
 /// error), `points`, `wall_s`, then `final:<column>` and `rms:<column>` for
-/// every recorded column (those of the first run that has any).
+/// every recorded column (those of the first run that has any); numbers
+/// as a result file writes them ([`crate::csvfile`]). CSV alone: its
+/// `status` column is text ([`crate::formats::ResultFormat::holds_text`]).
 /// Written through `out` ([`OutputFile`]): put in place whole or not at
 /// all.
-pub fn write_csv(outcomes: &[Outcome], mut out: OutputFile) -> Result<(), OutputError> {
+pub fn write_table(outcomes: &[Outcome], mut out: OutputFile) -> Result<(), OutputError> {
     // a write error is kept by the OutputFile and reported by commit
-    let _ = write_table(outcomes, &mut out);
+    let _ = out
+        .write_all(&table_text(outcomes))
+        .and_then(|()| out.flush());
     out.commit()
 }
 
-fn write_table(outcomes: &[Outcome], out: &mut OutputFile) -> std::io::Result<()> {
+/// The text of [`write_table`]'s table.
+fn table_text(outcomes: &[Outcome]) -> Vec<u8> {
     let ports: Vec<&str> = outcomes
         .first()
         .map(|o| o.point.iter().map(|(k, _)| k.as_str()).collect())
@@ -267,30 +273,33 @@ fn write_table(outcomes: &[Outcome], out: &mut OutputFile) -> std::io::Result<()
     header.extend(["status".into(), "points".into(), "wall_s".into()]);
     header.extend(columns.iter().map(|c| format!("final:{c}")));
     header.extend(columns.iter().map(|c| format!("rms:{c}")));
-    writeln!(out, "{}", header.join(","))?;
+    let mut text = header.join(",").into_bytes();
+    text.push(b'\n');
+    let mut digits = zmij::Buffer::new();
     for (i, o) in outcomes.iter().enumerate() {
-        write!(out, "{}", i + 1)?;
+        text.extend_from_slice(itoa::Buffer::new().format(i + 1).as_bytes());
         for (_, v) in &o.point {
-            write!(out, ",{v:?}")?;
+            text.push(b',');
+            push_number(&mut text, &mut digits, *v);
         }
         let status = match &o.error {
             None => "ok".to_string(),
             // one CSV field: no commas, quotes or line breaks
             Some(e) => format!("failed: {}", e.replace([',', '"', '\n', '\r'], " ")),
         };
-        write!(out, ",{status},{},{:.6}", o.points, o.wall)?;
+        text.extend_from_slice(format!(",{status},{},{:.6}", o.points, o.wall).as_bytes());
         let same = o.columns == columns;
         for values in [&o.last, &o.rms] {
             for k in 0..columns.len() {
-                match values.get(k).filter(|_| same) {
-                    Some(x) => write!(out, ",{x:?}")?,
-                    None => write!(out, ",")?,
+                text.push(b',');
+                if let Some(x) = values.get(k).filter(|_| same) {
+                    push_number(&mut text, &mut digits, *x);
                 }
             }
         }
-        writeln!(out)?;
+        text.push(b'\n');
     }
-    out.flush()
+    text
 }
 
 #[cfg(test)]

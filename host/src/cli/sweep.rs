@@ -3,9 +3,10 @@
 //! in parallel on all cores, summarised one row per run in a CSV
 //! ([`fricsim::sweep`]).
 
+use fricsim::formats::ResultFormat;
 use fricsim::output_file::OutputFile;
 use fricsim::ssp::SystemFile;
-use fricsim::sweep::{check_axes, grid, run_all, seed_ports, write_csv, Axis, Plan};
+use fricsim::sweep::{check_axes, grid, run_all, seed_ports, write_table, Axis, Plan};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -47,7 +48,7 @@ pub fn run(a: &SweepArgs) -> Result<(), String> {
         .out
         .clone()
         .unwrap_or_else(|| super::default_out(&a.system, "-sweep"));
-    if fricsim::matfile::is_mat(&out) {
+    if !ResultFormat::from_path(&out).holds_text() {
         // refused before anything runs: the table has a text column
         return Err(format!(
             "--out {}: a sweep's table is written as CSV only (its `status` column is text, which MAT v4 cannot hold); give a .csv name",
@@ -100,7 +101,7 @@ pub fn run(a: &SweepArgs) -> Result<(), String> {
     let started = std::time::Instant::now();
     let outcomes = run_all(&file, &plan, threads)?;
     let wall = started.elapsed().as_secs_f64();
-    write_csv(&outcomes, output).map_err(|e| e.to_string())?;
+    write_table(&outcomes, output).map_err(|e| e.to_string())?;
     let failed = outcomes.iter().filter(|o| o.error.is_some()).count();
     println!(
         "{}: {} runs ({} failed) of {} s with {} on {threads} threads in {wall:.3} s wall time ({:.2} runs/s)",
