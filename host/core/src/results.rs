@@ -1,6 +1,5 @@
-//! Writing result files, whatever their format: the [`RowFile`] trait
-//! that each format's writer implements ([`CsvFile`], [`MatFile`]; which
-//! one a path gets is [`ResultFormat::from_path`]), and
+//! Writing result files, whatever their format (a [`RowFile`] of the
+//! format the path names: [`ResultFormat::from_path`]):
 //! [`ResultWriter`], which takes the rows of a run as they are computed
 //! (the masters' `simulate_streaming`) and writes them at once, keeping
 //! only a summary of each column and the columns to be plotted, so that a
@@ -9,54 +8,11 @@
 //! an [`OutputFile`]: a result is put in place whole (or marked
 //! incomplete) or not at all.
 
-use crate::csvfile::CsvFile;
-use crate::formats::ResultFormat;
+use crate::formats::{ResultFormat, RowFile};
 use crate::master::{RowSink, Run};
-use crate::matfile::MatFile;
 use crate::output_file::{OutputError, OutputFile};
 use crate::rows::Rows;
 use crate::system::RecordedType;
-use std::path::Path;
-
-/// A result file written row by row, whatever its format.
-pub trait RowFile {
-    fn path(&self) -> &Path;
-    /// Write the Integer and Boolean columns as whole numbers, where the
-    /// format distinguishes them (CSV); `types` has one entry per column.
-    fn whole_number_columns(&mut self, _types: &[RecordedType]) {}
-    /// The first `times.len()` rows of `rows`, at `times`.
-    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()>;
-    /// The end of the file, saying why the run stopped early if `error`
-    /// is given; then the file is put in place ([`OutputFile::commit`]).
-    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError>;
-}
-
-impl RowFile for CsvFile {
-    fn path(&self) -> &Path {
-        CsvFile::path(self)
-    }
-    fn whole_number_columns(&mut self, types: &[RecordedType]) {
-        CsvFile::whole_number_columns(self, types)
-    }
-    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
-        CsvFile::write_rows(self, times, rows)
-    }
-    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError> {
-        CsvFile::finish(*self, error)
-    }
-}
-
-impl RowFile for MatFile {
-    fn path(&self) -> &Path {
-        MatFile::path(self)
-    }
-    fn write_rows(&mut self, times: &[f64], rows: &Rows) -> std::io::Result<()> {
-        MatFile::write_rows(self, times, rows)
-    }
-    fn finish(self: Box<Self>, error: Option<&str>) -> Result<(), OutputError> {
-        MatFile::finish(*self, error)
-    }
-}
 
 /// Write `run` (rows held in memory) to `out` in the format its path
 /// names ([`ResultFormat::from_path`]: MAT v4 for `.mat`, else CSV).
@@ -158,7 +114,7 @@ impl ResultWriter {
         self
     }
 
-    /// See [`CsvFile::whole_number_columns`].
+    /// See [`crate::csvfile::CsvFile::whole_number_columns`].
     pub fn whole_number_columns(&mut self, types: &[RecordedType]) {
         self.file.whole_number_columns(types);
     }
@@ -198,7 +154,8 @@ impl ResultWriter {
         })
     }
 
-    /// The end of the file (see [`CsvFile::finish`], [`MatFile::finish`]).
+    /// The end of the file (see [`crate::csvfile::CsvFile::finish`],
+    /// [`crate::matfile::MatFile::finish`]).
     pub fn finish(self, error: Option<&str>) -> Result<(), OutputError> {
         self.file.finish(error)
     }
