@@ -772,7 +772,7 @@ fn channel_scales(data: &Measured) -> Vec<f64> {
 fn step_of(file: &SystemFile, data: &Measured) -> f64 {
     match file.settings.step_size {
         Some(h) => h,
-        None => problem::median_spacing(&data.time),
+        None => quality::median_spacing(&data.time),
     }
 }
 
@@ -885,7 +885,7 @@ pub fn diagnose_records(
     let friction_data = |system: &mut crate::system::System, data: &Measured| {
         match &output_error_only {
         None => setup.friction_data(system, data, options.smooth),
-        Some(why) => setup.friction_data_simulated(file, system, data, why).map_err(|e| {
+        Some(why) => sim::friction_data_simulated(&setup, file, system, data, why).map_err(|e| {
             format!(
                 "{}: the friction force cannot be estimated from the data ({why}), and the nominal system could not be co-simulated along it to fit by output error: {e}",
                 data.label

@@ -211,7 +211,7 @@ impl Measured {
         for p in parts {
             let offset = match joined.time.last() {
                 None => 0.0,
-                Some(&end) => end + median_spacing(&p.time) - p.time[0],
+                Some(&end) => end + quality::median_spacing(&p.time) - p.time[0],
             };
             let start = joined.time.len();
             joined.time.extend(p.time.iter().map(|t| t + offset));
@@ -386,7 +386,7 @@ pub struct FrictionData {
 
 impl FrictionData {
     /// No interval yet, of one record, obtained as `source` says.
-    fn empty(source: String) -> FrictionData {
+    pub(crate) fn empty(source: String) -> FrictionData {
         FrictionData {
             t: Vec::new(),
             h: Vec::new(),
@@ -406,7 +406,7 @@ impl FrictionData {
 
     /// `one` of each record of `data` (of `data` itself when it is one
     /// record), joined ([`FrictionData::join`]); an error names its record.
-    fn per_record(
+    pub(crate) fn per_record(
         data: &Measured,
         mut one: impl FnMut(&Measured) -> Result<FrictionData, String>,
     ) -> Result<FrictionData, String> {
@@ -595,128 +595,10 @@ impl Setup {
             })
     }
 
-    /// The friction law's inputs and force along a co-simulation of the
-    /// nominal system with the data's inputs: for a plant whose inverse
-    /// dynamics diagnose does not know (not a Rig1D) and no measured
-    /// friction force. The force is then not estimated from the data: every
-    /// fit goes by output error through co-simulation, and these series
-    /// only set the candidates' starting ranges (speeds, travel) and the
-    /// states the report bins the change of the force by. `why` says why
-    /// the force could not be estimated.
-    pub fn friction_data_simulated(
-        &self,
-        file: &SystemFile,
-        system: &mut System,
-        data: &Measured,
-        why: &str,
-    ) -> Result<FrictionData, String> {
-        FrictionData::per_record(data, |record| {
-            self.record_friction_data_simulated(file, system, record, why)
-        })
-    }
-
-    /// [`Setup::friction_data_simulated`] of one record.
-    fn record_friction_data_simulated(
-        &self,
-        file: &SystemFile,
-        system: &mut System,
-        data: &Measured,
-        why: &str,
-    ) -> Result<FrictionData, String> {
-        let params = super::sim::system_parameters(file, self, &self.nominal);
-        // tried as every co-simulation of the diagnosis is
-        let mut failures = Vec::new();
-        let mut completed = None;
-        for (master, step) in super::sim::fallback_tries(self) {
-            match super::sim::run_on(system, &params, data, &master, step) {
-                Ok(run) if run.error.is_none() => {
-                    completed = Some(run);
-                    break;
-                }
-                Ok(run) => failures.push(format!(
-                    "{master} at {step} s: stopped early: {}",
-                    run.error.unwrap_or_default()
-                )),
-                Err(e) => failures.push(format!("{master} at {step} s: {e}")),
-            }
-        }
-        let run = completed.ok_or_else(|| {
-            format!(
-                "the nominal system as given cannot be co-simulated: no co-simulation completed ({})",
-                failures.join("; ")
-            )
-        })?;
-        let f = &self.friction_name;
-        let series = |port: &str| -> Option<Vec<f64>> {
-            let col = run.columns.iter().position(|c| c == port)?;
-            Some(run.rows.iter().map(|r| r[col]).collect())
-        };
-        let law_input = |var: &str| -> Vec<f64> {
-            let port = format!("{f}.{var}");
-            if let Some(col) = data.column(&port) {
-                return col.to_vec();
-            }
-            let simulated = self.input_source(system, var).and_then(|src| series(&src));
-            match simulated {
-                Some(s) => {
-                    let mut cursor = crate::inputs::Cursor::default();
-                    data.time
-                        .iter()
-                        .map(|&t| {
-                            crate::inputs::interpolate_from(&mut cursor, t, &run.time, &s, false)
-                        })
-                        .collect()
-                }
-                None => vec![0.0; data.time.len()],
-            }
-        };
-        let (v, x, fn_) = (law_input("v"), law_input("x"), law_input("Fn"));
-        let force = series(&format!("{f}.F"))
-            .ok_or_else(|| format!("the co-simulation does not record `{f}.F`"))?;
-        let n = data.time.len();
-        let mut d = FrictionData {
-            position_resolution: self
-                .input_source(system, "x")
-                .and_then(|src| data.column(&src))
-                .map(quality::resolution),
-            position_step: self
-                .input_source(system, "x")
-                .and_then(|src| data.column(&src))
-                .map(quality::step),
-            normal_force_measured: data.column(&format!("{f}.Fn")).is_some()
-                && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
-                    > fn_.iter().cloned().fold(f64::INFINITY, f64::min),
-            ..FrictionData::empty(format!(
-                "not estimated ({why}): every fit is by output error through co-simulation of the whole system"
-            ))
-        };
-        let mut force_cursor = crate::inputs::Cursor::default();
-        for k in 0..n - 1 {
-            if data.time[k + 1] > data.time[k] {
-                d.t.push(data.time[k]);
-                d.h.push(data.time[k + 1] - data.time[k]);
-                d.end.push(k + 1);
-                d.v.push(v[k]);
-                d.x.push(x[k]);
-                d.fn_.push(fn_[k]);
-                d.f.push(crate::inputs::interpolate_from(
-                    &mut force_cursor,
-                    data.time[k + 1],
-                    &run.time,
-                    &force,
-                    false,
-                ));
-                d.trusted
-                    .push(!data.quality.excluded[k + 1] && !data.quality.after_gap[k + 1]);
-            }
-        }
-        Ok(d)
-    }
-
     /// Whether the force the data imply can be estimated: measured as
     /// `friction.F`, or by the inverse dynamics of a Rig1D the friction
     /// acts on. Otherwise diagnose fits by output error alone
-    /// ([`Setup::friction_data_simulated`]); the reason when not.
+    /// ([`super::sim::friction_data_simulated`]); the reason when not.
     pub fn force_estimable(&self, data: &Measured) -> Result<(), String> {
         let f = &self.friction_name;
         if data.column(&format!("{f}.F")).is_some() || self.rig.is_some() {
@@ -1012,19 +894,7 @@ fn window_half_width(time: &[f64], seconds: f64) -> usize {
     if seconds <= 0.0 {
         return 0;
     }
-    ((0.5 * seconds / median_spacing(time)).round() as usize).min(time.len() / 4)
-}
-
-/// The median of the positive sample spacings (a file always has one:
-/// [`Measured::read`] requires time to advance).
-pub fn median_spacing(time: &[f64]) -> f64 {
-    let mut dt: Vec<f64> = time
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|d| *d > 0.0)
-        .collect();
-    dt.sort_by(f64::total_cmp);
-    dt.get(dt.len() / 2).copied().unwrap_or(f64::INFINITY)
+    ((0.5 * seconds / quality::median_spacing(time)).round() as usize).min(time.len() / 4)
 }
 
 /// Savitzky–Golay smoothing (local quadratic, window 2·w + 1), with the

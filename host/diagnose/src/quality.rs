@@ -188,6 +188,18 @@ impl Quality {
     }
 }
 
+/// The median of the positive sample spacings (a file always has one:
+/// [`super::problem::Measured::read`] requires time to advance).
+pub fn median_spacing(time: &[f64]) -> f64 {
+    let mut dt: Vec<f64> = time
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .collect();
+    dt.sort_by(f64::total_cmp);
+    dt.get(dt.len() / 2).copied().unwrap_or(f64::INFINITY)
+}
+
 fn median(mut x: Vec<f64>) -> f64 {
     if x.is_empty() {
         return 0.0;
@@ -264,7 +276,7 @@ pub fn inspect(time: &[f64], columns: &mut [(String, Vec<f64>)], lines: &[u64]) 
     let line = |k: usize| lines.get(k).copied().unwrap_or(k as u64 + 2);
 
     // gaps
-    let spacing = super::problem::median_spacing(time);
+    let spacing = median_spacing(time);
     for k in 1..n {
         let dt = time[k] - time[k - 1];
         if dt > GAP_FACTOR * spacing {

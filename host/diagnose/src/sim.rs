@@ -370,3 +370,119 @@ fn co_simulate_record(
         incomplete: run.error,
     })
 }
+
+/// The friction law's inputs and force along a co-simulation of the
+/// nominal system with the data's inputs: for a plant whose inverse
+/// dynamics diagnose does not know (not a Rig1D) and no measured
+/// friction force. The force is then not estimated from the data: every
+/// fit goes by output error through co-simulation, and these series
+/// only set the candidates' starting ranges (speeds, travel) and the
+/// states the report bins the change of the force by. `why` says why
+/// the force could not be estimated.
+pub fn friction_data_simulated(
+    setup: &Setup,
+    file: &SystemFile,
+    system: &mut System,
+    data: &Measured,
+    why: &str,
+) -> Result<FrictionData, String> {
+    FrictionData::per_record(data, |record| {
+        record_friction_data_simulated(setup, file, system, record, why)
+    })
+}
+
+/// [`friction_data_simulated`] of one record.
+fn record_friction_data_simulated(
+    setup: &Setup,
+    file: &SystemFile,
+    system: &mut System,
+    data: &Measured,
+    why: &str,
+) -> Result<FrictionData, String> {
+    let params = system_parameters(file, setup, &setup.nominal);
+    // tried as every co-simulation of the diagnosis is
+    let mut failures = Vec::new();
+    let mut completed = None;
+    for (master, step) in fallback_tries(setup) {
+        match run_on(system, &params, data, &master, step) {
+            Ok(run) if run.error.is_none() => {
+                completed = Some(run);
+                break;
+            }
+            Ok(run) => failures.push(format!(
+                "{master} at {step} s: stopped early: {}",
+                run.error.unwrap_or_default()
+            )),
+            Err(e) => failures.push(format!("{master} at {step} s: {e}")),
+        }
+    }
+    let run = completed.ok_or_else(|| {
+        format!(
+            "the nominal system as given cannot be co-simulated: no co-simulation completed ({})",
+            failures.join("; ")
+        )
+    })?;
+    let f = &setup.friction_name;
+    let series = |port: &str| -> Option<Vec<f64>> {
+        let col = run.columns.iter().position(|c| c == port)?;
+        Some(run.rows.iter().map(|r| r[col]).collect())
+    };
+    let law_input = |var: &str| -> Vec<f64> {
+        let port = format!("{f}.{var}");
+        if let Some(col) = data.column(&port) {
+            return col.to_vec();
+        }
+        let simulated = setup.input_source(system, var).and_then(|src| series(&src));
+        match simulated {
+            Some(s) => {
+                let mut cursor = crate::inputs::Cursor::default();
+                data.time
+                    .iter()
+                    .map(|&t| crate::inputs::interpolate_from(&mut cursor, t, &run.time, &s, false))
+                    .collect()
+            }
+            None => vec![0.0; data.time.len()],
+        }
+    };
+    let (v, x, fn_) = (law_input("v"), law_input("x"), law_input("Fn"));
+    let force = series(&format!("{f}.F"))
+        .ok_or_else(|| format!("the co-simulation does not record `{f}.F`"))?;
+    let n = data.time.len();
+    let mut d = FrictionData {
+        position_resolution: setup
+            .input_source(system, "x")
+            .and_then(|src| data.column(&src))
+            .map(crate::quality::resolution),
+        position_step: setup
+            .input_source(system, "x")
+            .and_then(|src| data.column(&src))
+            .map(crate::quality::step),
+        normal_force_measured: data.column(&format!("{f}.Fn")).is_some()
+            && fn_.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+                > fn_.iter().cloned().fold(f64::INFINITY, f64::min),
+        ..FrictionData::empty(format!(
+            "not estimated ({why}): every fit is by output error through co-simulation of the whole system"
+        ))
+    };
+    let mut force_cursor = crate::inputs::Cursor::default();
+    for k in 0..n - 1 {
+        if data.time[k + 1] > data.time[k] {
+            d.t.push(data.time[k]);
+            d.h.push(data.time[k + 1] - data.time[k]);
+            d.end.push(k + 1);
+            d.v.push(v[k]);
+            d.x.push(x[k]);
+            d.fn_.push(fn_[k]);
+            d.f.push(crate::inputs::interpolate_from(
+                &mut force_cursor,
+                data.time[k + 1],
+                &run.time,
+                &force,
+                false,
+            ));
+            d.trusted
+                .push(!data.quality.excluded[k + 1] && !data.quality.after_gap[k + 1]);
+        }
+    }
+    Ok(d)
+}
