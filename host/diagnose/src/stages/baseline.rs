@@ -1,0 +1,121 @@
+//! Stage 4, the baseline and the refit: the nominal model as given scored
+//! on the held-out data, the groups of the paired tests set from its
+//! scored samples, and the nominal's levels refitted (Fc, Fc_neg or the
+//! position scales, from three starts) and kept only when they pass the
+//! acceptance rule against the nominal as given ([`RefitDecision`]), so
+//! that the diagnosis never ends worse than the model it was given.
+//!
+//! Takes the [`Problem`] and the system; gives a [`Baseline`].
+
+use super::fitting::level_starts;
+use super::problem::Problem;
+use crate::acceptance::{drop_beyond_step_error, nested_test, Acceptance, Scored};
+use crate::model::FrictionModel;
+use crate::system::System;
+use crate::RefitDecision;
+
+/// The model the candidate rounds start from, and the nominal it came
+/// from.
+pub(crate) struct Baseline {
+    /// The nominal as given, scored.
+    pub(crate) nominal_scored: Scored,
+    /// The group of each scored sample in the paired tests
+    /// ([`acceptance_groups`]).
+    pub(crate) group: Vec<usize>,
+    pub(crate) refit: RefitDecision,
+    /// The refitted nominal when kept, else the nominal as given: the
+    /// model reported, one per fold, and its score.
+    pub(crate) model: FrictionModel,
+    pub(crate) folds: Vec<FrictionModel>,
+    pub(crate) scored: Scored,
+    /// Its co-simulation's step error ([`Problem::step_error`]).
+    pub(crate) step_error: f64,
+}
+
+/// Score the nominal, refit its levels, and keep the better.
+pub(crate) fn baseline(p: &Problem, system: &mut System) -> Result<Baseline, String> {
+    let nominal = &p.setup.nominal;
+    let nominal_folds = vec![nominal.clone(); p.split.folds.len()];
+    let nominal_scored = p.score(system, &nominal_folds).map_err(|e| {
+        format!(
+            "the nominal system as given cannot be co-simulated on {}: {e}",
+            p.scored_data().label
+        )
+    })?;
+    let group = acceptance_groups(p, &nominal_scored);
+    let refit_fits = p.fit_folds_any(&level_starts, &nominal_folds, &[], false)?;
+    let refit_model = p.fit_whole_any(&level_starts(nominal), &refit_fits.models, &[], false)?;
+    let refit_scored = p.score(system, &refit_fits.models);
+    let rule = Acceptance {
+        threshold: p.options.alpha,
+        min_gain: p.options.min_gain,
+    };
+    let nominal_step_error = p.step_error(system, &nominal_folds, &nominal_scored);
+    let refit = match &refit_scored {
+        Ok(scored) => {
+            let (gain, p_value) = nested_test(&nominal_scored, scored, &p.scales, &group)?;
+            let heldout_rms = scored.rms();
+            RefitDecision {
+                heldout_rms,
+                gain,
+                p_value,
+                threshold: rule.threshold,
+                kept: rule.passes(gain, p_value)
+                    && drop_beyond_step_error(&nominal_scored, heldout_rms, nominal_step_error),
+                force_rms: refit_fits.rms,
+                failure: None,
+            }
+        }
+        Err(e) => RefitDecision {
+            heldout_rms: f64::INFINITY,
+            gain: f64::NEG_INFINITY,
+            p_value: 1.0,
+            threshold: rule.threshold,
+            kept: false,
+            force_rms: refit_fits.rms,
+            failure: Some(e.clone()),
+        },
+    };
+    let (model, folds, scored) = match refit_scored {
+        Ok(scored) if refit.kept => (refit_model, refit_fits.models, scored),
+        _ => (nominal.clone(), nominal_folds, nominal_scored.clone()),
+    };
+    // the current model's step error: what a quarter step changes in its
+    // outputs (a drop of the error smaller than that may compensate the
+    // co-simulation's step error, not physics)
+    let step_error = if refit.kept {
+        p.step_error(system, &folds, &scored)
+    } else {
+        nominal_step_error
+    };
+    Ok(Baseline {
+        nominal_scored,
+        group,
+        refit,
+        model,
+        folds,
+        scored,
+        step_error,
+    })
+}
+
+/// The groups of the acceptance test: the held-out blocks when there are
+/// at least [`crate::Options::groups`] of them (each block an independent
+/// trial, `--blocks`), else that many runs of consecutive held-out
+/// samples; one label per sample `scored` picked.
+fn acceptance_groups(p: &Problem, scored: &Scored) -> Vec<usize> {
+    let picked = &scored.picked;
+    let n = picked.len();
+    let time = &p.scored_data().time;
+    let by_block: Vec<usize> = picked
+        .iter()
+        .map(|&k| p.split.blocks.block(time[scored.residuals.samples[k]]))
+        .collect();
+    let held_blocks = 1 + by_block.windows(2).filter(|w| w[0] != w[1]).count();
+    if p.heldout_records.is_none() && held_blocks >= p.options.groups {
+        by_block
+    } else {
+        let g = p.options.groups.clamp(2, n.max(2));
+        (0..n).map(|i| i * g / n.max(1)).collect()
+    }
+}

@@ -1,0 +1,329 @@
+//! Fitting a model: on the force the data imply ([`fit::fit`], on each
+//! fold's fit intervals) or by output error through co-simulation of the
+//! fit samples ([`fit::polish`]), per fold and for the model reported;
+//! and the starts a fit begins from.
+//!
+//! Methods of [`Problem`]; take starts (a function from a fold's current
+//! model to the models to start from) and give [`FoldFits`] or one model.
+
+use super::problem::Problem;
+use super::split::Picker;
+use crate::fit;
+use crate::model::{Context, Effect, FrictionModel};
+use crate::sim::{co_simulate_robust, co_simulate_with, system_parameters, FrictionSim};
+use crate::CANDIDATE_OUTPUT_ERROR_ITERATIONS;
+use nalgebra::DVector;
+use rayon::prelude::*;
+
+/// The models a fit starts from, built from a fold's current model.
+pub(crate) type Starts<'s> = dyn Fn(&FrictionModel) -> Vec<FrictionModel> + Sync + 's;
+
+/// One fit per fold.
+pub(crate) struct FoldFits {
+    /// One per fold.
+    pub(crate) models: Vec<FrictionModel>,
+    /// The mean over the folds of each fit's RMS ([`fit::Fitted::rms`]).
+    pub(crate) rms: f64,
+    pub(crate) evaluations: usize,
+}
+
+impl FoldFits {
+    fn of(fitted: Vec<fit::Fitted>) -> FoldFits {
+        let rms = fitted.iter().map(|f| f.rms).sum::<f64>() / fitted.len() as f64;
+        let evaluations = fitted.iter().map(|f| f.evaluations).sum();
+        FoldFits {
+            models: fitted.into_iter().map(|f| f.model).collect(),
+            rms,
+            evaluations,
+        }
+    }
+}
+
+impl Problem<'_> {
+    /// The normalised output residuals of `m` on the fit samples `pick` of
+    /// the data records (`step`: at that macro step instead, with the
+    /// diagnosis's master and no fallback); `None` when the co-simulation
+    /// fails.
+    pub(crate) fn fit_residuals(
+        &self,
+        m: &FrictionModel,
+        pick: &Picker,
+        step: Option<f64>,
+    ) -> Option<DVector<f64>> {
+        // a system of its own (an FMU instance stays on its thread)
+        let mut system = self.file.build(0.0).ok()?;
+        let params = system_parameters(self.file, &self.setup, m);
+        let records = pick.records.as_deref();
+        let r = match step {
+            None => {
+                co_simulate_robust(&mut system, &params, &self.setup, &self.data, records)
+                    .ok()?
+                    .0
+            }
+            Some(h) => co_simulate_with(
+                &mut system,
+                &params,
+                &self.data,
+                records,
+                &self.setup.master,
+                h,
+            )
+            .ok()?,
+        };
+        if r.incomplete.is_some() {
+            return None;
+        }
+        let picked = (pick.pick)(&r);
+        let scales = &self.scales;
+        let channels = scales.len();
+        let norm = ((picked.len() * channels) as f64).sqrt();
+        Some(DVector::from_iterator(
+            picked.len() * channels,
+            picked.iter().flat_map(|&s| {
+                let r = &r;
+                (0..channels).map(move |c| r.residuals[c][s] / scales[c] / norm)
+            }),
+        ))
+    }
+
+    /// Refine `model` on the output error of the fit samples `pick`, for
+    /// at most `iterations` Levenberg–Marquardt iterations
+    /// ([`fit::polish`]).
+    pub(crate) fn polish(
+        &self,
+        model: &FrictionModel,
+        pick: &Picker,
+        iterations: usize,
+    ) -> fit::Fitted {
+        let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
+            models
+                .par_iter()
+                .map(|m| self.fit_residuals(m, pick, None))
+                .collect()
+        };
+        let budget = iterations * (model.free().len() + 1) + 1;
+        fit::polish(model, &mut residual, budget)
+    }
+
+    /// Fit by output error alone, for an effect the force the data imply
+    /// cannot show (presliding: its hysteresis lives in the stick, which
+    /// the force fits leave out): the starts scored by co-simulating the
+    /// fit samples `pick`, then the best refined ([`Problem::polish`]).
+    fn fit_output_error(&self, starts: &[FrictionModel], pick: &Picker) -> fit::Fitted {
+        let costs: Vec<f64> = starts
+            .par_iter()
+            .map(|m| {
+                self.fit_residuals(m, pick, None)
+                    .map_or(f64::INFINITY, |r| r.norm_squared())
+            })
+            .collect();
+        let best = (0..starts.len())
+            .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
+            .unwrap_or(0);
+        let mut fitted = self.polish(&starts[best], pick, CANDIDATE_OUTPUT_ERROR_ITERATIONS);
+        fitted.evaluations += starts.len();
+        fitted
+    }
+
+    /// The model reported: fitted on every fit interval (the fold's own
+    /// model when there is one fold).
+    fn fit_whole(
+        &self,
+        starts: &[FrictionModel],
+        fold_models: &[FrictionModel],
+    ) -> Result<FrictionModel, String> {
+        if self.split.folds.len() == 1 {
+            return Ok(fold_models[0].clone());
+        }
+        let mut sim = FrictionSim::new(&self.setup.friction_fmu)?;
+        Ok(fit::fit(
+            starts,
+            &mut sim,
+            &self.force.data,
+            &self.split.fit_intervals,
+        )
+        .model)
+    }
+
+    /// Fit `starts` (per fold: built from that fold's model in `base`) on
+    /// each fold by output error alone ([`Problem::fit_output_error`]);
+    /// `also`: one more start per fold (the force fit's result, when there
+    /// is one).
+    fn fit_folds_output_error(
+        &self,
+        starts: &Starts,
+        base: &[FrictionModel],
+        also: &[FrictionModel],
+    ) -> FoldFits {
+        let fitted: Vec<fit::Fitted> = self
+            .split
+            .folds
+            .iter()
+            .zip(base)
+            .enumerate()
+            .map(|(i, (fold, b))| {
+                let mut s = starts(b);
+                s.extend(also.get(i).cloned());
+                self.fit_output_error(&s, &fold.fits)
+            })
+            .collect();
+        FoldFits::of(fitted)
+    }
+
+    /// Fit `starts` (per fold: built from that fold's model in `base`) on
+    /// each fold's intervals of the force the data imply.
+    fn fit_folds(&self, starts: &Starts, base: &[FrictionModel]) -> Result<FoldFits, String> {
+        let fitted: Vec<Result<fit::Fitted, String>> = self
+            .split
+            .folds
+            .par_iter()
+            .zip(base)
+            .map(|(fold, b)| {
+                let mut sim = FrictionSim::new(&self.setup.friction_fmu)?;
+                Ok(fit::fit(
+                    &starts(b),
+                    &mut sim,
+                    &self.force.data,
+                    &fold.fit_intervals,
+                ))
+            })
+            .collect();
+        Ok(FoldFits::of(fitted.into_iter().collect::<Result<_, _>>()?))
+    }
+
+    /// Whether the addition `added` is fitted by output error: when the
+    /// force cannot show it (presliding) or is not estimated at all
+    /// (another plant); else on the force.
+    pub(crate) fn by_output_error(&self, added: &[Effect]) -> bool {
+        self.force.output_error_only.is_some() || added.contains(&Effect::Presliding)
+    }
+
+    /// Fit `starts` on each fold, by output error or on the force as
+    /// [`Problem::by_output_error`] says for `added`. `oe`: by output
+    /// error whatever the addition, the force fit's result as a start (an
+    /// effect fitted to compete with one fitted so, see
+    /// [`Effect::OVERLAPPING`]).
+    pub(crate) fn fit_folds_any(
+        &self,
+        starts: &Starts,
+        base: &[FrictionModel],
+        added: &[Effect],
+        oe: bool,
+    ) -> Result<FoldFits, String> {
+        if self.force.output_error_only.is_some() {
+            Ok(self.fit_folds_output_error(starts, base, &[]))
+        } else if oe || self.by_output_error(added) {
+            // the force fit's result as one more start: what the force
+            // shows of the effect outside the stick
+            let forced = self.fit_folds(starts, base)?;
+            let by_output = self.fit_folds_output_error(starts, base, &forced.models);
+            Ok(FoldFits {
+                evaluations: forced.evaluations + by_output.evaluations,
+                ..by_output
+            })
+        } else {
+            self.fit_folds(starts, base)
+        }
+    }
+
+    /// The model reported for fold models `fold_models` fitted as
+    /// [`Problem::fit_folds_any`] fitted them: by output error on every
+    /// sample, or on every fit interval of the force.
+    pub(crate) fn fit_whole_any(
+        &self,
+        starts: &[FrictionModel],
+        fold_models: &[FrictionModel],
+        added: &[Effect],
+        oe: bool,
+    ) -> Result<FrictionModel, String> {
+        if (oe || self.by_output_error(added)) && self.split.folds.len() > 1 {
+            Ok(self.fit_output_error(starts, &self.every_sample).model)
+        } else {
+            self.fit_whole(starts, fold_models)
+        }
+    }
+
+    /// The starts of an addition to a model: its first effects added
+    /// neutrally, the last from a grid ([`starts`]); and the same from the
+    /// levels as given, when the baseline's refit moved them (a refit of
+    /// the levels alone may have bent them to mimic the missing effect, a
+    /// raised Fc standing in for a viscous term).
+    pub(crate) fn addition_starts<'s>(
+        &'s self,
+        added: &[Effect],
+    ) -> impl Fn(&FrictionModel) -> Vec<FrictionModel> + Sync + 's {
+        let added = added.to_vec();
+        let context = &self.context;
+        let nominal_levels = &self.setup.nominal;
+        move |m: &FrictionModel| -> Vec<FrictionModel> {
+            let (last, first) = added.split_last().expect("an addition has an effect");
+            let mut base = m.clone();
+            for &e in first {
+                base = base.with(e, context);
+            }
+            let mut s = starts(&base, *last, context);
+            let given = base.with_levels_of(nominal_levels);
+            if given != base {
+                s.extend(starts(&given, *last, context));
+            }
+            s
+        }
+    }
+}
+
+/// The starts of the nominal's levels refitted (the effects' own
+/// parameters stay as given: an effect that is off is a candidate of its
+/// own): from the nominal and from levels 20 % lower and 25 % higher.
+pub(crate) fn level_starts(m: &FrictionModel) -> Vec<FrictionModel> {
+    [1.0, 0.8, 1.25].map(|f| m.scaled_levels(f)).to_vec()
+}
+
+/// Starting models for adding `effect` to `current`: a grid over the
+/// nonlinear parameters (Stribeck velocity and excess, presliding distance).
+fn starts(current: &FrictionModel, effect: Effect, context: &Context) -> Vec<FrictionModel> {
+    let base = current.with(effect, context);
+    match effect {
+        Effect::Stribeck => {
+            // re-sized: from its own values too
+            let mut s = if current.has(Effect::Stribeck) {
+                vec![base.clone()]
+            } else {
+                Vec::new()
+            };
+            for vs in [0.03, 0.1, 0.3, 1.0] {
+                for excess in [0.05, 0.2] {
+                    let mut m = base.clone();
+                    m.vs = vs * context.speed_scale;
+                    m.fs = m.fc * (1.0 + excess);
+                    m.fs_neg = m.fc_neg * (1.0 + excess);
+                    s.push(m);
+                }
+            }
+            s
+        }
+        // presliding distances Fc/σ0 from half the position resolution the
+        // data show to 3 % of the travel, and the model's own (σ1 following
+        // σ0, [`FrictionModel::with_sigma0`])
+        Effect::Presliding => {
+            let r = context.position_resolution;
+            let mut s = vec![base.clone()];
+            for d in [0.5 * r, 2.0 * r, 8.0 * r, 32.0 * r, 128.0 * r, 512.0 * r]
+                .into_iter()
+                .chain([1e-2 * context.travel, 3e-2 * context.travel])
+            {
+                s.push(base.with_sigma0(base.fc / d));
+            }
+            s
+        }
+        Effect::Viscous => {
+            let mut s = vec![base.clone()];
+            for r in [0.01, 0.1] {
+                let mut m = base.clone();
+                m.sigma2 += r * m.fc / context.speed_scale;
+                s.push(m);
+            }
+            s
+        }
+        _ => vec![base],
+    }
+}

@@ -1,0 +1,83 @@
+//! Stage 6, the refinement: an accepted model's fold models, and the
+//! model reported, refined on the output error of their fit samples
+//! ([`fit::polish`](crate::fit::polish), [`crate::POLISH_ITERATIONS`]).
+//! The fold models are kept unrefined if a refined one's co-simulation
+//! fails, or if the refinement raises the held-out error (it fits the
+//! fit samples' noise): a reference worse than the fits it came from
+//! would let every candidate of the next round pass for undoing it. The
+//! reported model is refined too, unless its folds' refinement was not
+//! kept.
+//!
+//! Takes the [`Problem`], the accepted [`Fitted`] models and the running
+//! [`Polishing`] account; gives the refined [`Fitted`]. Called by the
+//! candidate rounds for every accepted model and for a model an effect
+//! was taken out of.
+
+use super::problem::Problem;
+use crate::acceptance::{mean, Scored};
+use crate::model::FrictionModel;
+use crate::system::System;
+use crate::POLISH_ITERATIONS;
+use std::time::Instant;
+
+/// A model as fitted: one per fold, their score, and the model reported.
+pub(crate) struct Fitted {
+    pub(crate) folds: Vec<FrictionModel>,
+    pub(crate) scored: Scored,
+    pub(crate) whole: FrictionModel,
+}
+
+/// What the refinements cost.
+#[derive(Default)]
+pub(crate) struct Polishing {
+    /// Co-simulations run.
+    pub(crate) cosimulations: usize,
+    pub(crate) seconds: f64,
+}
+
+/// Refine `fitted` ([the module](self)).
+pub(crate) fn refine(
+    p: &Problem,
+    system: &mut System,
+    fitted: Fitted,
+    polishing: &mut Polishing,
+) -> Fitted {
+    let started = Instant::now();
+    let Fitted {
+        folds: models,
+        scored,
+        whole,
+    } = fitted;
+    let polished: Vec<crate::fit::Fitted> = p
+        .split
+        .folds
+        .iter()
+        .zip(&models)
+        .map(|(fold, m)| p.polish(m, &fold.fits, POLISH_ITERATIONS))
+        .collect();
+    polishing.cosimulations += polished.iter().map(|p| p.evaluations).sum::<usize>();
+    let refined: Vec<FrictionModel> = polished.into_iter().map(|p| p.model).collect();
+    let (models, scored, kept) = if refined == models {
+        (models, scored, true)
+    } else {
+        match p.score(system, &refined) {
+            Ok(s) if mean(&s.q) <= mean(&scored.q) => (refined, s, true),
+            _ => (models, scored, false),
+        }
+    };
+    let whole = if p.split.folds.len() == 1 {
+        models[0].clone()
+    } else if !kept {
+        whole
+    } else {
+        let polished = p.polish(&whole, &p.every_sample, POLISH_ITERATIONS);
+        polishing.cosimulations += polished.evaluations;
+        polished.model
+    };
+    polishing.seconds += started.elapsed().as_secs_f64();
+    Fitted {
+        folds: models,
+        scored,
+        whole,
+    }
+}

@@ -1,0 +1,163 @@
+//! One signature, several explanations: the hypotheses a round tests
+//! (a family of explanations counts once, [`Effect::ASYMMETRY`]), which
+//! member of a family the data prefer, how strongly they separate the
+//! accepted one from the others ([`Alternative`]), and the check of two
+//! overlapping effects fitted together ([`OverlapCheck`],
+//! [`Effect::OVERLAPPING`]).
+
+use super::{label, try_additions, Tried};
+use crate::acceptance::{nested_test, separation_test, Acceptance};
+use crate::model::Effect;
+use crate::stages::problem::Problem;
+use crate::{Alternative, CandidateScore, OverlapCheck};
+
+/// The number of hypotheses a round of `additions` tests, for its
+/// Bonferroni threshold: one per addition, except that the single
+/// additions of one family ([`Effect::ASYMMETRY`]) test one hypothesis
+/// together (the friction differs between the directions); which of them
+/// explains it is decided among them afterwards ([`prefer_in_family`]).
+pub(super) fn hypotheses(additions: &[Vec<Effect>]) -> usize {
+    let mut families = Vec::new();
+    let mut n = 0;
+    for added in additions {
+        match added[..] {
+            [e] => match e.family() {
+                // a family is known by its first member
+                Some(f) if families.contains(&f[0]) => {}
+                Some(f) => {
+                    families.push(f[0]);
+                    n += 1;
+                }
+                None => n += 1,
+            },
+            _ => n += 1,
+        }
+    }
+    n.max(1)
+}
+
+/// Among the passing candidates (best first), when the best is a single
+/// effect of a family ([`Effect::ASYMMETRY`]): the family members that
+/// passed and that the held-out data do not separate from the best
+/// ([`separation_test`] at `threshold`) are equally good explanations of
+/// its signature; the first of them in the family's order is moved to the
+/// front (direction-dependent levels before an offset before
+/// direction-dependent viscous friction). A member the data separate
+/// from the others keeps its place.
+pub(super) fn prefer_in_family(
+    passing: &mut Vec<usize>,
+    tried: &[Tried],
+    group: &[usize],
+    threshold: f64,
+) -> Result<(), String> {
+    let Some(&best) = passing.first() else {
+        return Ok(());
+    };
+    let (Some(family), Ok(best_scored)) = (single_family(&tried[best]), &tried[best].scored) else {
+        return Ok(());
+    };
+    let rank = |k: usize| family.iter().position(|e| *e == tried[k].added[0]);
+    let mut equally_good = Vec::new();
+    for &k in passing.iter() {
+        if single_family(&tried[k]) != Some(family) {
+            continue;
+        }
+        let unseparated = k == best
+            || match &tried[k].scored {
+                Ok(s) => separation_test(best_scored, s, group)? >= threshold,
+                Err(_) => false,
+            };
+        if unseparated {
+            equally_good.push(k);
+        }
+    }
+    if let Some(preferred) = equally_good.into_iter().min_by_key(|&k| rank(k)) {
+        passing.retain(|&k| k != preferred);
+        passing.insert(0, preferred);
+    }
+    Ok(())
+}
+
+/// The family of `t`'s addition when it is one effect of a family.
+fn single_family(t: &Tried) -> Option<&'static [Effect]> {
+    match t.added[..] {
+        [e] => e.family(),
+        _ => None,
+    }
+}
+
+/// The other members of the accepted candidate `k`'s family tried in the
+/// same round, each with how strongly the held-out data separate it from
+/// `k` ([`Alternative`]).
+pub(super) fn family_alternatives(
+    k: usize,
+    tried: &[Tried],
+    round: &[CandidateScore],
+    group: &[usize],
+    rule: Acceptance,
+) -> Result<Vec<Alternative>, String> {
+    let (Some(family), Ok(chosen)) = (single_family(&tried[k]), &tried[k].scored) else {
+        return Ok(Vec::new());
+    };
+    (0..tried.len())
+        .filter(|&j| j != k && single_family(&tried[j]) == Some(family))
+        .map(|j| {
+            let p_value = match &tried[j].scored {
+                Ok(s) => separation_test(chosen, s, group)?,
+                Err(_) => 0.0,
+            };
+            let c = &round[j];
+            Ok(Alternative {
+                name: c.name.clone(),
+                heldout_rms: c.heldout_rms,
+                p_value,
+                passed: c.passes(rule),
+                separated: p_value < rule.threshold,
+            })
+        })
+        .collect()
+}
+
+/// Fit the effects of candidates `k` and `j` together, by output error,
+/// from each one's fitted model (in parallel; the fit with the smaller
+/// fit error is the joint model), and test the joint model against
+/// each alone on the held-out data ([`OverlapCheck`]): what `k`'s effect
+/// adds to `j`'s, and `j`'s to `k`'s. Both candidates are output-error
+/// fits here ([`refit_overlapping_by_output_error`]), so the joint model
+/// is compared with fits of its own kind. A joint fit whose co-simulation
+/// fails counts as adding nothing.
+pub(super) fn overlap_check(
+    p: &Problem,
+    tried: &[Tried],
+    k: usize,
+    j: usize,
+    group: &[usize],
+) -> Result<OverlapCheck, String> {
+    let after = |base: usize, added: &[Effect]| {
+        try_additions(p, &tried[base].models, &[added.to_vec()], true)
+    };
+    let (from_k, from_j) = rayon::join(|| after(k, &tried[j].added), || after(j, &tried[k].added));
+    let joint = from_k?
+        .into_iter()
+        .chain(from_j?)
+        .filter(|t| t.scored.is_ok())
+        .min_by(|a, b| a.force_rms.total_cmp(&b.force_rms));
+    let adds_to = |single: usize| match (&tried[single].scored, joint.as_ref().map(|t| &t.scored)) {
+        (Ok(before), Some(Ok(after))) => nested_test(before, after, &p.scales, group),
+        _ => Ok((f64::NEG_INFINITY, 1.0)),
+    };
+    let ((gain_after_other, p_after_other), (other_gain_after, other_p_after)) =
+        (adds_to(j)?, adds_to(k)?);
+    let p_separated = match (&tried[k].scored, &tried[j].scored) {
+        (Ok(better), Ok(other)) => separation_test(better, other, group)?,
+        _ => 1.0,
+    };
+    Ok(OverlapCheck {
+        other: label(&tried[j].added),
+        gain_after_other,
+        p_after_other,
+        other_gain_after,
+        other_p_after,
+        p_separated,
+    })
+}
