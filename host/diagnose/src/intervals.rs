@@ -40,7 +40,7 @@
 //! the truth in 21 of 30 cases (BENCHMARKS.md).
 
 use super::fit::Residuals;
-use super::model::{Effect, Free, FrictionModel};
+use super::model::{Free, FrictionModel};
 use nalgebra::{DMatrix, DVector};
 
 /// The covariance of the free parameters of a fitted model.
@@ -223,34 +223,6 @@ impl ThetaCovariance {
                 .map(|(_, x)| x)
         })
     }
-}
-
-/// What an effect adds to the model, as one number whose "no change" is
-/// 0, when it has one: for an interval that holds 0, the data do not
-/// resolve the effect. Direction-dependent levels: Fc_neg − Fc;
-/// direction-dependent viscous friction: sigma2_neg − sigma2; an offset:
-/// F_offset; Stribeck: Fs − Fc; viscous: σ2 − its nominal value.
-pub fn effect_change(effect: Effect, nominal: &FrictionModel, m: &FrictionModel) -> Option<f64> {
-    Some(match effect {
-        Effect::DirectionDependent => m.fc_neg - m.fc,
-        Effect::DirectionDependentViscous => m.sigma2_neg - m.sigma2,
-        Effect::Offset => m.f_offset,
-        Effect::Stribeck => m.fs - m.fc,
-        Effect::Viscous => m.sigma2 - nominal.sigma2,
-        _ => return None,
-    })
-}
-
-/// The name of [`effect_change`]'s quantity, for the report.
-pub fn effect_change_name(effect: Effect) -> Option<&'static str> {
-    Some(match effect {
-        Effect::DirectionDependent => "Fc_neg - Fc",
-        Effect::DirectionDependentViscous => "sigma2_neg - sigma2",
-        Effect::Offset => "F_offset",
-        Effect::Stribeck => "Fs - Fc",
-        Effect::Viscous => "sigma2 - nominal sigma2",
-        _ => return None,
-    })
 }
 
 #[cfg(test)]

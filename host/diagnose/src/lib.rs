@@ -338,7 +338,7 @@ pub struct FoundEffect {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub overlap: Option<OverlapCheck>,
     /// What the effect adds, as one number whose "no change" is 0
-    /// ([`intervals::effect_change`]), in the final model, with its 95 %
+    /// ([`model::Effect::change`]), in the final model, with its 95 %
     /// interval; `None` for an effect without such a number.
     pub change: Option<EffectChange>,
 }

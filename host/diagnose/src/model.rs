@@ -40,6 +40,17 @@
 //! instead of becoming over- or under-damped by orders of magnitude
 //! (Canudas de Wit et al. 1995 choose σ1 that way, near critical).
 //!
+//! **One place.** What the diagnosis knows of an effect is here: its name
+//! and wording ([`Effect::name`], [`Effect::meaning`]), whether the force
+//! the data imply shows it ([`Effect::force_shows`]), what the data must
+//! hold for it to be tried ([`Effect::shown_by_data`]), the number its
+//! interval is taken of ([`Effect::change`]), its parameters, its neutral
+//! start and grid of starts ([`FrictionModel::with`],
+//! [`FrictionModel::starts`]), how it is taken out again
+//! ([`FrictionModel::without`]) and what it frees
+//! ([`FrictionModel::free`]). docs/development.md lists the few places
+//! outside this file a new effect goes into.
+//!
 //! Parameters are fitted through transforms that keep them physical:
 //! levels, stiffness, speeds and scales are `exp(θ)` (> 0), the Stribeck
 //! excess `Fs/Fc − 1` is `exp(θ)` (Fs > Fc), σ2 is `exp(θ)` (> 0).
@@ -157,6 +168,54 @@ impl Effect {
                 "different viscous friction for the two directions (sigma2_neg for v < 0)"
             }
         }
+    }
+
+    /// Whether the force the data imply can show the effect: presliding's
+    /// hysteresis lives in the stick, which the force fits leave out, so
+    /// an addition with it is fitted by output error through
+    /// co-simulation.
+    pub fn force_shows(self) -> bool {
+        self != Effect::Presliding
+    }
+
+    /// Whether data can show the effect at all, to be tried: a normal
+    /// load needs a measured normal force (`normal_force_measured`), a
+    /// position dependence some travel.
+    pub fn shown_by_data(self, normal_force_measured: bool, context: &Context) -> bool {
+        match self {
+            Effect::NormalLoad => normal_force_measured,
+            Effect::PositionDependent => context.travel > 1e-9,
+            _ => true,
+        }
+    }
+
+    /// What the effect adds to model `m`, as one number whose "no change"
+    /// is 0, when it has one: for an interval that holds 0, the data do
+    /// not resolve the effect ([`crate::intervals`]). Direction-dependent
+    /// levels: Fc_neg − Fc; direction-dependent viscous friction:
+    /// sigma2_neg − sigma2; an offset: F_offset; Stribeck: Fs − Fc;
+    /// viscous: σ2 − its `nominal` value.
+    pub fn change(self, nominal: &FrictionModel, m: &FrictionModel) -> Option<f64> {
+        Some(match self {
+            Effect::DirectionDependent => m.fc_neg - m.fc,
+            Effect::DirectionDependentViscous => m.sigma2_neg - m.sigma2,
+            Effect::Offset => m.f_offset,
+            Effect::Stribeck => m.fs - m.fc,
+            Effect::Viscous => m.sigma2 - nominal.sigma2,
+            _ => return None,
+        })
+    }
+
+    /// The name of [`Effect::change`]'s quantity, for the report.
+    pub fn change_name(self) -> Option<&'static str> {
+        Some(match self {
+            Effect::DirectionDependent => "Fc_neg - Fc",
+            Effect::DirectionDependentViscous => "sigma2_neg - sigma2",
+            Effect::Offset => "F_offset",
+            Effect::Stribeck => "Fs - Fc",
+            Effect::Viscous => "sigma2 - nominal sigma2",
+            _ => return None,
+        })
     }
 }
 
@@ -418,6 +477,56 @@ impl FrictionModel {
             }
         }
         m
+    }
+
+    /// Starting models for adding `effect` to this model: a grid over the
+    /// nonlinear parameters (Stribeck velocity and excess, presliding distance).
+    pub fn starts(&self, effect: Effect, context: &Context) -> Vec<FrictionModel> {
+        let base = self.with(effect, context);
+        match effect {
+            Effect::Stribeck => {
+                // re-sized: from its own values too
+                let mut s = if self.has(Effect::Stribeck) {
+                    vec![base.clone()]
+                } else {
+                    Vec::new()
+                };
+                for vs in [0.03, 0.1, 0.3, 1.0] {
+                    for excess in [0.05, 0.2] {
+                        let mut m = base.clone();
+                        m.vs = vs * context.speed_scale;
+                        m.fs = m.fc * (1.0 + excess);
+                        m.fs_neg = m.fc_neg * (1.0 + excess);
+                        s.push(m);
+                    }
+                }
+                s
+            }
+            // presliding distances Fc/σ0 from half the position resolution the
+            // data show to 3 % of the travel, and the model's own (σ1 following
+            // σ0, [`FrictionModel::with_sigma0`])
+            Effect::Presliding => {
+                let r = context.position_resolution;
+                let mut s = vec![base.clone()];
+                for d in [0.5 * r, 2.0 * r, 8.0 * r, 32.0 * r, 128.0 * r, 512.0 * r]
+                    .into_iter()
+                    .chain([1e-2 * context.travel, 3e-2 * context.travel])
+                {
+                    s.push(base.with_sigma0(base.fc / d));
+                }
+                s
+            }
+            Effect::Viscous => {
+                let mut s = vec![base.clone()];
+                for r in [0.01, 0.1] {
+                    let mut m = base.clone();
+                    m.sigma2 += r * m.fc / context.speed_scale;
+                    s.push(m);
+                }
+                s
+            }
+            _ => vec![base],
+        }
     }
 
     /// The model with `effect` taken out again: its parameters as they

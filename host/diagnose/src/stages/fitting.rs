@@ -9,7 +9,7 @@
 use super::problem::Problem;
 use super::split::Picker;
 use crate::fit;
-use crate::model::{Context, Effect, FrictionModel};
+use crate::model::{Effect, FrictionModel};
 use crate::sim::{co_simulate_robust, co_simulate_with, system_parameters, FrictionSim};
 use crate::CANDIDATE_OUTPUT_ERROR_ITERATIONS;
 use nalgebra::DVector;
@@ -192,10 +192,10 @@ impl Problem<'_> {
     }
 
     /// Whether the addition `added` is fitted by output error: when the
-    /// force cannot show it (presliding) or is not estimated at all
-    /// (another plant); else on the force.
+    /// force cannot show it ([`Effect::force_shows`]) or is not estimated
+    /// at all (another plant); else on the force.
     pub(crate) fn by_output_error(&self, added: &[Effect]) -> bool {
-        self.force.output_error_only.is_some() || added.contains(&Effect::Presliding)
+        self.force.output_error_only.is_some() || added.iter().any(|e| !e.force_shows())
     }
 
     /// Fit `starts` on each fold, by output error or on the force as
@@ -244,7 +244,7 @@ impl Problem<'_> {
     }
 
     /// The starts of an addition to a model: its first effects added
-    /// neutrally, the last from a grid ([`starts`]); and the same from the
+    /// neutrally, the last from a grid ([`FrictionModel::starts`]); and the same from the
     /// levels as given, when the baseline's refit moved them (a refit of
     /// the levels alone may have bent them to mimic the missing effect, a
     /// raised Fc standing in for a viscous term).
@@ -261,10 +261,10 @@ impl Problem<'_> {
             for &e in first {
                 base = base.with(e, context);
             }
-            let mut s = starts(&base, *last, context);
+            let mut s = base.starts(*last, context);
             let given = base.with_levels_of(nominal_levels);
             if given != base {
-                s.extend(starts(&given, *last, context));
+                s.extend(given.starts(*last, context));
             }
             s
         }
@@ -276,54 +276,4 @@ impl Problem<'_> {
 /// own): from the nominal and from levels 20 % lower and 25 % higher.
 pub(crate) fn level_starts(m: &FrictionModel) -> Vec<FrictionModel> {
     [1.0, 0.8, 1.25].map(|f| m.scaled_levels(f)).to_vec()
-}
-
-/// Starting models for adding `effect` to `current`: a grid over the
-/// nonlinear parameters (Stribeck velocity and excess, presliding distance).
-fn starts(current: &FrictionModel, effect: Effect, context: &Context) -> Vec<FrictionModel> {
-    let base = current.with(effect, context);
-    match effect {
-        Effect::Stribeck => {
-            // re-sized: from its own values too
-            let mut s = if current.has(Effect::Stribeck) {
-                vec![base.clone()]
-            } else {
-                Vec::new()
-            };
-            for vs in [0.03, 0.1, 0.3, 1.0] {
-                for excess in [0.05, 0.2] {
-                    let mut m = base.clone();
-                    m.vs = vs * context.speed_scale;
-                    m.fs = m.fc * (1.0 + excess);
-                    m.fs_neg = m.fc_neg * (1.0 + excess);
-                    s.push(m);
-                }
-            }
-            s
-        }
-        // presliding distances Fc/σ0 from half the position resolution the
-        // data show to 3 % of the travel, and the model's own (σ1 following
-        // σ0, [`FrictionModel::with_sigma0`])
-        Effect::Presliding => {
-            let r = context.position_resolution;
-            let mut s = vec![base.clone()];
-            for d in [0.5 * r, 2.0 * r, 8.0 * r, 32.0 * r, 128.0 * r, 512.0 * r]
-                .into_iter()
-                .chain([1e-2 * context.travel, 3e-2 * context.travel])
-            {
-                s.push(base.with_sigma0(base.fc / d));
-            }
-            s
-        }
-        Effect::Viscous => {
-            let mut s = vec![base.clone()];
-            for r in [0.01, 0.1] {
-                let mut m = base.clone();
-                m.sigma2 += r * m.fc / context.speed_scale;
-                s.push(m);
-            }
-            s
-        }
-        _ => vec![base],
-    }
 }

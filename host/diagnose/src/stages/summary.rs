@@ -187,12 +187,10 @@ fn effect_changes(
     effects: &mut [FoundEffect],
 ) {
     for e in effects {
-        e.change = intervals::effect_change(e.name, nominal, current).map(|value| {
-            let interval = cov.interval(current, &|m: &FrictionModel| {
-                intervals::effect_change(e.name, nominal, m)
-            });
+        e.change = e.name.change(nominal, current).map(|value| {
+            let interval = cov.interval(current, &|m: &FrictionModel| e.name.change(nominal, m));
             EffectChange {
-                quantity: intervals::effect_change_name(e.name).unwrap_or(""),
+                quantity: e.name.change_name().unwrap_or(""),
                 value,
                 interval,
                 resolved: interval.map(|[low, high]| !(low <= 0.0 && 0.0 <= high)),

@@ -160,17 +160,15 @@ pub(crate) fn search(
 }
 
 /// The candidate effects of the next round: the options' candidates the
-/// current model can take, that the data can show (a normal load needs a
-/// measured normal force, a position dependence some travel), and that
-/// were not withdrawn.
+/// current model can take, that the data can show
+/// ([`Effect::shown_by_data`]), and that were not withdrawn.
 fn missing_effects(p: &Problem, s: &Search) -> Vec<Effect> {
     p.options
         .candidates
         .iter()
         .copied()
         .filter(|&e| s.current.can_try(e))
-        .filter(|&e| e != Effect::NormalLoad || p.force.data.normal_force_measured)
-        .filter(|&e| e != Effect::PositionDependent || p.context.travel > 1e-9)
+        .filter(|&e| e.shown_by_data(p.force.data.normal_force_measured, &p.context))
         .filter(|&e| s.withdrawn.iter().all(|w| w.name != e))
         .collect()
 }
