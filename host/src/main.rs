@@ -49,11 +49,10 @@ enum Command {
     /// equations in one process at tight tolerance, written as the same
     /// CSV as `run`.
     Reference(cli::reference::ReferenceArgs),
-    /// Where a system and measurements disagree: names the missing friction
-    /// effect (viscous, stribeck, presliding, position_dependent,
-    /// direction_dependent, normal_load), adds it to the LuGre FMU, refits,
-    /// and reports the error on held-out data; writes report.json,
-    /// report.md, plots and the refitted system.
+    // Where a system and measurements disagree: names the missing friction
+    // effect, adds it to the LuGre FMU, refits, ...: the text, with the
+    // effects of the library named, is `cli::diagnose::about`.
+    #[command(about = cli::diagnose::about())]
     Diagnose(cli::diagnose::DiagnoseArgs),
     /// Run a system once per point of a parameter grid (and per random
     /// seed), in parallel on all cores; writes one CSV row per run with the

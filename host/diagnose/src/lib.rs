@@ -39,6 +39,7 @@
 
 pub mod acceptance;
 pub mod dahl;
+pub mod effects;
 pub mod figures;
 pub mod fit;
 pub mod html;
@@ -59,7 +60,8 @@ pub use acceptance::{
     grouped_signed_rank_test, grouped_t_test, nested_test, separation_test, Scored,
     SIGNED_RANK_EXACT,
 };
-pub use stages::rounds::{PRESLIDING_RESOLVED, PRESLIDING_SWING, RESIZE_MIN_CHANGE};
+pub use effects::{PRESLIDING_RESOLVED, PRESLIDING_SWING};
+pub use stages::rounds::RESIZE_MIN_CHANGE;
 pub use stages::split::Blocks;
 
 use model::{Effect, FrictionModel};
@@ -239,7 +241,7 @@ pub struct CandidateScore {
     /// One-sided p-value of the paired test against the current model.
     pub p_value: f64,
     /// Why the data cannot tell the candidate from the current model, when
-    /// they cannot (`unresolved_presliding`); then it is not accepted.
+    /// they cannot (`effects/presliding.rs`); then it is not accepted.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub unresolved: Option<String>,
     /// Drop of the mean square and p-value when the current model and the

@@ -535,13 +535,13 @@ fn write_ssp(
         put(&p.variable, ty, v);
     }
     for (name, x) in model.parameters() {
-        match name.as_str() {
-            "direction_dependent"
-            | "normal_force_form"
-            | "position_dependent"
-            | "direction_dependent_viscous" => put(&name, "Boolean", (x != 0.0).to_string()),
-            "n_table" => put(&name, "Integer", (x as i64).to_string()),
-            _ => put(&name, "Real", format!("{x:e}")),
+        // the effects' switches are Booleans ([`crate::effects::EffectSpec::switch`])
+        if crate::effects::Effect::switches().any(|s| s == name) {
+            put(&name, "Boolean", (x != 0.0).to_string());
+        } else if name == "n_table" {
+            put(&name, "Integer", (x as i64).to_string());
+        } else {
+            put(&name, "Real", format!("{x:e}"));
         }
     }
 

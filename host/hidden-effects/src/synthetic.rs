@@ -206,7 +206,11 @@ pub fn generate(
             Effect::Viscous => (1e-6 * fc / speed, 10.0 * fc / speed),
             // σ2_neg/σ2 − 1: the viscous force may be small beside Fc
             Effect::DirectionDependentViscous => (1e-6, 1e3),
-            _ => (1e-6, 2.0),
+            Effect::Stribeck
+            | Effect::PositionDependent
+            | Effect::DirectionDependent
+            | Effect::NormalLoad
+            | Effect::Offset => (1e-6, 2.0),
         };
         for _ in 0..50 {
             let mid = (lo * hi).sqrt();

@@ -38,9 +38,9 @@ pub struct DiagnoseArgs {
     /// Output directory [default: out/<system name>-diagnosis].
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Candidate effects to try (repeat) [default: all: viscous, stribeck,
-    /// presliding, position_dependent, direction_dependent, normal_load].
-    #[arg(long = "candidate")]
+    // Candidate effects to try: the help lists the effects of the library
+    // with their meanings (`candidates_help`).
+    #[arg(long = "candidate", help = candidates_help())]
     pub candidates: Vec<String>,
     /// Knots of the position table of position_dependent.
     #[arg(long, default_value_t = fricsim::diagnose::model::DEFAULT_POSITION_KNOTS)]
@@ -76,6 +76,26 @@ pub struct DiagnoseArgs {
     /// the Dahl FMU]
     #[arg(long)]
     pub lugre: Option<PathBuf>,
+}
+
+/// The subcommand's description, naming every effect of the library
+/// ([`Effect::ALL`]).
+pub fn about() -> String {
+    format!(
+        "Where a system and measurements disagree: names the missing friction effect ({}), adds it to the LuGre FMU, refits, and reports the error on held-out data; writes report.json, report.md, plots and the refitted system",
+        Effect::ALL.map(|e| e.name()).join(", ")
+    )
+}
+
+/// `--candidate`'s help: every effect of the library with its meaning
+/// ([`Effect::help_list`]).
+fn candidates_help() -> String {
+    let list = Effect::help_list()
+        .lines()
+        .map(|line| format!("  {line}"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    format!("Candidate effects to try (repeat) [default: all]:\n{list}")
 }
 
 pub fn run(a: &DiagnoseArgs) -> Result<(), String> {

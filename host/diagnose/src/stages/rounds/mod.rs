@@ -28,8 +28,8 @@ use crate::{
 };
 use explanations::{family_alternatives, hypotheses, overlap_check, prefer_in_family};
 use rayon::prelude::*;
-use resolution::{unmoved_resize, unresolved_presliding};
-pub use resolution::{PRESLIDING_RESOLVED, PRESLIDING_SWING, RESIZE_MIN_CHANGE};
+pub use resolution::RESIZE_MIN_CHANGE;
+use resolution::{unmoved_resize, unresolved_change};
 
 /// The current model and what the rounds decided so far.
 pub(crate) struct Search {
@@ -375,7 +375,7 @@ fn candidate_score(
         Err(e) => (f64::INFINITY, f64::NEG_INFINITY, 1.0, Some(e.clone())),
     };
     let unresolved = t.models.iter().zip(s.folds.iter()).find_map(|(m, c)| {
-        unresolved_presliding(&t.added, c, m, &p.context)
+        unresolved_change(&t.added, c, m, &p.context)
             .or_else(|| unmoved_resize(&t.added, c, m, &p.context))
     });
     Ok(CandidateScore {
