@@ -3,8 +3,11 @@
 //!
 //! Uses the importer ([`crate::fmu`]), [`crate::rows`] and
 //! [`crate::time_grid`]; it knows nothing of the masters, which step it
-//! through its public fields and methods (the master module uses this
-//! one, never the reverse).
+//! through the methods of [`coupling`] (and `System::step_jacobi`,
+//! [`System::propagate`] and the recording here), never through its
+//! fields (the master module uses this one, never the reverse).
+
+pub mod coupling;
 
 use crate::fmu::model_description::{Causality, VariableKind};
 use crate::fmu::{Fmu, Instance, Rollback, ValueReference};

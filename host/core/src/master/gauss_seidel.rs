@@ -32,14 +32,14 @@ impl GaussSeidel {
     /// the first remaining one whose connected outputs do not depend on its
     /// inputs directly, or else the first remaining one.
     pub fn order(system: &System) -> Vec<usize> {
-        let n = system.components.len();
+        let n = system.component_count();
         let mut order = Vec::with_capacity(n);
         let mut placed = vec![false; n];
         while order.len() < n {
             let ready = (0..n).find(|&c| {
                 !placed[c]
                     && system
-                        .connections
+                        .connections()
                         .iter()
                         .filter(|k| k.to.0 == c)
                         .all(|k| placed[k.from.0] || k.from.0 == c)
@@ -48,10 +48,10 @@ impl GaussSeidel {
                 (0..n).find(|&c| {
                     !placed[c]
                         && system
-                            .connections
+                            .connections()
                             .iter()
                             .filter(|k| k.from.0 == c)
-                            .all(|k| !system.components[c].has_feedthrough(k.from.1))
+                            .all(|k| !system.has_feedthrough(c, k.from.1))
                 })
             };
             let next = ready
@@ -75,53 +75,45 @@ impl MasterAlgorithm for GaussSeidel {
     }
 
     fn step(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
-        if self.order.len() != system.components.len() {
+        if self.order.len() != system.component_count() {
             self.order = Self::order(system);
         }
         // every connected output at t, before anything steps
-        self.at_t.resize(system.connections.len(), 0.0);
-        for (k, c) in system.connections.iter().enumerate() {
+        let n = system.connections().len();
+        self.at_t.resize(n, 0.0);
+        for k in 0..n {
+            let (from, output) = system.connections()[k].from;
             let mut x = [0.0];
-            system.components[c.from.0]
-                .instance
-                .get_real(&[c.from.1], &mut x)?;
+            system.get_real(from, &[output], &mut x)?;
             self.at_t[k] = x[0];
         }
-        let mut stepped = vec![false; system.components.len()];
+        let mut stepped = vec![false; system.component_count()];
         for &comp in &self.order {
-            let can_interpolate = system.components[comp]
-                .fmu
-                .description()
-                .co_simulation
-                .can_interpolate_inputs;
-            for (k, c) in system
-                .connections
-                .iter()
-                .enumerate()
-                .filter(|(_, c)| c.to.0 == comp)
-            {
-                let source = c.from.0;
+            let can_interpolate = system.co_simulation(comp).can_interpolate_inputs;
+            for k in 0..n {
+                let c = &system.connections()[k];
+                if c.to.0 != comp {
+                    continue;
+                }
+                let ((source, output), input) = (c.from, c.to.1);
                 let mut now = [self.at_t[k]];
                 if stepped[source] {
-                    system.components[source]
-                        .instance
-                        .get_real(&[c.from.1], &mut now)?;
+                    system.get_real(source, &[output], &mut now)?;
                 }
-                let target = &mut system.components[comp].instance;
                 if stepped[source] && self.interpolate && can_interpolate {
-                    target.set_real(&[c.to.1], &[self.at_t[k]])?;
-                    target.set_real_input_derivatives(
-                        &[c.to.1],
+                    system.set_real(comp, &[input], &[self.at_t[k]])?;
+                    system.set_real_input_derivatives(
+                        comp,
+                        &[input],
                         &[1],
                         &[(now[0] - self.at_t[k]) / h],
                     )?;
                 } else {
-                    target.set_real(&[c.to.1], &now)?;
+                    system.set_real(comp, &[input], &now)?;
                 }
             }
             // Gauss–Seidel only goes forward: the step is final
-            let instance = &mut system.components[comp].instance;
-            instance.do_step_with(t, h, Rollback::Never)?;
+            system.do_step(comp, t, h, Rollback::Never)?;
             stepped[comp] = true;
         }
         Ok(())

@@ -141,24 +141,27 @@ impl Observer for NoObserver {
 /// connected inputs and make the run fail later in another FMU, or not at
 /// all; the run stops here instead, naming the FMU that produced it.
 fn non_finite(system: &System, row: &[f64]) -> Option<String> {
-    let columns: usize = system.components.iter().map(|c| c.outputs.len()).sum();
+    let columns: usize = (0..system.component_count())
+        .map(|c| system.recorded_names(c).count())
+        .sum();
     if row.len() == columns && all_finite(row) {
         return None;
     }
     let mut instances = Vec::new();
     let mut values = Vec::new();
     let mut k = 0;
-    for c in &system.components {
+    for c in 0..system.component_count() {
         let before = values.len();
-        for (name, _) in &c.outputs {
+        let instance = system.component_name(c);
+        for name in system.recorded_names(c) {
             let x = row.get(k).copied().unwrap_or(f64::NAN);
             k += 1;
             if !x.is_finite() {
-                values.push(format!("{}.{name} = {x}", c.name));
+                values.push(format!("{instance}.{name} = {x}"));
             }
         }
         if values.len() > before {
-            instances.push(format!("\"{}\"", c.name));
+            instances.push(format!("\"{instance}\""));
         }
     }
     if values.is_empty() {
@@ -242,12 +245,10 @@ fn initialize(
     start: f64,
     observer: &mut dyn Observer,
 ) -> Result<(), FmuError> {
-    let mut buffer = vec![0.0; system.connections.len()];
+    let mut buffer = vec![0.0; system.connections().len()];
     observer.before_step(system, start, true)?;
     system.propagate(&mut buffer)?;
-    for c in &mut system.components {
-        c.instance.exit_initialization_mode()?;
-    }
+    system.exit_initialization_mode()?;
     system.propagate(&mut buffer)
 }
 
@@ -643,11 +644,7 @@ fn ended_by(system: &mut System, error: &FmuError) -> Option<Ended> {
     else {
         return None;
     };
-    let c = system.components.iter_mut().find(|c| &c.name == instance)?;
-    if !c.instance.terminated().ok()? {
-        return None;
-    }
-    let time = c.instance.last_successful_time().ok()?;
+    let time = system.terminated_at(instance)?;
     Some(Ended {
         instance: instance.clone(),
         time,

@@ -39,7 +39,7 @@
 //! (`fmi2GetFMUstate` / `fmi2SetFMUstate`): every FMU must declare
 //! `canGetAndSetFMUstate`, and the first step refuses, naming the instance,
 //! before anything is stepped. Calls that would change nothing are left out
-//! (the FMU's change count, [`crate::fmu::Instance::changes`], tells): a
+//! (the FMU's change count, [`System::changes`], tells): a
 //! state is not saved again while the FMU is still in it, and the first
 //! iterate of a step, the last accepted U the FMUs were stepped on, is not
 //! set again while they have seen nothing but getters since.
@@ -51,8 +51,7 @@
 //! `atol_k = atol·nominal_k` from the input variable's nominal (default 1).
 
 use super::MasterAlgorithm;
-use crate::fmu::model_description::{Causality, VariableKind};
-use crate::fmu::{FmuState, Instance, ValueReference};
+use crate::fmu::{FmuState, Rollback, ValueReference};
 use crate::system::System;
 use crate::FmuError;
 use nalgebra::DMatrix;
@@ -165,7 +164,7 @@ impl std::fmt::Display for ConvergenceReport {
 
 /// Per component: its index lists into the connection table, its saved
 /// state, and where its Jacobian columns come from. Kept together so that
-/// the loops of a step walk one list beside `System::components`.
+/// the loops of a step walk one list, by component index.
 struct Ports {
     /// Connections whose input belongs to the component.
     inputs: Vec<usize>,
@@ -194,7 +193,7 @@ struct Ports {
     ramped: bool,
     /// The component's state at the start of the step being solved.
     state: Option<FmuState>,
-    /// The component's change count ([`crate::fmu::Instance::changes`])
+    /// The component's change count ([`System::changes`])
     /// when its state was last saved into `state` or restored from there.
     /// While the count stands still, the FMU is in that saved state, and
     /// saving it again would change nothing (the step after a split, the
@@ -215,16 +214,17 @@ impl Ports {
     #[inline(always)] // hot: every iteration of every step
     fn set_inputs(
         &self,
-        instance: &mut Instance,
+        system: &mut System,
+        c: usize,
         u: &[f64],
         start: &[f64],
         h: f64,
     ) -> Result<(), FmuError> {
         if self.ramped {
-            return self.set_ramped_inputs(instance, u, start, h);
+            return self.set_ramped_inputs(system, c, u, start, h);
         }
         for (&k, &vr) in self.inputs.iter().zip(&self.input_vrs) {
-            instance.set_real(&[vr], &[u[k]])?;
+            system.set_real(c, &[vr], &[u[k]])?;
         }
         Ok(())
     }
@@ -233,14 +233,15 @@ impl Ports {
     #[inline(never)]
     fn set_ramped_inputs(
         &self,
-        instance: &mut Instance,
+        system: &mut System,
+        c: usize,
         u: &[f64],
         start: &[f64],
         h: f64,
     ) -> Result<(), FmuError> {
         for (&k, &vr) in self.inputs.iter().zip(&self.input_vrs) {
-            instance.set_real(&[vr], &[start[k]])?;
-            instance.set_real_input_derivatives(&[vr], &[1], &[(u[k] - start[k]) / h])?;
+            system.set_real(c, &[vr], &[start[k]])?;
+            system.set_real_input_derivatives(c, &[vr], &[1], &[(u[k] - start[k]) / h])?;
         }
         Ok(())
     }
@@ -248,16 +249,21 @@ impl Ports {
     /// Read the component's connected outputs into `out` (one value per
     /// connection), with one `fmi2GetReal` for all of them.
     #[inline(always)] // hot: every iteration of every step
-    fn read_outputs(&mut self, instance: &mut Instance, out: &mut [f64]) -> Result<(), FmuError> {
+    fn read_outputs(
+        &mut self,
+        system: &mut System,
+        c: usize,
+        out: &mut [f64],
+    ) -> Result<(), FmuError> {
         if self.outputs.is_empty() {
             return Ok(());
         }
         if let Some(first) = self.consecutive_outputs {
             let values = &mut out[first..first + self.outputs.len()];
-            instance.get_real(&self.output_vrs, values)?;
+            system.get_real(c, &self.output_vrs, values)?;
             return Ok(());
         }
-        instance.get_real(&self.output_vrs, &mut self.output_values)?;
+        system.get_real(c, &self.output_vrs, &mut self.output_values)?;
         for (&k, &y) in self.outputs.iter().zip(&self.output_values) {
             out[k] = y;
         }
@@ -267,26 +273,26 @@ impl Ports {
     /// Save the component's state at the start of the step into `state`
     /// (`fmi2GetFMUstate`), unless it is the saved one already.
     #[inline] // hot: every step
-    fn save_state(&mut self, instance: &mut Instance) -> Result<(), FmuError> {
+    fn save_state(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         match &mut self.state {
-            Some(_) if self.in_saved_state == Some(instance.changes()) => return Ok(()),
+            Some(_) if self.in_saved_state == Some(system.changes(c)) => return Ok(()),
             Some(state) => {
-                instance.update_state(state)?;
+                system.update_state(c, state)?;
             }
-            None => self.state = Some(instance.get_state()?),
+            None => self.state = Some(system.get_state(c)?),
         }
         // fmi2GetFMUstate is a getter: the count has not moved
-        self.in_saved_state = Some(instance.changes());
+        self.in_saved_state = Some(system.changes(c));
         Ok(())
     }
 
     /// Roll the component back to its saved state (`fmi2SetFMUstate`).
     #[inline(always)] // hot: every iteration after the first
-    fn restore(&mut self, instance: &mut Instance) -> Result<(), FmuError> {
+    fn restore(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         let state = self.state.as_ref().expect("saved before stepping");
-        match instance.set_state(state) {
-            Ok(_) => {
-                self.in_saved_state = Some(instance.changes());
+        match system.set_state(c, state) {
+            Ok(()) => {
+                self.in_saved_state = Some(system.changes(c));
                 Ok(())
             }
             Err(e) => {
@@ -434,20 +440,20 @@ impl StrongCoupling {
     /// anything is stepped: the error names the instance and the capability.
     fn check_capabilities(&self, system: &System) -> Result<(), FmuError> {
         let refuse = |c: usize, capability, reason| {
-            let component = &system.components[c];
             Err(FmuError::MissingCapability {
                 master: self.name(),
-                instance: component.name.clone(),
-                model: component.fmu.description().model_name.clone(),
+                instance: system.component_name(c).to_string(),
+                model: system.model_name(c).to_string(),
                 capability,
                 reason,
             })
         };
-        if system.connections.is_empty() {
+        let connections = system.connections();
+        if connections.is_empty() {
             return Ok(()); // nothing to iterate: every step is taken once
         }
-        for (c, component) in system.components.iter().enumerate() {
-            let cs = &component.fmu.description().co_simulation;
+        for c in 0..system.component_count() {
+            let cs = system.co_simulation(c);
             if !cs.can_get_and_set_fmu_state {
                 return refuse(
                     c,
@@ -462,8 +468,8 @@ impl StrongCoupling {
                     "adaptive macro steps change the step size; newton keeps it fixed",
                 );
             }
-            let has_loop_inputs = system.connections.iter().any(|k| k.to.0 == c)
-                && system.connections.iter().any(|k| k.from.0 == c);
+            let has_loop_inputs = connections.iter().any(|k| k.to.0 == c)
+                && connections.iter().any(|k| k.from.0 == c);
             if self.update == Update::Newton
                 && self.jacobian == JacobianSource::Directional
                 && has_loop_inputs
@@ -481,16 +487,13 @@ impl StrongCoupling {
 
     fn prepare(&mut self, system: &System) -> Result<(), FmuError> {
         self.check_capabilities(system)?;
-        let n = system.connections.len();
-        self.ports = (0..system.components.len())
+        let connections = system.connections();
+        let n = connections.len();
+        self.ports = (0..system.component_count())
             .map(|c| {
-                let cs = &system.components[c].fmu.description().co_simulation;
-                let outputs: Vec<usize> = (0..n)
-                    .filter(|&k| system.connections[k].from.0 == c)
-                    .collect();
-                let inputs: Vec<usize> = (0..n)
-                    .filter(|&k| system.connections[k].to.0 == c)
-                    .collect();
+                let cs = system.co_simulation(c);
+                let outputs: Vec<usize> = (0..n).filter(|&k| connections[k].from.0 == c).collect();
+                let inputs: Vec<usize> = (0..n).filter(|&k| connections[k].to.0 == c).collect();
                 let ramped = self.interpolate && cs.can_interpolate_inputs;
                 let (columns, differenced) = match self.jacobian {
                     _ if inputs.is_empty() || outputs.is_empty() => (Columns::None, ""),
@@ -511,15 +514,9 @@ impl StrongCoupling {
                     ),
                 };
                 Ports {
-                    input_vrs: inputs
-                        .iter()
-                        .map(|&k| system.connections[k].to.1)
-                        .collect(),
+                    input_vrs: inputs.iter().map(|&k| connections[k].to.1).collect(),
                     inputs,
-                    output_vrs: outputs
-                        .iter()
-                        .map(|&k| system.connections[k].from.1)
-                        .collect(),
+                    output_vrs: outputs.iter().map(|&k| connections[k].from.1).collect(),
                     output_values: vec![0.0; outputs.len()],
                     consecutive_outputs: outputs
                         .first()
@@ -536,26 +533,18 @@ impl StrongCoupling {
                 }
             })
             .collect();
-        self.nominal = system
-            .connections
+        self.nominal = connections
             .iter()
             .map(|k| {
-                let d = system.components[k.to.0].fmu.description();
-                d.variables
-                    .iter()
-                    .find(|v| v.value_reference == k.to.1 && v.causality == Causality::Input)
-                    .and_then(|v| match v.kind {
-                        VariableKind::Real { nominal, .. } => nominal,
-                        _ => None,
-                    })
+                system
+                    .input_nominal(k.to.0, k.to.1)
                     .filter(|x| x.is_finite() && *x > 0.0)
                     .unwrap_or(1.0)
             })
             .collect();
-        self.variable_steps = system.components.iter().all(|c| {
-            c.fmu
-                .description()
-                .co_simulation
+        self.variable_steps = (0..system.component_count()).all(|c| {
+            system
+                .co_simulation(c)
                 .can_handle_variable_communication_step_size
         });
         let most_outputs = self.ports.iter().map(|p| p.outputs.len()).max();
@@ -569,10 +558,8 @@ impl StrongCoupling {
         self.range = vec![0.0; n];
         self.started = false;
         self.y = vec![0.0; n];
-        self.report.jacobian_of = system
-            .components
-            .iter()
-            .map(|c| (c.name.clone(), "not needed"))
+        self.report.jacobian_of = (0..system.component_count())
+            .map(|c| (system.component_name(c).to_string(), "not needed"))
             .collect();
         Ok(())
     }
@@ -580,16 +567,16 @@ impl StrongCoupling {
     /// Save every component's state at the start of the step
     /// ([`Ports::save_state`]).
     fn save_states(&mut self, system: &mut System) -> Result<(), FmuError> {
-        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
-            ports.save_state(&mut c.instance)?;
+        for (c, ports) in self.ports.iter_mut().enumerate() {
+            ports.save_state(system, c)?;
         }
         Ok(())
     }
 
     /// Roll every component back to its saved state ([`Ports::restore`]).
     fn restore_all(&mut self, system: &mut System) -> Result<(), FmuError> {
-        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
-            ports.restore(&mut c.instance)?;
+        for (c, ports) in self.ports.iter_mut().enumerate() {
+            ports.restore(system, c)?;
         }
         Ok(())
     }
@@ -637,15 +624,14 @@ impl StrongCoupling {
         for i in 0..self.ports[c].inputs.len() {
             let j = self.ports[c].inputs[i];
             let delta = f64::EPSILON.sqrt() * self.u[j].abs().max(self.nominal[j]);
-            let instance = &mut system.components[c].instance;
-            self.ports[c].restore(instance)?;
+            self.ports[c].restore(system, c)?;
             self.perturbed.clone_from(&self.u);
             self.perturbed[j] += delta;
-            self.ports[c].set_inputs(instance, &self.perturbed, &self.accepted, h)?;
-            instance.do_step(t, h)?;
+            self.ports[c].set_inputs(system, c, &self.perturbed, &self.accepted, h)?;
+            system.do_step(c, t, h, Rollback::Possible)?;
             self.report.difference_steps += 1;
             self.column.clone_from(&self.y);
-            self.ports[c].read_outputs(instance, &mut self.column)?;
+            self.ports[c].read_outputs(system, c, &mut self.column)?;
             for &k in &self.ports[c].outputs {
                 self.jac[(k, j)] = (self.column[k] - self.y[k]) / delta;
             }
@@ -658,19 +644,24 @@ impl StrongCoupling {
     #[inline(always)] // hot: at every Jacobian
     fn directional_columns(&mut self, system: &mut System, c: usize) -> Result<(), FmuError> {
         let ports = &self.ports[c];
-        let instance = &mut system.components[c].instance;
         let rows = self.jac.nrows();
         for (&j, &known) in ports.inputs.iter().zip(&ports.input_vrs) {
             if let Some(first) = ports.consecutive_outputs {
                 // straight into place: rows first.. of column j
                 let start = first + j * rows;
                 let column = &mut self.jac.as_mut_slice()[start..start + ports.outputs.len()];
-                instance.get_directional_derivative(&ports.output_vrs, &[known], &[1.0], column)?;
+                system.get_directional_derivative(
+                    c,
+                    &ports.output_vrs,
+                    &[known],
+                    &[1.0],
+                    column,
+                )?;
                 continue;
             }
             // (sized for the component with the most outputs in `prepare`)
             let out = &mut self.derivative[..ports.outputs.len()];
-            instance.get_directional_derivative(&ports.output_vrs, &[known], &[1.0], out)?;
+            system.get_directional_derivative(c, &ports.output_vrs, &[known], &[1.0], out)?;
             for (&k, d) in ports.outputs.iter().zip(out.iter()) {
                 self.jac[(k, j)] = *d;
             }
@@ -684,7 +675,7 @@ impl StrongCoupling {
     fn jacobian(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
         self.report.jacobians += 1;
         // Directional derivatives first: they need the step just taken.
-        for c in 0..system.components.len() {
+        for c in 0..system.component_count() {
             match self.ports[c].columns {
                 Columns::Directional => self.directional_columns(system, c)?,
                 Columns::Unchecked => {
@@ -698,7 +689,7 @@ impl StrongCoupling {
                 Columns::None | Columns::Differenced => {}
             }
         }
-        for c in 0..system.components.len() {
+        for c in 0..system.component_count() {
             match self.ports[c].columns {
                 Columns::None => {}
                 Columns::Directional => {
@@ -762,11 +753,11 @@ impl MasterAlgorithm for StrongCoupling {
     }
 
     fn step(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
-        if self.ports.len() != system.components.len() {
+        if self.ports.len() != system.component_count() {
             self.prepare(system)?;
         }
         match self.step_control {
-            Some(control) if !system.connections.is_empty() => {
+            Some(control) if !system.connections().is_empty() => {
                 self.adaptive_step(system, t, h, control)
             }
             _ => self.step_or_split(system, t, h, 0),
@@ -885,8 +876,8 @@ impl StrongCoupling {
     #[cold]
     #[inline(never)]
     fn start(&mut self, system: &mut System) -> Result<(), FmuError> {
-        for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
-            ports.read_outputs(&mut c.instance, &mut self.u)?;
+        for (c, ports) in self.ports.iter_mut().enumerate() {
+            ports.read_outputs(system, c, &mut self.u)?;
         }
         self.started = true;
         Ok(())
@@ -934,11 +925,9 @@ impl StrongCoupling {
     }
 
     fn solve(&mut self, system: &mut System, t: f64, h: f64) -> Result<(), FmuError> {
-        let n = system.connections.len();
+        let n = system.connections().len();
         if n == 0 {
-            for c in &mut system.components {
-                c.instance.do_step(t, h)?;
-            }
+            system.do_step_all(t, h, Rollback::Possible)?;
             self.report.steps += 1;
             return Ok(());
         }
@@ -962,23 +951,20 @@ impl StrongCoupling {
         let mut lambda = 1.0;
         let mut last_norm = f64::INFINITY;
         for iteration in 1..=self.max_iterations {
-            for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
-                let instance = &mut c.instance;
+            for (c, ports) in self.ports.iter_mut().enumerate() {
                 // (only a converged iteration leaves a mark, for the next step)
-                let holds_u = ports.holds_u.take() == Some(instance.changes());
+                let holds_u = ports.holds_u.take() == Some(system.changes(c));
                 if iteration > 1 {
-                    ports.restore(instance)?;
+                    ports.restore(system, c)?;
                 } else if holds_u {
                     // the first iterate is the last accepted U, still set
                     continue;
                 }
-                ports.set_inputs(instance, &self.u, &self.accepted, h)?;
+                ports.set_inputs(system, c, &self.u, &self.accepted, h)?;
             }
-            for c in &mut system.components {
-                c.instance.do_step(t, h)?;
-            }
-            for (ports, c) in self.ports.iter_mut().zip(&mut system.components) {
-                ports.read_outputs(&mut c.instance, &mut self.y)?;
+            system.do_step_all(t, h, Rollback::Possible)?;
+            for (c, ports) in self.ports.iter_mut().enumerate() {
+                ports.read_outputs(system, c, &mut self.y)?;
             }
             // (which connection is the worst is asked only if the step fails)
             let mut worst = 0.0;
@@ -1001,8 +987,8 @@ impl StrongCoupling {
                 self.report.worst_accepted = self.report.worst_accepted.max(worst);
                 // Every component was just stepped on U; a ramped one has
                 // moved its inputs along the ramp.
-                for (ports, c) in self.ports.iter_mut().zip(&system.components) {
-                    ports.holds_u = (!ports.ramped).then(|| c.instance.changes());
+                for (c, ports) in self.ports.iter_mut().enumerate() {
+                    ports.holds_u = (!ports.ramped).then(|| system.changes(c));
                 }
                 return Ok(());
             }
@@ -1057,7 +1043,7 @@ impl StrongCoupling {
             time: t,
             step: h,
             iterations: self.max_iterations,
-            connection: system.connections[k].label.clone(),
+            connection: system.connections()[k].label.clone(),
             mismatch: (self.u[k] - self.y[k]).abs(),
             input: self.u[k],
             output: self.y[k],
