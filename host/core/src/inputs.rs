@@ -374,21 +374,19 @@ impl ExternalInputs {
         for b in &self.bindings {
             let column = &self.table.columns[b.column].1;
             let x = interpolate_from(&mut cursor, t, &self.table.time, column, b.discrete);
-            let instance = &mut system.components[b.component].instance;
-            instance.set_real(&[b.vr], &[x])?;
+            system.set_real(b.component, &[b.vr], &[x])?;
             if let Some(h) = self.slopes {
-                if !b.discrete
-                    && instance
-                        .fmu()
-                        .description()
-                        .co_simulation
-                        .can_interpolate_inputs
-                {
+                if !b.discrete && system.co_simulation(b.component).can_interpolate_inputs {
                     // a cursor of its own: the next step starts from t + h
                     let mut ahead = cursor;
                     let time = &self.table.time;
                     let next = interpolate_from(&mut ahead, t + h, time, column, false);
-                    instance.set_real_input_derivatives(&[b.vr], &[1], &[(next - x) / h])?;
+                    system.set_real_input_derivatives(
+                        b.component,
+                        &[b.vr],
+                        &[1],
+                        &[(next - x) / h],
+                    )?;
                 }
             }
         }
@@ -407,17 +405,12 @@ impl ExternalInputs {
         // a search of its own: the next step's starts where this one does
         let mut cursor = self.cursor.get();
         for b in &self.bindings {
-            let instance = &mut system.components[b.component].instance;
-            let moved_by_the_fmu = !b.discrete
-                && instance
-                    .fmu()
-                    .description()
-                    .co_simulation
-                    .can_interpolate_inputs;
+            let moved_by_the_fmu =
+                !b.discrete && system.co_simulation(b.component).can_interpolate_inputs;
             if !moved_by_the_fmu {
                 let column = &self.table.columns[b.column].1;
                 let x = interpolate_from(&mut cursor, t, &self.table.time, column, b.discrete);
-                instance.set_real(&[b.vr], &[x])?;
+                system.set_real(b.component, &[b.vr], &[x])?;
             }
         }
         Ok(())

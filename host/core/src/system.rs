@@ -7,10 +7,13 @@
 //! [`System::propagate`] and the recording here), never through its
 //! fields (the master module uses this one, never the reverse).
 
+pub mod component;
 pub mod coupling;
 
+pub use component::ComponentInstance;
+
 use crate::fmu::model_description::{Causality, VariableKind};
-use crate::fmu::{Fmu, Instance, Rollback, ValueReference};
+use crate::fmu::{Fmu, Rollback, ValueReference};
 use crate::rows::Rows;
 use crate::FmuError;
 use std::path::Path;
@@ -27,7 +30,9 @@ pub enum SystemError {
 pub struct Component {
     pub name: String,
     pub fmu: Fmu,
-    pub instance: Instance,
+    /// Its instance, of its FMU's FMI version: the one type the system
+    /// and the masters call ([`component`]).
+    pub instance: ComponentInstance,
     /// The recorded variables (name, value reference), one column each in
     /// this order: the Real ones (the outputs, then those recorded by
     /// [`System::record`]), then the Integer and Enumeration ones, then
@@ -48,9 +53,9 @@ pub struct Component {
     /// there one after the other in the same order (see
     /// [`System::step_jacobi`]); 0 without inputs.
     first_column: usize,
-    /// Its [`Instance::changes`] when [`System::sample`] read the last row,
-    /// [`NOT_READ`] where that row cannot be used (none read, or
-    /// discarded): while the count stands there, the row holds what
+    /// Its [`ComponentInstance::changes`] when [`System::sample`] read
+    /// the last row, [`NOT_READ`] where that row cannot be used (none
+    /// read, or discarded): while the count stands there, the row holds what
     /// `fmi2GetReal` would answer for the outputs it recorded.
     sampled: u64,
 }
@@ -141,8 +146,8 @@ pub fn connection_units(
 }
 
 /// What [`System::sample`] has read: one row of every component's
-/// recorded outputs per call (with each component's [`Instance::changes`]
-/// then in [`Component::sampled`], so that [`System::propagate`] can take
+/// recorded outputs per call (with each component's
+/// [`ComponentInstance::changes`] then in [`Component::sampled`], so that [`System::propagate`] can take
 /// an output from the last row instead of asking the FMU again while the
 /// component has seen no call that could have changed it).
 struct Recording {
@@ -152,7 +157,7 @@ struct Recording {
 }
 
 /// In [`Component::sampled`]: the last row is not to be used. A count
-/// that [`Instance::changes`] does not reach (one more per FMI call).
+/// that [`ComponentInstance::changes`] does not reach (one more per FMI call).
 const NOT_READ: u64 = u64::MAX;
 
 /// In [`Source::column`]: the output is not recorded (no row has it).
@@ -168,8 +173,8 @@ fn forget_sampled(components: &mut [Component]) {
 /// Read every component's recorded outputs into `row`, one `fmi2GetReal`
 /// per component, one after the other (`row` holds as many values as
 /// they have; Integer and Boolean ones after the Real ones, see
-/// [`read_discrete`]), and note each component's [`Instance::changes`]
-/// then.
+/// [`read_discrete`]), and note each component's
+/// [`ComponentInstance::changes`] then.
 #[inline(always)] // into the run's loop
 fn read_outputs(components: &mut [Component], row: &mut [f64]) -> Result<(), FmuError> {
     let mut rest = row;
@@ -323,7 +328,7 @@ fn set_gathered(
         }
         values = rest;
         if let Some((t, h)) = step {
-            c.instance.do_step_with(t, h, Rollback::Never)?;
+            c.instance.do_step(t, h, Rollback::Never)?;
         }
     }
     Ok(())
@@ -461,7 +466,7 @@ impl System {
             let mut component = Component {
                 name,
                 fmu,
-                instance,
+                instance: ComponentInstance::Fmi2(instance),
                 output_vrs: Vec::new(),
                 integer_vrs: Vec::new(),
                 boolean_vrs: Vec::new(),
@@ -545,8 +550,7 @@ impl System {
         system.plan();
         for c in &mut system.components {
             c.instance
-                .setup_experiment(experiment.start, experiment.stop)?;
-            c.instance.enter_initialization_mode()?;
+                .initialize(false, experiment.start, experiment.stop)?;
         }
         system.set_parameters(parameters)?;
         Ok(system)
@@ -594,9 +598,7 @@ impl System {
         parameters: &[(String, ParameterValue)],
     ) -> Result<(), SystemError> {
         for c in &mut self.components {
-            c.instance.reset()?;
-            c.instance.setup_experiment(start, None)?;
-            c.instance.enter_initialization_mode()?;
+            c.instance.initialize(true, start, None)?;
         }
         self.set_parameters(parameters)
     }
@@ -690,7 +692,7 @@ impl System {
                 if !now.is_empty() {
                     c.instance.set_real(&c.inputs, now)?;
                 }
-                c.instance.do_step_with(t, h, Rollback::Never)?;
+                c.instance.do_step(t, h, Rollback::Never)?;
             }
             return Ok(());
         }

@@ -24,10 +24,10 @@
 use super::model::{Context, FrictionModel};
 use super::quality::{self, Quality};
 use crate::fmu::model_description::{Causality, VariableKind};
-use crate::fmu::{Fmu, Instance};
+use crate::fmu::Fmu;
 use crate::inputs::InputTable;
 use crate::ssp::SystemFile;
-use crate::system::System;
+use crate::system::{ComponentInstance, System};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -321,7 +321,7 @@ fn known_columns(system: &System) -> String {
 }
 
 /// The value of any scalar variable as a number (Booleans 0/1).
-pub fn read_value(instance: &mut Instance, fmu: &Fmu, name: &str) -> Result<f64, String> {
+pub fn read_value(instance: &mut ComponentInstance, fmu: &Fmu, name: &str) -> Result<f64, String> {
     let var = fmu.variable(name).map_err(|e| e.to_string())?;
     let vr = var.value_reference;
     let fail = |e: crate::FmuError| format!("reading `{name}`: {e}");

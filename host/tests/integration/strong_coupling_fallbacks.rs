@@ -189,6 +189,8 @@ fn assert_nothing_stepped(system: &mut System, run: &Run) {
     for c in &mut system.components {
         let reached = c
             .instance
+            .fmi2()
+            .expect("FMI 2.0")
             .last_successful_time()
             .unwrap_or_else(|e| panic!("{}: {e}", c.name));
         assert_eq!(reached, 0.0, "{} is no longer at t = 0", c.name);

@@ -13,7 +13,8 @@
 //! where the versions are told apart, and the masters stay as they are.
 //!
 //! Every method is a thin `#[inline]` forward to the component's
-//! instance (static dispatch): the strong-coupling masters call them in
+//! [`super::ComponentInstance`] (static dispatch: one `match` on the FMI
+//! version): the strong-coupling masters call them in
 //! their per-iteration loops. The Jacobi master's step is
 //! `System::step_jacobi`, in `system.rs`, beside the recording it reads.
 
@@ -78,7 +79,7 @@ impl System {
     }
 
     /// Component `c`'s change count: one more per FMI call that could
-    /// change it ([`crate::fmu::Instance::changes`]); while it stands
+    /// change it ([`super::ComponentInstance::changes`]); while it stands
     /// still, the component is as it was (only getters were called).
     #[inline(always)]
     pub fn changes(&self, c: usize) -> u64 {
@@ -93,8 +94,7 @@ impl System {
         vrs: &[ValueReference],
         values: &mut [f64],
     ) -> Result<(), FmuError> {
-        self.components[c].instance.get_real(vrs, values)?;
-        Ok(())
+        self.components[c].instance.get_real(vrs, values)
     }
 
     /// Set component `c`'s Real variables `vrs` to `values`.
@@ -105,8 +105,7 @@ impl System {
         vrs: &[ValueReference],
         values: &[f64],
     ) -> Result<(), FmuError> {
-        self.components[c].instance.set_real(vrs, values)?;
-        Ok(())
+        self.components[c].instance.set_real(vrs, values)
     }
 
     /// Set the time derivatives of component `c`'s Real inputs `vrs`, of
@@ -123,8 +122,7 @@ impl System {
     ) -> Result<(), FmuError> {
         self.components[c]
             .instance
-            .set_real_input_derivatives(vrs, orders, values)?;
-        Ok(())
+            .set_real_input_derivatives(vrs, orders, values)
     }
 
     /// Step component `c` from `t` over `h`; `rollback` says whether a
@@ -137,8 +135,7 @@ impl System {
         h: f64,
         rollback: Rollback,
     ) -> Result<(), FmuError> {
-        self.components[c].instance.do_step_with(t, h, rollback)?;
-        Ok(())
+        self.components[c].instance.do_step(t, h, rollback)
     }
 
     /// [`System::do_step`] of every component, in order; the first
@@ -146,7 +143,7 @@ impl System {
     #[inline]
     pub fn do_step_all(&mut self, t: f64, h: f64, rollback: Rollback) -> Result<(), FmuError> {
         for c in &mut self.components {
-            c.instance.do_step_with(t, h, rollback)?;
+            c.instance.do_step(t, h, rollback)?;
         }
         Ok(())
     }
@@ -164,8 +161,7 @@ impl System {
     ) -> Result<(), FmuError> {
         self.components[c]
             .instance
-            .get_directional_derivative(unknowns, knowns, seed, out)?;
-        Ok(())
+            .get_directional_derivative(unknowns, knowns, seed, out)
     }
 
     /// Component `c`'s state, saved into a new [`FmuState`].
@@ -176,15 +172,13 @@ impl System {
     /// Component `c`'s state saved into `state`, one it saved before.
     #[inline]
     pub fn update_state(&mut self, c: usize, state: &mut FmuState) -> Result<(), FmuError> {
-        self.components[c].instance.update_state(state)?;
-        Ok(())
+        self.components[c].instance.update_state(state)
     }
 
     /// Component `c` rolled back to `state`, one it saved before.
     #[inline(always)]
     pub fn set_state(&mut self, c: usize, state: &FmuState) -> Result<(), FmuError> {
-        self.components[c].instance.set_state(state)?;
-        Ok(())
+        self.components[c].instance.set_state(state)
     }
 
     /// Leave initialization mode, component after component; the first
@@ -202,9 +196,6 @@ impl System {
     /// component, or when either question fails.
     pub fn terminated_at(&mut self, instance: &str) -> Option<f64> {
         let c = self.components.iter_mut().find(|c| c.name == instance)?;
-        if !c.instance.terminated().ok()? {
-            return None;
-        }
-        c.instance.last_successful_time().ok()
+        c.instance.terminated_at()
     }
 }
