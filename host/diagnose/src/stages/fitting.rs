@@ -158,7 +158,7 @@ impl Problem<'_> {
         let fitted: Vec<fit::Fitted> = self
             .split
             .folds
-            .iter()
+            .par_iter()
             .zip(base)
             .enumerate()
             .map(|(i, (fold, b))| {

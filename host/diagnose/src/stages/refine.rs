@@ -18,6 +18,7 @@ use crate::acceptance::{mean, Scored};
 use crate::model::FrictionModel;
 use crate::system::System;
 use crate::POLISH_ITERATIONS;
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// A model as fitted: one per fold, their score, and the model reported.
@@ -48,23 +49,13 @@ pub(crate) fn refine(
         scored,
         whole,
     } = fitted;
-    let polished: Vec<crate::fit::Fitted> = p
-        .split
-        .folds
-        .iter()
-        .zip(&models)
-        .map(|(fold, m)| p.polish(m, &fold.fits, POLISH_ITERATIONS))
-        .collect();
-    polishing.cosimulations += polished.iter().map(|p| p.evaluations).sum::<usize>();
-    let refined: Vec<FrictionModel> = polished.into_iter().map(|p| p.model).collect();
-    let (models, scored, kept) = if refined == models {
-        (models, scored, true)
-    } else {
-        match p.score(system, &refined) {
-            Ok(s) if mean(&s.q) <= mean(&scored.q) => (refined, s, true),
-            _ => (models, scored, false),
-        }
-    };
+    let FoldsRefined {
+        models,
+        scored,
+        kept,
+        evaluations,
+    } = refine_folds(p, system, models, scored);
+    polishing.cosimulations += evaluations;
     let whole = if p.split.folds.len() == 1 {
         models[0].clone()
     } else if !kept {
@@ -79,5 +70,52 @@ pub(crate) fn refine(
         folds: models,
         scored,
         whole,
+    }
+}
+
+/// Fold models refined on the output error of their fit samples, and
+/// their score.
+pub(crate) struct FoldsRefined {
+    pub(crate) models: Vec<FrictionModel>,
+    pub(crate) scored: Scored,
+    /// Whether the refined models were kept: their co-simulation ran and
+    /// their held-out error is not above the unrefined models'.
+    pub(crate) kept: bool,
+    /// Co-simulations of the refinement.
+    pub(crate) evaluations: usize,
+}
+
+/// `models` (one per fold, scored as `scored`) refined on each fold's fit
+/// samples for [`POLISH_ITERATIONS`] iterations, and scored again; the
+/// unrefined ones are kept when the refined ones fail or score worse on
+/// the held-out data.
+pub(crate) fn refine_folds(
+    p: &Problem,
+    system: &mut System,
+    models: Vec<FrictionModel>,
+    scored: Scored,
+) -> FoldsRefined {
+    let polished: Vec<crate::fit::Fitted> = p
+        .split
+        .folds
+        .par_iter()
+        .zip(&models)
+        .map(|(fold, m)| p.polish(m, &fold.fits, POLISH_ITERATIONS))
+        .collect();
+    let evaluations = polished.iter().map(|p| p.evaluations).sum::<usize>();
+    let refined: Vec<FrictionModel> = polished.into_iter().map(|p| p.model).collect();
+    let (models, scored, kept) = if refined == models {
+        (models, scored, true)
+    } else {
+        match p.score(system, &refined) {
+            Ok(s) if mean(&s.q) <= mean(&scored.q) => (refined, s, true),
+            _ => (models, scored, false),
+        }
+    };
+    FoldsRefined {
+        models,
+        scored,
+        kept,
+        evaluations,
     }
 }

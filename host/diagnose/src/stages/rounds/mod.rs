@@ -11,10 +11,11 @@
 //! [`Search`]: the final model, the effects accepted and withdrawn, every
 //! round's candidates and thresholds, and the notes for the report.
 
+mod contenders;
 mod explanations;
 mod resolution;
 
-use crate::acceptance::{drop_beyond_step_error, nested_test, Acceptance, Scored};
+use crate::acceptance::{drop_beyond_step_error, mean, nested_test, Acceptance, Scored};
 use crate::model::{Effect, FrictionModel};
 use crate::sim::FrictionSim;
 use crate::stages::baseline::Baseline;
@@ -67,6 +68,9 @@ struct Tried {
     evaluations: usize,
     /// The held-out co-simulation, or why it failed.
     scored: Result<Scored, String>,
+    /// Set when its levels refitted without it score as well
+    /// ([`contenders::refine_contenders`]): why it is not named.
+    levels_only: Option<String>,
 }
 
 /// The addition a round accepted, and what the report says of it.
@@ -116,6 +120,18 @@ pub(crate) fn search(
     while s.effects.len() < p.options.max_effects {
         let missing = missing_effects(p, &s);
         if missing.is_empty() {
+            break;
+        }
+        // no candidate can lower the mean square by more than the step
+        // error's square ([`drop_beyond_step_error`]) when the current
+        // model's is below it: the round could only reject them all
+        if mean(&s.scored.q) <= s.step_error * s.step_error {
+            s.notes.push(format!(
+                "No round {} was run: the held-out RMS ({:.3e}) is already within the co-simulation's step error ({:.3e}), so no further effect could be told from the integration's error at this step.",
+                s.rounds.len() + 1,
+                s.scored.rms(),
+                s.step_error
+            ));
             break;
         }
         // single effects first; when none is accepted, the pairs that
@@ -200,6 +216,7 @@ fn try_additions(
                 force_rms,
                 evaluations,
                 scored,
+                levels_only: None,
             })
         })
         .collect()
@@ -222,6 +239,7 @@ fn round(
         min_gain: p.options.min_gain,
     };
     refit_overlapping_by_output_error(p, s, &mut tried, rule, group)?;
+    contenders::refine_contenders(p, s, &mut tried, rule, group)?;
     let mut round = tried
         .iter()
         .map(|t| candidate_score(p, s, t, group))
@@ -378,6 +396,7 @@ fn candidate_score(
         unresolved_change(&t.added, c, m, &p.context)
             .or_else(|| unmoved_resize(&t.added, c, m, &p.context))
     });
+    let unresolved = unresolved.or_else(|| t.levels_only.clone());
     Ok(CandidateScore {
         name: label(&t.added),
         heldout_rms,
