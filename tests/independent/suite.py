@@ -15,13 +15,18 @@ DATA.csv --out DIR`), and scored from its report.json:
 
 Usage: python3 tests/independent/suite.py [--quick] [--out DIR]
        [--seeds N] [--jobs N] [--fricsim BINARY] [--update BENCHMARKS.md]
-       [--any-plant] [--only KIND,...]
+       [--any-plant] [--only KIND,...] [--versus OLD_FRICSIM]
 --any-plant runs the any-plant cases instead (cases.PLANT_KINDS: every
 effect on each plant that is not Rig1D, at 10 % and 5 %; the null and
 presliding, whose size the magnitude does not set, at 10 %; no coarse
 or bad-data rows).
+--versus OLD_FRICSIM diagnoses each case with an older build as well, in
+turn with this one on the same data (the old first), and writes a
+before/after table: the effects found, the size error, the final/given
+RMS and the time of each case, and both summaries.
 Writes DIR/suite.json and DIR/suite.md; with --update, the table between
-the "independent-suite" markers of BENCHMARKS.md.
+the "independent-suite" markers of BENCHMARKS.md ("any-plant" with
+--any-plant).
 """
 
 from __future__ import annotations
@@ -170,9 +175,28 @@ def run_case(
     started = time.time()
     data, ssd = cases.make(case, work)
     marks = corrupt(data) if bad_data else []
-    out = work / f"out-{case.name}{'-bad' if bad_data else ''}"
+    return diagnose_case(case, work, data, ssd, marks, bad_data, extra, timeout, FRICSIM, "", started)
+
+
+def diagnose_case(
+    case: cases.Case,
+    work: Path,
+    data: Path,
+    ssd: Path,
+    marks: list,
+    bad_data: bool,
+    extra: tuple,
+    timeout: float | None,
+    fricsim: Path,
+    tag: str,
+    started: float,
+) -> dict:
+    """Diagnose a made case with `fricsim` and score it (`tag`: a suffix of
+    its output directory, to keep two builds' outputs apart)."""
+    out = work / f"out-{case.name}{'-bad' if bad_data else ''}{tag}"
     (out / "report.json").unlink(missing_ok=True)  # none left from an earlier run
-    argv = [str(FRICSIM), "diagnose", str(ssd), str(data), "--out", str(out), *extra]
+    argv = [str(fricsim), "diagnose", str(ssd), str(data), "--out", str(out), *extra]
+    command_started = time.time()
     try:
         proc = subprocess.run(argv, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -192,6 +216,7 @@ def run_case(
         "exit": proc.returncode,
         "stderr": proc.stderr[-2000:],
         "timed_out": proc.returncode is None,
+        "command_seconds": time.time() - command_started,
     }
     if not row["report"]:
         row["seconds"] = time.time() - started
@@ -280,6 +305,72 @@ def any_plant_grid(seeds: int, quick: bool) -> list[tuple[cases.Case, bool]]:
     ]
 
 
+def run_case_versus(case: cases.Case, work: Path, extra: tuple, timeout: float | None, old: Path) -> dict:
+    """Make one case and diagnose it with the build `old` and then with
+    this one (FRICSIM), in turn on the same data: the row of this build,
+    with the old build's row under "before"."""
+    data, ssd = cases.make(case, work)
+    before = diagnose_case(case, work, data, ssd, [], False, extra, timeout, old, "-before", time.time())
+    row = diagnose_case(case, work, data, ssd, [], False, extra, timeout, FRICSIM, "", time.time())
+    row["before"] = before
+    return row
+
+
+def seconds_of(r: dict) -> float:
+    """What the user waited for: the whole `fricsim diagnose` command,
+    a fresh process (report and plots written)."""
+    return r["command_seconds"]
+
+
+def times(rows: list[dict]) -> dict:
+    """Median and maximum diagnosis time and the cases over 60 s."""
+    ts = sorted(seconds_of(r) for r in rows)
+    n = len(ts)
+    median = (ts[(n - 1) // 2] + ts[n // 2]) / 2 if n else float("nan")
+    return {"median_seconds": median, "max_seconds": ts[-1] if n else float("nan"),
+            "over_60_s": sum(1 for t in ts if t > 60), "cases": n,
+            "timed_out": sum(1 for r in rows if r.get("timed_out"))}
+
+
+def versus_table(rows: list[dict]) -> str:
+    """Before → after, per case: the effects found, the size error, the
+    final/given RMS and the time; then both summaries and times."""
+    def found(r):
+        if not r["report"]:
+            return "timed out" if r.get("timed_out") else "NO REPORT"
+        return (", ".join(r["found"]) or "none") + ("" if r["named_right"] else " ✗")
+
+    def size(r):
+        return f"{100 * r['size']['relative_error']:.1f} %" if "size" in r else ""
+
+    def ratio(r):
+        return f"{r['final_rms'] / r['given_rms']:.3f}" if r["report"] else ""
+
+    lines = [
+        "| case | found before | found after | size error before → after | final / given RMS before → after | time (s) before → after |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in rows:
+        b = r["before"]
+        lines.append(
+            f"| {r['case']} | {found(b)} | {found(r)} | {size(b)} → {size(r)} | {ratio(b)} → {ratio(r)} "
+            f"| {seconds_of(b):.1f} → {seconds_of(r):.1f} |"
+        )
+    lines.append("")
+    sb, sa = summarise([r["before"] for r in rows]), summarise(rows)
+    for k in ("named_right_10pct", "named_right_5pct", "clean_null_no_claim", "never_worse", "sized_within_10pct",
+              "reports_written"):
+        lines.append(f"- {k.replace('_', ' ')}: {sb[k][0]}/{sb[k][1]} before, {sa[k][0]}/{sa[k][1]} after")
+    tb, ta = times([r["before"] for r in rows]), times(rows)
+    lines.append(
+        f"- time: median {tb['median_seconds']:.1f} s before, {ta['median_seconds']:.1f} s after; "
+        f"longest {tb['max_seconds']:.1f} s before, {ta['max_seconds']:.1f} s after; over 60 s: "
+        f"{tb['over_60_s']}/{tb['cases']} before, {ta['over_60_s']}/{ta['cases']} after; stopped by --case-timeout: "
+        f"{tb['timed_out']} before, {ta['timed_out']} after"
+    )
+    return "\n".join(lines) + "\n"
+
+
 def summarise(rows: list[dict]) -> dict:
     def share(sel, key):
         xs = [r for r in rows if sel(r)]
@@ -364,6 +455,13 @@ def main() -> int:
         action="store_true",
         help="run the any-plant cases instead (every effect on each plant that is not Rig1D)",
     )
+    ap.add_argument(
+        "--versus",
+        type=Path,
+        metavar="OLD_FRICSIM",
+        help="diagnose every case with this older build too, in turn with this one on the same data, and "
+        "write a before/after table (with --update: between the \"any-plant\" markers when --any-plant)",
+    )
     args = ap.parse_args()
     global FRICSIM
     if args.fricsim:
@@ -378,6 +476,16 @@ def main() -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     if args.render_only:
         rows = json.loads((args.out / "suite.json").read_text())["cases"]
+    elif args.versus:
+        old = args.versus.resolve()
+        with ThreadPoolExecutor(args.jobs) as pool:
+            rows = list(
+                pool.map(
+                    lambda cb: run_case_versus(cb[0], args.out / "cases", tuple(args.diagnose_arg),
+                                               args.case_timeout, old),
+                    [cb for cb in todo if not cb[1]],
+                )
+            )
     else:
         with ThreadPoolExecutor(args.jobs) as pool:
             rows = list(
@@ -389,8 +497,14 @@ def main() -> int:
     for r in rows:
         print(r["case"], r.get("found"), r.get("size", {}).get("relative_error"), r.get("final_rms", 0) / max(r.get("given_rms", 1), 1e-300), file=sys.stderr)
     summary = summarise(rows)
+    if args.versus or (rows and "before" in rows[0]):
+        summary["before"] = summarise([r["before"] for r in rows])
+        summary["times"] = times(rows)
+        summary["times_before"] = times([r["before"] for r in rows])
+        text = versus_table(rows)
+    else:
+        text = table(rows, summary)
     (args.out / "suite.json").write_text(json.dumps({"summary": summary, "cases": rows}, indent=1))
-    text = table(rows, summary)
     (args.out / "suite.md").write_text(text)
     print(text)
     if args.update:
@@ -405,12 +519,16 @@ def main() -> int:
         except OSError:
             pass
         seconds = sum(r.get("diagnose_seconds", 0) for r in rows)
+        flags = (f"{' --quick' if args.quick else ''}{' --any-plant' if args.any_plant else ''}"
+                 f"{' --versus OLD' if args.versus else ''}"
+                 f"{f' --case-timeout {args.case_timeout:g}' if args.case_timeout else ''}")
         head = (
             f"Generated {time.strftime('%Y-%m-%d')} by `python3 tests/independent/suite.py --seeds {args.seeds}"
-            f"{' --quick' if args.quick else ''}` on {cpu}, {os.cpu_count()} cores, {platform.system().lower()} "
+            f" --jobs {args.jobs}{flags}` on {cpu}, {os.cpu_count()} cores, {platform.system().lower()} "
             f"{platform.machine()}, {args.jobs} cases at a time; diagnose took {seconds:.0f} s for {len(rows)} cases.\n\n"
         )
-        begin, end = "<!-- independent-suite: begin", "<!-- independent-suite: end -->"
+        marker = "any-plant" if args.any_plant else "independent-suite"
+        begin, end = f"<!-- {marker}: begin", f"<!-- {marker}: end -->"
         doc = args.update.read_text()
         i, j = doc.index(begin), doc.index(end)
         i = doc.index("\n", i) + 1
