@@ -44,19 +44,36 @@ pub const NAMES: &[&str] = &[
 
 /// A master algorithm by its command-line name (see [`NAMES`]).
 pub fn by_name(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
+    configured(name, false)
+}
+
+/// [`by_name`], with the strong-coupling masters reusing each step's
+/// Jacobian for the next ([`strong::StrongCoupling::reuse_jacobian`]):
+/// for many co-simulations of one system with a law whose step has one
+/// solution (the diagnosis's fits of LuGre).
+pub fn by_name_reusing_jacobians(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
+    configured(name, true)
+}
+
+fn configured(name: &str, reuse_jacobian: bool) -> Result<Box<dyn MasterAlgorithm>, String> {
     use strong::{JacobianSource, StrongCoupling, Update};
+    let strong = |update| {
+        let mut master = StrongCoupling::new(update, JacobianSource::Auto);
+        master.reuse_jacobian = reuse_jacobian;
+        master
+    };
     Ok(match name {
         "jacobi" => Box::new(jacobi::Jacobi::default()),
         "gauss-seidel" => Box::new(gauss_seidel::GaussSeidel::new(false)),
         "gauss-seidel-interpolated" => Box::new(gauss_seidel::GaussSeidel::new(true)),
-        "newton" => Box::new(StrongCoupling::new(Update::Newton, JacobianSource::Auto)),
+        "newton" => Box::new(strong(Update::Newton)),
         "newton-interpolated" => {
-            let mut master = StrongCoupling::new(Update::Newton, JacobianSource::Auto);
+            let mut master = strong(Update::Newton);
             master.interpolate = true;
             Box::new(master)
         }
         "adaptive" => {
-            let mut master = StrongCoupling::new(Update::Newton, JacobianSource::Auto);
+            let mut master = strong(Update::Newton);
             master.step_control = Some(strong::StepControl {
                 rtol: 1e-3,
                 atol: 1e-6,
@@ -64,10 +81,7 @@ pub fn by_name(name: &str) -> Result<Box<dyn MasterAlgorithm>, String> {
             });
             Box::new(master)
         }
-        "fixed-point" => Box::new(StrongCoupling::new(
-            Update::FixedPoint,
-            JacobianSource::Auto,
-        )),
+        "fixed-point" => Box::new(strong(Update::FixedPoint)),
         other => {
             return Err(format!(
                 "unknown master algorithm `{other}` (known: {})",
