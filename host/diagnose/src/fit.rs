@@ -39,7 +39,8 @@ pub struct Fitted {
 }
 
 /// Residuals of a batch of models (one vector per model, `None` when it
-/// cannot be evaluated: the FMU refuses the parameters, the run fails).
+/// cannot be evaluated: the FMU refuses the parameters, the run fails; a
+/// shorter batch stops the fit).
 /// A batch is the columns of one forward-difference Jacobian, which an
 /// evaluator may run in parallel.
 pub type Residuals<'a> = dyn FnMut(&[FrictionModel]) -> Vec<Option<DVector<f64>>> + 'a;
@@ -71,6 +72,11 @@ impl Problem<'_, '_> {
         let models: Vec<FrictionModel> =
             thetas.iter().map(|t| self.base.at(&self.free, t)).collect();
         let results = (self.residual)(&models);
+        // an evaluator that gives fewer has stopped (the diagnosis's time
+        // limit): so does the fit, with the best seen
+        if results.len() != thetas.len() {
+            return None;
+        }
         let mut out = Vec::with_capacity(thetas.len());
         for (theta, r) in thetas.iter().zip(results) {
             let r = r

@@ -38,6 +38,7 @@
 //! [`acceptance`].
 
 pub mod acceptance;
+pub mod budget;
 pub mod dahl;
 pub mod effects;
 pub mod figures;
@@ -60,10 +61,12 @@ pub use acceptance::{
     grouped_signed_rank_test, grouped_t_test, nested_test, separation_test, Scored,
     SIGNED_RANK_EXACT,
 };
+pub use budget::{Progress, Snapshot, TimeLimit, DEFAULT_TIME_LIMIT};
 pub use effects::{PRESLIDING_RESOLVED, PRESLIDING_SWING};
 pub use stages::rounds::RESIZE_MIN_CHANGE;
 pub use stages::split::Blocks;
 
+use budget::Budget;
 use model::{Effect, FrictionModel};
 use problem::{Measured, Setup};
 use serde::Serialize;
@@ -111,6 +114,13 @@ pub struct Options {
     /// The master of the diagnosis's co-simulations (default: the system
     /// file's, with its inputs interpolated, [`diagnosis_master`]).
     pub master: Option<String>,
+    /// Seconds of wall time after which the diagnosis starts no new work
+    /// and reports what it has ([`budget`], [`Diagnosis::time_limit`]);
+    /// `None`: no limit (default [`DEFAULT_TIME_LIMIT`]).
+    pub time_limit: Option<f64>,
+    /// Counters the caller reads while the diagnosis runs (a progress
+    /// line, [`Progress`]); the diagnosis prints nothing itself.
+    pub progress: Option<Progress>,
 }
 
 /// Without a held-out file, whether every block is scored (three-fold
@@ -155,6 +165,9 @@ impl Options {
                 self.position_knots
             ));
         }
+        if let Some(s) = self.time_limit {
+            budget::check_time_limit(s)?;
+        }
         if self.blocks < 3 {
             return Err(format!(
                 "blocks {}: at least 3 (every third block is held out)",
@@ -179,6 +192,8 @@ impl Default for Options {
             blocks: SPLIT_BLOCKS,
             cross_validate: CrossValidate::Auto,
             master: None,
+            time_limit: Some(DEFAULT_TIME_LIMIT),
+            progress: None,
         }
     }
 }
@@ -498,6 +513,11 @@ pub struct Diagnosis {
     /// out in turn).
     pub folds: usize,
     pub wall_seconds: f64,
+    /// The time limit, whether it was reached, and what was left out
+    /// because of it ([`budget`]).
+    pub time_limit: TimeLimit,
+    /// Co-simulations run (fits, scores, refinements, intervals).
+    pub cosimulations: usize,
     /// Of which the output-error refinement of accepted models took this
     /// long, in this many co-simulations.
     pub polish_seconds: f64,
@@ -538,6 +558,9 @@ pub struct RefitDecision {
     pub force_rms: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub failure: Option<String>,
+    /// The time limit was reached before the refit finished (or started):
+    /// not kept, not scored ([`Diagnosis::time_limit`]).
+    pub unfinished: bool,
 }
 
 /// What [`quality::inspect`] found in each file.
@@ -660,7 +683,10 @@ pub fn diagnose_records(
     options: &Options,
 ) -> Result<Diagnosis, String> {
     let started = Instant::now();
+    // the clock of the time limit, and the progress counters
+    let budget = Budget::new(options);
     // 1. the data read and inspected
+    budget.progress().stage("reading the data");
     let Loaded {
         mut system,
         data,
@@ -668,6 +694,7 @@ pub fn diagnose_records(
         setup,
     } = load(file, data_paths, heldout_paths, options)?;
     // 2. the force the data imply, or the output-error set-up
+    budget.progress().stage("the force the data imply");
     let force = estimate_force(
         file,
         &setup,
@@ -678,14 +705,24 @@ pub fn diagnose_records(
     )?;
     // 3. which samples fit and which score
     let split = Split::new(&data, &force.data, force.heldout.as_ref(), options)?;
-    let problem = Problem::new(file, options, setup, (data, heldout_records), force, split);
+    let problem = Problem::new(
+        file,
+        options,
+        setup,
+        (data, heldout_records),
+        force,
+        split,
+        &budget,
+    );
     // 4. the nominal scored, its levels refitted
+    budget.progress().stage("the baseline");
     let mut sim = FrictionSim::new(&problem.setup.friction_fmu)?;
     let baseline = baseline(&problem, &mut system)?;
     // 5. and 6. the candidate rounds, each accepted model refined
     let mut polishing = Polishing::default();
     let search = search(&problem, &mut system, &mut sim, &baseline, &mut polishing)?;
     // 7. the report's figures
+    budget.progress().stage("the summary");
     summarise(&problem, &mut sim, baseline, search, polishing, started)
 }
 

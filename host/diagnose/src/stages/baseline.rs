@@ -5,6 +5,10 @@
 //! acceptance rule against the nominal as given ([`RefitDecision`]), so
 //! that the diagnosis never ends worse than the model it was given.
 //!
+//! Past the time limit ([`crate::budget`]) the refit is skipped, or not
+//! kept when a fit of it stopped at the limit, and the step error is not
+//! estimated (0); the nominal as given is always scored.
+//!
 //! Takes the [`Problem`] and the system; gives a [`Baseline`].
 
 use super::fitting::level_starts;
@@ -43,14 +47,33 @@ pub(crate) fn baseline(p: &Problem, system: &mut System) -> Result<Baseline, Str
         )
     })?;
     let group = acceptance_groups(p, &nominal_scored);
-    let refit_fits = p.fit_folds_any(&level_starts, &nominal_folds, &[], false)?;
-    let refit_model = p.fit_whole_any(&level_starts(nominal), &refit_fits.models, &[], false)?;
-    let refit_scored = p.score(system, &refit_fits.models);
     let rule = Acceptance {
         threshold: p.options.alpha,
         min_gain: p.options.min_gain,
     };
-    let nominal_step_error = p.step_error(system, &nominal_folds, &nominal_scored);
+    // past the time limit the refit is skipped, and one a fit of which
+    // stopped at the limit is not kept (crate::budget)
+    const REFIT: &str = "the refit of the nominal's levels";
+    if p.budget.skip_if_expired(|| REFIT.into()) {
+        return Ok(unrefitted(p, nominal_scored, group, rule, f64::NAN));
+    }
+    p.budget
+        .progress()
+        .stage("the baseline: the levels refitted");
+    let (refit, cut) = p.budget.cut_short(
+        || REFIT.into(),
+        || -> Result<_, String> {
+            let fits = p.fit_folds_any(&level_starts, &nominal_folds, &[], false)?;
+            let model = p.fit_whole_any(&level_starts(nominal), &fits.models, &[], false)?;
+            Ok((fits, model))
+        },
+    );
+    let (refit_fits, refit_model) = refit?;
+    if cut {
+        return Ok(unrefitted(p, nominal_scored, group, rule, refit_fits.rms));
+    }
+    let refit_scored = p.score(system, &refit_fits.models);
+    let nominal_step_error = step_error_in_time(p, system, &nominal_folds, &nominal_scored, GIVEN);
     let refit = match &refit_scored {
         Ok(scored) => {
             let (gain, p_value) = nested_test(&nominal_scored, scored, &p.scales, &group)?;
@@ -64,6 +87,7 @@ pub(crate) fn baseline(p: &Problem, system: &mut System) -> Result<Baseline, Str
                     && drop_beyond_step_error(&nominal_scored, heldout_rms, nominal_step_error),
                 force_rms: refit_fits.rms,
                 failure: None,
+                unfinished: false,
             }
         }
         Err(e) => RefitDecision {
@@ -74,6 +98,7 @@ pub(crate) fn baseline(p: &Problem, system: &mut System) -> Result<Baseline, Str
             kept: false,
             force_rms: refit_fits.rms,
             failure: Some(e.clone()),
+            unfinished: false,
         },
     };
     let (model, folds, scored) = match refit_scored {
@@ -84,7 +109,7 @@ pub(crate) fn baseline(p: &Problem, system: &mut System) -> Result<Baseline, Str
     // outputs (a drop of the error smaller than that may compensate the
     // co-simulation's step error, not physics)
     let step_error = if refit.kept {
-        p.step_error(system, &folds, &scored)
+        step_error_in_time(p, system, &folds, &scored, "the refitted nominal")
     } else {
         nominal_step_error
     };
@@ -98,6 +123,65 @@ pub(crate) fn baseline(p: &Problem, system: &mut System) -> Result<Baseline, Str
         step_error,
     })
 }
+
+/// The co-simulation's step error of `folds` scored as `scored`
+/// ([`Problem::step_error`]) when the time limit has not passed; else
+/// skipped, and 0 (`which`: whose, for the report).
+fn step_error_in_time(
+    p: &Problem,
+    system: &mut System,
+    folds: &[FrictionModel],
+    scored: &Scored,
+    which: &str,
+) -> f64 {
+    if p.budget.skip_if_expired(|| {
+        format!(
+            "the co-simulation's step error of {which} (taken as 0: the floor is the noise alone)"
+        )
+    }) {
+        0.0
+    } else {
+        p.step_error(system, folds, scored)
+    }
+}
+
+/// The baseline when the refit was skipped or cut short by the time
+/// limit: the nominal as given, the refit not kept (`force_rms`: of the
+/// refit's fits, NaN when none ran), the step error skipped (the limit
+/// has passed).
+fn unrefitted(
+    p: &Problem,
+    nominal_scored: Scored,
+    group: Vec<usize>,
+    rule: Acceptance,
+    force_rms: f64,
+) -> Baseline {
+    let nominal = &p.setup.nominal;
+    p.budget.skip(format!(
+        "the co-simulation's step error of {GIVEN} (taken as 0: the floor is the noise alone)"
+    ));
+    Baseline {
+        refit: RefitDecision {
+            heldout_rms: f64::INFINITY,
+            gain: f64::NEG_INFINITY,
+            p_value: 1.0,
+            threshold: rule.threshold,
+            kept: false,
+            force_rms,
+            failure: None,
+            unfinished: true,
+        },
+        model: nominal.clone(),
+        folds: vec![nominal.clone(); p.split.folds.len()],
+        scored: nominal_scored.clone(),
+        nominal_scored,
+        group,
+        step_error: 0.0,
+    }
+}
+
+/// The nominal as given, in the report's list of what was skipped.
+const GIVEN: &str = "the nominal as given";
 
 /// The groups of the acceptance test: the held-out blocks when there are
 /// at least [`crate::Options::groups`] of them (each block an independent

@@ -50,6 +50,11 @@ impl Problem<'_> {
         pick: &Picker,
         step: Option<f64>,
     ) -> Option<DVector<f64>> {
+        // past the time limit: none (the fit stops, crate::budget)
+        if self.budget.stop_here() {
+            return None;
+        }
+        self.budget.cosimulation();
         // a system of its own (an FMU instance stays on its thread)
         let mut system = self.file.build(0.0).ok()?;
         let params = system_parameters(self.file, &self.setup, m);
@@ -96,6 +101,11 @@ impl Problem<'_> {
         iterations: usize,
     ) -> fit::Fitted {
         let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
+            // past the time limit: no residuals, the fit stops with the
+            // best it has (crate::budget)
+            if self.budget.stop_here() {
+                return Vec::new();
+            }
             models
                 .par_iter()
                 .map(|m| self.fit_residuals(m, pick, None))

@@ -24,7 +24,11 @@
 //! 7. [`summary`]: the intervals, the floor, the localisation, the
 //!    report's figures: the [`crate::Diagnosis`].
 //!
-//! The tests that decide are in [`crate::acceptance`].
+//! The tests that decide are in [`crate::acceptance`]. The time limit
+//! ([`crate::budget`], carried in the [`problem::Problem`]) is checked by
+//! the fits before each co-simulation and by the stages before each step
+//! that costs: past it, the round in progress is not decided and the
+//! steps after it are skipped, each named in the report.
 
 pub(crate) mod baseline;
 pub(crate) mod fitting;

@@ -9,6 +9,7 @@
 
 use super::force::ForceEvidence;
 use super::split::{Picker, Split};
+use crate::budget::Budget;
 use crate::model::Context;
 use crate::problem::{FrictionData, Measured, Setup};
 use crate::ssp::SystemFile;
@@ -36,11 +37,13 @@ pub(crate) struct Problem<'a> {
     /// Every sample of every data record (the model fitted on all of
     /// them).
     pub(crate) every_sample: Picker,
+    /// The time limit and the progress counters ([`Budget`]).
+    pub(crate) budget: &'a Budget,
 }
 
 impl<'a> Problem<'a> {
     /// The problem of the loaded records ([`super::load::Loaded`]), their
-    /// friction data and split.
+    /// friction data and split, under `budget`.
     pub(crate) fn new(
         file: &'a SystemFile,
         options: &'a Options,
@@ -48,6 +51,7 @@ impl<'a> Problem<'a> {
         (data, heldout_records): (Measured, Option<Measured>),
         force: ForceEvidence,
         split: Split,
+        budget: &'a Budget,
     ) -> Problem<'a> {
         let scales = channel_scales(&data);
         let context = setup.context(&force.data, options.position_knots);
@@ -62,6 +66,7 @@ impl<'a> Problem<'a> {
             scales,
             context,
             every_sample: Picker::all(),
+            budget,
         }
     }
 

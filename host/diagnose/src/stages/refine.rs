@@ -8,6 +8,10 @@
 //! reported model is refined too, unless its folds' refinement was not
 //! kept.
 //!
+//! Past the time limit ([`crate::budget`]) the refinement is skipped; one
+//! the limit cuts short keeps what it reached (the refined fold models
+//! only if they score no worse), and the report says so.
+//!
 //! Takes the [`Problem`], the accepted [`Fitted`] models and the running
 //! [`Polishing`] account; gives the refined [`Fitted`]. Called by the
 //! candidate rounds for every accepted model and for a model an effect
@@ -43,7 +47,29 @@ pub(crate) fn refine(
     fitted: Fitted,
     polishing: &mut Polishing,
 ) -> Fitted {
+    const WHAT: &str = "the refinement on the output error of an accepted model";
+    if p.budget.skip_if_expired(|| WHAT.into()) {
+        return fitted;
+    }
+    p.budget
+        .progress()
+        .stage("refining the accepted model on the output error");
     let started = Instant::now();
+    let (refined, _) = p.budget.cut_short(
+        || WHAT.into(),
+        || refine_in_time(p, system, fitted, polishing),
+    );
+    polishing.seconds += started.elapsed().as_secs_f64();
+    refined
+}
+
+/// [`refine`], with the time limit checked by the fits.
+fn refine_in_time(
+    p: &Problem,
+    system: &mut System,
+    fitted: Fitted,
+    polishing: &mut Polishing,
+) -> Fitted {
     let Fitted {
         folds: models,
         scored,
@@ -65,7 +91,6 @@ pub(crate) fn refine(
         polishing.cosimulations += polished.evaluations;
         polished.model
     };
-    polishing.seconds += started.elapsed().as_secs_f64();
     Fitted {
         folds: models,
         scored,

@@ -32,6 +32,7 @@ impl Problem<'_> {
         for (fold, model) in self.split.folds.iter().zip(models) {
             let params = system_parameters(self.file, &self.setup, model);
             let records = fold.scores.records.as_deref();
+            self.budget.cosimulation();
             let r = match step {
                 None => {
                     let (r, note) =

@@ -47,7 +47,20 @@ pub(crate) fn summarise(
         notes,
         ..
     } = search;
-    let covariance = covariance(p, &current);
+    // the intervals: output-error co-simulations, skipped past the time
+    // limit and dropped when it cut them short
+    let covariance = if p.budget.skip_if_expired(|| "the 95 % intervals".into()) {
+        None
+    } else {
+        p.budget.progress().stage("the 95 % intervals");
+        match p
+            .budget
+            .cut_short(|| "the 95 % intervals".into(), || covariance(p, &current))
+        {
+            (c, false) => c,
+            (_, true) => None,
+        }
+    };
     if let Some(cov) = &covariance {
         effect_changes(cov, &p.setup.nominal, &current, &mut effects);
     }
@@ -136,6 +149,8 @@ pub(crate) fn summarise(
         min_gain: p.options.min_gain,
         folds: p.split.folds.len(),
         wall_seconds: started.elapsed().as_secs_f64(),
+        time_limit: p.budget.time_limit(),
+        cosimulations: p.budget.cosimulations(),
         polish_seconds: polishing.seconds,
         polish_cosimulations: polishing.cosimulations,
         step: p.setup.step,

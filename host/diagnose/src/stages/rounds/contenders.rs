@@ -44,7 +44,7 @@ pub(super) fn refine_contenders(
 ) -> Result<(), String> {
     let mut contenders = Vec::new();
     for (k, t) in tried.iter().enumerate() {
-        if !t.by_output_error {
+        if !t.by_output_error || t.unfinished {
             continue;
         }
         if let Ok(scored) = &t.scored {
@@ -91,6 +91,8 @@ pub(super) fn refine_contenders(
         t.models = r.models;
         t.scored = Ok(r.scored);
         t.levels_only = levels_only;
+        // refined past the time limit: its refinement may have been cut
+        t.unfinished |= p.budget.expired();
     }
     Ok(())
 }

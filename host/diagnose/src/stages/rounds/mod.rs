@@ -10,8 +10,11 @@
 //! Takes the [`Problem`], the [`Baseline`] and a system; gives the
 //! [`Search`]: the final model, the effects accepted and withdrawn, every
 //! round's candidates and thresholds, and the notes for the report.
+//! At the time limit the round in progress is not decided and the search
+//! ends (`deadline.rs`).
 
 mod contenders;
+mod deadline;
 mod explanations;
 mod resolution;
 
@@ -71,6 +74,8 @@ struct Tried {
     /// Set when its levels refitted without it score as well
     /// ([`contenders::refine_contenders`]): why it is not named.
     levels_only: Option<String>,
+    /// Not started, or not finished, within the time limit (`deadline.rs`).
+    unfinished: bool,
 }
 
 /// The addition a round accepted, and what the report says of it.
@@ -94,6 +99,8 @@ enum Outcome {
     Undecided,
     /// Nothing passed: these were tried.
     NoneAccepted(Vec<Tried>),
+    /// The time limit was reached in the round: not decided.
+    Stopped,
 }
 
 /// Run the candidate rounds from `baseline` ([the module](self)).
@@ -154,13 +161,18 @@ pub(crate) fn search(
             if additions.is_empty() {
                 continue;
             }
+            if p.budget.skip_if_expired(|| {
+                format!("candidate round {} and any after it", s.rounds.len() + 1)
+            }) {
+                break;
+            }
             match round(p, system, &mut s, &additions, group)? {
                 Outcome::Accepted(mut choice) => {
                     choice.singles = singles_tried;
                     accepted = Some(choice);
                     break;
                 }
-                Outcome::Undecided => break,
+                Outcome::Undecided | Outcome::Stopped => break,
                 Outcome::NoneAccepted(tried) => singles_tried = tried,
             }
         }
@@ -170,7 +182,14 @@ pub(crate) fn search(
         let earlier = s.effects.len();
         accept(p, system, sim, &mut s, choice, polishing)?;
         reexamine(p, system, &mut s, earlier, group, polishing)?;
-        s.step_error = p.step_error(system, &s.folds, &s.scored);
+        if !p.budget.skip_if_expired(|| {
+            format!(
+                "the co-simulation's step error after round {} (the one before is kept)",
+                s.rounds.len()
+            )
+        }) {
+            s.step_error = p.step_error(system, &s.folds, &s.scored);
+        }
     }
     Ok(s)
 }
@@ -201,6 +220,13 @@ fn try_additions(
     additions
         .par_iter()
         .map(|added| {
+            let by_output_error = oe || p.by_output_error(added);
+            // past the time limit a candidate is not started (deadline.rs)
+            if p.budget.expired() {
+                return Ok(Tried::not_started(added, by_output_error));
+            }
+            let name = label(added);
+            p.budget.progress().candidate_started(&name);
             let FoldFits {
                 models,
                 rms: force_rms,
@@ -209,14 +235,17 @@ fn try_additions(
             let mut system = p.file.build(0.0).map_err(|e| e.to_string())?;
             // a candidate whose co-simulation fails is rejected, not fatal
             let scored = p.score(&mut system, &models);
+            p.budget.progress().candidate_done(&name);
             Ok(Tried {
                 added: added.clone(),
-                by_output_error: oe || p.by_output_error(added),
+                by_output_error,
                 models,
                 force_rms,
                 evaluations,
                 scored,
                 levels_only: None,
+                // ended past the time limit: its fit may have been cut
+                unfinished: p.budget.expired(),
             })
         })
         .collect()
@@ -233,6 +262,13 @@ fn round(
     additions: &[Vec<Effect>],
     group: &[usize],
 ) -> Result<Outcome, String> {
+    let kind = match additions.first().map(Vec::len) {
+        Some(1) => "single effects",
+        _ => "pairs",
+    };
+    p.budget
+        .progress()
+        .round(s.rounds.len() + 1, kind, additions.len());
     let mut tried = try_additions(p, &s.folds, additions, false)?;
     let rule = Acceptance {
         threshold: p.options.alpha / hypotheses(additions) as f64,
@@ -240,6 +276,9 @@ fn round(
     };
     refit_overlapping_by_output_error(p, s, &mut tried, rule, group)?;
     contenders::refine_contenders(p, s, &mut tried, rule, group)?;
+    if let Some(stopped) = deadline::stopped(p, s, &tried, group)? {
+        return Ok(stopped);
+    }
     let mut round = tried
         .iter()
         .map(|t| candidate_score(p, s, t, group))
@@ -283,7 +322,14 @@ fn round(
             chosen = Some(k);
             break;
         };
-        let check = overlap_check(p, &tried, k, j, group)?;
+        let (check, cut) = p.budget.cut_short(
+            || format!("the overlap check of round {}", s.rounds.len() + 1),
+            || overlap_check(p, &tried, k, j, group),
+        );
+        if cut {
+            return deadline::stop(p, s, &tried, group);
+        }
+        let check = check?;
         if check.p_separated < rule.threshold {
             overlap = Some(check);
             chosen = Some(k);
@@ -484,12 +530,23 @@ fn accept(
         Ok(scored) => scored,
         Err(e) => return Err(format!("accepted {} without a score: {e}", label(&t.added))),
     };
-    let whole = p.fit_whole_any(
-        &p.addition_starts(&t.added)(&s.current),
-        &t.models,
-        &t.added,
-        t.by_output_error,
-    )?;
+    let (whole, _) = p.budget.cut_short(
+        || {
+            format!(
+                "the fit on every sample of the model accepted in round {}",
+                s.rounds.len()
+            )
+        },
+        || {
+            p.fit_whole_any(
+                &p.addition_starts(&t.added)(&s.current),
+                &t.models,
+                &t.added,
+                t.by_output_error,
+            )
+        },
+    );
+    let whole = whole?;
     let mut fitted = Fitted {
         folds: t.models,
         scored,
@@ -584,6 +641,17 @@ fn reexamine(
 ) -> Result<(), String> {
     let mut i = 0;
     while i < earlier {
+        if p.budget.skip_if_expired(|| {
+            format!(
+                "the re-examination of the earlier effects after round {}",
+                s.rounds.len()
+            )
+        }) {
+            break;
+        }
+        p.budget
+            .progress()
+            .stage("re-examining the effects accepted before");
         let effect = s.effects[i].name;
         let before = &s.accepted_as[i].before;
         let reduced: Option<Vec<FrictionModel>> = s
@@ -604,7 +672,19 @@ fn reexamine(
             .enumerate()
             .any(|(j, a)| j != i && a.by_output_error);
         let from_itself = |m: &FrictionModel| vec![m.clone()];
-        let refitted = p.fit_folds_any(&from_itself, &reduced, &rest, oe)?.models;
+        let (refitted, cut) = p.budget.cut_short(
+            || {
+                format!(
+                    "the re-examination of the earlier effects after round {}",
+                    s.rounds.len()
+                )
+            },
+            || p.fit_folds_any(&from_itself, &reduced, &rest, oe),
+        );
+        if cut {
+            break;
+        }
+        let refitted = refitted?.models;
         let Ok(reduced_scored) = p.score(system, &refitted) else {
             i += 1;
             continue;
