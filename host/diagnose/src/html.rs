@@ -158,7 +158,7 @@ pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) 
     );
     let _ = write!(
         s,
-        "<header>\n<h1>Diagnosis of <code>{}</code></h1>\n<p class=\"meta\">Measurements: <code>{}</code> ({} samples). Held out: {} ({} samples compared). Friction force: {}. Co-simulation: {} at {} s. {:.1} s wall time.</p>\n</header>\n",
+        "<header>\n<h1>Diagnosis of <code>{}</code></h1>\n<p class=\"meta\">Measurements: <code>{}</code> ({} samples). Held out: {} ({} samples compared). Friction force: {}. Co-simulation: {} at {} s. {:.1} s wall time, {} co-simulations. Time limit: {}.</p>\n</header>\n",
         escape(&d.system),
         escape(&d.data),
         d.samples,
@@ -167,7 +167,9 @@ pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) 
         escape(&d.force_source),
         escape(&d.master),
         number(d.step),
-        d.wall_seconds
+        d.wall_seconds,
+        d.cosimulations,
+        escape(&super::report::time_limit_words(&d.time_limit))
     );
     verdict(&mut s, d);
     let by_name = |name: &str| figures.iter().find(|f| f.name == name);
@@ -224,7 +226,18 @@ pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) 
 
 fn verdict(s: &mut String, d: &Diagnosis) {
     s.push_str("<section id=\"verdict\">\n<h2>Verdict</h2>\n");
+    if let Some(sentence) = d.time_limit.sentence() {
+        let _ = writeln!(
+            s,
+            "<p class=\"verdict open\" id=\"time-limit\"><strong>Time limit reached.</strong> {}</p>",
+            escape(&sentence)
+        );
+    }
     let (class, text) = match (d.effects.is_empty(), d.unexplained) {
+        (true, _) if d.time_limit.reached => (
+            "open",
+            "No effect was accepted before the time limit was reached.".to_string(),
+        ),
         (true, false) => (
             "clean",
             "No missing effect: the model as given explains these data down to the floor."
@@ -285,6 +298,9 @@ fn verdict(s: &mut String, d: &Diagnosis) {
     );
     let refit = &d.refit;
     let note = match (&refit.failure, refit.kept) {
+        _ if refit.unfinished => {
+            "the time limit was reached before the refit finished: the baseline is the model as given".to_string()
+        }
         (Some(f), _) => {
             format!("its co-simulation failed ({f}): the baseline is the model as given")
         }
@@ -360,6 +376,36 @@ fn candidates(s: &mut String, d: &Diagnosis, min_gain: f64) {
             );
         }
         s.push_str("</table>\n");
+    }
+    if let Some(r) = d.time_limit.round {
+        let _ = writeln!(
+            s,
+            "<h3>Round {r} (in progress when the time limit was reached: not decided)</h3>\n<p>Unfinished, neither accepted nor rejected: {}.</p>",
+            if d.time_limit.unfinished.is_empty() {
+                "none (the round's decision was cut short)".to_string()
+            } else {
+                d.time_limit
+                    .unfinished
+                    .iter()
+                    .map(|c| format!("<code>{}</code>", escape(c)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            }
+        );
+        if !d.time_limit.finished.is_empty() {
+            s.push_str("<table>\n<tr><th>finished candidate</th><th>held-out RMS</th><th>drop of the mean square</th><th>p</th></tr>\n");
+            for c in &d.time_limit.finished {
+                let _ = writeln!(
+                    s,
+                    "<tr><td><code>{}</code></td><td class=\"num\">{}</td><td class=\"num\">{:.1} %</td><td class=\"num\">{:.2e}</td></tr>",
+                    escape(&c.name),
+                    number(c.heldout_rms),
+                    100.0 * c.gain,
+                    c.p_value
+                );
+            }
+            s.push_str("</table>\n");
+        }
     }
     s.push_str("<h3>Data problems</h3>\n");
     let mut files = vec![(&d.data, &d.data_quality.data)];

@@ -84,14 +84,23 @@ pub fn markdown(d: &Diagnosis) -> String {
     let _ = writeln!(s, "- friction force from the data: {}", d.force_source);
     let _ = writeln!(
         s,
-        "- co-simulation: {} at {} s; {:.2} s wall time\n",
-        d.master, d.step, d.wall_seconds
+        "- co-simulation: {} at {} s; {:.2} s wall time, {} co-simulations",
+        d.master, d.step, d.wall_seconds, d.cosimulations
     );
+    let _ = writeln!(s, "- time limit: {}\n", time_limit_words(&d.time_limit));
     let _ = writeln!(s, "## Result\n");
+    if let Some(sentence) = d.time_limit.sentence() {
+        let _ = writeln!(s, "**Time limit reached.** {sentence}\n");
+    }
     for note in &d.notes {
         let _ = writeln!(s, "Note: {}.\n", note.trim_end_matches('.'));
     }
-    if d.effects.is_empty() {
+    if d.effects.is_empty() && d.time_limit.reached {
+        let _ = writeln!(
+            s,
+            "No effect was accepted before the time limit was reached (not every candidate was decided on)."
+        );
+    } else if d.effects.is_empty() {
         let _ = writeln!(
             s,
             "No effect of the library improves the model significantly on the held-out data."
@@ -114,10 +123,15 @@ pub fn markdown(d: &Diagnosis) -> String {
         d.nominal_rms,
         if d.refit.heldout_rms.is_finite() {
             format!("{:.5}", d.refit.heldout_rms)
+        } else if d.refit.unfinished {
+            "not finished".into()
         } else {
             "failed".into()
         },
         match (&d.refit.failure, d.refit.kept) {
+            _ if d.refit.unfinished => {
+                "not kept: the time limit was reached before the refit finished".into()
+            }
             (Some(e), _) => format!("not kept: its co-simulation failed ({})", e.replace('|', "/")),
             (None, true) => format!(
                 "{}; kept as the baseline (p = {:.2e} < {:.2e})",
@@ -143,8 +157,13 @@ pub fn markdown(d: &Diagnosis) -> String {
     if d.unexplained {
         let _ = writeln!(
             s,
-            "\n**Unexplained**: the final error is more than {} times the floor and no candidate of the library reduces it significantly. The remaining residual is largest in: {}.",
+            "\n**Unexplained**: the final error is more than {} times the floor and {}. The remaining residual is largest in: {}.",
             super::UNEXPLAINED_FACTOR,
+            if d.time_limit.reached {
+                "the diagnosis stopped at the time limit before it could try every candidate"
+            } else {
+                "no candidate of the library reduces it significantly"
+            },
             d.residual_pattern.strongest
         );
     } else {
@@ -303,6 +322,40 @@ pub fn markdown(d: &Diagnosis) -> String {
         }
         let _ = writeln!(s);
     }
+    if let Some(r) = d.time_limit.round {
+        let _ = writeln!(
+            s,
+            "Round {r} was in progress when the time limit was reached and is not decided. Unfinished (neither accepted nor rejected): {}.\n",
+            if d.time_limit.unfinished.is_empty() {
+                "none (the round's decision was cut short)".to_string()
+            } else {
+                d.time_limit
+                    .unfinished
+                    .iter()
+                    .map(|c| format!("`{c}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            }
+        );
+        if !d.time_limit.finished.is_empty() {
+            let _ = writeln!(
+                s,
+                "Its candidates that finished, against the current model (not decided on):\n\n| candidate | held-out RMS | drop of the mean square | p | fit runs |\n| --- | --- | --- | --- | --- |"
+            );
+            for c in &d.time_limit.finished {
+                let _ = writeln!(
+                    s,
+                    "| `{}` | {:.5} | {:.1} % | {:.2e} | {} |",
+                    c.name,
+                    c.heldout_rms,
+                    100.0 * c.gain,
+                    c.p_value,
+                    c.fit_evaluations
+                );
+            }
+            let _ = writeln!(s);
+        }
+    }
     let _ = writeln!(
         s,
         "## Where the baseline and the final model disagree with the data\n"
@@ -327,6 +380,16 @@ pub fn markdown(d: &Diagnosis) -> String {
         let _ = writeln!(s, "\n    {command}");
     }
     s
+}
+
+/// `600 s, not reached`, `0.5 s, REACHED (...)`, `none`: the time limit
+/// in a few words.
+pub fn time_limit_words(t: &super::TimeLimit) -> String {
+    match (t.seconds, t.reached) {
+        (None, _) => "none".into(),
+        (Some(x), false) => format!("{x} s, not reached"),
+        (Some(x), true) => format!("{x} s, REACHED: the diagnosis stopped early (see the Result)"),
+    }
 }
 
 /// `What it adds: Fc_neg - Fc = 6.37 N, 95 % interval [6.12, 6.62]:
