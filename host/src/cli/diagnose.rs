@@ -4,7 +4,12 @@
 //! ([`fricsim::diagnose`]).
 
 use fricsim::diagnose::model::Effect;
-use fricsim::diagnose::{diagnose_records, report, CrossValidate, Options};
+use fricsim::diagnose::{
+    diagnose_records, report, CrossValidate, Options, Progress, DEFAULT_TIME_LIMIT,
+};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::time::Duration;
 
 /// `--cross-validate`.
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -76,6 +81,38 @@ pub struct DiagnoseArgs {
     /// the Dahl FMU]
     #[arg(long)]
     pub lugre: Option<PathBuf>,
+    /// Wall time after which the diagnosis starts no new work (inf: no
+    /// limit). A fit or co-simulation running then stops within a few
+    /// co-simulations; the baseline and the effects accepted so far are
+    /// kept, the round in progress is not decided (its unfinished
+    /// candidates are named, neither accepted nor rejected), later steps
+    /// (refinement, re-examination, step error, intervals) are skipped,
+    /// and report.json (time_limit), report.md, report.html and the
+    /// summary say what was left out. A report is still written and the
+    /// exit status is 0.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = DEFAULT_TIME_LIMIT,
+        value_parser = time_limit,
+        allow_hyphen_values = true
+    )]
+    pub time_limit: f64,
+    /// No progress line (it is shown on stderr only when stderr is a
+    /// terminal: the stage or round, the candidates being fitted, the
+    /// co-simulations run, the time elapsed and an estimate of what is
+    /// left of the round).
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// `--time-limit`: a positive number of seconds, or inf.
+fn time_limit(text: &str) -> Result<f64, String> {
+    let seconds: f64 = text.trim().parse().map_err(|_| {
+        format!("`{text}` is not a number of seconds (a positive number, or inf for no limit)")
+    })?;
+    fricsim::diagnose::budget::check_time_limit(seconds)?;
+    Ok(seconds)
 }
 
 /// The subcommand's description, naming every effect of the library
@@ -106,6 +143,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         blocks: a.blocks,
         polish: !a.no_polish,
         master: a.master.clone(),
+        time_limit: fricsim::diagnose::budget::check_time_limit(a.time_limit)?,
         cross_validate: match a.cross_validate {
             CrossValidateArg::Auto => CrossValidate::Auto,
             CrossValidateArg::Always => CrossValidate::Always,
@@ -141,15 +179,22 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     }
     let mut file = SystemFile::open(&a.system).map_err(|e| e.to_string())?;
     let moved = fricsim::diagnose::dahl::move_to_lugre(&mut file, a.lugre.as_deref())?;
-    let mut d = diagnose_records(&file, &a.data, &a.heldout, &options)?;
+    // the progress line, drawn while the diagnosis and the report's
+    // writing run, and cleared before the summary is printed
+    let progress = Progress::new();
+    options.progress = Some(progress.clone());
+    let d = with_progress_line(a.quiet, &progress, || {
+        let mut d = diagnose_records(&file, &a.data, &a.heldout, &options)?;
+        if let Some(note) = moved {
+            d.notes.push(note);
+        }
+        progress.stage("writing the report");
+        report::write(&d, &file, &d.friction_component, &out)?;
+        Ok(d)
+    })?;
     for note in &d.notes {
         println!("note: {note}");
     }
-    if let Some(note) = moved {
-        println!("note: {note}");
-        d.notes.push(note);
-    }
-    report::write(&d, &file, &d.friction_component, &out)?;
     let names: Vec<&str> = d.effects.iter().map(|e| e.name.name()).collect();
     println!(
         "{}: {}",
@@ -174,10 +219,17 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
         );
     }
     println!(
-        "held-out RMS: given {:.5}, levels refitted {:.5} ({}), final {:.5}; floor {:.5} (noise {:.5}, step error {:.5}){}",
+        "held-out RMS: given {:.5}, levels refitted {}, final {:.5}; floor {:.5} (noise {:.5}, step error {:.5}){}",
         d.nominal_rms,
-        d.refit.heldout_rms,
-        if d.refit.kept { "kept" } else { "not kept" },
+        if d.refit.unfinished {
+            "not finished (time limit)".to_string()
+        } else {
+            format!(
+                "{:.5} ({})",
+                d.refit.heldout_rms,
+                if d.refit.kept { "kept" } else { "not kept" }
+            )
+        },
         d.final_rms,
         d.floor_rms,
         d.noise_floor_rms,
@@ -213,6 +265,9 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             d.polish_cosimulations, d.polish_seconds
         );
     }
+    if let Some(sentence) = d.time_limit.sentence() {
+        println!("TIME LIMIT REACHED: {sentence}");
+    }
     println!(
         "{:.2} s; wrote {}/report.html (open it in a browser), report.md, report.json, gap.png, fit.png, law.png, residual.png, refitted.ssp, {}",
         d.wall_seconds,
@@ -224,4 +279,39 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             .join(", ")
     );
     Ok(())
+}
+
+/// Run `work` with `progress` shown as one line on stderr, redrawn in
+/// place a few times a second and cleared at the end; not drawn with
+/// `quiet` or when stderr is not a terminal.
+fn with_progress_line<T>(
+    quiet: bool,
+    progress: &Progress,
+    work: impl FnOnce() -> Result<T, String>,
+) -> Result<T, String> {
+    if quiet || !std::io::stderr().is_terminal() {
+        return work();
+    }
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} diagnose: {wide_msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    let (stop, stopped) = std::sync::mpsc::channel::<()>();
+    let drawn = &bar;
+    let out = std::thread::scope(|scope| {
+        scope.spawn(move || loop {
+            drawn.set_message(progress.snapshot().line());
+            drawn.tick();
+            match stopped.recv_timeout(Duration::from_millis(200)) {
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => continue,
+                _ => break,
+            }
+        });
+        let out = work();
+        drop(stop);
+        out
+    });
+    bar.finish_and_clear();
+    out
 }

@@ -30,6 +30,7 @@ mod diagnose_any_plant;
 mod diagnose_hidden_effects;
 mod diagnose_records;
 mod diagnose_reexamine;
+mod diagnose_time_limit;
 mod docs;
 mod emps;
 mod fmu_logging;
