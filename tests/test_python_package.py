@@ -4,6 +4,7 @@ command bit for bit, the host's messages in its exceptions, DataFrames
 where the command takes CSV files, and Ctrl-C that stops a run cleanly."""
 
 import csv
+import math
 import re
 import os
 import signal
@@ -25,6 +26,8 @@ PLANAR = ROOT / "examples" / "planar_stick_slip.ssd"
 EMPS = ROOT / "examples" / "emps_nominal.ssd"
 EMPS_TRAIN = ROOT / "examples" / "data" / "emps_train.csv"
 EMPS_TEST = ROOT / "examples" / "data" / "emps_test_pulses.csv"
+SLIDER = ROOT / "examples" / "slider_breakaway.ssd"
+SLIDER_DATA = ROOT / "examples" / "data" / "slider_breakaway.csv"
 
 
 def cli(*args, cwd=ROOT):
@@ -277,6 +280,35 @@ def test_several_records_to_diagnose_as_paths_or_dataframes(tmp_path):
     assert (tmp_path / "a" / "inputs-1.csv").exists() and (tmp_path / "a" / "inputs-2.csv").exists()
     with pytest.raises(ValueError, match="no measurements"):
         fricsim.diagnose(EMPS, [], out=tmp_path / "c")
+
+
+def test_diagnose_stops_at_its_time_limit_and_says_so(tmp_path):
+    """time_limit: the slider table's diagnosis (several seconds in full)
+    stopped after half a second still writes its report, whose
+    time_limit says what was left out; diagnose_many passes the limit on;
+    a generous limit (the default, 600 s) is not reached; a limit that is
+    not a positive number is refused naming it."""
+    d = fricsim.diagnose(SLIDER, SLIDER_DATA, out=tmp_path / "a", time_limit=0.5, quiet=True)
+    t = d.time_limit
+    assert t["reached"] is True and t["seconds"] == 0.5, t
+    assert t["unfinished"] or t["skipped"], t
+    assert not set(t["unfinished"]) & set(d.effect_names), t
+    assert "Time limit reached" in d.report_md.read_text()
+    assert d.report_html.exists() and d.refitted_system.exists()
+    many = fricsim.diagnose_many([(SLIDER, SLIDER_DATA)], time_limit=0.5, quiet=True)
+    assert many["error"][0] is None, many["error"][0]
+    assert bool(many["time_limit_reached"][0])
+    assert many["report"][0]["time_limit"]["seconds"] == 0.5
+    whole = fricsim.diagnose(
+        SLIDER, SLIDER_DATA, out=tmp_path / "b", candidates=["viscous"], polish=False
+    )
+    assert whole.time_limit["seconds"] == 600
+    assert whole.time_limit["reached"] is False
+    assert not whole.time_limit["skipped"] and not whole.time_limit["unfinished"]
+    for bad, shown in [(0, "0"), (-1.5, "-1.5"), (float("nan"), "NaN"), (-math.inf, "-inf")]:
+        with pytest.raises(fricsim.FricsimError, match=f"time limit {re.escape(shown)}: must be a positive"):
+            fricsim.diagnose(SLIDER, SLIDER_DATA, out=tmp_path / "c", time_limit=bad)
+    assert not (tmp_path / "c").exists()
 
 
 CHILD = textwrap.dedent(

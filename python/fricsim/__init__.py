@@ -269,7 +269,11 @@ def diagnose(
     with underscores: ``candidates`` (list of effect names),
     ``position_knots``, ``alpha``, ``smooth``, ``blocks``,
     ``cross_validate`` ("auto", "always", "never", "records"), ``polish``,
-    ``master``, ``lugre``."""
+    ``master``, ``lugre``, ``time_limit`` (seconds of wall time, default
+    600, ``math.inf`` for none: past it the diagnosis starts no new work
+    and reports what it has, ``report["time_limit"]`` saying what was left
+    out) and ``quiet`` (no progress line on stderr, which is drawn only
+    when stderr is a terminal)."""
     system = Path(system)
     if out is None:
         out = Path("out") / f"{system.stem}-diagnosis"
@@ -283,6 +287,8 @@ def diagnose(
         "polish",
         "master",
         "lugre",
+        "time_limit",
+        "quiet",
     }
     unknown = sorted(set(options) - known)
     if unknown:

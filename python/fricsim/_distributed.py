@@ -248,6 +248,7 @@ def _diagnose_task(payload, data, heldout, options: dict) -> dict:
             "floor_rms": d.floor_rms,
             "unexplained": d.unexplained,
             "wall_seconds": d.wall_seconds,
+            "time_limit_reached": d.time_limit["reached"],
             "report": report,
             "refitted_ssp": refitted,
             "error": None,
@@ -304,11 +305,14 @@ def diagnose_many(
 ):
     """``fricsim diagnose`` on many datasets: ``pairs`` holds
     ``(system, data)`` or ``(system, data, heldout)``, each dataset a CSV
-    path or a DataFrame, or a list of them (several records); ``options`` as :func:`fricsim.diagnose`. With a
+    path or a DataFrame, or a list of them (several records); ``options`` as :func:`fricsim.diagnose`
+    (``time_limit`` bounds each diagnosis). With a
     Dask ``client`` each diagnosis is a task on the cluster, else they run
     here one after the other. Returns a DataFrame, one row per pair: the
     system and data, the effects found, the held-out RMS before and after
     and its floor, whether a residual stays unexplained, the wall time,
+    whether the diagnosis reached its ``time_limit`` (then its report's
+    ``time_limit`` says what it left out),
     the whole report (a dict), the refitted system (bytes of an ``.ssp``)
     and ``error``."""
     import pandas as pd

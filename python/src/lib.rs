@@ -15,7 +15,9 @@
 //! KeyboardInterrupt is raised.
 
 use fricsim_diagnose::model::Effect;
-use fricsim_diagnose::{diagnose_records as run_diagnosis, report, CrossValidate, Options};
+use fricsim_diagnose::{
+    diagnose_records as run_diagnosis, report, CrossValidate, Options, Progress,
+};
 use fricsim_fmi::archive::{unpack, UnpackOptions};
 use fricsim_fmi::library::platforms;
 use fricsim_fmi::ModelDescription;
@@ -297,9 +299,11 @@ fn sweep(
 
 /// `fricsim.diagnose`: `fricsim diagnose` on a system and measurement
 /// files (one record or several), the outputs written into `out`; the
-/// report (`report.json`'s content) as JSON.
+/// report (`report.json`'s content) as JSON. `time_limit`: seconds
+/// (default [`fricsim_diagnose::DEFAULT_TIME_LIMIT`], infinity: none);
+/// the progress line on stderr when it is a terminal, unless `quiet`.
 #[pyfunction]
-#[pyo3(signature = (system, data, out, heldout=Vec::new(), candidates=Vec::new(), position_knots=None, alpha=None, smooth=None, blocks=None, cross_validate=None, polish=true, master=None, lugre=None))]
+#[pyo3(signature = (system, data, out, heldout=Vec::new(), candidates=Vec::new(), position_knots=None, alpha=None, smooth=None, blocks=None, cross_validate=None, polish=true, master=None, lugre=None, time_limit=None, quiet=false))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,
@@ -316,9 +320,12 @@ fn diagnose(
     polish: bool,
     master: Option<String>,
     lugre: Option<PathBuf>,
+    time_limit: Option<f64>,
+    quiet: bool,
 ) -> PyResult<String> {
     py.allow_threads(move || -> Result<String, String> {
         let defaults = Options::default();
+        let progress = Progress::new();
         let mut options = Options {
             position_knots: position_knots.unwrap_or(defaults.position_knots),
             alpha: alpha.unwrap_or(defaults.alpha),
@@ -326,6 +333,11 @@ fn diagnose(
             blocks: blocks.unwrap_or(defaults.blocks),
             polish,
             master,
+            time_limit: match time_limit {
+                None => defaults.time_limit,
+                Some(s) => fricsim_diagnose::budget::check_time_limit(s)?,
+            },
+            progress: Some(progress.clone()),
             cross_validate: match cross_validate.as_deref() {
                 None | Some("auto") => CrossValidate::Auto,
                 Some("always") => CrossValidate::Always,
@@ -348,14 +360,56 @@ fn diagnose(
         }
         let mut file = SystemFile::open(&system).map_err(|e| e.to_string())?;
         let moved = fricsim_diagnose::dahl::move_to_lugre(&mut file, lugre.as_deref())?;
-        let mut d = run_diagnosis(&file, &data, &heldout, &options)?;
-        if let Some(note) = moved {
-            d.notes.push(note);
-        }
-        report::write(&d, &file, &d.friction_component, &out)?;
+        let d = with_progress_line(quiet, &progress, || {
+            let mut d = run_diagnosis(&file, &data, &heldout, &options)?;
+            if let Some(note) = moved {
+                d.notes.push(note);
+            }
+            progress.stage("writing the report");
+            report::write(&d, &file, &d.friction_component, &out)?;
+            Ok(d)
+        })?;
         serde_json::to_string(&d).map_err(|e| e.to_string())
     })
     .map_err(host_error)
+}
+
+/// Run `work` with `progress` as one line on the process's stderr,
+/// redrawn in place and cleared at the end, as `fricsim diagnose` shows
+/// it; not drawn with `quiet` or when stderr is not a terminal (a
+/// notebook, a pipe, pytest's capture).
+fn with_progress_line<T>(
+    quiet: bool,
+    progress: &Progress,
+    work: impl FnOnce() -> Result<T, String>,
+) -> Result<T, String> {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    use std::io::IsTerminal;
+    if quiet || !std::io::stderr().is_terminal() {
+        return work();
+    }
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} fricsim.diagnose: {wide_msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    let (stop, stopped) = std::sync::mpsc::channel::<()>();
+    let drawn = &bar;
+    let out = std::thread::scope(|scope| {
+        scope.spawn(move || loop {
+            drawn.set_message(progress.snapshot().line());
+            drawn.tick();
+            match stopped.recv_timeout(Duration::from_millis(200)) {
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => continue,
+                _ => break,
+            }
+        });
+        let out = work();
+        drop(stop);
+        out
+    });
+    bar.finish_and_clear();
+    out
 }
 
 /// The seed variables of a system (`component.seed` of every component
