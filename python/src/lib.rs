@@ -15,6 +15,7 @@
 //! KeyboardInterrupt is raised.
 
 use fricsim_diagnose::model::Effect;
+use fricsim_diagnose::progress_line::with_progress_line;
 use fricsim_diagnose::{
     diagnose_records as run_diagnosis, report, CrossValidate, Options, Progress,
 };
@@ -360,7 +361,7 @@ fn diagnose(
         }
         let mut file = SystemFile::open(&system).map_err(|e| e.to_string())?;
         let moved = fricsim_diagnose::dahl::move_to_lugre(&mut file, lugre.as_deref())?;
-        let d = with_progress_line(quiet, &progress, || {
+        let d = with_progress_line("fricsim.diagnose", quiet, &progress, || {
             let mut d = run_diagnosis(&file, &data, &heldout, &options)?;
             if let Some(note) = moved {
                 d.notes.push(note);
@@ -372,44 +373,6 @@ fn diagnose(
         serde_json::to_string(&d).map_err(|e| e.to_string())
     })
     .map_err(host_error)
-}
-
-/// Run `work` with `progress` as one line on the process's stderr,
-/// redrawn in place and cleared at the end, as `fricsim diagnose` shows
-/// it; not drawn with `quiet` or when stderr is not a terminal (a
-/// notebook, a pipe, pytest's capture).
-fn with_progress_line<T>(
-    quiet: bool,
-    progress: &Progress,
-    work: impl FnOnce() -> Result<T, String>,
-) -> Result<T, String> {
-    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-    use std::io::IsTerminal;
-    if quiet || !std::io::stderr().is_terminal() {
-        return work();
-    }
-    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} fricsim.diagnose: {wide_msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-    );
-    let (stop, stopped) = std::sync::mpsc::channel::<()>();
-    let drawn = &bar;
-    let out = std::thread::scope(|scope| {
-        scope.spawn(move || loop {
-            drawn.set_message(progress.snapshot().line());
-            drawn.tick();
-            match stopped.recv_timeout(Duration::from_millis(200)) {
-                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => continue,
-                _ => break,
-            }
-        });
-        let out = work();
-        drop(stop);
-        out
-    });
-    bar.finish_and_clear();
-    out
 }
 
 /// The seed variables of a system (`component.seed` of every component

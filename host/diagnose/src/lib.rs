@@ -48,6 +48,8 @@ pub mod intervals;
 pub mod localise;
 pub mod model;
 pub mod problem;
+#[cfg(feature = "progress-line")]
+pub mod progress_line;
 pub mod quality;
 pub mod report;
 pub mod sim;

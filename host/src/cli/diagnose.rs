@@ -4,12 +4,10 @@
 //! ([`fricsim::diagnose`]).
 
 use fricsim::diagnose::model::Effect;
+use fricsim::diagnose::progress_line::with_progress_line;
 use fricsim::diagnose::{
     diagnose_records, report, CrossValidate, Options, Progress, DEFAULT_TIME_LIMIT,
 };
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
-use std::time::Duration;
 
 /// `--cross-validate`.
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -183,7 +181,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     // writing run, and cleared before the summary is printed
     let progress = Progress::new();
     options.progress = Some(progress.clone());
-    let d = with_progress_line(a.quiet, &progress, || {
+    let d = with_progress_line("diagnose", a.quiet, &progress, || {
         let mut d = diagnose_records(&file, &a.data, &a.heldout, &options)?;
         if let Some(note) = moved {
             d.notes.push(note);
@@ -279,39 +277,4 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
             .join(", ")
     );
     Ok(())
-}
-
-/// Run `work` with `progress` shown as one line on stderr, redrawn in
-/// place a few times a second and cleared at the end; not drawn with
-/// `quiet` or when stderr is not a terminal.
-fn with_progress_line<T>(
-    quiet: bool,
-    progress: &Progress,
-    work: impl FnOnce() -> Result<T, String>,
-) -> Result<T, String> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return work();
-    }
-    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} diagnose: {wide_msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-    );
-    let (stop, stopped) = std::sync::mpsc::channel::<()>();
-    let drawn = &bar;
-    let out = std::thread::scope(|scope| {
-        scope.spawn(move || loop {
-            drawn.set_message(progress.snapshot().line());
-            drawn.tick();
-            match stopped.recv_timeout(Duration::from_millis(200)) {
-                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => continue,
-                _ => break,
-            }
-        });
-        let out = work();
-        drop(stop);
-        out
-    });
-    bar.finish_and_clear();
-    out
 }

@@ -275,7 +275,7 @@ fn round(
         min_gain: p.options.min_gain,
     };
     refit_overlapping_by_output_error(p, s, &mut tried, rule, group)?;
-    contenders::refine_contenders(p, s, &mut tried, rule, group)?;
+    let mut current_fine = contenders::refine_contenders(p, system, s, &mut tried, rule, group)?;
     if let Some(stopped) = deadline::stopped(p, s, &tried, group)? {
         return Ok(stopped);
     }
@@ -284,7 +284,6 @@ fn round(
         .map(|t| candidate_score(p, s, t, group))
         .collect::<Result<Vec<_>, String>>()?;
     let passing = rank_passing(&tried, &round, rule, s.step_error, group)?;
-    let mut current_fine: Option<Result<Scored, String>> = None;
     // whether candidate k's gain survives a finer co-simulation step
     let mut survives = |k: usize, round: &mut Vec<CandidateScore>| -> Result<bool, String> {
         let fine_current = current_fine.get_or_insert_with(|| p.score_fine(system, &s.folds));
