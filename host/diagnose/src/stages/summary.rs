@@ -255,7 +255,7 @@ fn channel_rms(s: &Scored, c: usize) -> f64 {
 /// differences of each measured channel (white noise of σ gives
 /// differences of σ·√6; the median absolute value / 0.6745 is robust to
 /// the signal's own curvature and to outliers).
-fn noise_floor(data: &Measured, scored: &Scored, scales: &[f64]) -> f64 {
+pub(crate) fn noise_floor(data: &Measured, scored: &Scored, scales: &[f64]) -> f64 {
     let mut q = 0.0;
     for (c, (_, values)) in data.outputs.iter().enumerate() {
         let idx: Vec<usize> = scored

@@ -26,9 +26,12 @@ use crate::stages::fitting::FoldFits;
 use crate::stages::problem::Problem;
 use crate::stages::refine::{refine, Fitted, Polishing};
 use crate::stages::run_force;
+use crate::stages::scoring::step_error_floor;
+use crate::stages::summary::noise_floor;
 use crate::system::System;
 use crate::{
     fmu_values, localise, Alternative, CandidateScore, FoundEffect, OverlapCheck, Withdrawn,
+    UNEXPLAINED_FACTOR,
 };
 use explanations::{family_alternatives, hypotheses, overlap_check, prefer_in_family};
 use rayon::prelude::*;
@@ -43,6 +46,10 @@ pub(crate) struct Search {
     pub(crate) folds: Vec<FrictionModel>,
     pub(crate) scored: Scored,
     pub(crate) step_error: f64,
+    /// The current fold models scored at the finer step, when known: the
+    /// step-error estimate's, reused by the next round's checks of the
+    /// step (emptied whenever the current models change).
+    fine: Option<Result<Scored, String>>,
     pub(crate) effects: Vec<FoundEffect>,
     /// Per effect of `effects`: how it was accepted.
     accepted_as: Vec<AcceptedAs>,
@@ -116,6 +123,7 @@ pub(crate) fn search(
         folds: baseline.folds.clone(),
         scored: baseline.scored.clone(),
         step_error: baseline.step_error,
+        fine: None,
         effects: Vec::new(),
         accepted_as: Vec::new(),
         withdrawn: Vec::new(),
@@ -139,6 +147,13 @@ pub(crate) fn search(
                 s.scored.rms(),
                 s.step_error
             ));
+            break;
+        }
+        // on the output-error path a further effect is sought only while
+        // the residual is unexplained (above UNEXPLAINED_FACTOR times the
+        // floor of noise and step error, as the report judges it)
+        if let Some(note) = explained_on_output_error(p, &s) {
+            s.notes.push(note);
             break;
         }
         // single effects first; when none is accepted, the pairs that
@@ -188,10 +203,45 @@ pub(crate) fn search(
                 s.rounds.len()
             )
         }) {
-            s.step_error = p.step_error(system, &s.folds, &s.scored);
+            let fine = p.score_fine(system, &s.folds);
+            s.step_error = fine
+                .as_ref()
+                .map_or(0.0, |fine| step_error_floor(&s.scored, fine, &p.scales));
+            s.fine = Some(fine);
         }
     }
     Ok(s)
+}
+
+/// On the output-error path (a plant whose friction force the data do
+/// not give), after an effect was accepted: why no further round is run
+/// when the current held-out RMS is within [`UNEXPLAINED_FACTOR`] times
+/// the floor √(noise² + step error²), the bound below which the report
+/// calls nothing unexplained; `None` otherwise.
+///
+/// Without it, on the servo axis with a hidden viscous term (seed 2, 10 %
+/// and 5 %) and a hidden 5 % Stribeck curve (seed 1), once the right
+/// effect was in (held-out RMS 1.1–1.2× the floor) a position table
+/// with levels of its own for each direction (twelve parameters) gained
+/// 13–39 % more of the held-out mean square at p = 2e-4 to 7e-4, also at
+/// the finer step, and was named: a structure of the remaining residual
+/// along the travel that no hidden effect made. The cost: a second
+/// effect on such a plant whose own residual is below twice the floor is
+/// not sought (the Rig1D path, with the force the data imply, does seek
+/// it).
+fn explained_on_output_error(p: &Problem, s: &Search) -> Option<String> {
+    if p.force.output_error_only.is_none() || s.effects.is_empty() {
+        return None;
+    }
+    let noise = noise_floor(p.scored_data(), &s.scored, &p.scales);
+    let floor = (noise * noise + s.step_error * s.step_error).sqrt();
+    let rms = s.scored.rms();
+    (rms <= UNEXPLAINED_FACTOR * floor).then(|| {
+        format!(
+            "No round {} was run: the held-out RMS ({rms:.3e}) is within {UNEXPLAINED_FACTOR} times the floor of noise and step error ({floor:.3e}), and on this plant every fit is by output error: nothing is left unexplained to look for.",
+            s.rounds.len() + 1
+        )
+    })
 }
 
 /// The candidate effects of the next round: the options' candidates the
@@ -275,7 +325,8 @@ fn round(
         min_gain: p.options.min_gain,
     };
     refit_overlapping_by_output_error(p, s, &mut tried, rule, group)?;
-    let mut current_fine = contenders::refine_contenders(p, system, s, &mut tried, rule, group)?;
+    let mut current_fine = s.fine.take();
+    contenders::refine_contenders(p, system, s, &mut current_fine, &mut tried, rule, group)?;
     if let Some(stopped) = deadline::stopped(p, s, &tried, group)? {
         return Ok(stopped);
     }
@@ -358,6 +409,9 @@ fn round(
         undecided = true;
         break;
     }
+    // the current models are unchanged by the round: their finer score
+    // serves the next (the pairs after the singles)
+    s.fine = current_fine;
     s.rounds.push(round.clone());
     s.round_thresholds.push(rule.threshold);
     if let Some(k) = chosen {
@@ -618,6 +672,7 @@ fn accept(
         });
         s.current = step.whole;
         s.folds = step.folds;
+        s.fine = None;
         s.scored = step.scored;
     }
     Ok(())
@@ -737,6 +792,7 @@ fn reexamine(
         earlier -= 1;
         s.current = without.whole;
         s.folds = without.folds;
+        s.fine = None;
         s.scored = without.scored;
     }
     Ok(())
