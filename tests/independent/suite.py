@@ -294,12 +294,12 @@ def grid(seeds: int, quick: bool, coarse: bool = True) -> list[tuple[cases.Case,
     return out
 
 
-def any_plant_grid(seeds: int, quick: bool) -> list[tuple[cases.Case, bool]]:
+def any_plant_grid(seeds: int, quick: bool, first_seed: int = 1) -> list[tuple[cases.Case, bool]]:
     """The any-plant cases (issue 43): each kind of cases.PLANT_KINDS at
-    its magnitudes, seeds 1..`seeds`."""
+    its magnitudes, `seeds` seeds from `first_seed` on."""
     return [
         (cases.draw(kind, mag, seed), False)
-        for seed in range(1, seeds + 1)
+        for seed in range(first_seed, first_seed + seeds)
         for kind in cases.PLANT_KINDS
         for mag in magnitudes(kind, quick)
     ]
@@ -462,11 +462,18 @@ def main() -> int:
         help="diagnose every case with this older build too, in turn with this one on the same data, and "
         "write a before/after table (with --update: between the \"any-plant\" markers when --any-plant)",
     )
+    ap.add_argument(
+        "--first-seed",
+        type=int,
+        default=1,
+        help="with --any-plant: the first seed (seeds FIRST.. FIRST+SEEDS-1), e.g. seeds not looked at while "
+        "the diagnosis was changed",
+    )
     args = ap.parse_args()
     global FRICSIM
     if args.fricsim:
         FRICSIM = args.fricsim.resolve()
-    todo = (any_plant_grid(args.seeds, args.quick) if args.any_plant
+    todo = (any_plant_grid(args.seeds, args.quick, args.first_seed) if args.any_plant
             else grid(args.seeds, args.quick, coarse=not args.no_coarse))
     if args.only:
         keep = args.only.split(",")
@@ -520,6 +527,7 @@ def main() -> int:
             pass
         seconds = sum(r.get("diagnose_seconds", 0) for r in rows)
         flags = (f"{' --quick' if args.quick else ''}{' --any-plant' if args.any_plant else ''}"
+                 f"{f' --first-seed {args.first_seed}' if args.first_seed != 1 else ''}"
                  f"{' --versus OLD' if args.versus else ''}"
                  f"{f' --case-timeout {args.case_timeout:g}' if args.case_timeout else ''}")
         head = (
