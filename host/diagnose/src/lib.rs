@@ -705,6 +705,10 @@ pub fn diagnose_records(
         heldout_records.as_ref(),
         options.smooth,
     )?;
+    // every fit by output error: its many co-simulations reuse each
+    // step's Newton Jacobian for the next (StrongCoupling::reuse_jacobian)
+    let mut setup = setup;
+    setup.reuse_jacobian = force.output_error_only.is_some();
     // 3. which samples fit and which score
     let split = Split::new(&data, &force.data, force.heldout.as_ref(), options)?;
     let problem = Problem::new(

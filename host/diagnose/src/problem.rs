@@ -468,6 +468,12 @@ pub struct Setup {
     /// Macro step of the co-simulation.
     pub step: f64,
     pub master: String,
+    /// Whether the co-simulations reuse each step's Newton Jacobian for
+    /// the next ([`crate::master::strong::StrongCoupling::reuse_jacobian`]):
+    /// on the output-error path, whose fits run hundreds of them; the
+    /// Rig1D path's (fewer) take a new one at every step, as `fricsim run`
+    /// does.
+    pub reuse_jacobian: bool,
 }
 
 /// Rig1D parameters used by the inverse dynamics.
@@ -564,6 +570,7 @@ impl Setup {
             None => None,
         };
         Ok(Setup {
+            reuse_jacobian: false,
             friction,
             friction_name: name,
             friction_fmu: fmu,

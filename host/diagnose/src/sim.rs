@@ -14,7 +14,7 @@ use super::problem::{FrictionData, Measured, Setup};
 use crate::fmu::model_description::VariableKind;
 use crate::fmu::{Fmu, Instance, Rollback, ValueReference};
 use crate::inputs::ExternalInputs;
-use crate::master::{by_name_reusing_jacobians, simulate_with};
+use crate::master::{by_name, by_name_reusing_jacobians, simulate_with};
 use crate::ssp::SystemFile;
 use crate::system::{ParameterValue, System};
 
@@ -198,7 +198,15 @@ pub fn co_simulate(
     setup: &Setup,
     data: &Measured,
 ) -> Result<ChannelResiduals, String> {
-    co_simulate_with(system, parameters, data, None, &setup.master, setup.step)
+    co_simulate_with(
+        system,
+        parameters,
+        data,
+        None,
+        &setup.master,
+        setup.step,
+        setup.reuse_jacobian,
+    )
 }
 
 /// A co-simulation that did not complete is tried again, in this order:
@@ -217,12 +225,19 @@ pub fn co_simulate_robust(
 ) -> Result<(ChannelResiduals, Option<String>), String> {
     let mut failures = Vec::new();
     for (master, step) in &fallback_tries(setup) {
-        let outcome = co_simulate_with(system, parameters, data, records, master, *step).and_then(
-            |r| match &r.incomplete {
-                Some(e) => Err(format!("stopped early: {e}")),
-                None => Ok(r),
-            },
-        );
+        let outcome = co_simulate_with(
+            system,
+            parameters,
+            data,
+            records,
+            master,
+            *step,
+            setup.reuse_jacobian,
+        )
+        .and_then(|r| match &r.incomplete {
+            Some(e) => Err(format!("stopped early: {e}")),
+            None => Ok(r),
+        });
         match outcome {
             Ok(r) => {
                 let note = (!failures.is_empty()).then(|| {
@@ -250,6 +265,7 @@ pub fn run_on(
     data: &Measured,
     master: &str,
     step: f64,
+    reuse_jacobian: bool,
 ) -> Result<crate::master::Run, String> {
     let start = data.time[0];
     let stop = *data.time.last().unwrap_or(&start);
@@ -259,7 +275,11 @@ pub fn run_on(
     let mut inputs = ExternalInputs::bind(data.input_table(), system)?.with_slopes(step);
     // (LuGre's step has one solution: a Jacobian reused from the step
     // before lands on the same interface values, within the tolerance)
-    let mut master = by_name_reusing_jacobians(master)?;
+    let mut master = if reuse_jacobian {
+        by_name_reusing_jacobians(master)?
+    } else {
+        by_name(master)?
+    };
     simulate_with(system, master.as_mut(), start, step, stop, &mut inputs)
         .map_err(|e| format!("co-simulation: {e}"))
 }
@@ -297,15 +317,23 @@ pub fn co_simulate_with(
     records: Option<&[usize]>,
     master: &str,
     step: f64,
+    reuse_jacobian: bool,
 ) -> Result<ChannelResiduals, String> {
     if data.records.len() == 1 {
-        return co_simulate_record(system, parameters, data, master, step);
+        return co_simulate_record(system, parameters, data, master, step, reuse_jacobian);
     }
     let all: Vec<usize> = (0..data.records.len()).collect();
     let mut joined: Option<ChannelResiduals> = None;
     for &i in records.unwrap_or(&all) {
         let record = &data.records[i];
-        let r = co_simulate_record(system, parameters, &data.record(i), master, step)?;
+        let r = co_simulate_record(
+            system,
+            parameters,
+            &data.record(i),
+            master,
+            step,
+            reuse_jacobian,
+        )?;
         let j = joined.get_or_insert_with(|| ChannelResiduals::empty(&r.channels));
         j.samples
             .extend(r.samples.iter().map(|k| k + record.rows.start));
@@ -328,8 +356,9 @@ fn co_simulate_record(
     data: &Measured,
     master: &str,
     step: f64,
+    reuse_jacobian: bool,
 ) -> Result<ChannelResiduals, String> {
-    let run = run_on(system, parameters, data, master, step)?;
+    let run = run_on(system, parameters, data, master, step, reuse_jacobian)?;
     let mut samples = Vec::new();
     for (k, &t) in data.time.iter().enumerate() {
         let repeated = (k > 0 && data.time[k - 1] == t) || data.quality.excluded[k];
@@ -406,7 +435,7 @@ fn record_friction_data_simulated(
     let mut failures = Vec::new();
     let mut completed = None;
     for (master, step) in fallback_tries(setup) {
-        match run_on(system, &params, data, &master, step) {
+        match run_on(system, &params, data, &master, step, setup.reuse_jacobian) {
             Ok(run) if run.error.is_none() => {
                 completed = Some(run);
                 break;

@@ -42,7 +42,7 @@ fn joined_records_co_simulate_each_from_its_own_start() {
     let setup = Setup::new(&file, &mut system, 1e-3, "jacobi").unwrap();
     let params = system_parameters(&file, &setup, &setup.nominal);
     let run = |system: &mut _, data: &Measured, records: Option<&[usize]>| {
-        co_simulate_with(system, &params, data, records, "jacobi", 1e-3).unwrap()
+        co_simulate_with(system, &params, data, records, "jacobi", 1e-3, false).unwrap()
     };
     let (ra, rb) = (run(&mut system, &a, None), run(&mut system, &b, None));
     let both = run(&mut system, &joined, None);

@@ -378,8 +378,8 @@ pub struct StrongCoupling {
     /// reconnecting when released) the other path of the iteration can
     /// end on another branch within the tolerance (a relaxation of
     /// 1.04e-8 m where the new-Jacobian run gives 1.10e-8 m and the paper's
-    /// mean 1.12e-8 m); `fricsim diagnose` turns it on for its
-    /// co-simulations of LuGre, whose step has one solution.
+    /// mean 1.12e-8 m); `fricsim diagnose` turns it on for the
+    /// co-simulations of its output-error fits of LuGre.
     pub reuse_jacobian: bool,
     /// The step size the Jacobian in `jac` was taken at, when it may be
     /// reused.

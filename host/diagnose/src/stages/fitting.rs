@@ -72,6 +72,7 @@ impl Problem<'_> {
                 records,
                 &self.setup.master,
                 h,
+                self.setup.reuse_jacobian,
             )
             .ok()?,
         };

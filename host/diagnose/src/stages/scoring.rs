@@ -48,6 +48,7 @@ impl Problem<'_> {
                         records,
                         &self.setup.master,
                         h,
+                        self.setup.reuse_jacobian,
                     )?;
                     if let Some(e) = &r.incomplete {
                         return Err(e.clone());
