@@ -1078,6 +1078,13 @@ impl Instance {
         if self.model_exchange {
             return self.me_directional_derivative(unknowns, (knowns, dv_known), dv_unknown);
         }
+        let is_parameter = |vr: &u32| {
+            self.variable(*vr)
+                .is_ok_and(|v| v.causality == Causality::Parameter)
+        };
+        if knowns.iter().any(is_parameter) {
+            return self.parameter_directional(unknowns, knowns, dv_known, dv_unknown);
+        }
         // the usual case through the flag bytes, else the messages below
         let has = |vr: u32, bits: u8| {
             self.flags
@@ -1092,18 +1099,54 @@ impl Instance {
                 .zip(dv_known)
                 .all(|(&vr, dv)| has(vr, flag::REAL | flag::INPUT) && dv.is_finite());
         if !fine {
-            self.check_directional(unknowns, knowns, dv_known)?;
+            self.check_directional(unknowns, knowns, dv_known, Causality::Input)?;
         }
         self.directional_checked(unknowns, knowns, dv_known, dv_unknown)
     }
 
+    /// [`Instance::directional_derivative`] with Real parameters as the
+    /// knowns: `dv_unknown = Σ ∂output/∂parameter · seed`, the parameter
+    /// sensitivities the model carries along its trajectory
+    /// ([`crate::Model::parameter_sensitivity`]), after initialization.
+    /// Inputs and parameters are not mixed in one call (a step
+    /// sensitivity and a trajectory sensitivity are different things).
+    #[inline(never)]
+    fn parameter_directional(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        self.check_directional(unknowns, knowns, dv_known, Causality::Parameter)?;
+        if !self.initialized {
+            return Err(
+                "parameter sensitivities are available once the FMU is initialized (fmi2ExitInitializationMode)".into(),
+            );
+        }
+        for (out, u) in dv_unknown.iter_mut().zip(unknowns) {
+            let mut acc = 0.0;
+            for (k, dv) in knowns.iter().zip(dv_known) {
+                if *dv != 0.0 {
+                    acc += self.model.parameter_sensitivity(&self.values, *u, *k)? * dv;
+                }
+            }
+            *out = acc;
+        }
+        self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
+    }
+
     /// The checks of [`Instance::directional_derivative`], value by value,
-    /// with the message of the first that fails.
+    /// with the message of the first that fails: every unknown a Real
+    /// output, every known a Real of causality `knowns_are` (inputs: the
+    /// step sensitivity; parameters: the parameter sensitivity), every
+    /// seed finite.
     fn check_directional(
         &self,
         unknowns: &[u32],
         knowns: &[u32],
         dv_known: &[f64],
+        knowns_are: Causality,
     ) -> Result<(), String> {
         for vr in unknowns {
             let v = self.variable_of_type(*vr, VarType::Real)?;
@@ -1116,9 +1159,14 @@ impl Instance {
         }
         for (vr, dv) in knowns.iter().zip(dv_known) {
             let v = self.variable_of_type(*vr, VarType::Real)?;
-            if v.causality != Causality::Input {
+            if v.causality != knowns_are {
+                let what = if knowns_are == Causality::Input {
+                    "an input"
+                } else {
+                    "a parameter: the knowns of one call are all inputs (the step sensitivity) or all parameters (the parameter sensitivity)"
+                };
                 return Err(format!(
-                    "known {} (value reference {vr}) is not an input",
+                    "known {} (value reference {vr}) is not {what}",
                     v.name
                 ));
             }

@@ -146,6 +146,21 @@ pub trait Model: Send {
         false
     }
 
+    /// `∂output/∂parameter` along the trajectory since initialization (the
+    /// parameter's sensitivity, carried by the model through its steps),
+    /// at the current state and inputs: what `fmi2GetDirectionalDerivative`
+    /// gives for a Real parameter as a known, an extension of this
+    /// project's FMUs for fitting (a standard importer never asks). `Err`
+    /// says why not (by default: the model carries none).
+    fn parameter_sensitivity(
+        &self,
+        _values: &Values,
+        _output: u32,
+        _parameter: u32,
+    ) -> Result<f64, String> {
+        Err("this FMU carries no parameter sensitivities".into())
+    }
+
     /// Whether the layer must keep a copy of the pre-step state so that it can
     /// replay the step for directional derivatives. Models whose
     /// `partial_derivative` covers every output/input pair return `false`.

@@ -12,6 +12,7 @@ use fmi2_cs::{
     Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
     Variable,
 };
+use friction_laws::lugre::parameter_sensitivity::Parameter;
 use friction_laws::lugre::{HeldInput, LuGre, LuGreInputs, LuGreParams, TABLE_POINTS};
 use friction_laws::Ramp;
 use std::sync::LazyLock;
@@ -47,6 +48,7 @@ pub mod vr {
     pub const DIRECTION_DEPENDENT_VISCOUS: u32 = DER_Z + 1;
     pub const SIGMA2_NEG: u32 = DER_Z + 2;
     pub const F_OFFSET: u32 = DER_Z + 3;
+    pub const PARAMETER_SENSITIVITIES: u32 = DER_Z + 4;
 }
 
 const INPUTS: &[u32] = &[vr::V, vr::X, vr::FN];
@@ -256,6 +258,12 @@ fn variables() -> Vec<Variable> {
         "N",
         "Constant force on the contact, added to F at rest and in motion (the offset of Janot, Gautier, Brunot 2019); not scaled by Fn",
     ));
+    v.push(Variable::boolean_parameter(
+        vr::PARAMETER_SENSITIVITIES,
+        "parameter_sensitivities",
+        false,
+        "Carry dz/dp along the run (Co-Simulation): fmi2GetDirectionalDerivative of F or z with Real parameters as the knowns then gives dF/dp, dz/dp (all parameters but x_table; for fitting)",
+    ));
     v
 }
 
@@ -350,6 +358,9 @@ impl Model for LuGreFmu {
             ));
         }
         self.law = LuGre::new(Self::params(values)).map_err(param_err)?;
+        if values.boolean(vr::PARAMETER_SENSITIVITIES) {
+            self.law.carry_parameter_sensitivities();
+        }
         Ok(())
     }
 
@@ -441,6 +452,46 @@ impl Model for LuGreFmu {
         true
     }
 
+    /// `∂F/∂p` and `∂z/∂p` along the run, for every Real parameter but
+    /// the table positions ([`LuGre::force_sensitivity`]), when the
+    /// parameter `parameter_sensitivities` is on.
+    fn parameter_sensitivity(
+        &self,
+        values: &Values,
+        output: u32,
+        parameter: u32,
+    ) -> Result<f64, String> {
+        let name = |vr: u32| {
+            INFO.variables
+                .iter()
+                .find(|v| v.vr == vr)
+                .map_or("?", |v| v.name)
+        };
+        let Some(p) = carried_parameter(parameter) else {
+            return Err(format!(
+                "no sensitivity to {} (value reference {parameter}) is carried: only to the Real parameters but x_table",
+                name(parameter)
+            ));
+        };
+        if !self.law.carries_parameter_sensitivities() {
+            return Err(
+                "parameter sensitivities are not carried: set the parameter parameter_sensitivities = true before fmi2ExitInitializationMode".into(),
+            );
+        }
+        let (v, x, fn_) = Self::inputs(values);
+        let d = match output {
+            vr::F => self.law.force_sensitivity(p, v, x, fn_),
+            vr::Z => self.law.z_sensitivity(p),
+            _ => {
+                return Err(format!(
+                    "no parameter sensitivity of {} (value reference {output}): only of F and z",
+                    name(output)
+                ))
+            }
+        };
+        d.ok_or_else(|| "parameter sensitivities are not carried".into())
+    }
+
     /// dz/dt from the state equation; dF/dt = σ0·ż + σ1·z̈ + σ2(v)·v̇ with
     /// z̈ = v̇ − σ0·d(|v|·z/g)/dt, for constant σ1 and x, Fn at rest (the
     /// general case is not offered: `None`; nor at v = 0 with a
@@ -489,11 +540,54 @@ impl Model for LuGreFmu {
     fmi2_cs::ode_is_self!();
 }
 
+/// The parameter of value reference `vr` as a [`Parameter`] whose
+/// sensitivity the law carries; `None` for any other variable.
+fn carried_parameter(vr: u32) -> Option<Parameter> {
+    let table =
+        |base: u32| (vr >= base && vr < base + TABLE_POINTS as u32).then(|| (vr - base) as usize);
+    Some(match vr {
+        vr::SIGMA0 => Parameter::Sigma0,
+        vr::SIGMA1 => Parameter::Sigma1,
+        vr::SIGMA2 => Parameter::Sigma2,
+        vr::SIGMA2_NEG => Parameter::Sigma2Neg,
+        vr::F_OFFSET => Parameter::FOffset,
+        vr::FC => Parameter::Fc,
+        vr::FS => Parameter::Fs,
+        vr::VS => Parameter::Vs,
+        vr::STRIBECK_EXPONENT => Parameter::StribeckExponent,
+        vr::VD => Parameter::Vd,
+        vr::FC_NEG => Parameter::FcNeg,
+        vr::FS_NEG => Parameter::FsNeg,
+        _ => {
+            if let Some(i) = table(vr::SCALE_POS) {
+                Parameter::ScalePos(i)
+            } else {
+                Parameter::ScaleNeg(table(vr::SCALE_NEG)?)
+            }
+        }
+    })
+}
+
 /// Model Exchange: the state is `z`; the one event indicator is `v`, where
 /// `|v|` (and, direction-dependent, the levels) switch; no discrete state,
 /// so an event changes nothing.
 impl Ode for LuGreFmu {
-    fmi2_cs::delegate_continuous_states!(law);
+    /// `z` (never the parameter sensitivities, which only a step carries).
+    fn continuous_states(&self, x: &mut [f64]) {
+        x[0] = self.law.z();
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        match x {
+            [z] if z.is_finite() => {
+                self.law.set_z(*z);
+                Ok(())
+            }
+            _ => Err(format!(
+                "LuGre continuous state must be one finite z, got {x:?}"
+            )),
+        }
+    }
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         z[0] = values.real(vr::V);

@@ -29,7 +29,6 @@
 
 use crate::error::{require_non_negative, require_positive};
 use crate::interval::{one_sign_pieces, sign_on};
-use crate::state::one_value_state;
 use crate::{ParamError, Ramp};
 
 /// Capacity of the position table.
@@ -321,6 +320,8 @@ pub struct LuGre {
     /// after the step ask for again (not state: a function of the
     /// parameters and its key).
     level: Level,
+    /// `∂z/∂p`, when asked for ([`LuGre::carry_parameter_sensitivities`]).
+    sens: Option<Box<parameter_sensitivity::Sensitivities>>,
 }
 
 /// `g_unit(w, dir, x)` for one (w, dir < 0, x); `w` NaN: empty.
@@ -365,6 +366,7 @@ impl LuGre {
             z: 0.0,
             table_rate,
             level: Level::EMPTY,
+            sens: None,
         })
     }
 
@@ -714,7 +716,12 @@ impl LuGre {
         };
         let zss = g * s / self.p.sigma0;
         let lambda = self.p.sigma0 * w / g;
+        let before = self.z;
         self.z = zss + (self.z - zss) * exp_neg(lambda * h);
+        if let Some(sens) = self.sens.as_deref_mut() {
+            let at = parameter_sensitivity::Point { w, x };
+            sens.sub_step(&self.p, s, before, (at, at, at), h);
+        }
     }
 
     /// The step sensitivity of the outputs `z` and `F` after a step of
@@ -1013,6 +1020,13 @@ impl LuGre {
             let lambda = self.p.sigma0 * wm / self.g_unit(wm, s, x.at(tm));
             let zss_b = self.zss(v.at(t1).abs(), s, x.at(t1));
             let (decay, phi) = decay_and_mean(lambda * hs);
+            if let Some(sens) = self.sens.as_deref_mut() {
+                let point = |t: f64| parameter_sensitivity::Point {
+                    w: v.at(t).abs(),
+                    x: x.at(t),
+                };
+                sens.sub_step(&self.p, s, z, (point(t), point(tm), point(t1)), hs);
+            }
             z = zss_b + (z - zss_a) * decay - (zss_b - zss_a) * phi;
             zss_a = zss_b;
             t = t1;
@@ -1020,8 +1034,71 @@ impl LuGre {
         self.z = z;
     }
 
-    // The state: the mean bristle deflection z, any finite value.
-    one_value_state!("LuGre", "z", z);
+    // The state: the mean bristle deflection z, any finite value, and,
+    // when they are carried, ∂z/∂p after it (parameter_sensitivity.rs).
+
+    /// The number of values of the state: 1, or 1 + the number of
+    /// parameters when their sensitivities are carried.
+    #[inline]
+    pub fn state_len(&self) -> usize {
+        match &self.sens {
+            None => 1,
+            Some(_) => 1 + parameter_sensitivity::PARAMETERS,
+        }
+    }
+
+    /// The state `[z, ∂z/∂p…]` into `out`, of [`Self::state_len`] values.
+    #[inline]
+    pub fn write_state_into(&self, out: &mut [f64]) {
+        match &self.sens {
+            None => out.copy_from_slice(&[self.z]),
+            Some(sens) => {
+                out[0] = self.z;
+                out[1..].copy_from_slice(&sens.dz);
+            }
+        }
+    }
+
+    /// Whether `z` (and every carried sensitivity) is finite.
+    #[inline]
+    pub fn state_is_finite(&self) -> bool {
+        self.z.is_finite()
+            && self
+                .sens
+                .as_ref()
+                .is_none_or(|s| s.dz.iter().all(|d| d.is_finite()))
+    }
+
+    /// The same state as a new vector.
+    pub fn state_to_vec(&self) -> Vec<f64> {
+        let mut v = vec![0.0; self.state_len()];
+        self.write_state_into(&mut v);
+        v
+    }
+
+    /// Restores `[z]`, or `[z, ∂z/∂p…]` when the sensitivities are carried
+    /// (any finite values).
+    #[inline]
+    pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
+        match self.sens.as_deref_mut() {
+            None => self.z = crate::state::one_finite_value(s, "LuGre", "z")?,
+            Some(sens) => {
+                if s.len() != 1 + parameter_sensitivity::PARAMETERS
+                    || !s.iter().all(|x| x.is_finite())
+                {
+                    return Err(format!(
+                        "LuGre state with parameter sensitivities has {} finite values, got {} ({})",
+                        1 + parameter_sensitivity::PARAMETERS,
+                        s.len(),
+                        if s.iter().all(|x| x.is_finite()) { "all finite" } else { "not all finite" }
+                    ));
+                }
+                self.z = s[0];
+                sens.dz.copy_from_slice(&s[1..]);
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The two factors of a sub-step's update over `lh = λ·hs ≥ 0`:
@@ -1062,6 +1139,8 @@ fn exp_neg(a: f64) -> f64 {
         (-a).exp()
     }
 }
+
+pub mod parameter_sensitivity;
 
 #[cfg(test)]
 mod step_sensitivity_tests;

@@ -42,6 +42,20 @@ pub struct FrictionSim {
     instance: Instance,
     inputs: [ValueReference; 3],
     force: ValueReference,
+    /// The Boolean parameter `parameter_sensitivities`, when the FMU has it
+    /// (this project's LuGre.fmu): it then carries `∂F/∂p` along a run.
+    sensitivities: Option<ValueReference>,
+}
+
+/// What [`FrictionSim::run_record_with`] fills with `∂F/∂p`: the
+/// parameters' value references, the intervals wanted, their columns.
+type SensitivityColumns<'a> = (&'a [ValueReference], &'a [bool], &'a mut Vec<Vec<f64>>);
+
+/// The friction force along the data and its parameter sensitivities:
+/// `columns[j][i]` = `∂F/∂p_j` after the `i`-th interval asked for.
+pub struct ForceSensitivities {
+    pub force: Vec<f64>,
+    pub columns: Vec<Vec<f64>>,
 }
 
 impl FrictionSim {
@@ -57,7 +71,56 @@ impl FrictionSim {
             instance,
             inputs: [vr("v")?, vr("x")?, vr("Fn")?],
             force: vr("F")?,
+            sensitivities: vr("parameter_sensitivities").ok(),
         })
+    }
+
+    /// Whether the FMU carries parameter sensitivities.
+    pub fn has_sensitivities(&self) -> bool {
+        self.sensitivities.is_some()
+    }
+
+    /// [`FrictionSim::run`] with `∂F/∂p` for each parameter of
+    /// `parameters` (FMU names) after each interval `k` with `wanted[k]`,
+    /// from one run: the FMU carries `∂z/∂p` through its steps and gives
+    /// `∂F/∂p` through `fmi2GetDirectionalDerivative` with the parameter
+    /// as the known (one call per parameter and interval, asked only where
+    /// wanted). An error when the FMU carries none.
+    pub fn run_with_sensitivities(
+        &mut self,
+        model: &FrictionModel,
+        d: &FrictionData,
+        parameters: &[String],
+        wanted: &[bool],
+    ) -> Result<ForceSensitivities, String> {
+        if self.sensitivities.is_none() {
+            return Err("the friction FMU carries no parameter sensitivities".into());
+        }
+        let vrs = parameters
+            .iter()
+            .map(|n| {
+                Ok(self
+                    .fmu
+                    .variable(n)
+                    .map_err(|e| e.to_string())?
+                    .value_reference)
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        let mut out = ForceSensitivities {
+            force: Vec::with_capacity(d.t.len()),
+            columns: vec![Vec::with_capacity(d.t.len()); vrs.len()],
+        };
+        for (r, &first) in d.record_starts.iter().enumerate() {
+            let last = d.record_starts.get(r + 1).copied().unwrap_or(d.t.len());
+            self.run_record_with(
+                model,
+                d,
+                first..last,
+                &mut out.force,
+                Some((&vrs, wanted, &mut out.columns)),
+            )?;
+        }
+        Ok(out)
     }
 
     /// The friction force after each interval of `d` for `model`; an error
@@ -67,19 +130,22 @@ impl FrictionSim {
         let mut out = Vec::with_capacity(d.t.len());
         for (r, &first) in d.record_starts.iter().enumerate() {
             let last = d.record_starts.get(r + 1).copied().unwrap_or(d.t.len());
-            self.run_record(model, d, first..last, &mut out)?;
+            self.run_record_with(model, d, first..last, &mut out, None)?;
         }
         Ok(out)
     }
 
     /// [`FrictionSim::run`] over the intervals `range` (one record), from
-    /// rest, appending the forces to `out`.
-    fn run_record(
+    /// rest, appending the forces to `out` and, with `sensitivities`
+    /// (parameters' value references, the intervals wanted, their
+    /// columns), `∂F/∂p`.
+    fn run_record_with(
         &mut self,
         model: &FrictionModel,
         d: &FrictionData,
         range: std::ops::Range<usize>,
         out: &mut Vec<f64>,
+        mut sensitivities: Option<SensitivityColumns<'_>>,
     ) -> Result<(), String> {
         let fail = |e: crate::FmuError| e.to_string();
         let i = &mut self.instance;
@@ -95,6 +161,10 @@ impl FrictionSim {
             }
             .map_err(fail)?;
         }
+        if let Some(vr) = self.sensitivities {
+            i.set_boolean(&[vr], &[sensitivities.is_some()])
+                .map_err(fail)?;
+        }
         if !range.is_empty() {
             let k = range.start;
             i.set_real(&self.inputs, &[d.v[k], d.x[k], d.fn_[k]])
@@ -109,6 +179,17 @@ impl FrictionSim {
                 .map_err(fail)?;
             i.get_real(&[self.force], &mut f).map_err(fail)?;
             out.push(f[0]);
+            if let Some((vrs, wanted, columns)) = sensitivities.as_mut() {
+                if !wanted[k] {
+                    continue;
+                }
+                let mut df = [0.0];
+                for (vr, column) in vrs.iter().zip(columns.iter_mut()) {
+                    i.get_directional_derivative(&[self.force], &[*vr], &[1.0], &mut df)
+                        .map_err(fail)?;
+                    column.push(df[0]);
+                }
+            }
         }
         // the FMI 2.0 end of a run (§4.2.4); the next run resets
         i.terminate().map_err(fail)?;

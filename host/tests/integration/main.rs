@@ -48,6 +48,7 @@ mod misuse;
 mod model_description;
 mod model_exchange;
 mod parallel_instances;
+mod parameter_sensitivities;
 mod reference;
 mod run_options;
 mod ssp;
