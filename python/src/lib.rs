@@ -17,7 +17,7 @@
 use fricsim_diagnose::model::Effect;
 use fricsim_diagnose::progress_line::with_progress_line;
 use fricsim_diagnose::{
-    diagnose_records as run_diagnosis, report, CrossValidate, Options, Progress,
+    diagnose_and_write, CrossValidate, Options, Progress,
 };
 use fricsim_fmi::archive::{unpack, UnpackOptions};
 use fricsim_fmi::library::platforms;
@@ -362,13 +362,7 @@ fn diagnose(
         let mut file = SystemFile::open(&system).map_err(|e| e.to_string())?;
         let moved = fricsim_diagnose::dahl::move_to_lugre(&mut file, lugre.as_deref())?;
         let d = with_progress_line("fricsim.diagnose", quiet, &progress, || {
-            let mut d = run_diagnosis(&file, &data, &heldout, &options)?;
-            if let Some(note) = moved {
-                d.notes.push(note);
-            }
-            progress.stage("writing the report");
-            report::write(&d, &file, &d.friction_component, &out)?;
-            Ok(d)
+            diagnose_and_write(&file, (&data, &heldout), &options, moved, &out)
         })?;
         serde_json::to_string(&d).map_err(|e| e.to_string())
     })

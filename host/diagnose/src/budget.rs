@@ -61,6 +61,20 @@ pub struct TimeLimit {
 }
 
 impl TimeLimit {
+    /// The candidates of the round the limit cut short, each written by
+    /// `code` (Markdown or HTML) and joined with commas; what to say when
+    /// there are none.
+    pub fn unfinished_list(&self, code: impl Fn(&str) -> String) -> String {
+        if self.unfinished.is_empty() {
+            return "none (the round's decision was cut short)".to_string();
+        }
+        self.unfinished
+            .iter()
+            .map(|c| code(c))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// The report's sentence when the limit was reached (`None`
     /// otherwise): what was left out, for report.md, report.html and the
     /// command's summary.

@@ -381,16 +381,8 @@ fn candidates(s: &mut String, d: &Diagnosis, min_gain: f64) {
         let _ = writeln!(
             s,
             "<h3>Round {r} (in progress when the time limit was reached: not decided)</h3>\n<p>Unfinished, neither accepted nor rejected: {}.</p>",
-            if d.time_limit.unfinished.is_empty() {
-                "none (the round's decision was cut short)".to_string()
-            } else {
-                d.time_limit
-                    .unfinished
-                    .iter()
-                    .map(|c| format!("<code>{}</code>", escape(c)))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            }
+            d.time_limit
+                .unfinished_list(|c| format!("<code>{}</code>", escape(c)))
         );
         if !d.time_limit.finished.is_empty() {
             s.push_str("<table>\n<tr><th>finished candidate</th><th>held-out RMS</th><th>drop of the mean square</th><th>p</th></tr>\n");

@@ -735,3 +735,26 @@ pub fn diagnose_records(
 /// The co-simulation step is divided by this for the step-error estimate
 /// and for the check that an accepted improvement survives a finer step.
 pub const FINE_STEP_DIVISOR: f64 = 4.0;
+
+/// What `fricsim diagnose` and `fricsim.diagnose` do: [`diagnose_records`],
+/// the note of a Dahl nominal moved to LuGre (`moved`,
+/// [`dahl::move_to_lugre`]) added to its notes, and the report written
+/// into `out` ([`report::write`]); `progress` (the one in `options`, if
+/// any) is told when the report is being written.
+pub fn diagnose_and_write(
+    file: &SystemFile,
+    (data, heldout): (&[PathBuf], &[PathBuf]),
+    options: &Options,
+    moved: Option<String>,
+    out: &Path,
+) -> Result<Diagnosis, String> {
+    let mut d = diagnose_records(file, data, heldout, options)?;
+    if let Some(note) = moved {
+        d.notes.push(note);
+    }
+    if let Some(progress) = &options.progress {
+        progress.stage("writing the report");
+    }
+    report::write(&d, file, &d.friction_component, out)?;
+    Ok(d)
+}

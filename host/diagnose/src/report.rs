@@ -326,16 +326,7 @@ pub fn markdown(d: &Diagnosis) -> String {
         let _ = writeln!(
             s,
             "Round {r} was in progress when the time limit was reached and is not decided. Unfinished (neither accepted nor rejected): {}.\n",
-            if d.time_limit.unfinished.is_empty() {
-                "none (the round's decision was cut short)".to_string()
-            } else {
-                d.time_limit
-                    .unfinished
-                    .iter()
-                    .map(|c| format!("`{c}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            }
+            d.time_limit.unfinished_list(|c| format!("`{c}`"))
         );
         if !d.time_limit.finished.is_empty() {
             let _ = writeln!(

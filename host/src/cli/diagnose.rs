@@ -6,7 +6,7 @@
 use fricsim::diagnose::model::Effect;
 use fricsim::diagnose::progress_line::with_progress_line;
 use fricsim::diagnose::{
-    diagnose_records, report, CrossValidate, Options, Progress, DEFAULT_TIME_LIMIT,
+    diagnose_and_write, report, CrossValidate, Options, Progress, DEFAULT_TIME_LIMIT,
 };
 
 /// `--cross-validate`.
@@ -182,13 +182,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     let progress = Progress::new();
     options.progress = Some(progress.clone());
     let d = with_progress_line("diagnose", a.quiet, &progress, || {
-        let mut d = diagnose_records(&file, &a.data, &a.heldout, &options)?;
-        if let Some(note) = moved {
-            d.notes.push(note);
-        }
-        progress.stage("writing the report");
-        report::write(&d, &file, &d.friction_component, &out)?;
-        Ok(d)
+        diagnose_and_write(&file, (&a.data, &a.heldout), &options, moved, &out)
     })?;
     for note in &d.notes {
         println!("note: {note}");
