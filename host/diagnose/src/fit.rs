@@ -265,7 +265,7 @@ fn parameter_map(base: &FrictionModel, free: &[Free], theta: &[f64]) -> Vec<(Str
 /// The Jacobian in θ of the force-fit residuals ([`force_residuals`]) at
 /// `base.at(free, θ)` from one run of the friction FMU with its parameter
 /// sensitivities ([`FrictionSim::run_with_sensitivities`]) and the chain
-/// rule through [`parameter_map`]: `∂r_k/∂θ_j = Σ_i ∂F_k/∂p_i · ∂p_i/∂θ_j
+/// rule through the parameter map (`parameter_map`): `∂r_k/∂θ_j = Σ_i ∂F_k/∂p_i · ∂p_i/∂θ_j
 /// / (√n·scale)`. `None` when the FMU carries no sensitivities (or not for
 /// a parameter that moves) or the run fails.
 pub fn force_jacobian(
