@@ -282,10 +282,7 @@ pub fn force_jacobian(
     let names: Vec<String> = map.iter().map(|(n, _)| n.clone()).collect();
     let model = base.at(free, theta);
     let mut wanted = vec![false; data.t.len()];
-    // the columns hold the wanted intervals in increasing order
-    let mut order: Vec<(usize, usize)> = train.iter().copied().zip(0..).collect();
-    order.sort_unstable();
-    for &(k, _) in &order {
+    for &k in train {
         wanted[k] = true;
     }
     let s = sim
@@ -296,13 +293,8 @@ pub fn force_jacobian(
     for ((_, row), column) in map.iter().zip(&s.columns) {
         for (j, &dp) in row.iter().enumerate() {
             if dp != 0.0 {
-                // (a training interval listed twice has one column entry)
-                let mut entry = 0;
-                for (i, &(k, r)) in order.iter().enumerate() {
-                    if i > 0 && order[i - 1].0 != k {
-                        entry += 1;
-                    }
-                    jac[(r, j)] += column[entry] * dp / norm;
+                for (r, &k) in train.iter().enumerate() {
+                    jac[(r, j)] += column[k] * dp / norm;
                 }
             }
         }

@@ -52,7 +52,7 @@ pub struct FrictionSim {
 type SensitivityColumns<'a> = (&'a [ValueReference], &'a [bool], &'a mut Vec<Vec<f64>>);
 
 /// The friction force along the data and its parameter sensitivities:
-/// `columns[j][i]` = `∂F/∂p_j` after the `i`-th interval asked for.
+/// `columns[j][k]` = `∂F/∂p_j` after interval `k` (0 where not asked for).
 pub struct ForceSensitivities {
     pub force: Vec<f64>,
     pub columns: Vec<Vec<f64>>,
@@ -180,14 +180,13 @@ impl FrictionSim {
             i.get_real(&[self.force], &mut f).map_err(fail)?;
             out.push(f[0]);
             if let Some((vrs, wanted, columns)) = sensitivities.as_mut() {
-                if !wanted[k] {
-                    continue;
-                }
                 let mut df = [0.0];
                 for (vr, column) in vrs.iter().zip(columns.iter_mut()) {
-                    i.get_directional_derivative(&[self.force], &[*vr], &[1.0], &mut df)
-                        .map_err(fail)?;
-                    column.push(df[0]);
+                    if wanted[k] {
+                        i.get_directional_derivative(&[self.force], &[*vr], &[1.0], &mut df)
+                            .map_err(fail)?;
+                    }
+                    column.push(if wanted[k] { df[0] } else { 0.0 });
                 }
             }
         }
