@@ -66,6 +66,8 @@ CASES = {
     "ResetIntegrator": ("ResetIntegrator", {"v": "v"}, {}),
     "Bristle": ("Bristle", {"x": "x"}, {"seed": 7}),
     "Bristle2D": ("Bristle2D", {"v1": "v", "v2": "v_cos"}, {}),
+    "Classical": ("Classical", {"v": "v", "F_app": "force"}, {"dv": 1e-4}),
+    "BlimanSorine": ("BlimanSorine", {"v": "v"}, {}),
     "Rig1D": ("Rig1D", {"F": "force"}, {}),
     "Rig2D": ("Rig2D", {"F1": "force", "F2": "v_cos"}, {}),
 }

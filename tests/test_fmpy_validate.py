@@ -16,7 +16,7 @@ RIGS = shipped.RIGS
 # the FMUs with a Model Exchange interface: their states, in order, and
 # their number of event indicators
 MODEL_EXCHANGE_STATES = {"Dahl": (["F_dahl"], 1), "LuGre": (["z"], 1), "ResetIntegrator": (["z"], 2),
-                  "Bristle2D": (["z1", "z2"], 1)}
+                  "Bristle2D": (["z1", "z2"], 1), "BlimanSorine": (["x1", "x2"], 1)}
 
 EXPECTED = {
     "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma", "Fc", "alpha", "F_offset"},
@@ -31,6 +31,12 @@ EXPECTED = {
                 "parameter": {"sigma_ini", "delta_max", "x_rel", "n_bristles", "c", "mu_c", "Fn", "seed"}},
     "Bristle2D": {"input": {"v1", "v2"}, "output": {"F1", "F2", "z1", "z2", "sliding"},
                   "parameter": {"sigma01", "sigma02", "sigma11", "sigma12", "a1", "a2", "z0", "av"}},
+    "Classical": {"input": {"v", "F_app"}, "output": {"F", "stuck", "P_diss", "E_stored"},
+                  "parameter": {"Fc", "Fs", "vs", "delta", "sigma2", "dv"}},
+    "BlimanSorine": {"input": {"v"}, "output": {"F", "sliding", "P_diss", "E_stored"},
+                     "parameter": {"f1", "f2", "eps_f", "eta", "from_reference_points", "Fs_ref", "Fc_ref",
+                                   "x_e", "x_p"},
+                     "local": {"x1", "x2", "der(x1)", "der(x2)"}},
     "Rig1D": {"input": {"F", "F_ext", "x_act_in", "x_ref", "v_ref"},
               "output": {"x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl"},
               "parameter": {"m", "c", "k", "x_a0", "v_a", "v_surface", "x0", "v0", "actuator", "act_amp",
@@ -88,5 +94,5 @@ def test_declared_variables_and_capabilities(name):
         assert me is None and md.numberOfEventIndicators == 0 and not md.derivatives
     for v in md.modelVariables:
         if v.type == "Real" and v.causality in ("input", "output", "parameter") and v.name not in (
-                "alpha", "a", "a1", "a2", "stribeck_exponent", "mu_c", "ctrl_ff") and not v.name.startswith("scale_"):
+                "alpha", "a", "a1", "a2", "stribeck_exponent", "mu_c", "ctrl_ff", "delta", "eta") and not v.name.startswith("scale_"):
             assert v.unit, f"{name}.{v.name} has no unit"

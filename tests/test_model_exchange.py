@@ -408,3 +408,35 @@ def test_bristle2d_sliding_on_the_boundary_equals_co_simulation(tmp_path):
     for k, (name, scale) in enumerate(zip(outputs, (z0, z0, 1.0, 1.0))):
         difference = np.max(np.abs(me[:, k] - cs[:, k]))
         assert difference <= 1e-5 * scale, f"{name}: {difference}"
+
+
+# ---- Bliman-Sorine --------------------------------------------------------------------
+
+def test_bliman_sorine_events_at_the_reversals_and_model_exchange_equals_co_simulation(tmp_path):
+    """Sun et al. 2016's trial 6 (v = 5e-3*sin(2t/3) m/s, Table 8's
+    parameters, the defaults) in Model Exchange: the one event indicator,
+    v, crosses zero at the reversals t = 1.5*pi*n; CVode's force equals the
+    Co-Simulation FMU's (exact in displacement for inputs ramped over each
+    step) and settles at the Coulomb level f1 - f2 before each reversal."""
+    amplitude, omega, stop = 5e-3, 2 / 3, 12.0
+
+    def v(t):
+        return {"v": amplitude * math.sin(omega * t)}
+
+    outputs = ["x1", "x2", "F"]
+    run = MeRun("BlimanSorine", tmp_path, {}, inputs=lambda t, xe: v(t), outputs=outputs, rtol=1e-10)
+    times = np.round(np.arange(0, 1201) * 1e-2, 10)
+    me = run.run(times)
+    run.close()
+    located = [e[0] for e in run.events]
+    expected = [1.5 * math.pi, 3.0 * math.pi]
+    assert len(located) == len(expected), located
+    for t, t_expected in zip(located, expected):
+        assert abs(t - t_expected) <= 1e-7, (t, t_expected)
+    cs = co_simulation("BlimanSorine", tmp_path, v, outputs, stop, 1e-4)[::100]
+    fs = 2.5017
+    assert np.max(np.abs(me[:, 2] - cs[:, 2])) <= 1e-6 * fs
+    fc = 19.875 - 17.8227
+    before = [int(round(t_expected / 1e-2)) - 1 for t_expected in expected]
+    for k, s in zip(before, (1, -1)):
+        assert abs(me[k, 2] - s * fc) <= 1e-6 * fc, (times[k], me[k, 2])

@@ -21,6 +21,9 @@ const UNITS: &[(&str, [i32; 4])] = &[
     ("N/m", [1, 0, -2, 0]),
     ("N.s/m", [1, 0, -1, 0]),
     ("Hz", [0, 0, -1, 0]),
+    // energy and power (the contact's stored energy and dissipated power)
+    ("J", [1, 2, -2, 0]),
+    ("W", [1, 2, -3, 0]),
     // a drive command in volts (the rig controller; EMPS: vir) and its gains
     ("V", [1, 2, -3, -1]),
     ("V/m", [1, 1, -3, -1]),

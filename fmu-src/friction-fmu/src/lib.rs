@@ -1,14 +1,17 @@
 //! The friction FMUs. Each module binds one law of `friction-laws` to the FMI
 //! layer: its variable table (the single source of the model description)
 //! and a [`fmi2_cs::Model`] implementation. The same binary is packaged as
-//! `Dahl.fmu`, `LuGre.fmu`, `ResetIntegrator.fmu`, `Bristle.fmu` and
-//! `Bristle2D.fmu`; `fmi2Instantiate` picks the law by GUID. Every law but
-//! the bristle one is also an ODE and is offered for Model Exchange too
-//! ([`fmi2_cs::Ode`]), from the same equations.
+//! `Dahl.fmu`, `LuGre.fmu`, `ResetIntegrator.fmu`, `Bristle.fmu`,
+//! `Bristle2D.fmu`, `Classical.fmu` and `BlimanSorine.fmu`;
+//! `fmi2Instantiate` picks the law by GUID. Every law but the bristle one
+//! and the stateless classical one is also an ODE and is offered for Model
+//! Exchange too ([`fmi2_cs::Ode`]), from the same equations.
 #![forbid(unsafe_code)]
 
+pub mod bliman_sorine;
 pub mod bristle;
 pub mod bristle2d;
+pub mod classical;
 pub mod dahl;
 pub mod in_process;
 pub mod lugre;
@@ -19,7 +22,7 @@ use friction_laws::Ramp;
 use std::sync::LazyLock;
 
 /// Every model this binary holds.
-pub static REGISTRY: LazyLock<[ModelFactory; 5]> = LazyLock::new(|| {
+pub static REGISTRY: LazyLock<[ModelFactory; 7]> = LazyLock::new(|| {
     [
         ModelFactory {
             info: &dahl::INFO,
@@ -47,6 +50,18 @@ pub static REGISTRY: LazyLock<[ModelFactory; 5]> = LazyLock::new(|| {
             info: &bristle2d::INFO,
             create: || Box::new(bristle2d::Bristle2DFmu::default()),
             create_model_exchange: Some(|| Box::new(bristle2d::Bristle2DMe::default())),
+        },
+        // Co-Simulation only: the classical law has no state (its force
+        // follows from v and F_app), so there is no ODE to offer
+        ModelFactory {
+            info: &classical::INFO,
+            create: || Box::new(classical::ClassicalFmu::default()),
+            create_model_exchange: None,
+        },
+        ModelFactory {
+            info: &bliman_sorine::INFO,
+            create: || Box::new(bliman_sorine::BlimanSorineFmu::default()),
+            create_model_exchange: Some(|| Box::new(bliman_sorine::BlimanSorineFmu::default())),
         },
     ]
 });

@@ -19,7 +19,14 @@ type BadCase<'a> = (&'a str, &'a [(&'a str, f64)], &'a str);
 /// A driving input for each model.
 fn drive(model: &str) -> Vec<Signal> {
     match model {
-        "Dahl" | "ResetIntegrator" => vec![("v", |t| 1e-3 * (2.0 * PI * t).sin())],
+        "Dahl" | "ResetIntegrator" | "BlimanSorine" => {
+            vec![("v", |t| 1e-3 * (2.0 * PI * t).sin())]
+        }
+        // through the band at both ends, F_app above Fs in part
+        "Classical" => vec![
+            ("v", |t| 2e-5 * (2.0 * PI * t).sin()),
+            ("F_app", |t| 3.0 * (3.0 * PI * t).cos()),
+        ],
         "LuGre" => vec![
             ("v", |t| 2e-3 * (2.0 * PI * t).sin()),
             ("x", |t| 0.4 + 0.1 * t),
@@ -41,12 +48,22 @@ fn params(model: &str) -> &'static [(&'static str, f64)] {
     }
 }
 
-const MODELS: [&str; 5] = ["Dahl", "LuGre", "ResetIntegrator", "Bristle", "Bristle2D"];
+const MODELS: [&str; 7] = [
+    "Dahl",
+    "LuGre",
+    "ResetIntegrator",
+    "Bristle",
+    "Bristle2D",
+    "Classical",
+    "BlimanSorine",
+];
 
 fn outputs(model: &str) -> &'static [&'static str] {
     match model {
         "Bristle2D" => &["F1", "F2", "z1", "z2"],
         "Bristle" => &["F"],
+        "Classical" => &["F", "P_diss"],
+        "BlimanSorine" => &["F", "x1", "x2", "P_diss", "E_stored"],
         _ => &["F", "z"],
     }
 }
@@ -113,6 +130,18 @@ fn directional_derivatives_agree_with_finite_differences() {
     check_step_sensitivity("Dahl", &[], "F", "v", &[("v", 1e-4)], h);
     check_step_sensitivity("Dahl", &[("F_offset", -0.4)], "F", "v", &[("v", -1e-4)], h);
     check_step_sensitivity("ResetIntegrator", &[], "F", "v", &[("v", 1e-6)], h);
+    check_step_sensitivity("BlimanSorine", &[], "F", "v", &[("v", 1e-4)], h);
+    check_step_sensitivity("BlimanSorine", &[], "F", "v", &[("v", -3e-3)], h);
+    check_step_sensitivity("Classical", &[], "F", "v", &[("v", 4e-4)], h);
+    check_step_sensitivity("Classical", &[], "P_diss", "v", &[("v", -2e-3)], h);
+    check_step_sensitivity(
+        "Classical",
+        &[],
+        "F",
+        "F_app",
+        &[("v", 1e-6), ("F_app", 1.5)],
+        h,
+    );
     check_step_sensitivity(
         "Bristle2D",
         &[],
@@ -500,6 +529,19 @@ fn invalid_parameters_are_refused_with_name_and_value() {
             "Bristle",
             &[("stiffness_from_load", 0.0), ("sigma_ini", 0.0)],
             "sigma_ini = 0",
+        ),
+        ("Classical", &[("Fs", 1.0)], "Fs = 1: must be >= Fc = 1.284"),
+        ("Classical", &[("dv", 0.0)], "dv = 0"),
+        (
+            "BlimanSorine",
+            &[("f2", 20.0)],
+            "f1 = 19.875: must be > f2 = 20",
+        ),
+        ("BlimanSorine", &[("eta", 1.0)], "eta = 1: must be < 1"),
+        (
+            "BlimanSorine",
+            &[("from_reference_points", 1.0), ("x_e", 3.63e-4)],
+            "from_reference_points: invalid parameter x_e = 0.000363: no solution",
         ),
     ];
     for (model, bad, needle) in cases {

@@ -359,6 +359,37 @@ fn reset_integrator_partials_match_differences() {
     }
 }
 
+/// Bliman–Sorine: the rates, the force and the energy outputs in both
+/// states and `v`, on the loop and off it, at rest (the kink of `|v|`).
+#[test]
+fn bliman_sorine_partials_match_differences() {
+    let me = Me::new("BlimanSorine", &[]);
+    for (x1, x2, v) in [
+        (0.0, 0.0, 1e-3),
+        (12.0, -9.0, 2e-3),
+        (-19.0, 17.0, 4e-4),
+        (5.0, 3.0, -1e-3),
+        (8.0, -6.0, 0.0),
+    ] {
+        me.set_states(&[x1, x2]);
+        me.set("v", v);
+        let context = format!("BlimanSorine at ({x1}, {x2}), v {v}");
+        check_partials(
+            &me,
+            &[
+                ("der(x1)", 1e2),
+                ("der(x2)", 1e2),
+                ("F", 1.0),
+                ("P_diss", 1e-3),
+                ("E_stored", 1e-6),
+            ],
+            &[("x1", 1e-6), ("x2", 1e-6), ("v", 1e-9)],
+            1e-6,
+            &context,
+        );
+    }
+}
+
 /// The 2-D bristle inside the disc and sliding on its boundary (reached by
 /// an event: the contact state is a discrete state), isotropic and not.
 #[test]
@@ -424,8 +455,14 @@ type Case = (
 /// the derivative.
 #[test]
 fn the_right_hand_side_is_the_one_the_step_integrates() {
-    let cases: [Case; 4] = [
+    let cases: [Case; 5] = [
         ("Dahl", &[("v", 3e-4)], &["F_dahl"], &["F", "z"]),
+        (
+            "BlimanSorine",
+            &[("v", -4e-4)],
+            &["x1", "x2"],
+            &["F", "P_diss", "E_stored"],
+        ),
         ("LuGre", &[("v", 2e-3)], &["z"], &["F", "z"]),
         ("ResetIntegrator", &[("v", 1e-3)], &["z"], &["F", "z"]),
         (
@@ -548,12 +585,14 @@ fn reset_integrator_events() {
 /// interface: instantiating it for Model Exchange is refused, naming it.
 #[test]
 fn the_bristle_law_is_co_simulation_only() {
-    let (c, info) = instantiate("Bristle", fmi2ModelExchange);
-    assert!(info.model_exchange.is_none());
-    assert!(c.is_null());
-    let m = last_error();
-    assert!(
-        m.contains("Bristle") && m.contains("Co-Simulation (1) only"),
-        "{m}"
-    );
+    for model in ["Bristle", "Classical"] {
+        let (c, info) = instantiate(model, fmi2ModelExchange);
+        assert!(info.model_exchange.is_none());
+        assert!(c.is_null());
+        let m = last_error();
+        assert!(
+            m.contains(model) && m.contains("Co-Simulation (1) only"),
+            "{m}"
+        );
+    }
 }

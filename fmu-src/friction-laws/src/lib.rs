@@ -11,8 +11,10 @@
 //! so in steady sliding `F` has the sign of `v` and the rig applies `−F`.
 #![forbid(unsafe_code)]
 
+pub mod bliman_sorine;
 pub mod bristle;
 pub mod bristle2d;
+pub mod classical;
 pub mod dahl;
 pub mod error;
 mod interval;

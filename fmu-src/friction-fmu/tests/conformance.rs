@@ -1,0 +1,378 @@
+//! The physical properties of every friction law, one table (docs/models.md
+//! "Which law has which property"): each law is driven through its C ABI by
+//! the same checks, each check has a tolerance, and each law states whether
+//! it has the property; a law that does not is shown not to, with the
+//! measured figure. Print the table with
+//!
+//! ```sh
+//! cargo test --release -p friction-fmu --test conformance -- --nocapture
+//! ```
+//!
+//! The checks:
+//! - **steady state**: at constant velocity (±1e-4, ±1e-3, ±1e-2 m/s, over
+//!   1 cm) the force equals the law's steady-state (Stribeck) curve, to
+//!   1e-6 of its level;
+//! - **loop dissipates**: over each closed cycle of `v = A·sin ωt` the work
+//!   done on the contact, `∮F·v dt`, is positive;
+//! - **energy balance**: `∫F·v dt = ∫P_diss dt + ΔE_stored` over cycles
+//!   with reversals, to 1e-4 of `∫|F·v| dt` (laws with the outputs);
+//! - **P_diss ≥ 0 at every instant** (laws with the outputs);
+//! - **rate independence**: the same path at 1× and 10× the speed gives
+//!   the same force, to 1e-9 of the level;
+//! - **no drift below break-away**: a 1 kg mass pushed by
+//!   `0.5·Fc + 0.4·Fc·sin(2π t)` (below the law's Coulomb level `Fc`)
+//!   creeps less than 1e-3 of LuGre's over cycles 2–5 (the defect of
+//!   LuGre that Dupont et al. 2002 document).
+
+mod common;
+use common::Fmu;
+use std::f64::consts::PI;
+
+/// A friction law as the checks drive it.
+struct Law {
+    name: &'static str,
+    /// The force output.
+    force: &'static str,
+    /// Sets the motion (velocity `v`, displacement `x`) and the force the
+    /// rest of the system applies (`f_app`) as the law's inputs.
+    drive: fn(&Fmu, f64, f64, f64),
+    /// The steady-state force at constant `v` from the FMU's parameters:
+    /// the law's own Stribeck curve (docs/models.md).
+    curve: fn(&Fmu, f64) -> f64,
+    /// The Coulomb level the drift check pushes below.
+    fc: fn(&Fmu) -> f64,
+    /// Whether it has `P_diss` and `E_stored`.
+    energy_outputs: bool,
+    /// Whether it is rate-independent (Dahl, Bliman–Sorine, the bristle
+    /// model: no viscous or damping term).
+    rate_independent: bool,
+    /// Whether it sticks without drift below break-away.
+    no_drift: bool,
+    /// Whether its `P_diss` is never negative.
+    instant_dissipation: bool,
+}
+
+fn by_velocity(f: &Fmu, v: f64, _x: f64, _f_app: f64) {
+    f.set("v", v);
+}
+
+fn lugre_curve(f: &Fmu, v: f64) -> f64 {
+    let (fc, fs, vs, s2) = (f.get("Fc"), f.get("Fs"), f.get("vs"), f.get("sigma2"));
+    let d = f.get("stribeck_exponent");
+    v.signum() * (fc + (fs - fc) * (-(v.abs() / vs).powf(d)).exp()) + s2 * v
+}
+
+const LAWS: &[Law] = &[
+    Law {
+        name: "Dahl",
+        force: "F",
+        drive: by_velocity,
+        curve: |f, v| v.signum() * f.get("Fc"),
+        fc: |f| f.get("Fc"),
+        energy_outputs: false,
+        rate_independent: true,
+        no_drift: false,
+        instant_dissipation: true,
+    },
+    Law {
+        name: "LuGre",
+        force: "F",
+        drive: by_velocity,
+        curve: lugre_curve,
+        fc: |f| f.get("Fc"),
+        energy_outputs: false,
+        rate_independent: false,
+        no_drift: false,
+        instant_dissipation: true,
+    },
+    Law {
+        name: "ResetIntegrator",
+        force: "F",
+        drive: by_velocity,
+        // in sliding ż = 0 at |z| = z0, where a(z) = 0
+        curve: |f, v| v.signum() * f.get("sigma0") * f.get("z0"),
+        fc: |f| f.get("sigma0") * f.get("z0"),
+        energy_outputs: false,
+        rate_independent: false,
+        no_drift: true,
+        instant_dissipation: true,
+    },
+    Law {
+        name: "Bristle",
+        force: "F",
+        drive: |f, _v, x, _f_app| f.set("x", x),
+        // every bristle disconnected: σ_ini·δmax = μc·Fn (the stiffness
+        // from the load, the default)
+        curve: |f, v| v.signum() * f.get("mu_c") * f.get("Fn"),
+        fc: |f| f.get("mu_c") * f.get("Fn"),
+        energy_outputs: false,
+        rate_independent: true,
+        // the mass rings on the undamped bristles, each ring reverses the
+        // motion, and each reversal reconnects bristles at a random
+        // relaxation (Appels and Herder): the contact creeps
+        no_drift: false,
+        instant_dissipation: true,
+    },
+    Law {
+        name: "Bristle2D",
+        force: "F1",
+        drive: |f, v, _x, _f_app| {
+            f.set("v1", v);
+            f.set("v2", 0.0);
+        },
+        curve: |f, v| v.signum() * f.get("sigma01") * f.get("z0"),
+        fc: |f| f.get("sigma01") * f.get("z0"),
+        energy_outputs: false,
+        rate_independent: false,
+        no_drift: true,
+        instant_dissipation: true,
+    },
+    Law {
+        name: "Classical",
+        force: "F",
+        drive: |f, v, _x, f_app| {
+            f.set("v", v);
+            f.set("F_app", f_app);
+        },
+        curve: |f, v| {
+            let (fc, fs, vs, s2, d) = (
+                f.get("Fc"),
+                f.get("Fs"),
+                f.get("vs"),
+                f.get("sigma2"),
+                f.get("delta"),
+            );
+            v.signum() * (fc + (fs - fc) * (-(v.abs() / vs).powf(d)).exp()) + s2 * v
+        },
+        fc: |f| f.get("Fc"),
+        energy_outputs: true,
+        rate_independent: false,
+        no_drift: true,
+        instant_dissipation: true,
+    },
+    Law {
+        name: "BlimanSorine",
+        force: "F",
+        drive: by_velocity,
+        curve: |f, v| v.signum() * (f.get("f1") - f.get("f2")),
+        fc: |f| f.get("f1") - f.get("f2"),
+        energy_outputs: true,
+        rate_independent: true,
+        no_drift: false,
+        instant_dissipation: false,
+    },
+];
+
+/// Largest `|F − curve(v)|/|curve(v)|` over the velocities, each held
+/// over 1 cm from a relaxed contact.
+fn steady_state_error(law: &Law) -> f64 {
+    let mut worst: f64 = 0.0;
+    for v in [1e-4_f64, -1e-4, 1e-3, -1e-3, 1e-2, -1e-2] {
+        let mut fmu = Fmu::new(law.name, &[]);
+        let n = 2000;
+        let h = 1e-2 / v.abs() / n as f64;
+        let mut x = 0.0;
+        for _ in 0..n {
+            x += v * h;
+            (law.drive)(&fmu, v, x, 0.0);
+            fmu.step(h);
+        }
+        let expected = (law.curve)(&fmu, v);
+        worst = worst.max((fmu.get(law.force) - expected).abs() / expected.abs());
+    }
+    worst
+}
+
+/// What a kinematic run of `v = A·sin(ωt)` over `cycles` cycles measures.
+struct CycleRun {
+    /// `∮F·v dt` of each cycle (J).
+    work_per_cycle: Vec<f64>,
+    /// `∫F·v dt − ∫P_diss dt − ΔE_stored`, and `∫|F·v| dt` (J), when the
+    /// law has the outputs.
+    balance: Option<(f64, f64)>,
+    /// The least `P_diss` seen (W), when the law has the output.
+    least_power: Option<f64>,
+    /// The force at each step.
+    forces: Vec<f64>,
+}
+
+/// Drives `v = amplitude·sin(ωt)` (`x = amplitude/ω·(1 − cos ωt)`),
+/// inputs held over each step; the work of a step is exact in `v`
+/// (held) and trapezoidal in `F` (and `P_diss`), both ends read with the
+/// step's input.
+fn cycles(
+    law: &Law,
+    amplitude: f64,
+    omega: f64,
+    cycles: usize,
+    steps_per_cycle: usize,
+) -> CycleRun {
+    let mut fmu = Fmu::new(law.name, &[]);
+    let period = 2.0 * PI / omega;
+    let h = period / steps_per_cycle as f64;
+    let energy = |f: &Fmu| {
+        law.energy_outputs
+            .then(|| (f.get("P_diss"), f.get("E_stored")))
+    };
+    let mut run = CycleRun {
+        work_per_cycle: vec![0.0; cycles],
+        balance: None,
+        least_power: None,
+        forces: Vec::new(),
+    };
+    let (mut work, mut dissipated, mut absolute) = (0.0, 0.0, 0.0);
+    let mut e_start = None;
+    let mut e_end = 0.0;
+    for k in 0..cycles * steps_per_cycle {
+        // the step's velocity at its midpoint, the displacement at its end
+        let t_mid = (k as f64 + 0.5) * h;
+        let v = amplitude * (omega * t_mid).sin();
+        let x = amplitude / omega * (1.0 - (omega * (k + 1) as f64 * h).cos());
+        (law.drive)(&fmu, v, x, 0.0);
+        let f0 = fmu.get(law.force);
+        let e0 = energy(&fmu);
+        fmu.step(h);
+        let f1 = fmu.get(law.force);
+        run.forces.push(f1);
+        // the bristle law moves to x at the step's start: its work is F·Δx
+        let dx = if law.name == "Bristle" {
+            f1 * v * h
+        } else {
+            0.5 * (f0 + f1) * v * h
+        };
+        work += dx;
+        absolute += dx.abs();
+        run.work_per_cycle[k / steps_per_cycle] += dx;
+        if let (Some((p0, e0)), Some((p1, e1))) = (e0, energy(&fmu)) {
+            e_start.get_or_insert(e0);
+            e_end = e1;
+            dissipated += 0.5 * (p0 + p1) * h;
+            let least = run.least_power.get_or_insert(p0);
+            *least = least.min(p0).min(p1);
+        }
+    }
+    if let Some(e0) = e_start {
+        run.balance = Some((work - dissipated - (e_end - e0), absolute));
+    }
+    run
+}
+
+/// How far a 1 kg mass pushed by `0.5·Fc + 0.4·Fc·sin(2πt)` against the
+/// law creeps from the end of the first cycle to the end of the fifth
+/// (the same phase, so the elastic deflection of the contact cancels):
+/// semi-implicit Euler, h = 1e-5 s, the friction force read after
+/// setting the step's inputs (the direct feedthrough of the classical
+/// law sees the applied force of the step).
+fn drift(law: &Law) -> f64 {
+    let mut fmu = Fmu::new(law.name, &[]);
+    let fc = (law.fc)(&fmu);
+    let (m, h, per_cycle) = (1.0, 1e-5, 100_000);
+    let (mut x, mut v) = (0.0, 0.0);
+    let mut after_first = 0.0;
+    for k in 0..5 * per_cycle {
+        if k == per_cycle {
+            after_first = x;
+        }
+        let t = k as f64 * h;
+        let push = 0.5 * fc + 0.4 * fc * (2.0 * PI * t).sin();
+        (law.drive)(&fmu, v, x, push);
+        let f = fmu.get(law.force);
+        v += h * (push - f) / m;
+        x += h * v;
+        fmu.step(h);
+    }
+    x - after_first
+}
+
+fn verdict(holds: bool) -> &'static str {
+    if holds {
+        "holds"
+    } else {
+        "does not"
+    }
+}
+
+#[test]
+fn every_law_has_the_properties_it_claims_and_not_the_others() {
+    let lugre = LAWS.iter().find(|l| l.name == "LuGre").unwrap();
+    let lugre_drift = drift(lugre).abs();
+    assert!(lugre_drift > 1e-6, "LuGre drifts: {lugre_drift:e} m");
+    let mut failures = Vec::new();
+    let mut check = |ok: bool, why: String| {
+        if !ok {
+            failures.push(why);
+        }
+    };
+    println!("| law | steady state = curve | loops dissipate | energy balance | P_diss >= 0 | rate-independent | no drift below break-away |");
+    println!("|---|---|---|---|---|---|---|");
+    for law in LAWS {
+        let name = law.name;
+        let steady = steady_state_error(law);
+        check(
+            steady < 1e-6,
+            format!("{name}: steady state off its curve by {steady:e}"),
+        );
+
+        let slow = cycles(law, 2e-3, 2.0 * PI, 3, 20_000);
+        let least_work = slow
+            .work_per_cycle
+            .iter()
+            .cloned()
+            .fold(f64::INFINITY, f64::min);
+        check(
+            least_work > 0.0,
+            format!("{name}: a cycle's work {least_work:e} J"),
+        );
+
+        let balance = match (law.energy_outputs, slow.balance) {
+            (true, Some((gap, scale))) => {
+                check(
+                    gap.abs() < 1e-4 * scale,
+                    format!("{name}: balance off by {gap:e} J of {scale:e}"),
+                );
+                format!("holds ({:.0e} of the work)", gap.abs() / scale)
+            }
+            (false, None) => "no P_diss/E_stored outputs yet".into(),
+            _ => panic!("{name}: energy outputs declared {}", law.energy_outputs),
+        };
+        let instant = match slow.least_power {
+            Some(p) => {
+                check(
+                    (p >= -1e-12) == law.instant_dissipation,
+                    format!("{name}: least P_diss {p:e} W"),
+                );
+                format!("{} (least {p:.2e} W)", verdict(p >= -1e-12))
+            }
+            None => "no P_diss output yet".into(),
+        };
+
+        // the same path ten times as fast: same displacements per step
+        let fast = cycles(law, 2e-2, 20.0 * PI, 3, 20_000);
+        let level = (law.fc)(&Fmu::new(name, &[]));
+        let rate_gap = slow
+            .forces
+            .iter()
+            .zip(&fast.forces)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+            / level;
+        check(
+            (rate_gap < 1e-9) == law.rate_independent,
+            format!("{name}: 1x and 10x speed differ by {rate_gap:e} of the level"),
+        );
+
+        let moved = drift(law).abs();
+        let ratio = moved / lugre_drift;
+        check(
+            (ratio < 1e-3) == law.no_drift,
+            format!("{name}: moved {moved:e} m, {ratio:e} of LuGre's {lugre_drift:e} m"),
+        );
+
+        println!(
+            "| {name} | holds ({steady:.0e}) | holds (least {least_work:.2e} J/cycle) | {balance} | {instant} | {} ({rate_gap:.0e}) | {} ({moved:.1e} m, {ratio:.1e} of LuGre's) |",
+            verdict(rate_gap < 1e-9),
+            verdict(ratio < 1e-3),
+        );
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

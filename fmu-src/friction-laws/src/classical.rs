@@ -1,0 +1,262 @@
+//! Classical friction: Coulomb + viscous + static friction, with the
+//! Stribeck curve (Sun et al. 2016 eq. 1 and 12; Thimmalapura 2004 eq.
+//! 2.1–2.3), made usable in discrete time by Karnopp's zero-velocity band
+//! (Karnopp 1985; docs/models.md "Classical").
+//!
+//! Sliding (`|v| ≥ dv`): the steady-state curve
+//! `Fss(v) = sgn v·(Fc + (Fs − Fc)·e^(−|v/vs|^δ)) + σ2·v` (with `vs = 0`:
+//! `Fc·sgn v + σ2·v`, Sun et al. eq. 1 without the Stribeck term).
+//!
+//! Inside the band (`|v| < dv`) the contact sticks and holds the force
+//! `F_app` that the rest of the system applies to it, up to the static
+//! level: `F = F_app` while `|F_app| ≤ Fs` (stuck), `F = Fs·sgn F_app`
+//! beyond (breaking away). The law has no state: the force follows from
+//! the two inputs, so a step changes nothing and the stick/slip switch is
+//! where an input crosses `±dv` or `±Fs`.
+
+use crate::error::{require_non_negative, require_positive};
+use crate::ParamError;
+
+/// Classical parameters: Coulomb level `fc` (N), static level `fs` (N),
+/// Stribeck velocity `vs` (m/s, 0: no Stribeck term), Stribeck exponent
+/// `delta` (–), viscous coefficient `sigma2` (N·s/m), half-width of the
+/// zero-velocity band `dv` (m/s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClassicalParams {
+    pub fc: f64,
+    pub fs: f64,
+    pub vs: f64,
+    pub delta: f64,
+    pub sigma2: f64,
+    pub dv: f64,
+}
+
+impl Default for ClassicalParams {
+    /// Sun et al. 2016, Table 6 (brass on steel, nominal): Fc = 1.284 N,
+    /// Fs = 2.35 N, vs = 1.13975e-3 m/s, σ2 = 173 N·s/m, δ = 2; the band
+    /// dv = 1e-5 m/s (1 % of vs).
+    fn default() -> Self {
+        ClassicalParams {
+            fc: 1.284,
+            fs: 2.35,
+            vs: 1.13975e-3,
+            delta: 2.0,
+            sigma2: 173.0,
+            dv: 1e-5,
+        }
+    }
+}
+
+impl ClassicalParams {
+    /// `Fc > 0`, `Fs ≥ Fc`, `vs ≥ 0`, `δ > 0`, `σ2 ≥ 0`, `dv > 0`, all
+    /// finite.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        require_positive("Fc", self.fc)?;
+        require_positive("Fs", self.fs)?;
+        if self.fs < self.fc {
+            return Err(ParamError::new(
+                "Fs",
+                self.fs,
+                format!(
+                    "must be >= Fc = {} (the static level is the higher)",
+                    self.fc
+                ),
+            ));
+        }
+        require_non_negative("vs", self.vs)?;
+        require_positive("delta", self.delta)?;
+        require_non_negative("sigma2", self.sigma2)?;
+        require_positive("dv", self.dv)?;
+        Ok(())
+    }
+}
+
+/// The classical law (stateless: its parameters).
+#[derive(Clone, Debug)]
+pub struct Classical {
+    p: ClassicalParams,
+}
+
+impl Classical {
+    /// The law with validated parameters.
+    pub fn new(p: ClassicalParams) -> Result<Self, ParamError> {
+        p.validate()?;
+        Ok(Classical { p })
+    }
+
+    pub fn params(&self) -> &ClassicalParams {
+        &self.p
+    }
+
+    /// The level `g(v) = Fc + (Fs − Fc)·e^(−|v/vs|^δ)` of the Stribeck
+    /// curve, `Fc` when `vs = 0`.
+    fn level(&self, v: f64) -> f64 {
+        let p = &self.p;
+        if p.vs == 0.0 {
+            p.fc
+        } else {
+            p.fc + (p.fs - p.fc) * (-(v.abs() / p.vs).powf(p.delta)).exp()
+        }
+    }
+
+    /// The steady-state (Stribeck) curve
+    /// `Fss(v) = sgn v·g(v) + σ2·v` (Sun et al. 2016 eq. 12), 0 at `v = 0`.
+    pub fn steady_state(&self, v: f64) -> f64 {
+        if v == 0.0 {
+            return 0.0;
+        }
+        v.signum() * self.level(v) + self.p.sigma2 * v
+    }
+
+    /// `dFss/dv = −(Fs − Fc)·δ·(|v|/vs)^(δ−1)/vs·e^(−|v/vs|^δ) + σ2`
+    /// (the same on both sides of 0).
+    pub fn steady_state_slope(&self, v: f64) -> f64 {
+        let p = &self.p;
+        if p.vs == 0.0 {
+            return p.sigma2;
+        }
+        let r = v.abs() / p.vs;
+        -(p.fs - p.fc) * p.delta * r.powf(p.delta - 1.0) / p.vs * (-r.powf(p.delta)).exp()
+            + p.sigma2
+    }
+
+    /// Whether the velocity is inside the zero-velocity band `|v| < dv`.
+    #[inline]
+    pub fn in_band(&self, v: f64) -> bool {
+        v.abs() < self.p.dv
+    }
+
+    /// Stuck: inside the band with `|F_app| ≤ Fs`.
+    pub fn stuck(&self, v: f64, f_app: f64) -> bool {
+        self.in_band(v) && f_app.abs() <= self.p.fs
+    }
+
+    /// The friction force: `F_app` when stuck, `Fs·sgn F_app` inside the
+    /// band beyond the static level, `Fss(v)` outside the band.
+    pub fn force(&self, v: f64, f_app: f64) -> f64 {
+        if self.in_band(v) {
+            f_app.clamp(-self.p.fs, self.p.fs)
+        } else {
+            self.steady_state(v)
+        }
+    }
+
+    /// `(∂F/∂v, ∂F/∂F_app)`: `(0, 1)` stuck, `(0, 0)` breaking away,
+    /// `(dFss/dv, 0)` sliding.
+    pub fn force_partials(&self, v: f64, f_app: f64) -> (f64, f64) {
+        if self.in_band(v) {
+            (0.0, if f_app.abs() <= self.p.fs { 1.0 } else { 0.0 })
+        } else {
+            (self.steady_state_slope(v), 0.0)
+        }
+    }
+
+    /// The power the contact dissipates, `F·v` (W): the law stores no
+    /// energy. Inside the band a stuck contact holds `F_app` at a small
+    /// `v` of either sign, so there it can be slightly negative
+    /// (`|P| < Fs·dv`).
+    pub fn dissipated_power(&self, v: f64, f_app: f64) -> f64 {
+        self.force(v, f_app) * v
+    }
+
+    /// The number of values of the state (0: the law has none).
+    pub fn state_len(&self) -> usize {
+        0
+    }
+
+    /// Writes the empty state.
+    pub fn write_state_into(&self, _out: &mut [f64]) {}
+
+    /// The empty state is finite.
+    pub fn state_is_finite(&self) -> bool {
+        true
+    }
+
+    /// The empty state as a vector.
+    pub fn state_to_vec(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    /// Restores the empty state (any other length is refused).
+    pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
+        if s.is_empty() {
+            Ok(())
+        } else {
+            Err(format!("Classical has no state, got {} values", s.len()))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_names_the_parameter() {
+        let p = ClassicalParams::default();
+        for (bad, name) in [
+            (ClassicalParams { fs: 1.0, ..p }, "Fs"),
+            (ClassicalParams { fc: 0.0, ..p }, "Fc"),
+            (ClassicalParams { vs: -1.0, ..p }, "vs"),
+            (ClassicalParams { dv: 0.0, ..p }, "dv"),
+            (
+                ClassicalParams {
+                    sigma2: f64::NAN,
+                    ..p
+                },
+                "sigma2",
+            ),
+        ] {
+            assert_eq!(Classical::new(bad).unwrap_err().name, name);
+        }
+    }
+
+    /// The curve of Sun et al. 2016 eq. 12 at points computed by hand:
+    /// `Fss(vs) = Fc + (Fs − Fc)/e + σ2·vs`, odd in `v`, `Fs` at 0+ (less
+    /// the viscous term), and `Fc + σ2·v` far out; with `vs = 0` eq. 1.
+    #[test]
+    fn steady_state_is_the_stribeck_curve() {
+        let p = ClassicalParams::default();
+        let law = Classical::new(p).unwrap();
+        let at_vs = p.fc + (p.fs - p.fc) / std::f64::consts::E + p.sigma2 * p.vs;
+        assert!((law.steady_state(p.vs) - at_vs).abs() < 1e-12);
+        assert!((law.steady_state(-p.vs) + at_vs).abs() < 1e-12);
+        assert!((law.steady_state(1e-9) - p.fs).abs() < 1e-6);
+        assert!((law.steady_state(0.05) - (p.fc + p.sigma2 * 0.05)).abs() < 1e-12);
+        let plain = Classical::new(ClassicalParams { vs: 0.0, ..p }).unwrap();
+        assert_eq!(plain.steady_state(-2e-3), -p.fc - p.sigma2 * 2e-3);
+    }
+
+    /// Inside the band the force is the applied force up to `Fs`, then
+    /// `Fs` in its direction; outside it is the curve whatever the
+    /// applied force.
+    #[test]
+    fn sticks_inside_the_band_and_breaks_away_at_fs() {
+        let p = ClassicalParams::default();
+        let law = Classical::new(p).unwrap();
+        for v in [0.0, 0.5 * p.dv, -0.9 * p.dv] {
+            assert_eq!(law.force(v, 1.7), 1.7);
+            assert!(law.stuck(v, 1.7));
+            assert_eq!(law.force(v, -2.35), -2.35);
+            assert_eq!(law.force(v, 3.0), p.fs);
+            assert!(!law.stuck(v, 3.0));
+            assert_eq!(law.force(v, -9.0), -p.fs);
+        }
+        assert_eq!(law.force(2.0 * p.dv, -9.0), law.steady_state(2.0 * p.dv));
+        assert!(!law.stuck(p.dv, 0.0));
+    }
+
+    #[test]
+    fn partials_match_differences() {
+        let law = Classical::new(ClassicalParams::default()).unwrap();
+        for v in [3e-4, -1.2e-3, 4e-3] {
+            let e = 1e-9;
+            let fd = (law.force(v + e, 0.3) - law.force(v - e, 0.3)) / (2.0 * e);
+            let (dv, dapp) = law.force_partials(v, 0.3);
+            assert!((fd - dv).abs() < 1e-5 * dv.abs().max(1.0), "{fd} vs {dv}");
+            assert_eq!(dapp, 0.0);
+        }
+        assert_eq!(law.force_partials(0.0, 1.0), (0.0, 1.0));
+        assert_eq!(law.force_partials(0.0, 5.0), (0.0, 0.0));
+    }
+}
