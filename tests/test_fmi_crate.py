@@ -68,6 +68,7 @@ CASES = {
     "Bristle2D": ("Bristle2D", {"v1": "v", "v2": "v_cos"}, {}),
     "Classical": ("Classical", {"v": "v", "F_app": "force"}, {"dv": 1e-4}),
     "BlimanSorine": ("BlimanSorine", {"v": "v"}, {}),
+    "ElastoPlastic": ("ElastoPlastic", {"v": "v"}, {}),
     "Rig1D": ("Rig1D", {"F": "force"}, {}),
     "Rig2D": ("Rig2D", {"F1": "force", "F2": "v_cos"}, {}),
 }

@@ -41,6 +41,8 @@ CASES = {
     "Classical": (signal(v=2e-3 * np.sin(w * T_SIGNAL), F_app=3.0 * np.cos(1.5 * w * T_SIGNAL)), {}),
     # Sun et al. 2016's Bliman-Sorine trials: sinusoidal velocity, here one cycle a second
     "BlimanSorine": (signal(v=5e-3 * np.sin(w * T_SIGNAL)), {}),
+    # through the elastic, transition and plastic zones, with reversals
+    "ElastoPlastic": (signal(v=2e-3 * np.sin(w * T_SIGNAL)), {}),
 }
 # outputs that are zero by definition (documented in the model description)
 ZERO_BY_DEFINITION = {("Classical", "E_stored")}

@@ -16,7 +16,8 @@ RIGS = shipped.RIGS
 # the FMUs with a Model Exchange interface: their states, in order, and
 # their number of event indicators
 MODEL_EXCHANGE_STATES = {"Dahl": (["F_dahl"], 1), "LuGre": (["z"], 1), "ResetIntegrator": (["z"], 2),
-                  "Bristle2D": (["z1", "z2"], 1), "BlimanSorine": (["x1", "x2"], 1)}
+                  "Bristle2D": (["z1", "z2"], 1), "BlimanSorine": (["x1", "x2"], 1),
+                  "ElastoPlastic": (["z"], 5)}
 
 EXPECTED = {
     "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma", "Fc", "alpha", "F_offset"},
@@ -37,6 +38,8 @@ EXPECTED = {
                      "parameter": {"f1", "f2", "eps_f", "eta", "from_reference_points", "Fs_ref", "Fc_ref",
                                    "x_e", "x_p"},
                      "local": {"x1", "x2", "der(x1)", "der(x2)"}},
+    "ElastoPlastic": {"input": {"v"}, "output": {"F", "z", "elastic", "P_diss", "E_stored"},
+                      "parameter": {"sigma0", "sigma1", "sigma2", "Fc", "Fs", "vs", "stribeck_exponent", "z_ba"}},
     "Rig1D": {"input": {"F", "F_ext", "x_act_in", "x_ref", "v_ref"},
               "output": {"x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl"},
               "parameter": {"m", "c", "k", "x_a0", "v_a", "v_surface", "x0", "v0", "actuator", "act_amp",

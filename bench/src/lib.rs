@@ -177,6 +177,18 @@ pub const FRICTION_FMUS: &[DrivenFmu] = &[
         &[("v1", 1e-3, 0.0), ("v2", 1e-3, std::f64::consts::FRAC_PI_2)],
         &["F1", "F2"],
     ),
+    // through the zero-velocity band twice a period, the applied force
+    // (3 N) above the static level (2.35 N) in part of it
+    (
+        "Classical",
+        &[
+            ("v", 1e-3, 0.0),
+            ("F_app", 3.0, std::f64::consts::FRAC_PI_2),
+        ],
+        &["F"],
+    ),
+    ("BlimanSorine", &[("v", 1e-3, 0.0)], &["F"]),
+    ("ElastoPlastic", &[("v", 1e-3, 0.0)], &["F"]),
 ];
 
 /// One initialised instance of a friction FMU of [`FRICTION_FMUS`] and its

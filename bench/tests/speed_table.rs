@@ -44,7 +44,16 @@ fn quick_mode_writes_every_table_between_its_markers() {
         assert!(generated.contains(part), "{generated}");
     }
 
-    for model in ["Dahl", "LuGre", "ResetIntegrator", "Bristle", "Bristle2D"] {
+    for model in [
+        "Dahl",
+        "LuGre",
+        "ResetIntegrator",
+        "Bristle",
+        "Bristle2D",
+        "Classical",
+        "BlimanSorine",
+        "ElastoPlastic",
+    ] {
         let cells = common::table_row(&text, "**One communication step", model);
         assert_eq!(cells.len(), 3, "{cells:?}");
         for ns in &cells[1..] {

@@ -2,7 +2,8 @@
 //! layer: its variable table (the single source of the model description)
 //! and a [`fmi2_cs::Model`] implementation. The same binary is packaged as
 //! `Dahl.fmu`, `LuGre.fmu`, `ResetIntegrator.fmu`, `Bristle.fmu`,
-//! `Bristle2D.fmu`, `Classical.fmu` and `BlimanSorine.fmu`;
+//! `Bristle2D.fmu`, `Classical.fmu`, `BlimanSorine.fmu` and
+//! `ElastoPlastic.fmu`;
 //! `fmi2Instantiate` picks the law by GUID. Every law but the bristle one
 //! and the stateless classical one is also an ODE and is offered for Model
 //! Exchange too ([`fmi2_cs::Ode`]), from the same equations.
@@ -13,6 +14,7 @@ pub mod bristle;
 pub mod bristle2d;
 pub mod classical;
 pub mod dahl;
+pub mod elasto_plastic;
 pub mod in_process;
 pub mod lugre;
 pub mod reset_integrator;
@@ -22,7 +24,7 @@ use friction_laws::Ramp;
 use std::sync::LazyLock;
 
 /// Every model this binary holds.
-pub static REGISTRY: LazyLock<[ModelFactory; 7]> = LazyLock::new(|| {
+pub static REGISTRY: LazyLock<[ModelFactory; 8]> = LazyLock::new(|| {
     [
         ModelFactory {
             info: &dahl::INFO,
@@ -62,6 +64,11 @@ pub static REGISTRY: LazyLock<[ModelFactory; 7]> = LazyLock::new(|| {
             info: &bliman_sorine::INFO,
             create: || Box::new(bliman_sorine::BlimanSorineFmu::default()),
             create_model_exchange: Some(|| Box::new(bliman_sorine::BlimanSorineFmu::default())),
+        },
+        ModelFactory {
+            info: &elasto_plastic::INFO,
+            create: || Box::new(elasto_plastic::ElastoPlasticFmu::default()),
+            create_model_exchange: Some(|| Box::new(elasto_plastic::ElastoPlasticFmu::default())),
         },
     ]
 });

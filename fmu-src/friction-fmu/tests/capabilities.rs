@@ -19,7 +19,7 @@ type BadCase<'a> = (&'a str, &'a [(&'a str, f64)], &'a str);
 /// A driving input for each model.
 fn drive(model: &str) -> Vec<Signal> {
     match model {
-        "Dahl" | "ResetIntegrator" | "BlimanSorine" => {
+        "Dahl" | "ResetIntegrator" | "BlimanSorine" | "ElastoPlastic" => {
             vec![("v", |t| 1e-3 * (2.0 * PI * t).sin())]
         }
         // through the band at both ends, F_app above Fs in part
@@ -48,7 +48,7 @@ fn params(model: &str) -> &'static [(&'static str, f64)] {
     }
 }
 
-const MODELS: [&str; 7] = [
+const MODELS: [&str; 8] = [
     "Dahl",
     "LuGre",
     "ResetIntegrator",
@@ -56,6 +56,7 @@ const MODELS: [&str; 7] = [
     "Bristle2D",
     "Classical",
     "BlimanSorine",
+    "ElastoPlastic",
 ];
 
 fn outputs(model: &str) -> &'static [&'static str] {
@@ -64,6 +65,7 @@ fn outputs(model: &str) -> &'static [&'static str] {
         "Bristle" => &["F"],
         "Classical" => &["F", "P_diss"],
         "BlimanSorine" => &["F", "x1", "x2", "P_diss", "E_stored"],
+        "ElastoPlastic" => &["F", "z", "P_diss", "E_stored"],
         _ => &["F", "z"],
     }
 }
@@ -133,6 +135,10 @@ fn directional_derivatives_agree_with_finite_differences() {
     check_step_sensitivity("BlimanSorine", &[], "F", "v", &[("v", 1e-4)], h);
     check_step_sensitivity("BlimanSorine", &[], "F", "v", &[("v", -3e-3)], h);
     check_step_sensitivity("Classical", &[], "F", "v", &[("v", 4e-4)], h);
+    // sticking elastically, in the transition, sliding
+    check_step_sensitivity("ElastoPlastic", &[], "F", "v", &[("v", 1e-6)], h);
+    check_step_sensitivity("ElastoPlastic", &[], "F", "v", &[("v", 1e-5)], h);
+    check_step_sensitivity("ElastoPlastic", &[], "F", "v", &[("v", -5e-2)], h);
     check_step_sensitivity("Classical", &[], "P_diss", "v", &[("v", -2e-3)], h);
     check_step_sensitivity(
         "Classical",
@@ -538,6 +544,11 @@ fn invalid_parameters_are_refused_with_name_and_value() {
             "f1 = 19.875: must be > f2 = 20",
         ),
         ("BlimanSorine", &[("eta", 1.0)], "eta = 1: must be < 1"),
+        (
+            "ElastoPlastic",
+            &[("z_ba", 2e-5)],
+            "z_ba = 0.00002: must be < Fc/sigma0 = 0.00001",
+        ),
         (
             "BlimanSorine",
             &[("from_reference_points", 1.0), ("x_e", 3.63e-4)],

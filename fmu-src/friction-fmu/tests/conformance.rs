@@ -161,6 +161,19 @@ const LAWS: &[Law] = &[
         no_drift: false,
         instant_dissipation: false,
     },
+    Law {
+        name: "ElastoPlastic",
+        force: "F",
+        drive: by_velocity,
+        curve: lugre_curve,
+        fc: |f| f.get("Fc"),
+        energy_outputs: true,
+        rate_independent: false,
+        no_drift: true,
+        // in this run; σ1·v·ż < 0 where the steady state falls faster
+        // than the deflection follows (as for LuGre)
+        instant_dissipation: true,
+    },
 ];
 
 /// Largest `|F − curve(v)|/|curve(v)|` over the velocities, each held

@@ -390,6 +390,37 @@ fn bliman_sorine_partials_match_differences() {
     }
 }
 
+/// Elasto-plastic: elastic, in the transition, plastic, unloading, at
+/// rest; the rate, the force and the energy outputs in `z` and `v`.
+#[test]
+fn elasto_plastic_partials_match_differences() {
+    let me = Me::new("ElastoPlastic", &[]);
+    for (z, v) in [
+        (4e-6, 1e-3),
+        (1.05e-5, 1e-3),
+        (-1.1e-5, -4e-4),
+        (1.3e-5, 5e-3),
+        (9e-6, -2e-3),
+        (6e-6, 0.0),
+    ] {
+        me.set_states(&[z]);
+        me.set("v", v);
+        let context = format!("ElastoPlastic at z {z}, v {v}");
+        check_partials(
+            &me,
+            &[
+                ("der(z)", 1.0),
+                ("F", 1e3),
+                ("P_diss", 1.0),
+                ("E_stored", 1e-5),
+            ],
+            &[("z", 1e-12), ("v", 1e-10)],
+            1e-5,
+            &context,
+        );
+    }
+}
+
 /// The 2-D bristle inside the disc and sliding on its boundary (reached by
 /// an event: the contact state is a discrete state), isotropic and not.
 #[test]
@@ -455,7 +486,13 @@ type Case = (
 /// the derivative.
 #[test]
 fn the_right_hand_side_is_the_one_the_step_integrates() {
-    let cases: [Case; 5] = [
+    let cases: [Case; 6] = [
+        (
+            "ElastoPlastic",
+            &[("v", 1e-3)],
+            &["z"],
+            &["F", "z", "P_diss"],
+        ),
         ("Dahl", &[("v", 3e-4)], &["F_dahl"], &["F", "z"]),
         (
             "BlimanSorine",

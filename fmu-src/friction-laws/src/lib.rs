@@ -16,6 +16,7 @@ pub mod bristle;
 pub mod bristle2d;
 pub mod classical;
 pub mod dahl;
+pub mod elasto_plastic;
 pub mod error;
 mod interval;
 pub mod lugre;
