@@ -25,7 +25,7 @@
 //! ([`BlimanSorineParams::from_reference_points`], their eq. 5–8).
 
 use crate::error::require_positive;
-use crate::interval::{displacement, one_sign_pieces, sign_on};
+use crate::interval::each_one_sign_displacement;
 use crate::{ParamError, Ramp};
 
 /// Bliman–Sorine parameters (Sun et al. 2016 notation): the levels `f1`,
@@ -306,18 +306,7 @@ impl BlimanSorine {
     /// states take their exact update over the exact displacement (the
     /// module's documentation).
     pub fn step(&mut self, v: Ramp, h: f64) {
-        if h.is_nan() || h <= 0.0 {
-            return;
-        }
-        let (pieces, n) = one_sign_pieces(v, h);
-        for &(a, b) in &pieces[..n] {
-            let s = sign_on(v, a, b);
-            if s == 0.0 {
-                continue;
-            }
-            let u = displacement(v, a, b).abs();
-            self.advance(s, u);
-        }
+        each_one_sign_displacement(v, h, |s, u| self.advance(s, u));
     }
 
     /// The exact update over a displacement `u ≥ 0` in direction `s`, in

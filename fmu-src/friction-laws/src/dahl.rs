@@ -16,7 +16,7 @@
 //! The same term as LuGre's offset (Janot, Gautier, Brunot 2019).
 
 use crate::error::{require_finite, require_positive};
-use crate::interval::{displacement, one_sign_pieces, sign_on};
+use crate::interval::each_one_sign_displacement;
 use crate::state::one_value_state;
 use crate::{ParamError, Ramp};
 
@@ -169,18 +169,9 @@ impl Dahl {
     /// is the exact solution of `d|y|/du = −(σ/Fc)|y|^α`, evaluated in
     /// increment form (`expm1`/`ln_1p`) so small steps lose no digits.
     pub fn step(&mut self, v: Ramp, h: f64) {
-        if h.is_nan() || h <= 0.0 {
-            return;
-        }
-        let (pieces, n) = one_sign_pieces(v, h);
-        for &(a, b) in &pieces[..n] {
-            let s = sign_on(v, a, b);
-            if s == 0.0 {
-                continue;
-            }
-            let u = displacement(v, a, b).abs();
-            self.f = advance(&self.p, self.f, s, u);
-        }
+        let p = self.p;
+        let f = &mut self.f;
+        each_one_sign_displacement(v, h, |s, u| *f = advance(&p, *f, s, u));
     }
 
     // The state: the force of the law F_dahl, any finite value.

@@ -35,3 +35,20 @@ pub(crate) fn sign_on(v: Ramp, a: f64, b: f64) -> f64 {
         0.0
     }
 }
+
+/// For a rate-independent law: calls `advance(s, u)` with the direction
+/// `s = ±1` and the exact distance `u = |Δx|` of each piece of `[0, h]` on
+/// which `v` keeps one sign (none for a non-positive or NaN `h`, none for
+/// a piece where `v` vanishes).
+pub(crate) fn each_one_sign_displacement(v: Ramp, h: f64, mut advance: impl FnMut(f64, f64)) {
+    if h.is_nan() || h <= 0.0 {
+        return;
+    }
+    let (pieces, n) = one_sign_pieces(v, h);
+    for &(a, b) in &pieces[..n] {
+        let s = sign_on(v, a, b);
+        if s != 0.0 {
+            advance(s, displacement(v, a, b).abs());
+        }
+    }
+}
