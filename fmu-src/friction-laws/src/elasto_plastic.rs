@@ -89,6 +89,14 @@ impl ElastoPlasticParams {
         require_positive("vs", self.vs)?;
         require_positive("stribeck_exponent", self.delta)?;
         require_non_negative("z_ba", self.z_ba)?;
+        let most = self.fs / self.sigma0;
+        if !most.is_finite() {
+            return Err(ParamError::new(
+                "sigma0",
+                self.sigma0,
+                format!("too small: Fs/sigma0 = {most} (the largest deflection) is not finite"),
+            ));
+        }
         let least = self.fc / self.sigma0;
         if self.z_ba >= least {
             return Err(ParamError::new(
@@ -114,6 +122,11 @@ const MAX_SUBSTEPS: usize = 1000;
 const KAPPA_V: f64 = 1e-3;
 /// Tolerance of the Runge–Kutta pair, relative to `w_ss`.
 const TOLERANCE: f64 = 1e-13;
+/// The shortest step of the pair, relative to `w_ss`: a floor that only a
+/// transition zone narrower than about 1e-9 of `w_ss` reaches (`z_ba`
+/// within 1e-9 of `Fc/σ0`); there the step is taken with a larger error
+/// rather than cut without end.
+const MIN_SCALED_STEP: f64 = 1e-12;
 
 impl ElastoPlastic {
     /// A relaxed contact (`z = 0`) with validated parameters.
@@ -283,53 +296,78 @@ impl ElastoPlastic {
 
     /// `dw/du = 1 − α(w)·w/w_ss` across the transition zone
     /// `z_ba ≤ w < w_ss` by the Dormand–Prince 5(4) pair with step
-    /// control. `w` rises towards `w_ss`, a fixed point the zone never
-    /// leaves: within a few ulps of it, it is put on it.
-    fn transition(&self, mut w: f64, u: f64, w_ss: f64) -> f64 {
-        let f = |w: f64| 1.0 - self.alpha_parts(w, w_ss).0 * w / w_ss;
-        let tolerance = TOLERANCE * w_ss;
-        let mut done = 0.0;
-        let mut du = (0.05 * (w_ss - self.p.z_ba)).min(u);
-        while done < u {
-            if w_ss - w <= 4.0 * f64::EPSILON * w_ss {
-                return w_ss;
+    /// control, in the scaled deflection `r = w/w_ss` and distance
+    /// `s = u/w_ss`: `dr/ds = 1 − α̂(r)·r`, with
+    /// `α̂ = ½·sin(π·(r − (1 + b)/2)/(1 − b)) + ½` and `b = z_ba/w_ss`,
+    /// the same on every scale (a `w_ss` of 1e-300 m integrates as
+    /// 1e-3 m does). `r` rises towards 1, where `α̂` reaches 1 to rounding
+    /// (about 1e-8 of the zone's width below it): from there on the
+    /// relaxation is LuGre's, exact. (Integrating on, the pair's step
+    /// grows to its stability limit and `r` hovers near 1 - 4e-14 without
+    /// settling.) A step the
+    /// control would cut below `MIN_SCALED_STEP` is taken as it is, so the
+    /// loop always advances.
+    fn transition(&self, w: f64, u: f64, w_ss: f64) -> f64 {
+        let b = self.p.z_ba / w_ss;
+        let span = 1.0 - b;
+        let alpha = |r: f64| {
+            if r <= b {
+                0.0
+            } else if r >= 1.0 {
+                1.0
+            } else {
+                0.5 * (PI * (r - 0.5 * (1.0 + b)) / span).sin() + 0.5
             }
-            du = du.min(u - done);
-            let k1 = f(w);
-            let k2 = f(w + du * (1.0 / 5.0) * k1);
-            let k3 = f(w + du * (3.0 / 40.0 * k1 + 9.0 / 40.0 * k2));
-            let k4 = f(w + du * (44.0 / 45.0 * k1 - 56.0 / 15.0 * k2 + 32.0 / 9.0 * k3));
-            let k5 = f(w + du
+        };
+        let f = |r: f64| 1.0 - alpha(r) * r;
+        let length = u / w_ss;
+        let mut r = w / w_ss;
+        let mut done = 0.0;
+        let mut ds = (0.05 * span).min(length);
+        while done < length {
+            if alpha(r) == 1.0 {
+                // α is 1 to rounding from here on (it rises with r):
+                // LuGre's exact relaxation, as in the plastic zone
+                return w_ss * (1.0 - (1.0 - r) * (-(length - done)).exp());
+            }
+            ds = ds.min(length - done).max(MIN_SCALED_STEP);
+            let k1 = f(r);
+            let k2 = f(r + ds * (1.0 / 5.0) * k1);
+            let k3 = f(r + ds * (3.0 / 40.0 * k1 + 9.0 / 40.0 * k2));
+            let k4 = f(r + ds * (44.0 / 45.0 * k1 - 56.0 / 15.0 * k2 + 32.0 / 9.0 * k3));
+            let k5 = f(r + ds
                 * (19372.0 / 6561.0 * k1 - 25360.0 / 2187.0 * k2 + 64448.0 / 6561.0 * k3
                     - 212.0 / 729.0 * k4));
-            let k6 = f(w + du
+            let k6 = f(r + ds
                 * (9017.0 / 3168.0 * k1 - 355.0 / 33.0 * k2
                     + 46732.0 / 5247.0 * k3
                     + 49.0 / 176.0 * k4
                     - 5103.0 / 18656.0 * k5));
-            let next = w + du
+            let next = r + ds
                 * (35.0 / 384.0 * k1 + 500.0 / 1113.0 * k3 + 125.0 / 192.0 * k4
                     - 2187.0 / 6784.0 * k5
                     + 11.0 / 84.0 * k6);
             let k7 = f(next);
-            let error = du
+            let error = ds
                 * (71.0 / 57600.0 * k1 - 71.0 / 16695.0 * k3 + 71.0 / 1920.0 * k4
                     - 17253.0 / 339200.0 * k5
                     + 22.0 / 525.0 * k6
                     - 1.0 / 40.0 * k7)
                     .abs();
-            if error <= tolerance {
-                done += du;
-                w = next.min(w_ss);
+            if error <= TOLERANCE || ds <= MIN_SCALED_STEP {
+                done += ds;
+                r = next.min(1.0);
             }
             let scale = if error == 0.0 {
                 5.0
+            } else if error.is_finite() {
+                (0.9 * (TOLERANCE / error).powf(0.2)).clamp(0.2, 5.0)
             } else {
-                (0.9 * (tolerance / error).powf(0.2)).clamp(0.2, 5.0)
+                0.2
             };
-            du *= scale;
+            ds *= scale;
         }
-        w
+        r * w_ss
     }
 
     one_value_state!("ElastoPlastic", "z", z);
@@ -446,6 +484,49 @@ mod tests {
 
     /// At constant velocity the force settles on the Stribeck curve, for
     /// any step size.
+    /// Steps end, and end in the zone, on every scale: a steady
+    /// deflection of 1e-300 m, a transition zone 1e-14 of it wide, a
+    /// distance of 1e300 m (the fuzzed FMU once looped here: the
+    /// unscaled step control underflowed to a zero step).
+    #[test]
+    fn steps_end_on_extreme_scales() {
+        for (sigma0, z_ba_fraction) in [
+            (1e300, 0.0),
+            (1e300, 0.5),
+            (1e5, 1.0 - 1e-14),
+            (1e-290, 0.3),
+        ] {
+            let fc = 1.0;
+            let p = ElastoPlasticParams {
+                sigma0,
+                z_ba: z_ba_fraction * fc / sigma0,
+                ..Default::default()
+            };
+            let mut l = ElastoPlastic::new(p).unwrap();
+            let w_ss = l.level(1e-3) / sigma0;
+            for (v, h) in [(1e-3, 1e-12), (1e-3, 1.0), (1e300, 1.0), (-1e-3, 0.5)] {
+                l.step(Ramp::constant(v), h);
+                assert!(
+                    l.z().is_finite() && l.z().abs() <= 1.5 * fc / sigma0,
+                    "{p:?}: {}",
+                    l.z()
+                );
+            }
+            // 100 steady deflections further on, at the steady state
+            l.step(Ramp::constant(1e-3), 100.0 * w_ss / 1e-3);
+            assert!(
+                (l.z() - w_ss).abs() <= 1e-12 * w_ss,
+                "{p:?}: {} vs {w_ss}",
+                l.z()
+            );
+        }
+        let p = ElastoPlasticParams {
+            sigma0: 1e-310,
+            ..Default::default()
+        };
+        assert!(p.validate().is_err());
+    }
+
     #[test]
     fn steady_state_is_the_stribeck_curve() {
         for v in [1e-4_f64, -5e-4, 2e-3, -1e-2] {

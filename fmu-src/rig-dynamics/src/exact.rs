@@ -79,6 +79,11 @@ pub(crate) struct ExactStep {
     rate_at_end: [f64; 3],
 }
 
+/// The largest sum of `|h·L|` entries an exponential is formed for: its
+/// tenth power stays finite (a rig beyond it, `h·k/m > 1e25`, has no
+/// meaningful step).
+const MAX_NORM: f64 = 1e25;
+
 impl ExactStep {
     /// Not formed for any step length: [`ExactStep::h`] is NaN.
     pub(crate) const UNFORMED: ExactStep = ExactStep {
@@ -100,6 +105,22 @@ impl ExactStep {
             for c in 0..2 {
                 w[(r, c)] = h * l[r][c];
             }
+        }
+        if !(w.iter().map(|x| x.abs()).sum::<f64>() <= MAX_NORM) {
+            // h·L overflowed (e.g. k/m = 1e300/1e-300) or is so large
+            // that the powers nalgebra's exponential estimates its scaling
+            // from (up to the tenth) overflow: it would then square 2^64
+            // times. The step comes out NaN, which the FMU layer refuses
+            // as a non-finite state.
+            return ExactStep {
+                h,
+                linear: l,
+                scale,
+                transition: [[f64::NAN; 2]; 2],
+                weights: [[f64::NAN; 2]; 3],
+                at_end: [f64::NAN; 3],
+                rate_at_end: [f64::NAN; 3],
+            };
         }
         w[(1, 2)] = 1.0;
         w[(2, 3)] = 1.0;
@@ -196,6 +217,18 @@ impl ExactStep {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A linear part that overflows (k/m = inf, or so large that its tenth
+    /// power does) forms a NaN step at once (nalgebra's exponential would
+    /// square 2^64 times).
+    #[test]
+    fn an_overflowing_linear_part_gives_nan_not_a_hang() {
+        for k in [f64::INFINITY, 1e40, 1e300] {
+            let step = ExactStep::new(1.0, [[0.0, 1.0], [-k, 0.0]], 1.0);
+            let got = step.advance([0.3, 0.0], [0.0; 3], 1.0);
+            assert!(got.iter().all(|x| x.is_nan()), "{got:?}");
+        }
+    }
 
     /// Linear parts from a slow undamped oscillator to stiff damping, a
     /// critically damped and a free mass, at small and large steps,

@@ -14,7 +14,8 @@
 
 use crate::fmi;
 use fmi::*;
-use std::time::Instant;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
 /// Fixed seed: the same programs on every run.
 const SEED: u64 = 0x5eed_0007;
@@ -110,16 +111,54 @@ impl Tally {
     }
 }
 
+/// A hang detector: if no program finishes for `STALL` (a program takes
+/// milliseconds), the test process stops with the FMU and program it was
+/// running, instead of a CI job that times out without saying where.
+struct Watchdog {
+    current: Arc<Mutex<(String, Instant)>>,
+}
+
+const STALL: Duration = Duration::from_secs(120);
+
+impl Watchdog {
+    fn start() -> Watchdog {
+        let current = Arc::new(Mutex::new((String::new(), Instant::now())));
+        let watched = Arc::clone(&current);
+        std::thread::spawn(move || loop {
+            std::thread::sleep(Duration::from_secs(1));
+            let Some(watched) = watched.lock().ok().map(|c| c.clone()) else {
+                return;
+            };
+            if watched.1.elapsed() > STALL {
+                eprintln!(
+                    "fuzz_bounded: {} has not returned in {STALL:?}: a hang (seed {SEED:#x})",
+                    watched.0
+                );
+                std::process::abort();
+            }
+        });
+        Watchdog { current }
+    }
+
+    fn running(&self, what: String) {
+        if let Ok(mut c) = self.current.lock() {
+            *c = (what, Instant::now());
+        }
+    }
+}
+
 #[test]
 fn random_call_sequences_against_every_shipped_fmu() {
     let mut rng = Rng(SEED);
     let start = Instant::now();
     let mut calls = 0;
+    let watchdog = Watchdog::start();
     for &name in SHIPPED.iter() {
         let loaded = load_shipped(name);
         for iteration in 0..1000 {
             let len = 16 + rng.below(600);
             let program = rng.bytes(len);
+            watchdog.running(format!("{name}: program {iteration}"));
             let outcome =
                 std::panic::catch_unwind(|| sequence::run(loaded.api, &loaded.model, &program));
             match outcome {
