@@ -106,7 +106,8 @@ impl ExactStep {
                 w[(r, c)] = h * l[r][c];
             }
         }
-        if !(w.iter().map(|x| x.abs()).sum::<f64>() <= MAX_NORM) {
+        let norm: f64 = w.iter().map(|x| x.abs()).sum();
+        if norm.is_nan() || norm > MAX_NORM {
             // h·L overflowed (e.g. k/m = 1e300/1e-300) or is so large
             // that the powers nalgebra's exponential estimates its scaling
             // from (up to the tenth) overflow: it would then square 2^64
