@@ -69,6 +69,8 @@ CASES = {
     "Classical": ("Classical", {"v": "v", "F_app": "force"}, {"dv": 1e-4}),
     "BlimanSorine": ("BlimanSorine", {"v": "v"}, {}),
     "ElastoPlastic": ("ElastoPlastic", {"v": "v"}, {}),
+    "MaxwellSlip": ("MaxwellSlip", {"v": "v"}, {}),
+    "GMS": ("GMS", {"v": "v"}, {}),
     "Rig1D": ("Rig1D", {"F": "force"}, {}),
     "Rig2D": ("Rig2D", {"F1": "force", "F2": "v_cos"}, {}),
 }

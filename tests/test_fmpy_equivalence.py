@@ -43,6 +43,10 @@ CASES = {
     "BlimanSorine": (signal(v=5e-3 * np.sin(w * T_SIGNAL)), {}),
     # through the elastic, transition and plastic zones, with reversals
     "ElastoPlastic": (signal(v=2e-3 * np.sin(w * T_SIGNAL)), {}),
+    # pre-sliding loops and gross sliding, reversals every half cycle
+    "MaxwellSlip": (signal(v=2e-4 * np.sin(w * T_SIGNAL)), {}),
+    "GMS": (signal(v=2e-3 * np.sin(w * T_SIGNAL)), {"n_elements": 4, "alpha[1]": 0.1, "alpha[2]": 0.2,
+                                                    "alpha[3]": 0.3, "alpha[4]": 0.4}),
 }
 # outputs that are zero by definition (documented in the model description)
 ZERO_BY_DEFINITION = {("Classical", "E_stored")}

@@ -40,6 +40,12 @@ EXPECTED = {
                      "local": {"x1", "x2", "der(x1)", "der(x2)"}},
     "ElastoPlastic": {"input": {"v"}, "output": {"F", "z", "elastic", "P_diss", "E_stored"},
                       "parameter": {"sigma0", "sigma1", "sigma2", "Fc", "Fs", "vs", "stribeck_exponent", "z_ba"}},
+    "MaxwellSlip": {"input": {"v"}, "output": {"F", "P_diss", "E_stored", "n_slipping"},
+                    "parameter": {"sigma2", "n_elements"} | {f"k[{i}]" for i in range(1, 101)}
+                    | {f"W[{i}]" for i in range(1, 101)}},
+    "GMS": {"input": {"v"}, "output": {"F", "P_diss", "E_stored", "n_slipping"},
+            "parameter": {"sigma2", "n_elements", "Fc", "Fs", "vs", "stribeck_exponent", "C"}
+            | {f"k[{i}]" for i in range(1, 101)} | {f"alpha[{i}]" for i in range(1, 101)}},
     "Rig1D": {"input": {"F", "F_ext", "x_act_in", "x_ref", "v_ref"},
               "output": {"x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl"},
               "parameter": {"m", "c", "k", "x_a0", "v_a", "v_surface", "x0", "v0", "actuator", "act_amp",
@@ -97,5 +103,5 @@ def test_declared_variables_and_capabilities(name):
         assert me is None and md.numberOfEventIndicators == 0 and not md.derivatives
     for v in md.modelVariables:
         if v.type == "Real" and v.causality in ("input", "output", "parameter") and v.name not in (
-                "alpha", "a", "a1", "a2", "stribeck_exponent", "mu_c", "ctrl_ff", "delta", "eta") and not v.name.startswith("scale_"):
+                "alpha", "a", "a1", "a2", "stribeck_exponent", "mu_c", "ctrl_ff", "delta", "eta") and not v.name.startswith(("scale_", "alpha[")):
             assert v.unit, f"{name}.{v.name} has no unit"

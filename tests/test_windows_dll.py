@@ -98,6 +98,8 @@ CASES = {
                                     "F_app": lambda t: 3.0 * np.cos(1.5 * w * t)}),
     "BlimanSorine": ("BlimanSorine", {}, {"v": lambda t: 5e-3 * np.sin(w * t)}),
     "ElastoPlastic": ("ElastoPlastic", {}, {"v": lambda t: 2e-3 * np.sin(w * t)}),
+    "MaxwellSlip": ("MaxwellSlip", {}, {"v": lambda t: 2e-4 * np.sin(w * t)}),
+    "GMS": ("GMS", {}, {"v": lambda t: 2e-3 * np.sin(w * t)}),
     # the 1995 rig (defaults) with a friction force that holds and lets go, and dither
     "Rig1D": ("Rig1D", {"dither_amp": 0.01, "dither_freq": 7.0},
               {"F": lambda t: 1.2 + 0.3 * np.sin(w * t)}),

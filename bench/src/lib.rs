@@ -189,6 +189,8 @@ pub const FRICTION_FMUS: &[DrivenFmu] = &[
     ),
     ("BlimanSorine", &[("v", 1e-3, 0.0)], &["F"]),
     ("ElastoPlastic", &[("v", 1e-3, 0.0)], &["F"]),
+    ("MaxwellSlip", &[("v", 1e-3, 0.0)], &["F"]),
+    ("GMS", &[("v", 1e-3, 0.0)], &["F"]),
 ];
 
 /// One initialised instance of a friction FMU of [`FRICTION_FMUS`] and its

@@ -53,6 +53,8 @@ fn quick_mode_writes_every_table_between_its_markers() {
         "Classical",
         "BlimanSorine",
         "ElastoPlastic",
+        "MaxwellSlip",
+        "GMS",
     ] {
         let cells = common::table_row(&text, "**One communication step", model);
         assert_eq!(cells.len(), 3, "{cells:?}");

@@ -17,6 +17,7 @@ pub mod dahl;
 pub mod elasto_plastic;
 pub mod in_process;
 pub mod lugre;
+pub mod maxwell_slip;
 pub mod reset_integrator;
 
 use fmi2_cs::{Model, ModelFactory, ModelInfo, Values, Variable};
@@ -24,7 +25,7 @@ use friction_laws::Ramp;
 use std::sync::LazyLock;
 
 /// Every model this binary holds.
-pub static REGISTRY: LazyLock<[ModelFactory; 8]> = LazyLock::new(|| {
+pub static REGISTRY: LazyLock<[ModelFactory; 10]> = LazyLock::new(|| {
     [
         ModelFactory {
             info: &dahl::INFO,
@@ -69,6 +70,18 @@ pub static REGISTRY: LazyLock<[ModelFactory; 8]> = LazyLock::new(|| {
             info: &elasto_plastic::INFO,
             create: || Box::new(elasto_plastic::ElastoPlasticFmu::default()),
             create_model_exchange: Some(|| Box::new(elasto_plastic::ElastoPlasticFmu::default())),
+        },
+        // Co-Simulation only so far (issue: Model Exchange with an event
+        // at each element's switch is not built yet)
+        ModelFactory {
+            info: &maxwell_slip::MAXWELL_SLIP_INFO,
+            create: || Box::new(maxwell_slip::MaxwellSlipFmu::default()),
+            create_model_exchange: None,
+        },
+        ModelFactory {
+            info: &maxwell_slip::GMS_INFO,
+            create: || Box::new(maxwell_slip::GmsFmu::default()),
+            create_model_exchange: None,
         },
     ]
 });

@@ -22,6 +22,8 @@ fn drive(model: &str) -> Vec<Signal> {
         "Dahl" | "ResetIntegrator" | "BlimanSorine" | "ElastoPlastic" => {
             vec![("v", |t| 1e-3 * (2.0 * PI * t).sin())]
         }
+        // pre-sliding and gross sliding with reversals
+        "MaxwellSlip" | "GMS" => vec![("v", |t| 5e-4 * (2.0 * PI * t).sin() + 1e-4)],
         // through the band at both ends, F_app above Fs in part
         "Classical" => vec![
             ("v", |t| 2e-5 * (2.0 * PI * t).sin()),
@@ -48,7 +50,7 @@ fn params(model: &str) -> &'static [(&'static str, f64)] {
     }
 }
 
-const MODELS: [&str; 8] = [
+const MODELS: [&str; 10] = [
     "Dahl",
     "LuGre",
     "ResetIntegrator",
@@ -57,6 +59,8 @@ const MODELS: [&str; 8] = [
     "Classical",
     "BlimanSorine",
     "ElastoPlastic",
+    "MaxwellSlip",
+    "GMS",
 ];
 
 fn outputs(model: &str) -> &'static [&'static str] {
@@ -66,6 +70,7 @@ fn outputs(model: &str) -> &'static [&'static str] {
         "Classical" => &["F", "P_diss"],
         "BlimanSorine" => &["F", "x1", "x2", "P_diss", "E_stored"],
         "ElastoPlastic" => &["F", "z", "P_diss", "E_stored"],
+        "MaxwellSlip" | "GMS" => &["F", "P_diss", "E_stored"],
         _ => &["F", "z"],
     }
 }
@@ -140,6 +145,10 @@ fn directional_derivatives_agree_with_finite_differences() {
     check_step_sensitivity("ElastoPlastic", &[], "F", "v", &[("v", 1e-5)], h);
     check_step_sensitivity("ElastoPlastic", &[], "F", "v", &[("v", -5e-2)], h);
     check_step_sensitivity("Classical", &[], "P_diss", "v", &[("v", -2e-3)], h);
+    // all elements sticking, and gross sliding (every element slipping)
+    check_step_sensitivity("MaxwellSlip", &[], "F", "v", &[("v", 1e-6)], h);
+    check_step_sensitivity("GMS", &[], "F", "v", &[("v", 1e-6)], h);
+    check_step_sensitivity("GMS", &[], "F", "v", &[("v", -5e-2)], h);
     check_step_sensitivity(
         "Classical",
         &[],
@@ -549,6 +558,10 @@ fn invalid_parameters_are_refused_with_name_and_value() {
             &[("z_ba", 2e-5)],
             "z_ba = 0.00002: must be < Fc/sigma0 = 0.00001",
         ),
+        ("MaxwellSlip", &[("n_elements", 101.0)], "n_elements = 101"),
+        ("MaxwellSlip", &[("W[3]", 0.0)], "W = 0: element 3"),
+        ("GMS", &[("alpha[1]", 0.5)], "must sum to 1"),
+        ("GMS", &[("C", 0.0)], "C = 0"),
         (
             "BlimanSorine",
             &[("from_reference_points", 1.0), ("x_e", 3.63e-4)],

@@ -20,6 +20,7 @@ pub mod elasto_plastic;
 pub mod error;
 mod interval;
 pub mod lugre;
+pub mod maxwell_slip;
 pub mod reset_integrator;
 pub mod rng;
 mod state;
