@@ -17,7 +17,9 @@ RIGS = shipped.RIGS
 # their number of event indicators
 MODEL_EXCHANGE_STATES = {"Dahl": (["F_dahl"], 1), "LuGre": (["z"], 1), "ResetIntegrator": (["z"], 2),
                   "Bristle2D": (["z1", "z2"], 1), "BlimanSorine": (["x1", "x2"], 1),
-                  "ElastoPlastic": (["z"], 5)}
+                  "ElastoPlastic": (["z"], 5),
+                  "MaxwellSlip": ([f"F_element[{i}]" for i in range(1, 101)], 101),
+                  "GMS": ([f"F_element[{i}]" for i in range(1, 101)], 101)}
 
 EXPECTED = {
     "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma", "Fc", "alpha", "F_offset"},

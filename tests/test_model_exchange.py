@@ -498,3 +498,32 @@ def test_elasto_plastic_model_exchange_equals_co_simulation(tmp_path):
     z_scale, f_scale = 1.5e-5, 1.5
     assert np.max(np.abs(me[:, 0] - cs[:, 0])) <= 1e-6 * z_scale
     assert np.max(np.abs(me[:, 1] - cs[:, 1])) <= 1e-5 * f_scale
+
+
+@pytest.mark.parametrize("name, amplitude", [("MaxwellSlip", 2e-4), ("GMS", 2e-3)])
+def test_element_laws_events_at_each_switch_and_model_exchange_equals_co_simulation(name, amplitude,
+                                                                                     tmp_path):
+    """Maxwell-slip in pre-sliding loops that slip every element (path
+    amplitude 3.2e-5 m against 1.8e-5 m to slip them all), GMS through
+    gross sliding and the Stribeck curve: CVode with an event at each
+    element's stick/slip switch and at each reversal gives the
+    Co-Simulation FMU's force (exact, or exact for held inputs, over
+    1e-5 s steps)."""
+    def v(t):
+        return {"v": amplitude * math.sin(2 * math.pi * t)}
+
+    outputs = ["F", "E_stored"]
+    run = MeRun(name, tmp_path, {}, inputs=lambda t, xe: v(t), outputs=outputs, rtol=1e-10)
+    times = np.round(np.arange(0, 1501) * 1e-3, 10)
+    me = run.run(times)
+    run.close()
+    # every element reached its slip level (indicators 1..10), and v's
+    # sign changes (indicator 0) stuck them again
+    crossed = {int(k) for _, roots, _, _ in run.events for k in np.flatnonzero(roots)}
+    assert set(range(0, 11)) <= crossed, crossed
+    assert not crossed - set(range(0, 11)), crossed
+    cs = co_simulation(name, tmp_path, v, outputs, 1.5, 1e-5)[::100]
+    level = 1.0 if name == "MaxwellSlip" else 1.5
+    error = np.max(np.abs(me[:, 0] - cs[:, 0])) / level
+    print(f"{name}: Model Exchange - Co-Simulation, {error:.2e} of the level")
+    assert error <= (1e-7 if name == "MaxwellSlip" else 1e-5), error

@@ -71,17 +71,15 @@ pub static REGISTRY: LazyLock<[ModelFactory; 10]> = LazyLock::new(|| {
             create: || Box::new(elasto_plastic::ElastoPlasticFmu::default()),
             create_model_exchange: Some(|| Box::new(elasto_plastic::ElastoPlasticFmu::default())),
         },
-        // Co-Simulation only so far (issue: Model Exchange with an event
-        // at each element's switch is not built yet)
         ModelFactory {
             info: &maxwell_slip::MAXWELL_SLIP_INFO,
             create: || Box::new(maxwell_slip::MaxwellSlipFmu::default()),
-            create_model_exchange: None,
+            create_model_exchange: Some(|| Box::new(maxwell_slip::MaxwellSlipFmu::default())),
         },
         ModelFactory {
             info: &maxwell_slip::GMS_INFO,
             create: || Box::new(maxwell_slip::GmsFmu::default()),
-            create_model_exchange: None,
+            create_model_exchange: Some(|| Box::new(maxwell_slip::GmsFmu::default())),
         },
     ]
 });

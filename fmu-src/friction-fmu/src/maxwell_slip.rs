@@ -3,16 +3,25 @@
 //! Swevers, Al-Bender 2002) slides each element at a constant force
 //! `W_i`; the Generalized Maxwell-Slip model (Al-Bender, Lampaert,
 //! Swevers 2005) at its share `α_i` of the Stribeck curve, with an
-//! attraction `C` that gives frictional lag. Co-Simulation only for
-//! now: Maxwell-slip's update is exact, GMS's exact for a held velocity
-//! with every element's switch located inside the step.
+//! attraction `C` that gives frictional lag. In Co-Simulation,
+//! Maxwell-slip's update is exact, GMS's exact for a held velocity with
+//! every element's switch located inside the step. In Model Exchange the
+//! element forces `F_element[i]` are the continuous states (all 100 are
+//! declared, as FMI 2.0 fixes their number; those past `n_elements` stay
+//! 0), each element's stick/slip switch has an event indicator, and the
+//! reversal is `v`'s.
 //!
 //! The element arrays are `k[i]` and `W[i]` (or `alpha[i]`), `i` =
-//! 1..=100; `n_elements` says how many are used.
+//! 1..=100; `n_elements` says how many are used. Both FMUs are one
+//! generic model, [`ElementsFmu`], over the two laws ([`ElementLaw`]).
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi2_cs::{
+    Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
+    Variable,
+};
 use friction_laws::maxwell_slip::{Gms, GmsParams, MaxwellSlip, MaxwellSlipParams, MAX_ELEMENTS};
+use friction_laws::Ramp;
 use std::sync::LazyLock;
 
 /// Value references: 0..=6 shared by both FMUs, 7..=11 GMS's curve, then
@@ -34,23 +43,46 @@ pub mod vr {
     pub const C: u32 = 11;
 }
 
-/// Where an FMU's arrays start: `k[i]`, i = 1..=100, at `k + i − 1`;
-/// `W[i]` (Maxwell-slip) or `alpha[i]` (GMS) at `second + i − 1`.
+/// Where an FMU's arrays start (each of `MAX_ELEMENTS` values, element
+/// `i` = 1..=100 at `base + i − 1`): `k[i]`; `W[i]` (Maxwell-slip) or
+/// `alpha[i]` (GMS); the states `F_element[i]`; their derivatives.
 #[derive(Clone, Copy)]
 pub struct Layout {
     pub k: u32,
     pub second: u32,
+    pub state: u32,
+    pub derivative: u32,
 }
 
-pub const MAXWELL_SLIP_LAYOUT: Layout = Layout {
-    k: vr::N_ELEMENTS + 1,
-    second: vr::N_ELEMENTS + 1 + MAX_ELEMENTS as u32,
-};
+impl Layout {
+    const fn after(last_scalar: u32) -> Layout {
+        let n = MAX_ELEMENTS as u32;
+        Layout {
+            k: last_scalar + 1,
+            second: last_scalar + 1 + n,
+            state: last_scalar + 1 + 2 * n,
+            derivative: last_scalar + 1 + 3 * n,
+        }
+    }
 
-pub const GMS_LAYOUT: Layout = Layout {
-    k: vr::C + 1,
-    second: vr::C + 1 + MAX_ELEMENTS as u32,
-};
+    /// Element index of a state's value reference.
+    fn state_index(&self, vr: u32) -> Option<usize> {
+        (self.state..self.state + MAX_ELEMENTS as u32)
+            .contains(&vr)
+            .then(|| (vr - self.state) as usize)
+    }
+
+    /// Element index of a derivative's value reference.
+    fn derivative_index(&self, vr: u32) -> Option<usize> {
+        (self.derivative..self.derivative + MAX_ELEMENTS as u32)
+            .contains(&vr)
+            .then(|| (vr - self.derivative) as usize)
+    }
+}
+
+pub const MAXWELL_SLIP_LAYOUT: Layout = Layout::after(vr::N_ELEMENTS);
+
+pub const GMS_LAYOUT: Layout = Layout::after(vr::C);
 
 /// The variables before the arrays.
 fn common(law: &str, sigma2: f64) -> Vec<Variable> {
@@ -147,7 +179,63 @@ fn arrays(
             .with_min(0.0),
         );
     }
+    for i in 0..MAX_ELEMENTS {
+        v.push(Variable::state(
+            at.state + i as u32,
+            name("F_element", i + 1),
+            "N",
+            "Force of element i, the spring k[i] between the body and the element's end on the surface (0 at the start; 0 past n_elements)",
+        ));
+    }
+    let states: &'static [u32] = Box::leak(
+        (0..MAX_ELEMENTS as u32)
+            .map(|i| at.state + i)
+            .collect::<Vec<_>>()
+            .into_boxed_slice(),
+    );
+    for i in 0..MAX_ELEMENTS {
+        v.push(Variable::derivative(
+            at.derivative + i as u32,
+            Box::leak(format!("der(F_element[{}])", i + 1).into_boxed_str()),
+            "N/s",
+            "dF_element[i]/dt: k[i]*v while element i sticks, its slip law while it slips (Model Exchange)",
+            &[vr::V],
+            &states[i..i + 1],
+        ));
+    }
     v
+}
+
+/// The outputs' dependencies on the states (all of them), for the
+/// model structure.
+fn with_states(variables: &mut [Variable], at: Layout) {
+    let states: &'static [u32] = Box::leak(
+        (0..MAX_ELEMENTS as u32)
+            .map(|i| at.state + i)
+            .collect::<Vec<_>>()
+            .into_boxed_slice(),
+    );
+    for v in variables.iter_mut() {
+        if [vr::F, vr::P_DISS, vr::E_STORED].contains(&v.vr) {
+            *v = v.with_state_dependencies(states);
+        }
+    }
+}
+
+/// The Model Exchange declaration: 100 states, an event indicator for
+/// `v` and one per element.
+fn model_exchange(at: Layout) -> ModelExchange {
+    let states: Vec<ContinuousState> = (0..MAX_ELEMENTS as u32)
+        .map(|i| ContinuousState {
+            state: at.state + i,
+            derivative: at.derivative + i,
+        })
+        .collect();
+    ModelExchange {
+        states: Box::leak(states.into_boxed_slice()),
+        event_indicators: 1 + MAX_ELEMENTS,
+        states_jump_at_events: false,
+    }
 }
 
 /// The element arrays' first `n` values.
@@ -185,6 +273,7 @@ pub static MAXWELL_SLIP_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
         "Slip force of element i (> 0): the element sticks until |F_i| reaches it, then slides at it until the motion reverses",
         (d.k, d.w),
     ));
+    with_states(&mut variables, MAXWELL_SLIP_LAYOUT);
     ModelInfo {
         model_name: "MaxwellSlip",
         model_identifier: "MaxwellSlip",
@@ -194,7 +283,7 @@ pub static MAXWELL_SLIP_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
         variables: Box::leak(variables.into_boxed_slice()),
         default_experiment: EXPERIMENT,
         capabilities: Capabilities::FULL,
-        model_exchange: None,
+        model_exchange: Some(model_exchange(MAXWELL_SLIP_LAYOUT)),
     }
 });
 
@@ -230,6 +319,7 @@ pub static GMS_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
         "Weight of element i (> 0; the n_elements weights sum to 1): the element sticks until sgn(v)*F_i reaches alpha[i]*s(v), then slips towards it until the motion reverses",
         (d.k, d.alpha),
     ));
+    with_states(&mut variables, GMS_LAYOUT);
     ModelInfo {
         model_name: "GMS",
         model_identifier: "GMS",
@@ -239,30 +329,105 @@ pub static GMS_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
         variables: Box::leak(variables.into_boxed_slice()),
         default_experiment: EXPERIMENT,
         capabilities: Capabilities::FULL,
-        model_exchange: None,
+        model_exchange: Some(model_exchange(GMS_LAYOUT)),
     }
 });
 
-#[derive(Clone, Debug)]
-pub struct MaxwellSlipFmu {
-    law: MaxwellSlip,
+/// What the FMU layer needs of an element law (the two laws' methods of
+/// the same names).
+pub trait ElementLaw: Clone + std::fmt::Debug + Send + 'static {
+    fn info() -> &'static ModelInfo;
+    fn layout() -> Layout;
+    fn default_law() -> Self;
+    /// The law from the parameters in `values` (`n_elements` checked).
+    fn from_values(values: &Values) -> Result<Self, String>;
+    /// The slip level of element `i` at rest, from the parameters in
+    /// `values` (a state's nominal scale).
+    fn nominal(values: &Values, i: usize) -> f64;
+    fn k(&self) -> &[f64];
+    fn sigma2(&self) -> f64;
+    fn forces(&self) -> &[f64];
+    fn set_forces(&mut self, f: &[f64]);
+    fn step(&mut self, v: Ramp, h: f64);
+    fn force(&self, v: f64) -> f64;
+    fn dissipated_power(&self, v: f64) -> f64;
+    fn stored_energy(&self) -> f64;
+    fn slips(&self, i: usize, v: f64) -> bool;
+    fn rate(&self, i: usize, v: f64) -> f64;
+    fn rate_partials(&self, i: usize, v: f64) -> (f64, f64);
+    fn update_modes(&mut self, v: f64) -> bool;
+    fn indicator(&self, i: usize, v: f64) -> f64;
+    fn state_len(&self) -> usize;
+    fn write_state_into(&self, out: &mut [f64]);
+    fn state_is_finite(&self) -> bool;
+    fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String>;
 }
 
-impl Default for MaxwellSlipFmu {
-    fn default() -> Self {
-        MaxwellSlipFmu {
-            law: MaxwellSlip::new(MaxwellSlipParams::default())
-                .expect("default parameters are valid"),
+/// The trait's methods that both laws have under the same names.
+macro_rules! element_law_methods {
+    () => {
+        fn forces(&self) -> &[f64] {
+            self.element_forces()
         }
-    }
+        fn set_forces(&mut self, f: &[f64]) {
+            self.set_element_forces(f)
+        }
+        fn step(&mut self, v: Ramp, h: f64) {
+            Self::step(self, v, h)
+        }
+        fn force(&self, v: f64) -> f64 {
+            Self::force(self, v)
+        }
+        fn dissipated_power(&self, v: f64) -> f64 {
+            Self::dissipated_power(self, v)
+        }
+        fn stored_energy(&self) -> f64 {
+            Self::stored_energy(self)
+        }
+        fn rate(&self, i: usize, v: f64) -> f64 {
+            self.element_rate(i, v)
+        }
+        fn rate_partials(&self, i: usize, v: f64) -> (f64, f64) {
+            self.element_rate_partials(i, v)
+        }
+        fn update_modes(&mut self, v: f64) -> bool {
+            Self::update_modes(self, v)
+        }
+        fn indicator(&self, i: usize, v: f64) -> f64 {
+            self.element_indicator(i, v)
+        }
+        fn state_len(&self) -> usize {
+            Self::state_len(self)
+        }
+        fn write_state_into(&self, out: &mut [f64]) {
+            Self::write_state_into(self, out)
+        }
+        fn state_is_finite(&self) -> bool {
+            Self::state_is_finite(self)
+        }
+        fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
+            Self::state_from_slice(self, s)
+        }
+        fn k(&self) -> &[f64] {
+            &self.params().k
+        }
+        fn sigma2(&self) -> f64 {
+            self.params().sigma2
+        }
+    };
 }
 
-impl Model for MaxwellSlipFmu {
-    fn info(&self) -> &'static ModelInfo {
+impl ElementLaw for MaxwellSlip {
+    fn info() -> &'static ModelInfo {
         &MAXWELL_SLIP_INFO
     }
-
-    fn initialize(&mut self, values: &Values) -> Result<(), String> {
+    fn layout() -> Layout {
+        MAXWELL_SLIP_LAYOUT
+    }
+    fn default_law() -> Self {
+        MaxwellSlip::new(MaxwellSlipParams::default()).expect("default parameters are valid")
+    }
+    fn from_values(values: &Values) -> Result<Self, String> {
         check_count(values)?;
         let (k, w) = element_arrays(values, MAXWELL_SLIP_LAYOUT);
         let p = MaxwellSlipParams {
@@ -270,60 +435,28 @@ impl Model for MaxwellSlipFmu {
             w,
             sigma2: values.real(vr::SIGMA2),
         };
-        self.law = MaxwellSlip::new(p).map_err(param_err)?;
-        Ok(())
+        MaxwellSlip::new(p).map_err(param_err)
     }
-
-    fn compute_outputs(&self, values: &mut Values) {
-        let v = values.real(vr::V);
-        values.set(vr::F, self.law.force(v));
-        values.set(vr::P_DISS, self.law.dissipated_power(v));
-        values.set(vr::E_STORED, self.law.stored_energy());
-        values.set_integer(vr::N_SLIPPING, self.law.slipping_count(v) as i32);
+    fn nominal(values: &Values, i: usize) -> f64 {
+        values.real(MAXWELL_SLIP_LAYOUT.second + i as u32)
     }
-
-    fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
-        self.law.step(input_ramp(values, slopes, vr::V), h);
-        Ok(())
+    fn slips(&self, i: usize, v: f64) -> bool {
+        self.slipping(i, v)
     }
-
-    fmi2_cs::delegate_state!(law);
-
-    /// Directional derivatives of a step by replaying it (the step
-    /// moves the element forces with `v`).
-    fn supplies_partial_derivatives(&self) -> bool {
-        false
-    }
-
-    /// `dF/dt = Σ Ḟ_i + σ2·dv/dt`.
-    fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {
-        let v = values.real(vr::V);
-        let elements: f64 = (0..self.law.params().k.len())
-            .map(|i| self.law.element_rate(i, v))
-            .sum();
-        (output == vr::F).then(|| elements + self.law.params().sigma2 * slopes[vr::V as usize])
-    }
+    element_law_methods!();
 }
 
-#[derive(Clone, Debug)]
-pub struct GmsFmu {
-    law: Gms,
-}
-
-impl Default for GmsFmu {
-    fn default() -> Self {
-        GmsFmu {
-            law: Gms::new(GmsParams::default()).expect("default parameters are valid"),
-        }
-    }
-}
-
-impl Model for GmsFmu {
-    fn info(&self) -> &'static ModelInfo {
+impl ElementLaw for Gms {
+    fn info() -> &'static ModelInfo {
         &GMS_INFO
     }
-
-    fn initialize(&mut self, values: &Values) -> Result<(), String> {
+    fn layout() -> Layout {
+        GMS_LAYOUT
+    }
+    fn default_law() -> Self {
+        Gms::new(GmsParams::default()).expect("default parameters are valid")
+    }
+    fn from_values(values: &Values) -> Result<Self, String> {
         check_count(values)?;
         let (k, alpha) = element_arrays(values, GMS_LAYOUT);
         let p = GmsParams {
@@ -336,7 +469,46 @@ impl Model for GmsFmu {
             c: values.real(vr::C),
             sigma2: values.real(vr::SIGMA2),
         };
-        self.law = Gms::new(p).map_err(param_err)?;
+        Gms::new(p).map_err(param_err)
+    }
+    fn nominal(values: &Values, i: usize) -> f64 {
+        values.real(GMS_LAYOUT.second + i as u32) * values.real(vr::FS)
+    }
+    fn slips(&self, i: usize, _v: f64) -> bool {
+        self.slipping(i)
+    }
+    element_law_methods!();
+}
+
+/// An FMU of `n` elements in parallel: `MaxwellSlip.fmu` with
+/// `L = MaxwellSlip`, `GMS.fmu` with `L = Gms`.
+#[derive(Clone, Debug)]
+pub struct ElementsFmu<L: ElementLaw> {
+    law: L,
+    /// The Model Exchange states past `n_elements`: kept as the importer
+    /// set them (their derivatives are 0; nothing reads them).
+    unused: Vec<f64>,
+}
+
+pub type MaxwellSlipFmu = ElementsFmu<MaxwellSlip>;
+pub type GmsFmu = ElementsFmu<Gms>;
+
+impl<L: ElementLaw> Default for ElementsFmu<L> {
+    fn default() -> Self {
+        let law = L::default_law();
+        let unused = vec![0.0; MAX_ELEMENTS - law.forces().len()];
+        ElementsFmu { law, unused }
+    }
+}
+
+impl<L: ElementLaw> Model for ElementsFmu<L> {
+    fn info(&self) -> &'static ModelInfo {
+        L::info()
+    }
+
+    fn initialize(&mut self, values: &Values) -> Result<(), String> {
+        self.law = L::from_values(values)?;
+        self.unused = vec![0.0; MAX_ELEMENTS - self.law.forces().len()];
         Ok(())
     }
 
@@ -345,7 +517,13 @@ impl Model for GmsFmu {
         values.set(vr::F, self.law.force(v));
         values.set(vr::P_DISS, self.law.dissipated_power(v));
         values.set(vr::E_STORED, self.law.stored_energy());
-        values.set_integer(vr::N_SLIPPING, self.law.slipping_count() as i32);
+        let n = self.law.forces().len();
+        let slipping = (0..n).filter(|&i| self.law.slips(i, v)).count();
+        values.set_integer(vr::N_SLIPPING, slipping as i32);
+        let at = L::layout();
+        for (i, f) in self.law.forces().iter().chain(&self.unused).enumerate() {
+            values.set(at.state + i as u32, *f);
+        }
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
@@ -353,9 +531,53 @@ impl Model for GmsFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    // the law's state, then the unused Model Exchange states
+    fn save_state(&self, out: &mut Vec<f64>) {
+        let start = out.len();
+        out.resize(start + self.law.state_len(), 0.0);
+        self.law.write_state_into(&mut out[start..]);
+        out.extend_from_slice(&self.unused);
+    }
 
-    /// Directional derivatives of a step by replaying it.
+    fn state_len(&self) -> Option<usize> {
+        Some(self.law.state_len() + self.unused.len())
+    }
+
+    fn write_state_into(&self, out: &mut [f64]) {
+        let (law, unused) = out.split_at_mut(self.law.state_len());
+        self.law.write_state_into(law);
+        unused.copy_from_slice(&self.unused);
+    }
+
+    fn state_is_finite(&self) -> Option<bool> {
+        Some(self.law.state_is_finite() && self.unused.iter().all(|x| x.is_finite()))
+    }
+
+    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+        let n = self.law.state_len();
+        let expected = n + self.unused.len();
+        if state.len() != expected {
+            return Err(format!(
+                "state has {} values, {} expected (the law's {n} and {} unused Model Exchange states)",
+                state.len(),
+                expected,
+                self.unused.len()
+            ));
+        }
+        if let Some(x) = state[n..].iter().find(|x| !x.is_finite()) {
+            return Err(format!("an unused Model Exchange state is {x}, not finite"));
+        }
+        self.law.state_from_slice(&state[..n])?;
+        self.unused.copy_from_slice(&state[n..]);
+        Ok(())
+    }
+
+    fn clone_model(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
+
+    /// Directional derivatives of a step by replaying it (the step
+    /// moves the element forces with `v`).
     fn supplies_partial_derivatives(&self) -> bool {
         false
     }
@@ -363,9 +585,108 @@ impl Model for GmsFmu {
     /// `dF/dt = Σ Ḟ_i + σ2·dv/dt`.
     fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {
         let v = values.real(vr::V);
-        let elements: f64 = (0..self.law.params().k.len())
-            .map(|i| self.law.element_rate(i, v))
-            .sum();
-        (output == vr::F).then(|| elements + self.law.params().sigma2 * slopes[vr::V as usize])
+        let n = self.law.forces().len();
+        let elements: f64 = (0..n).map(|i| self.law.rate(i, v)).sum();
+        (output == vr::F).then(|| elements + self.law.sigma2() * slopes[vr::V as usize])
+    }
+
+    /// `Ḟ_i` in the current modes; 0 past `n_elements`.
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        let v = values.real(vr::V);
+        let n = self.law.forces().len();
+        for (i, d) in dx.iter_mut().enumerate() {
+            *d = if i < n { self.law.rate(i, v) } else { 0.0 };
+        }
+    }
+
+    fmi2_cs::ode_is_self!();
+}
+
+/// Model Exchange: the states are the element forces; indicator 0 is
+/// `v` (a reversal sticks the slipping elements), indicator `i` the
+/// element's distance to its slip level while it sticks (1 while it
+/// slips, and past `n_elements`); the event update switches the modes.
+impl<L: ElementLaw> Ode for ElementsFmu<L> {
+    fn continuous_states(&self, x: &mut [f64]) {
+        let n = self.law.forces().len();
+        x[..n].copy_from_slice(self.law.forces());
+        x[n..].copy_from_slice(&self.unused);
+    }
+
+    /// The first `n_elements` states are the element forces; the others
+    /// are kept as given.
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        let n = self.law.forces().len();
+        self.law.set_forces(&x[..n]);
+        self.unused.copy_from_slice(&x[n..]);
+        Ok(())
+    }
+
+    fn event_indicators(&self, values: &Values, z: &mut [f64]) {
+        let v = values.real(vr::V);
+        let n = self.law.forces().len();
+        z[0] = v;
+        for (i, z) in z[1..].iter_mut().enumerate() {
+            *z = if i < n { self.law.indicator(i, v) } else { 1.0 };
+        }
+    }
+
+    /// Each element force on the scale of its slip level at rest.
+    fn nominals(&self, values: &Values, nominal: &mut [f64]) {
+        for (i, n) in nominal.iter_mut().enumerate() {
+            *n = L::nominal(values, i);
+        }
+    }
+
+    /// Switches the modes; the forces do not jump.
+    fn event_update(&mut self, values: &Values) -> bool {
+        self.law.update_modes(values.real(vr::V));
+        false
+    }
+
+    /// In closed form: `der(F_element[i])` has `∂/∂F_i` and `∂/∂v` from
+    /// the law; `F = Σ F_i + σ2·v`; `E_stored = Σ F_i²/(2·k_i)`;
+    /// `P_diss = Σ_slipping F_i·(v − Ḟ_i/k_i) + σ2·v²`. Past
+    /// `n_elements` every partial is 0.
+    fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
+        let v = values.real(vr::V);
+        let at = L::layout();
+        let n = self.law.forces().len();
+        let f = self.law.forces();
+        let k = self.law.k();
+        // the state known: Some(i) for element i, None for v
+        let by_state = match at.state_index(known) {
+            Some(i) => Some(i),
+            None if known == vr::V => None,
+            None => return None,
+        };
+        if let Some(i) = at.derivative_index(unknown) {
+            return Some(match by_state {
+                _ if i >= n => 0.0,
+                Some(j) if j != i => 0.0,
+                Some(_) => self.law.rate_partials(i, v).0,
+                None => self.law.rate_partials(i, v).1,
+            });
+        }
+        let slipping = |i: usize| i < n && self.law.slips(i, v);
+        Some(match (unknown, by_state) {
+            (vr::F, Some(i)) => (i < n) as u8 as f64,
+            (vr::F, None) => self.law.sigma2(),
+            (vr::E_STORED, Some(i)) if i < n => f[i] / k[i],
+            (vr::E_STORED, _) => 0.0,
+            (vr::P_DISS, Some(i)) if slipping(i) => {
+                let (by_f, _) = self.law.rate_partials(i, v);
+                v - self.law.rate(i, v) / k[i] - f[i] * by_f / k[i]
+            }
+            (vr::P_DISS, Some(_)) => 0.0,
+            (vr::P_DISS, None) => {
+                let elements: f64 = (0..n)
+                    .filter(|&i| slipping(i))
+                    .map(|i| f[i] * (1.0 - self.law.rate_partials(i, v).1 / k[i]))
+                    .sum();
+                elements + 2.0 * self.law.sigma2() * v
+            }
+            _ => return None,
+        })
     }
 }

@@ -73,6 +73,18 @@ impl Me {
         x
     }
 
+    fn get_integer(&self, name: &str) -> i32 {
+        let mut x = 0;
+        let vr = self.vr(name);
+        assert_eq!(
+            unsafe { fmi2GetInteger(self.c, &vr, 1, &mut x) },
+            OK,
+            "{}",
+            last_error()
+        );
+        x
+    }
+
     fn nx(&self) -> usize {
         self.info.model_exchange.unwrap().states.len()
     }
@@ -421,6 +433,48 @@ fn elasto_plastic_partials_match_differences() {
     }
 }
 
+/// Maxwell-slip and GMS with element 1 slipping (put at its level and
+/// switched by an event) and the others sticking, in both directions.
+#[test]
+fn element_laws_partials_match_differences() {
+    for model in ["MaxwellSlip", "GMS"] {
+        for v in [2e-4, -1.5e-3] {
+            let me = Me::new(model, &[]);
+            me.set("v", v);
+            let level = if model == "GMS" {
+                // alpha[1]*s(v), s(v) = Fc + (Fs - Fc)*exp(-(v/vs)^2)
+                (1.0 + 0.5 * (-(v / 1e-3f64).powi(2)).exp()) / 55.0
+            } else {
+                me.get("W[1]")
+            };
+            let mut x = vec![0.0; me.nx()];
+            x[0] = v.signum() * level;
+            x[1] = 0.3 * me.get("k[2]") * 1e-6;
+            x[2] = -0.2 * me.get("k[3]") * 1e-6;
+            me.set_states(&x);
+            me.event();
+            assert_eq!(me.get_integer("n_slipping"), 1, "{model}");
+            // off the level, so that the attraction acts (GMS)
+            x[0] *= 0.97;
+            me.set_states(&x);
+            let context = format!("{model} at v {v}");
+            check_partials(
+                &me,
+                &[
+                    ("der(F_element[1])", 1.0),
+                    ("der(F_element[2])", 1.0),
+                    ("F", 1.0),
+                    ("P_diss", 1e-4),
+                    ("E_stored", 1e-8),
+                ],
+                &[("F_element[1]", 1e-6), ("F_element[2]", 1e-6), ("v", 1e-9)],
+                1e-6,
+                &context,
+            );
+        }
+    }
+}
+
 /// The 2-D bristle inside the disc and sliding on its boundary (reached by
 /// an event: the contact state is a discrete state), isotropic and not.
 #[test]
@@ -539,6 +593,67 @@ fn the_right_hand_side_is_the_one_the_step_integrates() {
                 (slope - dx[k]).abs() <= 1e-5 * dx[k].abs(),
                 "{model}: {s} moved at {slope}, der {}",
                 dx[k]
+            );
+        }
+    }
+}
+
+/// The same for the element laws, whose modes are discrete states: a
+/// Co-Simulation instance driven until some elements slip and others
+/// stick, then a Model Exchange instance given its element forces and one
+/// event iteration (which sets the modes from the forces) has the same
+/// `der(F_element[i])` for all 100 states, bit for bit, and the same
+/// outputs; a tiny step moves each force by its derivative. Then the
+/// reversal: an event at `v < 0` sticks every element.
+#[test]
+fn element_laws_right_hand_side_is_the_one_the_step_integrates() {
+    for (model, v) in [("MaxwellSlip", 2e-4), ("GMS", -3e-4)] {
+        let mut cs = Fmu::new(model, &[]);
+        cs.set("v", v);
+        cs.step(6e-2);
+        let slipping = cs.get_any("n_slipping");
+        assert!(
+            slipping > 0.0 && slipping < 10.0,
+            "{model}: {slipping} slip"
+        );
+        let me = Me::new(model, &[]);
+        me.set("v", v);
+        let names: Vec<String> = (1..=100).map(|i| format!("F_element[{i}]")).collect();
+        let x: Vec<f64> = names.iter().map(|s| cs.get(s)).collect();
+        me.set_states(&x);
+        me.event();
+        assert_eq!(me.states(), x, "{model}: the event moved a force");
+        let dx = me.derivatives();
+        for (k, s) in names.iter().enumerate() {
+            let der = cs.get(&format!("der({s})"));
+            assert_eq!(dx[k].to_bits(), der.to_bits(), "{model}: der({s})");
+        }
+        assert!(dx[..10].iter().any(|d| *d != 0.0), "{model}: nothing moves");
+        for o in ["F", "P_diss", "E_stored"] {
+            assert_eq!(me.get(o).to_bits(), cs.get(o).to_bits(), "{model}: {o}");
+        }
+        assert_eq!(me.get_integer("n_slipping") as f64, slipping, "{model}");
+        let h = 1e-9;
+        cs.step(h);
+        for (k, s) in names.iter().enumerate().take(10) {
+            let slope = (cs.get(s) - x[k]) / h;
+            assert!(
+                (slope - dx[k]).abs() <= 1e-5 * dx[k].abs().max(1e-3),
+                "{model}: {s} moved at {slope}, der {}",
+                dx[k]
+            );
+        }
+        // the reversal sticks every element: each loads at k[i]*v
+        me.set("v", -v);
+        me.event();
+        assert_eq!(me.get_integer("n_slipping"), 0, "{model}");
+        let dx = me.derivatives();
+        for (k, d) in dx.iter().enumerate().take(10) {
+            assert_eq!(
+                *d,
+                cs.get(&format!("k[{}]", k + 1)) * -v,
+                "{model}: element {}",
+                k + 1
             );
         }
     }

@@ -136,19 +136,108 @@ impl MaxwellSlipParams {
     }
 }
 
-/// Maxwell-slip state: the element forces `F_i` (N), `|F_i| ≤ W_i`.
+/// Maxwell-slip state: the element forces `F_i` (N) and each element's
+/// mode: 0 sticking, `±1` sliding in that direction (at `±W_i`).
 #[derive(Clone, Debug)]
 pub struct MaxwellSlip {
     p: MaxwellSlipParams,
     f: Vec<f64>,
+    mode: Vec<f64>,
+}
+
+/// How close to its slip level an element must be, relative to it, for
+/// a Model Exchange event to start its slip (an integrator locates the
+/// crossing to its own tolerance).
+const SLIP_START_TOLERANCE: f64 = 1e-9;
+
+/// `1`, `-1` or `0` (for 0 and NaN).
+fn sign(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// The mode updates of a Model Exchange event, shared by both laws: an
+/// element whose force reached `level(i)` in the direction of motion
+/// starts slipping; a slipping element whose motion reversed (or
+/// stopped) sticks. Returns whether a mode changed.
+fn update_modes(f: &[f64], mode: &mut [f64], v: f64, level: impl Fn(usize) -> f64) -> bool {
+    let s = sign(v);
+    let mut changed = false;
+    for i in 0..f.len() {
+        let next = if mode[i] != 0.0 {
+            if mode[i] == s {
+                s
+            } else {
+                0.0
+            }
+        } else if s != 0.0 && s * f[i] >= level(i) * (1.0 - SLIP_START_TOLERANCE) {
+            s
+        } else {
+            0.0
+        };
+        changed |= next != mode[i];
+        mode[i] = next;
+    }
+    changed
+}
+
+/// Writes forces then modes.
+fn write_forces_and_modes(f: &[f64], mode: &[f64], out: &mut [f64]) {
+    let n = f.len();
+    out[..n].copy_from_slice(f);
+    out[n..].copy_from_slice(mode);
+}
+
+/// Restores forces (finite) and modes (each 0, 1 or −1) of law `law`.
+fn read_forces_and_modes(
+    law: &str,
+    s: &[f64],
+    f: &mut [f64],
+    mode: &mut [f64],
+) -> Result<(), String> {
+    let n = f.len();
+    if s.len() != 2 * n {
+        return Err(format!(
+            "{law} state has {} values (a force and a mode per element), got {}",
+            2 * n,
+            s.len()
+        ));
+    }
+    if let Some(i) = s[..n].iter().position(|f| !f.is_finite()) {
+        return Err(format!(
+            "{law} state: element {} force {} is not finite",
+            i + 1,
+            s[i]
+        ));
+    }
+    if let Some(i) = s[n..].iter().position(|m| ![0.0, 1.0, -1.0].contains(m)) {
+        return Err(format!(
+            "{law} state: element {} mode {} is not 0 (sticking), 1 or -1 (slipping)",
+            i + 1,
+            s[n + i]
+        ));
+    }
+    f.copy_from_slice(&s[..n]);
+    mode.copy_from_slice(&s[n..]);
+    Ok(())
 }
 
 impl MaxwellSlip {
-    /// A relaxed contact (every `F_i = 0`) with validated parameters.
+    /// A relaxed contact (every `F_i = 0`, every element sticking) with
+    /// validated parameters.
     pub fn new(p: MaxwellSlipParams) -> Result<Self, ParamError> {
         p.validate()?;
-        let f = vec![0.0; p.k.len()];
-        Ok(MaxwellSlip { p, f })
+        let n = p.k.len();
+        Ok(MaxwellSlip {
+            p,
+            f: vec![0.0; n],
+            mode: vec![0.0; n],
+        })
     }
 
     pub fn params(&self) -> &MaxwellSlipParams {
@@ -162,24 +251,28 @@ impl MaxwellSlip {
 
     /// Advances over `[0, h]` with `v(τ) = v.value + v.slope·τ`: on each
     /// one-sign piece, `F_i ← F_i + k_i·Δx` clipped at `sgn(Δx)·W_i`
-    /// (exact: the law depends on the path, not on its speed).
+    /// (exact: the law depends on the path, not on its speed); an element
+    /// clipped ends the piece sliding, any other sticking.
     pub fn step(&mut self, v: Ramp, h: f64) {
         crate::interval::each_one_sign_displacement(v, h, |s, u| {
-            for ((f, k), w) in self.f.iter_mut().zip(&self.p.k).zip(&self.p.w) {
-                let moved = *f + s * k * u;
-                *f = if s > 0.0 {
-                    moved.min(*w)
+            for i in 0..self.f.len() {
+                let (k, w) = (self.p.k[i], self.p.w[i]);
+                let moved = self.f[i] + s * k * u;
+                if s * moved >= w {
+                    self.f[i] = s * w;
+                    self.mode[i] = s;
                 } else {
-                    moved.max(-w)
-                };
+                    self.f[i] = moved;
+                    self.mode[i] = 0.0;
+                }
             }
         });
     }
 
-    /// Whether element `i` slides at velocity `v`: at its slip force,
-    /// pushed further.
+    /// Whether element `i` slides at velocity `v`: it slid into its slip
+    /// force in the direction of `v`.
     pub fn slipping(&self, i: usize, v: f64) -> bool {
-        v != 0.0 && v.signum() * self.f[i] >= self.p.w[i]
+        self.mode[i] != 0.0 && self.mode[i] == sign(v)
     }
 
     /// The number of sliding elements at velocity `v`.
@@ -192,11 +285,6 @@ impl MaxwellSlip {
         self.f.iter().sum::<f64>() + self.p.sigma2 * v
     }
 
-    /// `∂F/∂v = σ2` (the element forces depend on the path only).
-    pub fn force_by_v(&self) -> f64 {
-        self.p.sigma2
-    }
-
     /// `Ḟ_i`: `k_i·v` sticking, 0 sliding.
     pub fn element_rate(&self, i: usize, v: f64) -> f64 {
         if self.slipping(i, v) {
@@ -206,62 +294,70 @@ impl MaxwellSlip {
         }
     }
 
+    /// `(∂Ḟ_i/∂F_i, ∂Ḟ_i/∂v)`: `(0, k_i)` sticking, `(0, 0)` sliding.
+    pub fn element_rate_partials(&self, i: usize, v: f64) -> (f64, f64) {
+        if self.slipping(i, v) {
+            (0.0, 0.0)
+        } else {
+            (0.0, self.p.k[i])
+        }
+    }
+
     /// The elastic energy of the elements, `Σ F_i²/(2·k_i)` (J).
     pub fn stored_energy(&self) -> f64 {
         spring_energy(&self.p.k, &self.f)
     }
 
-    /// `P_diss = F·v − dE/dt = Σ_sliding W_i·|v| + σ2·v²` (W): never
-    /// negative.
+    /// `P_diss = F·v − dE/dt = Σ_sliding F_i·v + σ2·v²` (W), which is
+    /// `Σ_sliding W_i·|v| + σ2·v²`: never negative.
     pub fn dissipated_power(&self, v: f64) -> f64 {
         let sliding: f64 = (0..self.f.len())
             .filter(|&i| self.slipping(i, v))
-            .map(|i| self.p.w[i])
+            .map(|i| self.f[i])
             .sum();
-        sliding * v.abs() + self.p.sigma2 * v * v
+        sliding * v + self.p.sigma2 * v * v
     }
 
-    /// The state: the `n` element forces.
+    /// Model Exchange event handling ([`update_modes`] at the levels
+    /// `W_i`). Returns whether a mode changed.
+    pub fn update_modes(&mut self, v: f64) -> bool {
+        let w = &self.p.w;
+        update_modes(&self.f, &mut self.mode, v, |i| w[i])
+    }
+
+    /// Model Exchange event indicator of element `i`: `W_i − |F_i|` while
+    /// it sticks (zero when it reaches its slip force), 1 while it slides
+    /// (its switch back is the reversal, `v`'s own indicator).
+    pub fn element_indicator(&self, i: usize, _v: f64) -> f64 {
+        if self.mode[i] == 0.0 {
+            self.p.w[i] - self.f[i].abs()
+        } else {
+            1.0
+        }
+    }
+
+    /// Sets the element forces (Model Exchange states: an integrator may
+    /// overshoot a slip force by its tolerance, which is kept).
+    pub fn set_element_forces(&mut self, f: &[f64]) {
+        self.f.copy_from_slice(f);
+    }
+
+    /// The state: `n` element forces, then `n` modes.
     pub fn state_len(&self) -> usize {
-        self.f.len()
+        2 * self.f.len()
     }
 
     pub fn write_state_into(&self, out: &mut [f64]) {
-        out.copy_from_slice(&self.f);
+        write_forces_and_modes(&self.f, &self.mode, out);
     }
 
     pub fn state_is_finite(&self) -> bool {
         self.f.iter().all(|f| f.is_finite())
     }
 
-    /// Restores the element forces: `n` values, each within `±W_i`.
+    /// Restores forces (finite) and modes (each 0, 1 or −1).
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
-        if s.len() != self.f.len() {
-            return Err(format!(
-                "MaxwellSlip state has {} values (one per element), got {}",
-                self.f.len(),
-                s.len()
-            ));
-        }
-        for (i, (&f, w)) in s.iter().zip(&self.p.w).enumerate() {
-            if f.is_nan() || f.abs() > *w {
-                return Err(format!(
-                    "MaxwellSlip state: element {} force {f} is not within its slip force +-{w}",
-                    i + 1
-                ));
-            }
-        }
-        self.f.copy_from_slice(s);
-        Ok(())
-    }
-
-    /// Sets element forces directly (Model Exchange states), each
-    /// clipped to `±W_i`: an integrator may overshoot a slip force by its
-    /// tolerance.
-    pub fn set_element_forces(&mut self, f: &[f64]) {
-        for ((dst, src), w) in self.f.iter_mut().zip(f).zip(&self.p.w) {
-            *dst = src.clamp(-w, *w);
-        }
+        read_forces_and_modes("MaxwellSlip", s, &mut self.f, &mut self.mode)
     }
 }
 
@@ -395,6 +491,11 @@ impl Gms {
         self.mode[i] != 0.0
     }
 
+    /// The slip level of element `i` at rest, `α_i·Fs` (its largest).
+    pub fn static_level(&self, i: usize) -> f64 {
+        self.p.alpha[i] * self.p.fs
+    }
+
     /// The number of slipping elements.
     pub fn slipping_count(&self) -> usize {
         self.mode.iter().filter(|m| **m != 0.0).count()
@@ -482,7 +583,7 @@ impl Gms {
             return (0.0, self.p.k[i]);
         }
         if v == 0.0 {
-            return (-self.p.c / self.level(v), 0.0);
+            return (0.0, 0.0); // slipping at rest: Ḟ_i = 0 until the event sticks it
         }
         let s = self.level(v);
         (
@@ -491,36 +592,12 @@ impl Gms {
         )
     }
 
-    /// Model Exchange event handling: an element whose force reached
-    /// its level in the direction of motion starts slipping; a slipping
-    /// element whose motion reversed (or stopped) sticks. Returns whether
-    /// a mode changed.
+    /// Model Exchange event handling ([`update_modes`] at the levels
+    /// `α_i·s(v)`). Returns whether a mode changed.
     pub fn update_modes(&mut self, v: f64) -> bool {
-        let mut changed = false;
-        let s = if v > 0.0 {
-            1.0
-        } else if v < 0.0 {
-            -1.0
-        } else {
-            0.0
-        };
         let level = self.level(v);
-        for i in 0..self.f.len() {
-            let next = if self.mode[i] != 0.0 {
-                if self.mode[i] == s {
-                    s
-                } else {
-                    0.0
-                }
-            } else if s != 0.0 && s * self.f[i] >= self.p.alpha[i] * level * (1.0 - 1e-12) {
-                s
-            } else {
-                0.0
-            };
-            changed |= next != self.mode[i];
-            self.mode[i] = next;
-        }
-        changed
+        let alpha = &self.p.alpha;
+        update_modes(&self.f, &mut self.mode, v, |i| alpha[i] * level)
     }
 
     /// Model Exchange event indicator of element `i`: `α_i·s(v) − |F_i|`
@@ -562,9 +639,7 @@ impl Gms {
     }
 
     pub fn write_state_into(&self, out: &mut [f64]) {
-        let n = self.f.len();
-        out[..n].copy_from_slice(&self.f);
-        out[n..].copy_from_slice(&self.mode);
+        write_forces_and_modes(&self.f, &self.mode, out);
     }
 
     pub fn state_is_finite(&self) -> bool {
@@ -573,31 +648,7 @@ impl Gms {
 
     /// Restores forces (finite) and modes (each 0, 1 or −1).
     pub fn state_from_slice(&mut self, s: &[f64]) -> Result<(), String> {
-        let n = self.f.len();
-        if s.len() != 2 * n {
-            return Err(format!(
-                "GMS state has {} values (a force and a mode per element), got {}",
-                2 * n,
-                s.len()
-            ));
-        }
-        if let Some(i) = s[..n].iter().position(|f| !f.is_finite()) {
-            return Err(format!(
-                "GMS state: element {} force {} is not finite",
-                i + 1,
-                s[i]
-            ));
-        }
-        if let Some(i) = s[n..].iter().position(|m| ![0.0, 1.0, -1.0].contains(m)) {
-            return Err(format!(
-                "GMS state: element {} mode {} is not 0 (sticking), 1 or -1 (slipping)",
-                i + 1,
-                s[n + i]
-            ));
-        }
-        self.f.copy_from_slice(&s[..n]);
-        self.mode.copy_from_slice(&s[n..]);
-        Ok(())
+        read_forces_and_modes("GMS", s, &mut self.f, &mut self.mode)
     }
 }
 
@@ -797,6 +848,6 @@ mod tests {
             .contains("mode 0.5"));
         let mut m = maxwell();
         let e = m.state_from_slice(&[2.0; 10]).unwrap_err();
-        assert!(e.contains("slip force"), "{e}");
+        assert!(e.contains("20 values"), "{e}");
     }
 }

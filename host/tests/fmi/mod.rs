@@ -457,9 +457,11 @@ pub fn call_function(i: &Instance, function: &str, input: Vr, output: Vr, start:
             }
             "fmi2SerializeFMUstate" => {
                 let (_, st) = i.get_state();
-                let mut bytes = vec![0u8; 4096];
                 let mut size = 0;
                 (a.serialized_fmu_state_size)(c, st, &mut size);
+                // as large as the FMU says (GMS's state, with its 400
+                // element variables, is over 6 kB)
+                let mut bytes = vec![0u8; size];
                 let s = (a.serialize_fmu_state)(c, st, bytes.as_mut_ptr() as _, size);
                 i.free_state(st);
                 s
