@@ -22,17 +22,18 @@ MODEL_EXCHANGE_STATES = {"Dahl": (["F_dahl"], 1), "LuGre": (["z"], 1), "ResetInt
                   "GMS": ([f"F_element[{i}]" for i in range(1, 101)], 101)}
 
 EXPECTED = {
-    "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma", "Fc", "alpha", "F_offset"},
+    "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding", "P_diss", "E_stored"}, "parameter": {"sigma", "Fc", "alpha", "F_offset"},
              "local": {"F_dahl", "der(F_dahl)"}},
-    "LuGre": {"input": {"v", "x", "Fn"}, "output": {"F", "z", "sliding"},
+    "LuGre": {"input": {"v", "x", "Fn"}, "output": {"F", "z", "sliding", "P_diss", "E_stored"},
               "parameter": {"sigma0", "sigma1", "sigma2", "Fc", "Fs", "vs", "stribeck_exponent", "vd",
                             "direction_dependent", "Fc_neg", "Fs_neg", "normal_force_form",
                             "position_dependent", "n_table", "direction_dependent_viscous", "sigma2_neg",
                             "F_offset"}},
-    "ResetIntegrator": {"input": {"v"}, "output": {"F", "z", "sliding"}, "parameter": {"sigma0", "sigma1", "a", "z0"}},
-    "Bristle": {"input": {"x"}, "output": {"F", "n_connected", "sliding"},
+    "ResetIntegrator": {"input": {"v"}, "output": {"F", "z", "sliding", "P_diss", "E_stored"},
+                        "parameter": {"sigma0", "sigma1", "a", "z0"}},
+    "Bristle": {"input": {"x"}, "output": {"F", "n_connected", "sliding", "P_diss", "E_stored"},
                 "parameter": {"sigma_ini", "delta_max", "x_rel", "n_bristles", "c", "mu_c", "Fn", "seed"}},
-    "Bristle2D": {"input": {"v1", "v2"}, "output": {"F1", "F2", "z1", "z2", "sliding"},
+    "Bristle2D": {"input": {"v1", "v2"}, "output": {"F1", "F2", "z1", "z2", "sliding", "P_diss", "E_stored"},
                   "parameter": {"sigma01", "sigma02", "sigma11", "sigma12", "a1", "a2", "z0", "av"}},
     "Classical": {"input": {"v", "F_app"}, "output": {"F", "stuck", "P_diss", "E_stored"},
                   "parameter": {"Fc", "Fs", "vs", "delta", "sigma2", "dv"}},

@@ -266,7 +266,8 @@ def test_belt_oscillator_with_lugre_equals_fmpy_jacobi(belt, tmp_path):
     step, stop = 1e-4, 3.0
     process, header, ours = cosim(components, parameters, connections, step, stop, tmp_path / "c.csv")
     assert process.returncode == 0, process.stderr
-    assert header == ["time", "rig.x", "rig.v", "rig.a", "friction.F", "friction.z", "friction.sliding"]
+    assert header == ["time", "rig.x", "rig.v", "rig.a", "friction.F", "friction.z", "friction.P_diss",
+                      "friction.E_stored", "friction.sliding"]
     theirs = fmpy_jacobi(components, parameters, connections, step, stop, tmp_path)
     assert_equal_to_1e9(header, ours, theirs)
     # the comparison covers stick and slip
@@ -339,7 +340,8 @@ def test_pythonfmu_drive_with_dahl_equals_fmpy_jacobi(drive, python_runtime, tmp
     process, header, ours = cosim(components, parameters, connections, step, stop, tmp_path / "c.csv",
                                   env=python_runtime)
     assert process.returncode == 0, process.stderr
-    assert header == ["time", "drive.v", "drive.v_cmd", "friction.F", "friction.z", "friction.sliding"]
+    assert header == ["time", "drive.v", "drive.v_cmd", "friction.F", "friction.z", "friction.P_diss",
+                      "friction.E_stored", "friction.sliding"]
     theirs = fmpy_jacobi(components, parameters, connections, step, stop, tmp_path)
     assert_equal_to_1e9(header, ours, theirs)
     # the drive sweeps the contact both ways: Dahl's force reaches both levels

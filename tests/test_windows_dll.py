@@ -187,8 +187,12 @@ def variables(name):
     return out
 
 
+@lru_cache(maxsize=None)
 def unpack(name):
-    """The FMU unpacked to C:\\fmu tests\\<name>\\ of the Wine prefix."""
+    """The FMU unpacked to C:\\fmu tests\\<name>\\ of the Wine prefix, afresh
+    once per test session: the prefix outlives the session, and binaries
+    left from an earlier build would be run against today's model
+    description."""
     target = DRIVE_C_DIR / name
     shutil.rmtree(target, ignore_errors=True)
     with zipfile.ZipFile(DIST / f"{name}.fmu") as z:
@@ -258,8 +262,7 @@ def run(case, windows, wine_debug=None):
     native, exe = tools()
     fmu = CASES[case][0]
     root = DRIVE_C_DIR / fmu
-    if not (root / "modelDescription.xml").exists():
-        unpack(fmu)
+    unpack(fmu)
     identifier = model_description(fmu).find("CoSimulation").get("modelIdentifier")
     text, names, types = plan_text(case)
     plan = root / f"plan-{case}.txt"

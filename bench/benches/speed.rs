@@ -19,13 +19,14 @@ use std::path::Path;
 fn fmu_step(c: &mut Criterion) {
     let dist = Path::new(env!("CARGO_MANIFEST_DIR")).join("../dist");
     let mut group = c.benchmark_group("fmu_step");
-    for (index, &(model, _, _)) in FRICTION_FMUS.iter().enumerate() {
+    for (index, driven) in FRICTION_FMUS.iter().enumerate() {
+        let model = driven.model;
         let fmu = Fmu::open(dist.join(format!("{model}.fmu")))
             .unwrap_or_else(|e| panic!("{model}.fmu: {e} (run ./build-fmu.sh)"));
         let mut stepper = FmuStepper::new(&fmu, index).unwrap();
         let h = 1e-3;
         let mut k = 0u64;
-        group.bench_function(model, |b| {
+        group.bench_function(driven.label, |b| {
             b.iter(|| {
                 stepper.step(k as f64 * h, h).unwrap();
                 k += 1;

@@ -161,25 +161,47 @@ pub fn command_line(variable: &str, program: &str) -> String {
 /// An input signal `u(t) = A·sin(2π·t + φ)`: (name, A, φ).
 pub type Sinusoid = (&'static str, f64, f64);
 
-/// A benchmarked FMU: model name, its inputs, the outputs read every step.
-pub type DrivenFmu = (&'static str, &'static [Sinusoid], &'static [&'static str]);
+/// A benchmarked FMU: the row's label, the model, its inputs, the outputs
+/// read every step, and for the element laws (Maxwell-slip, GMS) the
+/// number of elements (`None`: the FMU's default set).
+pub struct DrivenFmu {
+    pub label: &'static str,
+    pub model: &'static str,
+    pub inputs: &'static [Sinusoid],
+    pub outputs: &'static [&'static str],
+    pub elements: Option<usize>,
+}
+
+const fn driven(
+    model: &'static str,
+    inputs: &'static [Sinusoid],
+    outputs: &'static [&'static str],
+) -> DrivenFmu {
+    DrivenFmu {
+        label: model,
+        model,
+        inputs,
+        outputs,
+        elements: None,
+    }
+}
 
 /// The friction FMUs of dist/ and how a benchmark drives them: inputs
 /// through stick and slip at the default parameters.
 pub const FRICTION_FMUS: &[DrivenFmu] = &[
-    ("Dahl", &[("v", 1e-3, 0.0)], &["F"]),
-    ("LuGre", &[("v", 1e-3, 0.0)], &["F"]),
-    ("ResetIntegrator", &[("v", 1e-3, 0.0)], &["F"]),
+    driven("Dahl", &[("v", 1e-3, 0.0)], &["F"]),
+    driven("LuGre", &[("v", 1e-3, 0.0)], &["F"]),
+    driven("ResetIntegrator", &[("v", 1e-3, 0.0)], &["F"]),
     // 3·δmax = 4.7e-8 m of Appels and Herder: loads to sliding, reverses twice a period
-    ("Bristle", &[("x", 4.7e-8, 0.0)], &["F"]),
-    (
+    driven("Bristle", &[("x", 4.7e-8, 0.0)], &["F"]),
+    driven(
         "Bristle2D",
         &[("v1", 1e-3, 0.0), ("v2", 1e-3, std::f64::consts::FRAC_PI_2)],
         &["F1", "F2"],
     ),
     // through the zero-velocity band twice a period, the applied force
     // (3 N) above the static level (2.35 N) in part of it
-    (
+    driven(
         "Classical",
         &[
             ("v", 1e-3, 0.0),
@@ -187,11 +209,75 @@ pub const FRICTION_FMUS: &[DrivenFmu] = &[
         ],
         &["F"],
     ),
-    ("BlimanSorine", &[("v", 1e-3, 0.0)], &["F"]),
-    ("ElastoPlastic", &[("v", 1e-3, 0.0)], &["F"]),
-    ("MaxwellSlip", &[("v", 1e-3, 0.0)], &["F"]),
-    ("GMS", &[("v", 1e-3, 0.0)], &["F"]),
+    driven("BlimanSorine", &[("v", 1e-3, 0.0)], &["F"]),
+    driven("ElastoPlastic", &[("v", 1e-3, 0.0)], &["F"]),
+    driven("MaxwellSlip", &[("v", 1e-3, 0.0)], &["F"]),
+    DrivenFmu {
+        label: "MaxwellSlip, 100 elements",
+        elements: Some(100),
+        ..driven("MaxwellSlip", &[("v", 1e-3, 0.0)], &["F"])
+    },
+    driven("GMS", &[("v", 1e-3, 0.0)], &["F"]),
+    DrivenFmu {
+        label: "GMS, 100 elements",
+        elements: Some(100),
+        ..driven("GMS", &[("v", 1e-3, 0.0)], &["F"])
+    },
 ];
+
+/// The element laws' parameters for `n` elements: `n_elements` and `n`
+/// even elements of the default initial stiffness 1e5 N/m
+/// ([`friction_laws::maxwell_slip::even_elements`]) up to the FMU's level
+/// (GMS: weights `alpha[i]` of `Fs`; Maxwell-slip: slip forces `W[i]`
+/// summing to its default Coulomb level).
+fn set_elements(
+    instance: &mut fricsim_fmi::Instance,
+    fmu: &fricsim_fmi::Fmu,
+    model: &str,
+    n: usize,
+) -> Result<(), String> {
+    let vr = |name: &str| {
+        fmu.variable(name)
+            .map(|v| v.value_reference)
+            .map_err(|e| e.to_string())
+    };
+    // the defaults from the model description (no value can be read
+    // before initialization)
+    let start = |name: &str| -> Result<f64, String> {
+        match &fmu.variable(name).map_err(|e| e.to_string())?.kind {
+            fricsim_fmi::VariableKind::Real { start: Some(x), .. } => Ok(*x),
+            fricsim_fmi::VariableKind::Integer { start: Some(x), .. } => Ok(f64::from(*x)),
+            _ => Err(format!("{model}: no start value for {name}")),
+        }
+    };
+    let gms = model == "GMS";
+    let level = if gms {
+        start("Fs")?
+    } else {
+        let n0 = start("n_elements")? as usize;
+        (1..=n0)
+            .map(|i| start(&format!("W[{i}]")))
+            .sum::<Result<f64, String>>()?
+    };
+    let (k, w) = friction_laws::maxwell_slip::even_elements(n, 1e5, level);
+    instance
+        .set_integer(&[vr("n_elements")?], &[n as i32])
+        .map_err(|e| e.to_string())?;
+    for i in 0..n {
+        let second = if gms {
+            (format!("alpha[{}]", i + 1), w[i] / level)
+        } else {
+            (format!("W[{}]", i + 1), w[i])
+        };
+        instance
+            .set_real(
+                &[vr(&format!("k[{}]", i + 1))?, vr(&second.0)?],
+                &[k[i], second.1],
+            )
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
 
 /// One initialised instance of a friction FMU of [`FRICTION_FMUS`] and its
 /// resolved value references: [`FmuStepper::step`] is one communication
@@ -210,7 +296,8 @@ impl FmuStepper {
     /// Instantiate the `index`-th model of [`FRICTION_FMUS`] from `fmu`,
     /// initialised at t = 0 with its default parameters.
     pub fn new(fmu: &fricsim_fmi::Fmu, index: usize) -> Result<FmuStepper, String> {
-        let (model, inputs, outputs) = FRICTION_FMUS[index];
+        let driven = &FRICTION_FMUS[index];
+        let (model, inputs, outputs) = (driven.model, driven.inputs, driven.outputs);
         let vr = |name: &str| {
             fmu.variable(name)
                 .map(|v| v.value_reference)
@@ -222,6 +309,9 @@ impl FmuStepper {
             .collect::<Result<Vec<_>, _>>()?;
         let output_vrs = outputs.iter().map(|n| vr(n)).collect::<Result<_, _>>()?;
         let mut instance = fmu.instantiate(model).map_err(|e| e.to_string())?;
+        if let Some(n) = driven.elements {
+            set_elements(&mut instance, fmu, model, n)?;
+        }
         instance
             .setup_experiment(0.0, None)
             .and_then(|_| instance.enter_initialization_mode())

@@ -17,7 +17,7 @@ fn every_shipped_law_is_timed() {
         })
         .collect();
     assert!(!laws.is_empty());
-    let timed: Vec<&str> = FRICTION_FMUS.iter().map(|(name, _, _)| *name).collect();
+    let timed: Vec<&str> = FRICTION_FMUS.iter().map(|d| d.model).collect();
     let missing: Vec<&&str> = laws.iter().filter(|l| !timed.contains(l)).collect();
     assert!(
         missing.is_empty(),

@@ -54,7 +54,9 @@ fn quick_mode_writes_every_table_between_its_markers() {
         "BlimanSorine",
         "ElastoPlastic",
         "MaxwellSlip",
+        "MaxwellSlip, 100 elements",
         "GMS",
+        "GMS, 100 elements",
     ] {
         let cells = common::table_row(&text, "**One communication step", model);
         assert_eq!(cells.len(), 3, "{cells:?}");

@@ -112,8 +112,13 @@ fn lugre_columns_are_the_fmus_outputs_and_consistent_with_the_equations() {
         .iter()
         .all(|c| c.starts_with("rig.") || c.starts_with("friction.")));
     assert_eq!(
-        &t.columns[t.columns.len() - 2..],
-        ["friction.F", "friction.z"]
+        &t.columns[t.columns.len() - 4..],
+        [
+            "friction.F",
+            "friction.z",
+            "friction.P_diss",
+            "friction.E_stored"
+        ]
     );
     let (x, v, a) = (col(&t, "rig.x"), col(&t, "rig.v"), col(&t, "rig.a"));
     let (spring, xa) = (col(&t, "rig.F_spring"), col(&t, "rig.x_act"));
@@ -250,8 +255,15 @@ fn recorded_inputs_and_parameters_follow_the_outputs_they_are_connected_to() {
     let k = cols.iter().position(|c| c == "rig.F").unwrap();
     assert_eq!(cols[k - 1], "rig.F_ctrl", "after the rig's outputs");
     assert_eq!(
-        &cols[cols.len() - 4..],
-        ["friction.F", "friction.z", "friction.v", "friction.sigma0"]
+        &cols[cols.len() - 6..],
+        [
+            "friction.F",
+            "friction.z",
+            "friction.P_diss",
+            "friction.E_stored",
+            "friction.v",
+            "friction.sigma0"
+        ]
     );
     let times: Vec<f64> = (0..=900).map(|i| i as f64 * 0.01).collect();
     let t = m.solve(0.0, &times, RTOL).unwrap().0;

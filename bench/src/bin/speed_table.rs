@@ -299,7 +299,8 @@ struct LawRow {
 
 fn law_table(root: &Path, sizes: &Sizes) -> Result<Vec<LawRow>, String> {
     let mut rows = Vec::new();
-    for (index, &(model, _, _)) in FRICTION_FMUS.iter().enumerate() {
+    for (index, driven) in FRICTION_FMUS.iter().enumerate() {
+        let (model, label) = (driven.model, driven.label);
         let fmu = Fmu::open(root.join("dist").join(format!("{model}.fmu")))
             .map_err(|e| format!("{model}.fmu: {e} (run ./build-fmu.sh)"))?;
         let per_step = |h: f64| {
@@ -317,9 +318,9 @@ fn law_table(root: &Path, sizes: &Sizes) -> Result<Vec<LawRow>, String> {
         };
         let small = per_step(SMALL_STEP)?;
         let large = per_step(LARGE_STEP)?;
-        eprintln!("{model}: {small:.0} ns/step at h = {SMALL_STEP:e} s, {large:.0} ns/step at h = {LARGE_STEP:e} s");
+        eprintln!("{label}: {small:.0} ns/step at h = {SMALL_STEP:e} s, {large:.0} ns/step at h = {LARGE_STEP:e} s");
         rows.push(LawRow {
-            model,
+            model: label,
             small,
             large,
         });

@@ -24,12 +24,15 @@ pub mod vr {
     pub const MU_C: u32 = 11;
     pub const FN: u32 = 12;
     pub const SEED: u32 = 13;
+    /// Added with the energy outputs of the newer laws.
+    pub const P_DISS: u32 = 14;
+    pub const E_STORED: u32 = 15;
 }
 
 /// Appels & Herder: lightest mass 0.352 kg, g = 9.81 m/s².
 const APPELS_HERDER_NORMAL_FORCE: f64 = 0.352 * 9.81;
 
-static VARIABLES: [Variable; 14] = [
+static VARIABLES: [Variable; 16] = [
     Variable::input(vr::X, "x", 0.0, "m", 1e-8, "Relative displacement of the body"),
     Variable::output(vr::F, "F", "N", "Friction force sigma_b*(sum of connected deflections + disconnected +-delta_max)", &[vr::X]),
     Variable::integer_output(vr::N_CONNECTED, "n_connected", "Number of connected bristles", &[vr::X]),
@@ -44,6 +47,8 @@ static VARIABLES: [Variable; 14] = [
     Variable::parameter(vr::MU_C, "mu_c", 0.0633, "", "Coulomb friction coefficient (Appels and Herder, Table 3)").with_min(0.0),
     Variable::parameter(vr::FN, "Fn", APPELS_HERDER_NORMAL_FORCE, "N", "Normal force m*g (Appels and Herder: 0.352 kg)").with_min(0.0),
     Variable::integer_parameter(vr::SEED, "seed", 1, "Random seed of the bristle realisation: same seed, bit-identical output"),
+    Variable::output(vr::P_DISS, "P_diss", "W", "Mean power the contact dissipated over the last communication step, (integral of F dx - change of E_stored)/h: the sliding of disconnected bristles and the loss of each reconnection at a reversal (an impulse); never negative, 0 before the first step", &[]),
+    Variable::output(vr::E_STORED, "E_stored", "J", "Elastic energy held in the bristles, sigma_b*(sum of connected deflections^2 + disconnected*delta_max^2)/2", &[vr::X]),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -141,12 +146,16 @@ impl Model for BristleFmu {
             values.set(vr::F, self.law.force());
             values.set_integer(vr::N_CONNECTED, self.law.n_connected() as i32);
             values.set_boolean(vr::SLIDING, self.law.sliding());
+            values.set(vr::E_STORED, self.law.stored_energy());
         } else {
-            values.set(vr::F, self.law.force_at(x));
-            let n = self.law.n_connected_at(x);
+            // one evaluation: a reversal rebuilds the offsets, O(N)
+            let (force, n, energy) = self.law.outputs_at(x);
+            values.set(vr::F, force);
             values.set_integer(vr::N_CONNECTED, n as i32);
             values.set_boolean(vr::SLIDING, n == 0);
+            values.set(vr::E_STORED, energy);
         }
+        values.set(vr::P_DISS, self.law.step_power());
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {

@@ -31,12 +31,15 @@ pub mod vr {
     pub const AV: u32 = 14;
     pub const DER_Z1: u32 = 15;
     pub const DER_Z2: u32 = 16;
+    /// Added with the energy outputs of the newer laws.
+    pub const P_DISS: u32 = 17;
+    pub const E_STORED: u32 = 18;
 }
 
 const V: &[u32] = &[vr::V1, vr::V2];
 const Z: &[u32] = &[vr::Z1, vr::Z2];
 
-static VARIABLES: [Variable; 17] = [
+static VARIABLES: [Variable; 19] = [
     Variable::input(vr::V1, "v1", 0.0, "m/s", 1e-3, "Slip velocity along axis 1"),
     Variable::input(vr::V2, "v2", 0.0, "m/s", 1e-3, "Slip velocity along axis 2"),
     Variable::output(
@@ -132,6 +135,22 @@ static VARIABLES: [Variable; 17] = [
         V,
         Z,
     ),
+    Variable::output(
+        vr::P_DISS,
+        "P_diss",
+        "W",
+        "Power the contact dissipates, F.v - dE_stored/dt: the dampers inside the stiction disc, sigma0*z.v + damping sliding on its boundary (never negative for equal axes)",
+        V,
+    )
+    .with_state_dependencies(Z),
+    Variable::output(
+        vr::E_STORED,
+        "E_stored",
+        "J",
+        "Elastic energy held in the bristle, ((1 + a1)*sigma01*z1^2 + (1 + a2)*sigma02*z2^2)/2",
+        &[],
+    )
+    .with_state_dependencies(Z),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -207,6 +226,8 @@ impl Model for Bristle2DFmu {
         values.set(vr::Z1, z[0]);
         values.set(vr::Z2, z[1]);
         values.set_boolean(vr::SLIDING, self.law.sliding(v));
+        values.set(vr::P_DISS, self.law.dissipated_power(v));
+        values.set(vr::E_STORED, self.law.stored_energy());
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
@@ -288,6 +309,9 @@ impl Model for Bristle2DMe {
         values.set(vr::Z2, self.z[1]);
         let sliding = self.law.sliding_of(self.z, v, self.on_boundary);
         values.set_boolean(vr::SLIDING, sliding);
+        let power = self.law.dissipated_power_of(self.z, v, self.on_boundary);
+        values.set(vr::P_DISS, power);
+        values.set(vr::E_STORED, self.law.stored_energy_of(self.z));
     }
 
     /// Never called: a Model Exchange instance takes no communication
@@ -370,7 +394,12 @@ impl Ode for Bristle2DMe {
     /// `der(z2)`, `F1`, `F2`; the outputs `z1`, `z2` are the states.
     fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
         let d = self.law.partials(self.z, slip(values), self.on_boundary);
+        let (p_z, p_v, e_z) = self
+            .law
+            .energy_partials(self.z, slip(values), self.on_boundary);
         let (by_z, by_v) = match unknown {
+            vr::P_DISS => (p_z, p_v),
+            vr::E_STORED => (e_z, [0.0; 2]),
             vr::DER_Z1 => (d.rate_z[0], d.rate_v[0]),
             vr::DER_Z2 => (d.rate_z[1], d.rate_v[1]),
             vr::F1 => (d.force_z[0], d.force_v[0]),

@@ -26,9 +26,12 @@ pub mod vr {
     /// `F_dahl` and the parameter `F_offset`.
     pub const F_DAHL: u32 = 8;
     pub const F_OFFSET: u32 = 9;
+    /// Added with the energy outputs of the newer laws.
+    pub const P_DISS: u32 = 10;
+    pub const E_STORED: u32 = 11;
 }
 
-static VARIABLES: [Variable; 10] = [
+static VARIABLES: [Variable; 12] = [
     sliding_velocity_input(vr::V),
     Variable::output(
         vr::F,
@@ -92,6 +95,22 @@ static VARIABLES: [Variable; 10] = [
         "N",
         "Constant force on the contact, added to F at rest and in motion (as the offset of Janot, Gautier, Brunot 2019); the Dahl law does not see it",
     ),
+    Variable::output(
+        vr::P_DISS,
+        "P_diss",
+        "W",
+        "Power the contact dissipates, F*v - F_dahl*dF_dahl/dt/sigma = F_dahl*v*(1 - |y|^alpha*sgn(y)) + F_offset*v: the law's part never negative",
+        &[vr::V],
+    )
+    .with_state_dependencies(&[vr::F_DAHL]),
+    Variable::output(
+        vr::E_STORED,
+        "E_stored",
+        "J",
+        "Elastic energy held in the contact, F_dahl^2/(2*sigma)",
+        &[],
+    )
+    .with_state_dependencies(&[vr::F_DAHL]),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -154,6 +173,8 @@ impl Model for DahlFmu {
         values.set(vr::Z, self.law.z());
         values.set_boolean(vr::SLIDING, self.law.sliding(v));
         values.set(vr::F_DAHL, self.law.dahl_force());
+        values.set(vr::P_DISS, self.law.dissipated_power(v));
+        values.set(vr::E_STORED, self.law.stored_energy());
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
@@ -216,10 +237,22 @@ impl Ode for DahlFmu {
     /// and `z = F_dahl/σ` do not depend on `v` (nor on the offset).
     fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
         let v = values.real(vr::V);
+        let f = self.law.dahl_force();
+        let sigma = self.law.params().sigma;
         let (by_f, by_v) = match unknown {
-            vr::DER_F_DAHL => self.law.force_rate_partials(self.law.dahl_force(), v),
+            vr::DER_F_DAHL => self.law.force_rate_partials(f, v),
             vr::F => (1.0, 0.0),
-            vr::Z => (1.0 / self.law.params().sigma, 0.0),
+            vr::Z => (1.0 / sigma, 0.0),
+            // P = (F_dahl + F_offset)·v − F_dahl·Ḟ(F_dahl, v)/σ
+            vr::P_DISS => {
+                let rate = self.law.force_rate(f, v);
+                let (rf, rv) = self.law.force_rate_partials(f, v);
+                (
+                    v - (rate + f * rf) / sigma,
+                    self.law.force() - f * rv / sigma,
+                )
+            }
+            vr::E_STORED => (f / sigma, 0.0),
             _ => return None,
         };
         match known {

@@ -49,6 +49,9 @@ pub mod vr {
     pub const SIGMA2_NEG: u32 = DER_Z + 2;
     pub const F_OFFSET: u32 = DER_Z + 3;
     pub const PARAMETER_SENSITIVITIES: u32 = DER_Z + 4;
+    /// The energy outputs, added last.
+    pub const P_DISS: u32 = DER_Z + 5;
+    pub const E_STORED: u32 = DER_Z + 6;
 }
 
 const INPUTS: &[u32] = &[vr::V, vr::X, vr::FN];
@@ -264,6 +267,26 @@ fn variables() -> Vec<Variable> {
         false,
         "Carry dz/dp along the run (Co-Simulation): fmi2GetDirectionalDerivative of F or z with Real parameters as the knowns then gives dF/dp, dz/dp (all parameters but x_table; for fitting)",
     ));
+    v.push(
+        Variable::output(
+            vr::P_DISS,
+            "P_diss",
+            "W",
+            "Power the contact dissipates, F*v - sigma0*z*dz/dt*[Fn] = (sigma0^2*|v|*z^2/g + sigma1*v*dz/dt + sigma2*v^2)*[Fn] + F_offset*v; with F, E_stored: int F*v dt = int P_diss dt + delta E_stored at a constant Fn",
+            INPUTS,
+        )
+        .with_state_dependencies(&[vr::Z]),
+    );
+    v.push(
+        Variable::output(
+            vr::E_STORED,
+            "E_stored",
+            "J",
+            "Elastic energy of the bristles, sigma0*z^2/2*[Fn] ([Fn]: the normal force in the normal-force form, else 1)",
+            &[vr::FN],
+        )
+        .with_state_dependencies(&[vr::Z]),
+    );
     v
 }
 
@@ -378,10 +401,12 @@ impl Model for LuGreFmu {
 
     fn compute_outputs(&self, values: &mut Values) {
         let (v, x, fn_) = Self::inputs(values);
-        let (force, sliding) = self.law.force_and_sliding(v, x, fn_);
+        let (force, sliding, power) = self.law.outputs(v, x, fn_);
         values.set(vr::F, force);
         values.set(vr::Z, self.law.z());
         values.set_boolean(vr::SLIDING, sliding);
+        values.set(vr::P_DISS, power);
+        values.set(vr::E_STORED, self.law.stored_energy(fn_));
     }
 
     /// The outputs asked for only (a directional derivative wants F, and
@@ -394,6 +419,8 @@ impl Model for LuGreFmu {
                 vr::F => values.set(vr::F, self.law.force(v, x, fn_)),
                 vr::Z => values.set(vr::Z, self.law.z()),
                 vr::SLIDING => values.set_boolean(vr::SLIDING, self.law.sliding(v, x, fn_)),
+                vr::P_DISS => values.set(vr::P_DISS, self.law.dissipated_power(v, x, fn_)),
+                vr::E_STORED => values.set(vr::E_STORED, self.law.stored_energy(fn_)),
                 _ => {}
             }
         }
@@ -619,6 +646,29 @@ impl Ode for LuGreFmu {
                 [f.z, f.v, f.x, f.fn_]
             }
             vr::Z => [1.0, 0.0, 0.0, 0.0],
+            // P = F·v − σ0·z·ż·φ(Fn), E = σ0·z²/2·φ(Fn)
+            vr::P_DISS => {
+                let f = self.law.force_partials(z, v, x, fn_);
+                let r = self.law.rate_partials(z, v, x);
+                let zd = self.law.z_rate(z, v, x, fn_);
+                let s0 = self.law.params().sigma0;
+                let phi = self.law.normal_force_factor(fn_);
+                [
+                    f.z * v - s0 * phi * (zd + z * r.z),
+                    f.v * v + self.law.force(v, x, fn_) - s0 * phi * z * r.v,
+                    f.x * v - s0 * phi * z * r.x,
+                    f.fn_ * v - s0 * self.law.fn_factor_slope(fn_) * z * zd,
+                ]
+            }
+            vr::E_STORED => {
+                let s0 = self.law.params().sigma0;
+                [
+                    s0 * z * self.law.normal_force_factor(fn_),
+                    0.0,
+                    0.0,
+                    0.5 * s0 * z * z * self.law.fn_factor_slope(fn_),
+                ]
+            }
             _ => return None,
         };
         match known {

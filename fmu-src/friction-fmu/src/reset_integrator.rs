@@ -22,9 +22,12 @@ pub mod vr {
     pub const A: u32 = 6;
     pub const Z0: u32 = 7;
     pub const DER_Z: u32 = 8;
+    /// Added with the energy outputs of the newer laws.
+    pub const P_DISS: u32 = 9;
+    pub const E_STORED: u32 = 10;
 }
 
-static VARIABLES: [Variable; 9] = [
+static VARIABLES: [Variable; 11] = [
     sliding_velocity_input(vr::V),
     Variable::output(
         vr::F,
@@ -69,6 +72,22 @@ static VARIABLES: [Variable; 9] = [
         &[vr::V],
         &[vr::Z],
     ),
+    Variable::output(
+        vr::P_DISS,
+        "P_diss",
+        "W",
+        "Power the contact dissipates, F*v - dE_stored/dt: sigma1*v^2 inside the stiction range, sigma0*z0*|v| held at its limit; never negative",
+        &[vr::V],
+    )
+    .with_state_dependencies(&[vr::Z]),
+    Variable::output(
+        vr::E_STORED,
+        "E_stored",
+        "J",
+        "Elastic energy held in the bristle, (1 + a)*sigma0*z^2/2 (it stays (1 + a)*sigma0*z0^2/2 held at the limit)",
+        &[],
+    )
+    .with_state_dependencies(&[vr::Z]),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -131,6 +150,8 @@ impl Model for ResetFmu {
         values.set(vr::F, self.law.force(v));
         values.set(vr::Z, self.law.z());
         values.set_boolean(vr::SLIDING, self.law.sliding(v));
+        values.set(vr::P_DISS, self.law.dissipated_power(v));
+        values.set(vr::E_STORED, self.law.stored_energy());
     }
 
     fn do_step(&mut self, values: &Values, slopes: &[f64], h: f64) -> Result<(), String> {
@@ -212,6 +233,9 @@ impl Model for ResetMe {
         values.set(vr::F, self.law.force_of(z, v, self.contact));
         values.set(vr::Z, z);
         values.set_boolean(vr::SLIDING, self.law.sliding_of(v, self.contact));
+        let power = self.law.dissipated_power_of(z, v, self.contact);
+        values.set(vr::P_DISS, power);
+        values.set(vr::E_STORED, self.law.stored_energy_of(z));
     }
 
     /// Never called: a Model Exchange instance takes no communication
@@ -279,10 +303,13 @@ impl Ode for ResetMe {
     fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
         let v = values.real(vr::V);
         let (dzd_dz, dzd_dv, df_dz, df_dv) = self.law.partials(v, self.contact);
+        let (dp_dz, dp_dv, de_dz) = self.law.energy_partials(self.law.z(), v, self.contact);
         let (by_z, by_v) = match unknown {
             vr::DER_Z => (dzd_dz, dzd_dv),
             vr::F => (df_dz, df_dv),
             vr::Z => (1.0, 0.0),
+            vr::P_DISS => (dp_dz, dp_dv),
+            vr::E_STORED => (de_dz, 0.0),
             _ => return None,
         };
         match known {

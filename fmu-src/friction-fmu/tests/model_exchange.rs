@@ -233,7 +233,13 @@ fn dahl_partials_match_differences() {
                 let context = format!("Dahl alpha {alpha}, F_offset {offset} at F_dahl {f}, v {v}");
                 check_partials(
                     &me,
-                    &[("der(F_dahl)", 87750.0 * 1e-3), ("F", 1.0), ("z", 1e-5)],
+                    &[
+                        ("der(F_dahl)", 87750.0 * 1e-3),
+                        ("F", 1.0),
+                        ("z", 1e-5),
+                        ("P_diss", 1e-3),
+                        ("E_stored", 1e-5),
+                    ],
                     &[("F_dahl", 1e-7), ("v", 1e-9)],
                     1e-6,
                     &context,
@@ -330,6 +336,8 @@ fn lugre_partials_match_differences_with_every_option() {
                     ("der(z)", (lambda * 1e-5).max(1.0)),
                     ("F", 1e5 * 3.0),
                     ("z", 1.0),
+                    ("P_diss", 1e5 * 3.0 * 1e-2),
+                    ("E_stored", 1.0),
                 ],
                 &[("z", 1e-12), ("v", 1e-9), ("x", 1e-6), ("Fn", 1e-6)],
                 1e-6,
@@ -359,7 +367,13 @@ fn reset_integrator_partials_match_differences() {
         let context = format!("ResetIntegrator at z {z}, v {v}");
         assert_eq!(me.derivatives() == [0.0], held, "{context}");
         let knowns = [("z", 1e-11), ("v", 1e-9)];
-        let unknowns = [("der(z)", 1.0), ("F", 1e4), ("z", 1.0)];
+        let unknowns = [
+            ("der(z)", 1.0),
+            ("F", 1e4),
+            ("z", 1.0),
+            ("P_diss", 10.0),
+            ("E_stored", 1.0),
+        ];
         check_partials(&me, &unknowns, &knowns, 1e-6, &context);
         if held {
             // released by the reversal, and moving again
@@ -512,6 +526,8 @@ fn bristle2d_partials_match_differences_inside_and_sliding() {
                     ("F2", 1e4),
                     ("z1", 1.0),
                     ("z2", 1.0),
+                    ("P_diss", 10.0),
+                    ("E_stored", 1.0),
                 ],
                 &[("z1", 1e-12), ("z2", 1e-12), ("v1", 1e-9), ("v2", 1e-9)],
                 1e-6,
@@ -555,12 +571,17 @@ fn the_right_hand_side_is_the_one_the_step_integrates() {
             &["F", "P_diss", "E_stored"],
         ),
         ("LuGre", &[("v", 2e-3)], &["z"], &["F", "z"]),
-        ("ResetIntegrator", &[("v", 1e-3)], &["z"], &["F", "z"]),
+        (
+            "ResetIntegrator",
+            &[("v", 1e-3)],
+            &["z"],
+            &["F", "z", "P_diss", "E_stored"],
+        ),
         (
             "Bristle2D",
             &[("v1", 1e-3), ("v2", -5e-4)],
             &["z1", "z2"],
-            &["F1", "F2", "z1", "z2"],
+            &["F1", "F2", "z1", "z2", "P_diss", "E_stored"],
         ),
     ];
     for (model, inputs, states, outputs) in cases {

@@ -202,6 +202,76 @@ impl Bristle2D {
         ]
     }
 
+    /// The elastic energy held in the bristle (J),
+    /// `E = Σ (1 + ai)·σ0i·zi²/2`: the potential of the elastic force the
+    /// deflection moves against inside the disc. On the boundary the
+    /// deflection turns along the circle, where the force has `ai = 0`: the
+    /// energy it then holds stays that of the inside (for an isotropic
+    /// bristle it is constant there), so the drop of the force at the
+    /// boundary loses no energy and its rise on release gains none.
+    pub fn stored_energy_of(&self, z: [f64; 2]) -> f64 {
+        let g = self.energy_gains();
+        0.5 * (g[0] * z[0] * z[0] + g[1] * z[1] * z[1])
+    }
+
+    /// [`Bristle2D::stored_energy_of`] at the law's deflection.
+    pub fn stored_energy(&self) -> f64 {
+        self.stored_energy_of(self.z)
+    }
+
+    /// `(1 + ai)·σ0i`, the stiffnesses of [`Bristle2D::stored_energy_of`].
+    fn energy_gains(&self) -> [f64; 2] {
+        [
+            (1.0 + self.p.a1) * self.p.sigma01,
+            (1.0 + self.p.a2) * self.p.sigma02,
+        ]
+    }
+
+    /// `P_diss = F·v − dE/dt = F·v − ∇E·ż` (W) for any deflection and
+    /// contact state: inside the disc `Σ σ1i(|v|)·vi²`; sliding on the
+    /// boundary of an isotropic bristle `σ0·z·v + σ1(|v|)·ż·v` with
+    /// `z·ż = 0`, never negative. Unequal stiffnesses along the two axes
+    /// can make it negative for a while on the boundary.
+    pub fn dissipated_power_of(&self, z: [f64; 2], v: [f64; 2], on_boundary: bool) -> f64 {
+        let f = self.force_of(z, v, on_boundary);
+        let zd = self.z_rate(z, v, on_boundary);
+        let g = self.energy_gains();
+        dot(f, v) - (g[0] * z[0] * zd[0] + g[1] * z[1] * zd[1])
+    }
+
+    /// [`Bristle2D::dissipated_power_of`] at the law's deflection.
+    pub fn dissipated_power(&self, v: [f64; 2]) -> f64 {
+        self.dissipated_power_of(self.z, v, self.on_boundary())
+    }
+
+    /// The gradients of `P_diss` and `E_stored` with respect to `z` and of
+    /// `P_diss` with respect to `v`, from [`Bristle2D::partials`]:
+    /// `∂P/∂zj = Σi ∂Fi/∂zj·vi − gj·żj − Σi gi·zi·∂żi/∂zj`,
+    /// `∂P/∂vj = Fj + Σi ∂Fi/∂vj·vi − Σi gi·zi·∂żi/∂vj`, `∂E/∂zj = gj·zj`
+    /// with `gi = (1 + ai)·σ0i`.
+    pub fn energy_partials(
+        &self,
+        z: [f64; 2],
+        v: [f64; 2],
+        on_boundary: bool,
+    ) -> ([f64; 2], [f64; 2], [f64; 2]) {
+        let d = self.partials(z, v, on_boundary);
+        let f = self.force_of(z, v, on_boundary);
+        let zd = self.z_rate(z, v, on_boundary);
+        let g = self.energy_gains();
+        let mut p_z = [0.0; 2];
+        let mut p_v = [0.0; 2];
+        for j in 0..2 {
+            p_z[j] = -g[j] * zd[j];
+            p_v[j] = f[j];
+            for i in 0..2 {
+                p_z[j] += d.force_z[i][j] * v[i] - g[i] * z[i] * d.rate_z[i][j];
+                p_v[j] += d.force_v[i][j] * v[i] - g[i] * z[i] * d.rate_v[i][j];
+            }
+        }
+        (p_z, p_v, [g[0] * z[0], g[1] * z[1]])
+    }
+
     /// Sliding: on the boundary of the stiction disc and slipping outward
     /// (`z·v > 0`).
     pub fn sliding(&self, v: [f64; 2]) -> bool {
@@ -500,6 +570,59 @@ mod tests {
 
     fn norm(a: [f64; 2]) -> f64 {
         a[0].hypot(a[1])
+    }
+
+    #[test]
+    fn energy_outputs_inside_and_on_the_boundary() {
+        let p = Bristle2DParams::default();
+        let b = Bristle2D::new(p).unwrap();
+        let damp = |v: [f64; 2]| (-dot(v, v) / (p.av * p.av)).exp();
+        // inside: only the dampers dissipate
+        let (z, v) = ([3e-5, -2e-5], [1e-3, 2e-3]);
+        let inside = b.dissipated_power_of(z, v, false);
+        assert!((inside - p.sigma11 * damp(v) * dot(v, v)).abs() < 1e-15);
+        let e = 0.5 * (1.0 + p.a1) * p.sigma01 * dot(z, z);
+        assert!((b.stored_energy_of(z) - e).abs() < 1e-18);
+        // sliding on the boundary of the isotropic bristle: never negative
+        for k in 0..16 {
+            let phi = 2.0 * PI * k as f64 / 16.0;
+            let z = [p.z0 * phi.cos(), p.z0 * phi.sin()];
+            let v = [2e-3 * (phi + 0.7).cos(), 2e-3 * (phi + 0.7).sin()];
+            assert!(b.dissipated_power_of(z, v, true) > 0.0);
+        }
+        // the partials against central differences, both contact states
+        for (z, on) in [([3e-5, -2e-5], false), ([6e-5, 8e-5], true)] {
+            let v = [1e-3, 2e-3];
+            let (p_z, p_v, e_z) = b.energy_partials(z, v, on);
+            for j in 0..2 {
+                let bump = |a: [f64; 2], h: f64| {
+                    let mut a = a;
+                    a[j] += h;
+                    a
+                };
+                let (hz, hv) = (1e-11, 1e-9);
+                let fd_pz = (b.dissipated_power_of(bump(z, hz), v, on)
+                    - b.dissipated_power_of(bump(z, -hz), v, on))
+                    / (2.0 * hz);
+                let fd_pv = (b.dissipated_power_of(z, bump(v, hv), on)
+                    - b.dissipated_power_of(z, bump(v, -hv), on))
+                    / (2.0 * hv);
+                let fd_ez = (b.stored_energy_of(bump(z, hz)) - b.stored_energy_of(bump(z, -hz)))
+                    / (2.0 * hz);
+                assert!(
+                    (p_z[j] - fd_pz).abs() <= 1e-6 * p_z[j].abs().max(1.0),
+                    "{p_z:?} {fd_pz}"
+                );
+                assert!(
+                    (p_v[j] - fd_pv).abs() <= 1e-6 * p_v[j].abs().max(1.0),
+                    "{p_v:?} {fd_pv}"
+                );
+                assert!(
+                    (e_z[j] - fd_ez).abs() <= 1e-6 * e_z[j].abs().max(1e-3),
+                    "{e_z:?} {fd_ez}"
+                );
+            }
+        }
     }
 
     #[test]

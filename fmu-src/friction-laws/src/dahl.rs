@@ -96,6 +96,21 @@ impl Dahl {
         f_dahl + self.p.f_offset
     }
 
+    /// The elastic energy held in the contact, `F_dahl²/(2·σ)` (J): the
+    /// energy of a spring of the rest stiffness σ carrying `F_dahl`.
+    pub fn stored_energy(&self) -> f64 {
+        0.5 * self.f * self.f / self.p.sigma
+    }
+
+    /// `P_diss = F·v − dE/dt = F·v − F_dahl·Ḟ_dahl/σ` (W), which is
+    /// `F_dahl·v·(1 − |y|^α·sgn y) + F_offset·v` with
+    /// `y = 1 − F_dahl/Fc·sgn v`: the law's part is never negative (it
+    /// loads when `|y| < 1` and unloads when `y > 1`); the offset's
+    /// `F_offset·v` has the sign of the motion.
+    pub fn dissipated_power(&self, v: f64) -> f64 {
+        self.force() * v - self.f * self.force_rate(self.f, v) / self.p.sigma
+    }
+
     /// Equivalent bristle deflection `z = F_dahl/σ` (m).
     pub fn z(&self) -> f64 {
         self.f / self.p.sigma

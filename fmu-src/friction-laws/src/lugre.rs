@@ -630,6 +630,38 @@ impl LuGre {
         self.p.sigma0 * z + self.sigma1_at(v) * zd + self.sigma2_at(v) * v
     }
 
+    /// The elastic energy of the bristles, `σ0·z²/2·φ(Fn)` (J; `φ = Fn`
+    /// in the normal-force form, else 1).
+    pub fn stored_energy(&self, fn_: f64) -> f64 {
+        0.5 * self.p.sigma0 * self.z * self.z * self.fn_factor(fn_)
+    }
+
+    /// `P_diss = F·v − σ0·z·ż·φ(Fn)` (W): the power the contact
+    /// dissipates at a constant normal force, `∫F·v dt = ∫P_diss dt +
+    /// ΔE_stored` (a changing `Fn` changes `E_stored` at constant `z`,
+    /// work of the normal force that is in neither). It is
+    /// `(σ0²·|v|·z²/g + σ1·ż·v + σ2·v²)·φ + F_offset·v`.
+    pub fn dissipated_power(&self, v: f64, x: f64, fn_: f64) -> f64 {
+        self.outputs(v, x, fn_).2
+    }
+
+    /// `dφ/dFn`: 1 for `Fn > 0` in the normal-force form, ½ at its kink
+    /// `Fn = 0`, else 0 (as [`LuGre::force_partials`] takes it).
+    pub fn fn_factor_slope(&self, fn_: f64) -> f64 {
+        if !self.p.normal_force_form || fn_ < 0.0 {
+            0.0
+        } else if fn_ > 0.0 {
+            1.0
+        } else {
+            0.5
+        }
+    }
+
+    /// `φ(Fn)`: `max(Fn, 0)` in the normal-force form, else 1.
+    pub fn normal_force_factor(&self, fn_: f64) -> f64 {
+        self.fn_factor(fn_)
+    }
+
     /// `true` when moving with the bristles at the sliding level:
     /// `v ≠ 0` and `sgn(v)·σ0·z ≥ 0.99·g(v)`.
     pub fn sliding(&self, v: f64, x: f64, fn_: f64) -> bool {
@@ -647,15 +679,22 @@ impl LuGre {
     /// looked up once for both (an FMU's outputs are computed together);
     /// the same operations as the two, so the same results.
     pub fn force_and_sliding(&self, v: f64, x: f64, fn_: f64) -> (f64, bool) {
+        let (force, sliding, _) = self.outputs(v, x, fn_);
+        (force, sliding)
+    }
+
+    /// The force, whether sliding, and `P_diss` ([`LuGre::dissipated_power`])
+    /// at once, from one evaluation of the Stribeck level.
+    #[inline]
+    pub fn outputs(&self, v: f64, x: f64, fn_: f64) -> (f64, bool, f64) {
         if v == 0.0 {
-            return (self.force_at_rate(self.z, v, 0.0, fn_), false);
+            return (self.force_at_rate(self.z, v, 0.0, fn_), false, 0.0);
         }
         let g = self.g_unit(v.abs(), v, x);
         let zd = self.z_rate_at_level(self.z, v, g);
-        (
-            self.force_at_rate(self.z, v, zd, fn_),
-            self.sliding_at_level(v, g),
-        )
+        let force = self.force_at_rate(self.z, v, zd, fn_);
+        let power = force * v - self.p.sigma0 * self.z * zd * self.fn_factor(fn_);
+        (force, self.sliding_at_level(v, g), power)
     }
 
     /// Steady deflection `zss = g·s/σ0` for speed `w`, direction `s`.
@@ -1238,6 +1277,12 @@ mod tests {
                         let expected = law.force(v, 0.0, fn_);
                         assert_eq!(f.to_bits(), expected.to_bits(), "z {z}, v {v}");
                         assert_eq!(sliding, law.sliding(v, 0.0, fn_), "z {z}, v {v}");
+                        // P_diss = F·v − σ0·z·ż·φ(Fn), from the same level
+                        let zd = law.z_rate(z, v, 0.0, fn_);
+                        let phi = if p.normal_force_form { fn_ } else { 1.0 };
+                        let power = expected * v - p.sigma0 * z * zd * phi;
+                        let got = law.dissipated_power(v, 0.0, fn_);
+                        assert!((got - power).abs() <= 1e-15 * (expected * v).abs().max(1e-300));
                     }
                 }
             }

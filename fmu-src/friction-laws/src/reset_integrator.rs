@@ -132,6 +132,53 @@ impl ResetIntegrator {
         Self::held(v, contact)
     }
 
+    /// The elastic energy held in the bristle (J), `(1 + a)·σ0·z²/2`: the
+    /// potential of the elastic force the strain moves against inside the
+    /// range. Held at the limit the strain does not move and the energy
+    /// stays `(1 + a)·σ0·z0²/2`: the drop of the force from `(1 + a)·σ0·z0`
+    /// to `σ0·z0` there loses no energy, and its rise on the reversal gains
+    /// none. (A strain set beyond the range only comes back: with the force
+    /// `σ0·z` there, `P_diss = −a·σ0·z·v + σ1·v²` is still not negative.)
+    pub fn stored_energy_of(&self, z: f64) -> f64 {
+        0.5 * self.energy_stiffness() * z * z
+    }
+
+    /// [`ResetIntegrator::stored_energy_of`] at the law's strain.
+    pub fn stored_energy(&self) -> f64 {
+        self.stored_energy_of(self.z)
+    }
+
+    /// `(1 + a)·σ0`, the stiffness of [`ResetIntegrator::stored_energy_of`].
+    fn energy_stiffness(&self) -> f64 {
+        (1.0 + self.p.a) * self.p.sigma0
+    }
+
+    /// `P_diss = F·v − dE/dt = F·v − E'(z)·ż` (W) for any strain, velocity
+    /// and contact: `σ1·v²` inside the range, `σ0·z0·|v|` held at a limit,
+    /// never negative.
+    pub fn dissipated_power_of(&self, z: f64, v: f64, contact: i8) -> f64 {
+        self.force_of(z, v, contact) * v - self.energy_stiffness() * z * self.z_rate(v, contact)
+    }
+
+    /// [`ResetIntegrator::dissipated_power_of`] at the law's strain.
+    pub fn dissipated_power(&self, v: f64) -> f64 {
+        self.dissipated_power_of(self.z, v, self.contact())
+    }
+
+    /// `(∂P/∂z, ∂P/∂v, ∂E/∂z)` of the energy outputs for a given contact,
+    /// from [`ResetIntegrator::partials`]: `P = F·v − E'(z)·ż`.
+    pub fn energy_partials(&self, z: f64, v: f64, contact: i8) -> (f64, f64, f64) {
+        let (_, dzd_dv, df_dz, df_dv) = self.partials(v, contact);
+        let curvature = self.energy_stiffness();
+        let slope = curvature * z;
+        let z_dot = self.z_rate(v, contact);
+        (
+            df_dz * v - curvature * z_dot,
+            df_dv * v + self.force_of(z, v, contact) - slope * dzd_dv,
+            slope,
+        )
+    }
+
     /// The partial derivatives of [`ResetIntegrator::z_rate`] and
     /// [`ResetIntegrator::force_of`] at strain `z`, velocity `v` and
     /// contact `contact`: `(∂ż/∂z, ∂ż/∂v, ∂F/∂z, ∂F/∂v)`. `ż` is `v` or 0,
@@ -218,6 +265,52 @@ mod tests {
 
     fn rel(a: f64, b: f64) -> f64 {
         (a - b).abs() / b.abs()
+    }
+
+    #[test]
+    fn energy_is_stored_inside_and_dissipated_at_the_limit() {
+        let p = ResetParams::default();
+        let mut r = ResetIntegrator::new(p).unwrap();
+        let v = 1e-3;
+        r.step(Ramp::constant(v), 0.05);
+        // inside: E = (1 + a)·σ0·z²/2, only the damper dissipates
+        let z = r.z();
+        assert!(rel(r.stored_energy(), 0.5 * (1.0 + p.a) * p.sigma0 * z * z) < 1e-15);
+        assert!(rel(r.dissipated_power(v), p.sigma1 * v * v) < 1e-12);
+        // held at the limit: E stays, F·v = σ0·z0·v is all dissipated
+        r.step(Ramp::constant(v), 0.1);
+        let held = 0.5 * (1.0 + p.a) * p.sigma0 * p.z0 * p.z0;
+        assert_eq!(r.stored_energy(), held);
+        assert!(rel(r.dissipated_power(v), p.sigma0 * p.z0 * v) < 1e-15);
+        // reversing: the force rises back to (1 + a)·σ0·z, no energy made
+        assert!(r.dissipated_power(-v) > 0.0);
+        // the partials against differences
+        for (z, c) in [(0.3 * p.z0, 0), (p.z0, 1), (-p.z0, -1), (1.2 * p.z0, 1)] {
+            for v in [2e-3, -3e-3] {
+                let (pz, pv, ez) = r.energy_partials(z, v, c);
+                let dz = 1e-6 * p.z0;
+                let (up, down) = (z + dz, z - dz);
+                let span = up - down;
+                let fd_pz =
+                    (r.dissipated_power_of(up, v, c) - r.dissipated_power_of(down, v, c)) / span;
+                let fd_pv = (r.dissipated_power_of(z, v + 1e-6, c)
+                    - r.dissipated_power_of(z, v - 1e-6, c))
+                    / 2e-6;
+                let fd_ez = (r.stored_energy_of(up) - r.stored_energy_of(down)) / span;
+                assert!(
+                    (pz - fd_pz).abs() <= 1e-6 * pz.abs().max(1.0),
+                    "{pz} {fd_pz}"
+                );
+                assert!(
+                    (pv - fd_pv).abs() <= 1e-6 * pv.abs().max(1.0),
+                    "{pv} {fd_pv}"
+                );
+                assert!(
+                    (ez - fd_ez).abs() <= 1e-6 * ez.abs().max(1e-3),
+                    "{ez} {fd_ez}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -14,6 +14,8 @@
 
 use crate::fmi;
 use fmi::*;
+use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -113,9 +115,17 @@ impl Tally {
 
 /// A hang detector: if no program finishes for `STALL` (a program takes
 /// milliseconds), the test process stops with the FMU and program it was
-/// running, instead of a CI job that times out without saying where.
+/// running, instead of a CI job that times out without saying where. It
+/// watches until dropped, at the end of the test.
 struct Watchdog {
     current: Arc<Mutex<(String, Instant)>>,
+    done: Arc<AtomicBool>,
+}
+
+impl Drop for Watchdog {
+    fn drop(&mut self) {
+        self.done.store(true, Ordering::Relaxed);
+    }
 }
 
 const STALL: Duration = Duration::from_secs(120);
@@ -123,21 +133,28 @@ const STALL: Duration = Duration::from_secs(120);
 impl Watchdog {
     fn start() -> Watchdog {
         let current = Arc::new(Mutex::new((String::new(), Instant::now())));
-        let watched = Arc::clone(&current);
+        let done = Arc::new(AtomicBool::new(false));
+        let (watched, finished) = (Arc::clone(&current), Arc::clone(&done));
         std::thread::spawn(move || loop {
             std::thread::sleep(Duration::from_secs(1));
+            if finished.load(Ordering::Relaxed) {
+                return;
+            }
             let Some(watched) = watched.lock().ok().map(|c| c.clone()) else {
                 return;
             };
             if watched.1.elapsed() > STALL {
-                eprintln!(
+                // straight to the process's stderr: the test harness's
+                // capture of eprintln! would be lost with the process
+                let _ = writeln!(
+                    std::io::stderr(),
                     "fuzz_bounded: {} has not returned in {STALL:?}: a hang (seed {SEED:#x})",
                     watched.0
                 );
                 std::process::abort();
             }
         });
-        Watchdog { current }
+        Watchdog { current, done }
     }
 
     fn running(&self, what: String) {

@@ -329,7 +329,7 @@ fn fricsim_cosim_exits_nonzero_names_the_failure_and_keeps_the_rows_so_far() {
         // every output, the Boolean friction.sliding too, as run records them
         assert_eq!(
             lines[0],
-            "time,rig.x,rig.v,rig.a,friction.F,friction.z,friction.sliding"
+            "time,rig.x,rig.v,rig.a,friction.F,friction.z,friction.P_diss,friction.E_stored,friction.sliding"
         );
         assert_eq!(lines.len(), 1 + FAULT_STEP + 1, "{csv}");
         let marker = lines[FAULT_STEP + 1];
