@@ -900,7 +900,7 @@ fn input_nominal(fmus: &[(String, Fmu)], name: &str, variable: &str) -> f64 {
 /// `friction.F → rig.F`.
 /// Columns the monolithic loops record: Rig1D's ten outputs, LuGre's three
 /// (F, z and the Boolean `sliding`, as 0 or 1).
-const RECORDED: usize = 13;
+const RECORDED: usize = 15;
 
 /// What a run of a monolithic loop records, as a host run does
 /// ([`fricsim_core::master::Run`]): the time of each communication point and a
@@ -981,21 +981,23 @@ impl StickSlipModel {
         )
     }
 
-    /// The outputs the FMUs record (Rig1D's ten, LuGre's F, z and sliding) at time
+    /// The outputs the FMUs record (Rig1D's ten, LuGre's F, z, P_diss,
+    /// E_stored and sliding) at time
     /// `t`, one row per communication point in the host's format
     /// ([`fricsim_core::master::Run`]: the time, and a [`Rows`] of [`RECORDED`]
     /// columns written in place), so that only the FMI boundary differs
     /// between the two loops.
     /// `friction_force` is LuGre's output F at its input, computed once by
     /// the caller for the row and the exchange alike (as the host passes
-    /// on the values it recorded), and `sliding` its flag there.
+    /// on the values it recorded), `sliding` its flag and `power` its
+    /// P_diss there.
     fn record(
         recording: &mut Recording,
         t: f64,
         rig: &Rig1D,
         lugre: &LuGre,
         force_in: f64,
-        (friction_force, sliding): (f64, bool),
+        (friction_force, sliding, power): (f64, bool, f64),
     ) {
         let u = Rig1DInputs {
             friction: force_in,
@@ -1017,6 +1019,8 @@ impl StickSlipModel {
             y.control_force,
             friction_force,
             lugre.z(),
+            power,
+            lugre.stored_energy(0.0),
             f64::from(u8::from(sliding)),
         ]);
     }
@@ -1042,8 +1046,9 @@ impl StickSlipModel {
             }
             // LuGre's F at the communication point: recorded, then passed
             // on at the next exchange
-            // (force and flag computed together, as the FMU's outputs are)
-            let mut output = lugre.force_and_sliding(v_in, 0.0, 0.0);
+            // (force, flag and P_diss computed together, as the FMU's
+            // outputs are)
+            let mut output = lugre.outputs(v_in, 0.0, 0.0);
             let mut force = output.0;
             Self::record(&mut recording, 0.0, &rig, &lugre, force_in, output);
             for i in 0..n {
@@ -1059,7 +1064,7 @@ impl StickSlipModel {
                     ..Default::default()
                 };
                 lugre.step(&held, h);
-                output = lugre.force_and_sliding(v_in, 0.0, 0.0);
+                output = lugre.outputs(v_in, 0.0, 0.0);
                 force = output.0;
                 let t = (i + 1) as f64 * h;
                 Self::record(&mut recording, t, &rig, &lugre, force_in, output);
@@ -1103,9 +1108,9 @@ impl StickSlipModel {
         let wall = timed(|| {
             recording = Recording::with_capacity(n + 1);
             let mut u = [rig.slip_velocity(), lugre.force(0.0, 0.0, 0.0)];
-            u[1] = lugre.force(u[0], 0.0, 0.0);
-            let sliding = lugre.sliding(u[0], 0.0, 0.0);
-            Self::record(&mut recording, 0.0, &rig, &lugre, u[1], (u[1], sliding));
+            let output = lugre.outputs(u[0], 0.0, 0.0);
+            u[1] = output.0;
+            Self::record(&mut recording, 0.0, &rig, &lugre, u[1], output);
             'steps: for i in 0..n {
                 let (rig0, lugre0) = (rig.clone(), lugre.clone());
                 for iteration in 1..=50 {
@@ -1122,8 +1127,9 @@ impl StickSlipModel {
                     if converged {
                         iterations += iteration;
                         let t = (i + 1) as f64 * h;
-                        let sliding = lugre.sliding(u[0], 0.0, 0.0);
-                        Self::record(&mut recording, t, &rig, &lugre, u[1], (y[1], sliding));
+                        // the recorded outputs, as the FMU computes them
+                        let output = lugre.outputs(u[0], 0.0, 0.0);
+                        Self::record(&mut recording, t, &rig, &lugre, u[1], output);
                         continue 'steps;
                     }
                     // ∂(rig.v)/∂F and ∂(friction.F)/∂v of the step just

@@ -78,6 +78,11 @@ pub enum FmuError {
     #[error("modelDescription.xml: fmiVersion is \"{found}\", but only FMI 2.0 is supported")]
     UnsupportedFmiVersion { found: String },
 
+    /// An FMI 3.0 FMU asked to run: its model description is read (what
+    /// `fricsim info` shows), its binary is not called.
+    #[error("an FMI 3.0 FMU (model \"{model}\"): fricsim reads its model description (`fricsim info`) but does not run FMI 3.0 FMUs yet; export it as FMI 2.0 to co-simulate it")]
+    Fmi3NotRunnable { model: String },
+
     #[error("modelDescription.xml: not a co-simulation FMU (it has no <CoSimulation> element)")]
     NotCoSimulation,
 

@@ -63,6 +63,9 @@ impl Library {
     /// `dir` and resolve its functions against the capabilities `description`
     /// declares.
     pub fn load(dir: &Path, description: &ModelDescription) -> Result<Library, FmuError> {
+        // before looking for the binary: FMI 3.0 keeps it elsewhere
+        // (binaries/x86_64-linux)
+        refuse_fmi3(description)?;
         let identifier = &description.co_simulation.model_identifier;
         let relative = format!("binaries/{PLATFORM}/{identifier}.so");
         let path = dir.join(&relative);
@@ -79,6 +82,7 @@ impl Library {
     /// Load the shared library at `path` (see [`Library::load`]).
     pub fn load_file(path: &Path, description: &ModelDescription) -> Result<Library, FmuError> {
         use libloading::os::unix::{Library as UnixLibrary, RTLD_LOCAL, RTLD_NOW};
+        refuse_fmi3(description)?;
         // RTLD_NOW: an unresolved dependency fails here, not in mid-run.
         // SAFETY: loading runs the library's initialisers; importing an FMU
         // means trusting its binary to that extent.
@@ -258,4 +262,15 @@ pub fn platforms(dir: &Path) -> Vec<String> {
         .unwrap_or_default();
     found.sort();
     found
+}
+
+/// An FMI 3.0 FMU is described ([`ModelDescription`] reads it) but not
+/// run: its functions are `fmi3…`, with other signatures.
+fn refuse_fmi3(description: &ModelDescription) -> Result<(), FmuError> {
+    if description.fmi_version.trim() == "3.0" {
+        return Err(FmuError::Fmi3NotRunnable {
+            model: description.model_name.clone(),
+        });
+    }
+    Ok(())
 }

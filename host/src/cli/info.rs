@@ -133,7 +133,7 @@ pub fn render(d: &ModelDescription, platforms: &[String]) -> String {
             v.name.clone(),
             v.causality.to_string(),
             v.variability.to_string(),
-            v.kind.type_name().to_string(),
+            v.kind.type_name_in(&d.fmi_version).to_string(),
             v.kind.start_text().unwrap_or_default(),
             v.kind.unit().unwrap_or_default().to_string(),
             v.description.clone().unwrap_or_default(),

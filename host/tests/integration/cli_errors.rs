@@ -274,3 +274,67 @@ fn an_output_connected_to_an_output() {
         &["`friction.sigma0` is not an input"],
     );
 }
+
+/// An FMI 3.0 FMU: `fricsim info` shows it (with FMI 3.0's type names);
+/// co-simulating it is refused with a message that says why and what to
+/// do, before its binary is called.
+#[test]
+fn an_fmi3_fmu_is_shown_by_info_and_refused_by_cosim() {
+    let s = setup();
+    let (_, binary) = s.parts();
+    let description = br#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="Dahlquist" instantiationToken="{221063d2-ef4a-45e5-a57a-c4d1f8e3a3ce}">
+  <CoSimulation modelIdentifier="BeltOscillator" canHandleVariableCommunicationStepSize="true"/>
+  <DefaultExperiment stopTime="10" stepSize="0.1"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
+    <Float64 name="x" valueReference="1" causality="output" initial="exact" start="1"/>
+    <Float64 name="der(x)" valueReference="2" causality="local" derivative="1"/>
+    <Float64 name="k" valueReference="3" causality="parameter" variability="fixed" start="1"/>
+    <Int32 name="n" valueReference="4" causality="output" start="0"/>
+  </ModelVariables>
+  <ModelStructure><Output valueReference="1"/><Output valueReference="4"/></ModelStructure>
+</fmiModelDescription>
+"#;
+    let fmu = s.archive(
+        "Dahlquist3.fmu",
+        &[
+            ("modelDescription.xml", &description[..]),
+            // where FMI 3.0 keeps a Linux binary
+            ("binaries/x86_64-linux/BeltOscillator.so", &binary),
+        ],
+    );
+    let f = fmu.to_str().unwrap();
+    let (code, stdout, stderr) = fricsim(&["info", f]);
+    assert_eq!(code, Some(0), "{stderr}");
+    for part in [
+        "FMI Version        3.0",
+        "Dahlquist",
+        "221063d2",
+        "Float64",
+        "Int32",
+    ] {
+        assert!(stdout.contains(part), "missing {part:?} in\n{stdout}");
+    }
+    let row = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("k "))
+        .unwrap();
+    assert!(
+        row.contains("parameter") && row.contains("Float64"),
+        "{row}"
+    );
+    let out = s.out();
+    let rig = format!("rig={f}");
+    assert_refused(
+        &cosim_alone(&rig, out.to_str().unwrap()),
+        &[
+            f,
+            "an FMI 3.0 FMU",
+            "\"Dahlquist\"",
+            "does not run FMI 3.0 FMUs yet",
+            "FMI 2.0",
+        ],
+    );
+    assert!(!out.exists());
+}

@@ -298,7 +298,7 @@ fn truncated_xml_is_refused() {
 
 #[test]
 fn other_fmi_versions_are_refused() {
-    for version in ["1.0", "3.0"] {
+    for version in ["1.0", "2.1", "4.0"] {
         let xml = VALID.replace(r#"fmiVersion="2.0""#, &format!(r#"fmiVersion="{version}""#));
         let e = refused(
             &xml,
@@ -306,11 +306,9 @@ fn other_fmi_versions_are_refused() {
         );
         assert!(matches!(e, FmuError::UnsupportedFmiVersion { .. }));
     }
-    // An FMI 3.0 file has another structure altogether.
-    refused(
-        r#"<fmiModelDescription fmiVersion="3.0" modelName="M" instantiationToken="t"><CoSimulation modelIdentifier="M"/><ModelVariables><Float64 name="x" valueReference="0"/></ModelVariables></fmiModelDescription>"#,
-        &["\"3.0\""],
-    );
+    // An FMI 2.0 body under "3.0" is read as FMI 3.0, which has no guid.
+    let xml = VALID.replace(r#"fmiVersion="2.0""#, r#"fmiVersion="3.0""#);
+    refused(&xml, &["no instantiationToken attribute"]);
     refused(
         r#"<fmiModelDescription modelName="M" guid="g"/>"#,
         &["no fmiVersion"],
@@ -565,4 +563,272 @@ fn structural_errors_are_refused_with_the_element() {
     );
     let end = VALID.find("<ScalarVariable name=\"k\"").unwrap() + 10;
     refused(&VALID[..end], &["truncated", "<ModelVariables>"]);
+}
+
+/// An FMI 3.0 description in the style of the Modelica Reference-FMUs
+/// (a Van der Pol oscillator with a counter and a mode), written for the
+/// test against FMI 3.0.1 §2.4.
+const VALID_FMI3: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="VanDerPol" instantiationToken="{8c4e810f-3da3-4a00-8276-176fa3c9f000}"
+    description="Van der Pol oscillator" generationTool="hand">
+  <ModelExchange modelIdentifier="VanDerPol"/>
+  <CoSimulation modelIdentifier="VanDerPol" canHandleVariableCommunicationStepSize="true"
+      canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"
+      hasEventMode="true" providesIntermediateUpdate="true"/>
+  <UnitDefinitions><Unit name="s"><BaseUnit s="1"/></Unit></UnitDefinitions>
+  <TypeDefinitions>
+    <EnumerationType name="Mode"><Item name="a" value="1"/><Item name="b" value="2"/></EnumerationType>
+  </TypeDefinitions>
+  <LogCategories><Category name="logEvents" description="Log events"/></LogCategories>
+  <DefaultExperiment startTime="0" stopTime="20" stepSize="1e-2"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent" variability="continuous" unit="s"/>
+    <Float64 name="x0" valueReference="1" causality="output" initial="exact" start="2"/>
+    <Float64 name="der(x0)" valueReference="2" causality="local" derivative="1"/>
+    <Float64 name="x1" valueReference="3" causality="output" initial="exact" start="0"/>
+    <Float64 name="der(x1)" valueReference="4" causality="local" derivative="3"/>
+    <Float64 name="mu" valueReference="5" causality="parameter" variability="fixed" initial="exact" start="1" min="0"/>
+    <Int32 name="counter" valueReference="10" causality="output" initial="exact" start="-3"/>
+    <Boolean name="on" valueReference="11" causality="input" start="true"/>
+    <String name="label" valueReference="12" causality="parameter" variability="fixed">
+      <Start value="van der Pol"/>
+    </String>
+    <Enumeration name="mode" valueReference="13" causality="parameter" variability="tunable" declaredType="Mode" start="2"/>
+  </ModelVariables>
+  <ModelStructure>
+    <Output valueReference="1"/>
+    <Output valueReference="3"/>
+    <Output valueReference="10" dependencies="11 5"/>
+    <ContinuousStateDerivative valueReference="2"/>
+    <ContinuousStateDerivative valueReference="4" dependencies="1 3 5"/>
+    <InitialUnknown valueReference="2"/>
+    <EventIndicator valueReference="1"/>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+
+#[test]
+fn an_fmi3_description_is_read_into_the_same_types() {
+    let d = ModelDescription::parse(VALID_FMI3).unwrap();
+    assert_eq!(d.fmi_version, "3.0");
+    assert_eq!(d.model_name, "VanDerPol");
+    // instantiationToken is FMI 2.0's guid
+    assert_eq!(d.guid, "{8c4e810f-3da3-4a00-8276-176fa3c9f000}");
+    assert_eq!(d.model_exchange.as_deref(), Some("VanDerPol"));
+    let cs = &d.co_simulation;
+    assert_eq!(cs.model_identifier, "VanDerPol");
+    assert!(cs.can_get_and_set_fmu_state && cs.can_serialize_fmu_state);
+    assert!(cs.provides_directional_derivative);
+    assert!(cs.can_handle_variable_communication_step_size);
+    assert!(!cs.can_interpolate_inputs && !cs.can_run_asynchronuously);
+    assert_eq!(d.number_of_event_indicators, 1);
+    assert_eq!(d.unit_definitions.as_deref(), Some(&["s".to_string()][..]));
+    assert_eq!(d.log_categories[0].name, "logEvents");
+    let e = d.default_experiment.as_ref().unwrap();
+    assert_eq!((e.stop_time, e.step_size), (Some(20.0), Some(1e-2)));
+    assert_eq!(d.variables.len(), 10);
+
+    let x0 = d.variable("x0").unwrap();
+    assert_eq!((x0.index, x0.value_reference), (2, 1));
+    assert_eq!(x0.causality, Causality::Output);
+    assert_eq!(x0.variability, Variability::Continuous);
+    assert_eq!(x0.initial, Some(Initial::Exact));
+    assert!(matches!(x0.kind, VariableKind::Real { start: Some(s), .. } if s == 2.0));
+    // derivative names a value reference in FMI 3.0: 1 is x0, index 2
+    let der = d.variable("der(x1)").unwrap();
+    assert!(matches!(
+        der.kind,
+        VariableKind::Real {
+            derivative: Some(4),
+            ..
+        }
+    ));
+    let mu = d.variable("mu").unwrap();
+    assert!(matches!(mu.kind, VariableKind::Real { min: Some(m), .. } if m == 0.0));
+    // a non-float defaults to discrete
+    let counter = d.variable("counter").unwrap();
+    assert_eq!(counter.variability, Variability::Discrete);
+    assert!(matches!(
+        counter.kind,
+        VariableKind::Integer {
+            start: Some(-3),
+            ..
+        }
+    ));
+    assert_eq!(counter.kind.type_name_in("3.0"), "Int32");
+    assert_eq!(x0.kind.type_name_in("3.0"), "Float64");
+    assert_eq!(x0.kind.type_name_in("2.0"), "Real");
+    assert!(matches!(
+        d.variable("on").unwrap().kind,
+        VariableKind::Boolean { start: Some(true) }
+    ));
+    assert!(matches!(&d.variable("label").unwrap().kind,
+        VariableKind::String { start: Some(s) } if s == "van der Pol"));
+    assert!(matches!(&d.variable("mode").unwrap().kind,
+        VariableKind::Enumeration { declared_type, start: Some(2), .. } if declared_type == "Mode"));
+
+    // outputs by index, their dependencies from value references
+    assert_eq!(
+        d.outputs,
+        vec![
+            Unknown {
+                index: 2,
+                dependencies: None
+            },
+            Unknown {
+                index: 4,
+                dependencies: None
+            },
+            Unknown {
+                index: 7,
+                dependencies: Some(vec![8, 6])
+            },
+        ]
+    );
+}
+
+#[test]
+fn what_fmi3_has_and_fricsim_does_not_read_yet_is_refused_by_name() {
+    let with = |old: &str, new: &str| {
+        assert!(VALID_FMI3.contains(old), "{old}");
+        VALID_FMI3.replace(old, new)
+    };
+    let mu = r#"<Float64 name="mu" valueReference="5" causality="parameter" variability="fixed" initial="exact" start="1" min="0"/>"#;
+    // an array
+    refused(
+        &with(
+            mu,
+            r#"<Float64 name="mu" valueReference="5" causality="parameter" variability="fixed" start="1 2"><Dimension start="2"/></Float64>"#,
+        ),
+        &["variable \"mu\" (index 6)", "array", "not read yet"],
+    );
+    // the types without an FMI 2.0 counterpart
+    for t in ["Float32", "Int8", "UInt64", "Binary"] {
+        refused(
+            &with(
+                mu,
+                &format!(
+                    r#"<{t} name="mu" valueReference="5" causality="parameter" variability="fixed"/>"#
+                ),
+            ),
+            &[
+                "variable \"mu\"",
+                &format!("<{t}> is not read yet"),
+                "Float64, Int32",
+            ],
+        );
+    }
+    refused(
+        &with(mu, r#"<Float65 name="mu" valueReference="5"/>"#),
+        &["<Float65> is not a variable type of FMI 3.0"],
+    );
+    refused(
+        &with(
+            mu,
+            r#"<UInt32 name="n" valueReference="5" causality="structuralParameter" variability="fixed" start="2"/>"#,
+        ),
+        &["<UInt32> is not read yet"],
+    );
+    refused(
+        &with(
+            mu,
+            r#"<Int32 name="n" valueReference="5" causality="structuralParameter" variability="fixed" start="2"/>"#,
+        ),
+        &["variable \"n\"", "structural parameters"],
+    );
+    // the rules of the standard
+    refused(
+        &with(
+            r#"<Int32 name="counter" valueReference="10" causality="output""#,
+            r#"<Int32 name="counter" valueReference="10" variability="continuous" causality="output""#,
+        ),
+        &["variable \"counter\"", "cannot be continuous"],
+    );
+    refused(
+        &with(r#"valueReference="13""#, r#"valueReference="12""#),
+        &["valueReference 12 is already the variable at index 9"],
+    );
+    refused(
+        &with(r#"derivative="3""#, r#"derivative="99""#),
+        &[
+            "variable \"der(x1)\"",
+            "derivative=\"99\" is not the value reference of a variable",
+        ],
+    );
+    refused(
+        &with(
+            r#"<Output valueReference="3"/>"#,
+            r#"<Output valueReference="98"/>"#,
+        ),
+        &[
+            "ModelStructure/Output[2] (valueReference 98)",
+            "not the value reference of a variable",
+        ],
+    );
+    refused(
+        &with(
+            r#"<Output valueReference="3"/>"#,
+            r#"<Output valueReference="5"/>"#,
+        ),
+        &["variable \"mu\" has causality \"parameter\", expected \"output\""],
+    );
+    refused(
+        &with(r#"dependencies="11 5""#, r#"dependencies="11 x""#),
+        &["dependency \"x\" is not a value reference"],
+    );
+    refused(
+        &with(r#"unit="s"/>"#, r#"unit="ms"/>"#),
+        &["unit \"ms\" is not defined in <UnitDefinitions>"],
+    );
+    refused(
+        &with(
+            r#"canSerializeFMUState="true""#,
+            r#"canGetAndSetFMUState="false" canSerializeFMUState="true""#,
+        )
+        .replacen(r#"canGetAndSetFMUState="true""#, "", 1),
+        &["canSerializeFMUState=\"true\" requires canGetAndSetFMUState=\"true\""],
+    );
+    refused(
+        &with(r#"start="-3""#, r#"start="3000000000""#),
+        &["start=\"3000000000\" is not a 32-bit integer"],
+    );
+    refused(
+        &with(
+            r#"instantiationToken="{8c4e810f-3da3-4a00-8276-176fa3c9f000}""#,
+            "",
+        ),
+        &["no instantiationToken attribute"],
+    );
+    let e = ModelDescription::parse(&with(
+        r#"<CoSimulation modelIdentifier="VanDerPol""#,
+        r#"<ScheduledExecution modelIdentifier="VanDerPol""#,
+    ))
+    .unwrap_err();
+    assert!(matches!(e, FmuError::NotCoSimulation), "{e}");
+}
+
+/// Cut anywhere, or with any one byte changed, the FMI 3.0 description is
+/// read or refused with a message, never a panic.
+#[test]
+fn an_fmi3_description_cut_or_changed_anywhere_never_panics() {
+    let bytes = VALID_FMI3.as_bytes();
+    // cut before the root's end tag is complete
+    let complete = VALID_FMI3.find("</fmiModelDescription>").unwrap() + 21;
+    for cut in 0..complete {
+        if let Ok(text) = std::str::from_utf8(&bytes[..cut]) {
+            let e = ModelDescription::parse(text).expect_err("a cut description is refused");
+            assert!(!e.to_string().is_empty());
+        }
+    }
+    for (i, replacement) in (0..bytes.len())
+        .step_by(7)
+        .zip([b'"', b'<', b'0', b' ', b'x'].iter().cycle())
+    {
+        let mut changed = bytes.to_vec();
+        changed[i] = *replacement;
+        if let Ok(text) = std::str::from_utf8(&changed) {
+            // read or refused: both are fine, a panic is not
+            let _ = ModelDescription::parse(text).map_err(|e| e.to_string());
+        }
+    }
 }

@@ -13,12 +13,11 @@
 
 use super::xml::{Document, ElementAt, Root};
 use super::{
-    Causality, CoSimulation, DefaultExperiment, Initial, LogCategory, ModelDescription, Unknown,
-    Variability, Variable, VariableKind,
+    check_unit, choice, combination_allowed, default_experiment, index_variables, invalid,
+    is_c_identifier, log_category, output_unknown, required, Causality, CoSimulation,
+    DefaultExperiment, Initial, LogCategory, ModelDescription, Variability, Variable, VariableKind,
 };
 use crate::error::FmuError;
-use std::collections::HashMap;
-use std::fmt;
 
 /// The rest of an FMI 2.0 document whose root (`fmiVersion` = `version`)
 /// has been read: the root's other attributes, the elements inside it,
@@ -55,18 +54,6 @@ pub(super) fn read(
         element(&mut raw, scope, e, at)
     })?;
     raw.validate()
-}
-
-/// The causality/variability combinations the table of §2.2.7 allows.
-fn combination_allowed(c: Causality, v: Variability) -> bool {
-    use Causality as C;
-    use Variability as V;
-    match v {
-        V::Constant => matches!(c, C::Output | C::Local),
-        V::Fixed | V::Tunable => matches!(c, C::Parameter | C::CalculatedParameter | C::Local),
-        V::Discrete => matches!(c, C::Input | C::Output | C::Local),
-        V::Continuous => matches!(c, C::Input | C::Output | C::Local | C::Independent),
-    }
 }
 
 /// What the children of an open element are read as.
@@ -106,14 +93,7 @@ fn element(
     Ok(match (scope, name) {
         (Scope::Root, "ModelExchange") => {
             once(raw.model_exchange.is_some())?;
-            let mut me = RawModelExchange::default();
-            at.attributes(e, |key, value| {
-                if key == "modelIdentifier" {
-                    me.model_identifier = value.into_owned();
-                }
-                Ok(())
-            })?;
-            raw.model_exchange = Some(me);
+            raw.model_exchange = Some(required(e, at, "modelIdentifier")?);
             Scope::Skip
         }
         (Scope::Root, "CoSimulation") => {
@@ -123,29 +103,17 @@ fn element(
         }
         (Scope::Root, "UnitDefinitions") => {
             once(raw.unit_definitions.is_some())?;
-            raw.unit_definitions = Some(RawUnitDefinitions::default());
+            raw.unit_definitions = Some(Vec::new());
             Scope::UnitDefinitions
         }
         (Scope::Root, "LogCategories") => {
             once(raw.log_categories.is_some())?;
-            raw.log_categories = Some(RawLogCategories::default());
+            raw.log_categories = Some(Vec::new());
             Scope::LogCategories
         }
         (Scope::Root, "DefaultExperiment") => {
             once(raw.default_experiment.is_some())?;
-            let mut d = RawDefaultExperiment::default();
-            at.attributes(e, |key, value| {
-                let field = match key {
-                    "startTime" => &mut d.start_time,
-                    "stopTime" => &mut d.stop_time,
-                    "tolerance" => &mut d.tolerance,
-                    "stepSize" => &mut d.step_size,
-                    _ => return Ok(()),
-                };
-                *field = Some(at.number(key, &value)?);
-                Ok(())
-            })?;
-            raw.default_experiment = Some(d);
+            raw.default_experiment = Some(default_experiment(e, at)?);
             Scope::Skip
         }
         (Scope::Root, "ModelVariables") => {
@@ -159,37 +127,13 @@ fn element(
             Scope::ModelStructure
         }
         (Scope::UnitDefinitions, "Unit") => {
-            let mut unit = None;
-            at.attributes(e, |key, value| {
-                if key == "name" {
-                    unit = Some(value.into_owned());
-                }
-                Ok(())
-            })?;
-            let name = unit.ok_or_else(|| at.missing("name"))?;
-            let units = raw.unit_definitions.as_mut().expect("open");
-            units.units.push(RawUnit { name });
+            let unit = required(e, at, "name")?;
+            raw.unit_definitions.as_mut().expect("open").push(unit);
             Scope::Skip
         }
         (Scope::LogCategories, "Category") => {
-            let mut category = RawCategory::default();
-            let mut named = false;
-            at.attributes(e, |key, value| {
-                match key {
-                    "name" => {
-                        category.name = value.into_owned();
-                        named = true;
-                    }
-                    "description" => category.description = Some(value.into_owned()),
-                    _ => {}
-                }
-                Ok(())
-            })?;
-            if !named {
-                return Err(at.missing("name"));
-            }
-            let categories = raw.log_categories.as_mut().expect("open");
-            categories.categories.push(category);
+            let category = log_category(e, at)?;
+            raw.log_categories.as_mut().expect("open").push(category);
             Scope::Skip
         }
         (Scope::ModelVariables, "ScalarVariable") => {
@@ -378,21 +322,6 @@ fn type_element(
     Ok(())
 }
 
-fn invalid(location: impl Into<String>, message: impl Into<String>) -> FmuError {
-    FmuError::InvalidModelDescription {
-        location: location.into(),
-        message: message.into(),
-    }
-}
-
-/// A valid C identifier: `modelIdentifier` names the binary and prefixes
-/// function names (§2.2.1, §4.3.1), so anything else (a `/`, `..`) is refused.
-fn is_c_identifier(s: &str) -> bool {
-    let mut chars = s.chars();
-    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
-}
-
 // The XML as it is, before validation: the attributes and child elements
 // fricsim reads, filled in by `read`; elements not listed
 // here (TypeDefinitions, annotations, …) are skipped.
@@ -408,19 +337,15 @@ struct RawModelDescription {
     generation_tool: Option<String>,
     generation_date_and_time: Option<String>,
     number_of_event_indicators: Option<u32>,
-    model_exchange: Option<RawModelExchange>,
+    /// `ModelExchange`'s `modelIdentifier`.
+    model_exchange: Option<String>,
     co_simulation: Option<RawCoSimulation>,
-    unit_definitions: Option<RawUnitDefinitions>,
-    log_categories: Option<RawLogCategories>,
-    default_experiment: Option<RawDefaultExperiment>,
+    /// The names of `UnitDefinitions`' units.
+    unit_definitions: Option<Vec<String>>,
+    log_categories: Option<Vec<LogCategory>>,
+    default_experiment: Option<DefaultExperiment>,
     model_variables: Option<RawModelVariables>,
     model_structure: Option<RawModelStructure>,
-}
-
-/// The one attribute of `ModelExchange` fricsim reports.
-#[derive(Default)]
-struct RawModelExchange {
-    model_identifier: String,
 }
 
 #[derive(Default)]
@@ -435,35 +360,6 @@ struct RawCoSimulation {
     can_get_and_set_fmu_state: Option<bool>,
     can_serialize_fmu_state: Option<bool>,
     provides_directional_derivative: Option<bool>,
-}
-
-#[derive(Default)]
-struct RawUnitDefinitions {
-    units: Vec<RawUnit>,
-}
-
-#[derive(Default)]
-struct RawUnit {
-    name: String,
-}
-
-#[derive(Default)]
-struct RawLogCategories {
-    categories: Vec<RawCategory>,
-}
-
-#[derive(Default)]
-struct RawCategory {
-    name: String,
-    description: Option<String>,
-}
-
-#[derive(Default)]
-struct RawDefaultExperiment {
-    start_time: Option<f64>,
-    stop_time: Option<f64>,
-    tolerance: Option<f64>,
-    step_size: Option<f64>,
 }
 
 #[derive(Default)]
@@ -569,9 +465,7 @@ impl RawModelDescription {
             ));
         }
 
-        let unit_definitions = self
-            .unit_definitions
-            .map(|u| u.units.into_iter().map(|u| u.name).collect::<Vec<_>>());
+        let unit_definitions = self.unit_definitions;
         let raw_variables = self
             .model_variables
             .ok_or_else(|| {
@@ -582,39 +476,12 @@ impl RawModelDescription {
             })?
             .variables;
 
-        let mut variables = Vec::with_capacity(raw_variables.len());
-        let mut by_name = HashMap::with_capacity(raw_variables.len());
-        for (i, raw) in raw_variables.into_iter().enumerate() {
-            let variable = raw.validate(i + 1, unit_definitions.as_deref())?;
-            if let Some(&first) = by_name.get(&variable.name) {
-                return Err(invalid(
-                    format!("variable \"{}\" (index {})", variable.name, i + 1),
-                    format!(
-                        "the name is already used by the variable at index {}",
-                        first + 1
-                    ),
-                ));
-            }
-            by_name.insert(variable.name.clone(), i);
-            variables.push(variable);
-        }
-        for v in &variables {
-            if let VariableKind::Real {
-                derivative: Some(d),
-                ..
-            } = v.kind
-            {
-                if d == 0 || d > variables.len() {
-                    return Err(invalid(
-                        format!("variable \"{}\" (index {})", v.name, v.index),
-                        format!(
-                            "derivative=\"{d}\" is not an index of ModelVariables (1..={})",
-                            variables.len()
-                        ),
-                    ));
-                }
-            }
-        }
+        let variables = raw_variables
+            .into_iter()
+            .enumerate()
+            .map(|(i, raw)| raw.validate(i + 1, unit_definitions.as_deref()))
+            .collect::<Result<Vec<_>, _>>()?;
+        let (variables, by_name) = index_variables(variables)?;
 
         let mut outputs = Vec::new();
         for (i, raw) in self
@@ -630,51 +497,32 @@ impl RawModelDescription {
                 i + 1,
                 raw.index
             );
-            let variable = raw
-                .index
-                .checked_sub(1)
-                .and_then(|k| variables.get(k))
-                .ok_or_else(|| {
-                    invalid(
-                        &location,
-                        format!("not an index of ModelVariables (1..={})", variables.len()),
-                    )
-                })?;
-            if variable.causality != Causality::Output {
-                return Err(invalid(
-                    &location,
-                    format!(
-                        "variable \"{}\" has causality \"{}\", expected \"output\"",
-                        variable.name, variable.causality
-                    ),
-                ));
-            }
             let dependencies = match raw.dependencies {
                 None => None,
-                Some(text) => {
-                    let mut deps = Vec::new();
-                    for word in text.split_whitespace() {
-                        let d: usize = word
-                            .parse()
-                            .ok()
-                            .filter(|&d| d >= 1 && d <= variables.len())
-                            .ok_or_else(|| {
-                                invalid(
-                                    &location,
-                                    format!(
-                                        "dependency \"{word}\" is not an index of ModelVariables"
-                                    ),
-                                )
-                            })?;
-                        deps.push(d);
-                    }
-                    Some(deps)
-                }
+                Some(text) => Some(
+                    text.split_whitespace()
+                        .map(|word| {
+                            word.parse::<usize>()
+                                .ok()
+                                .filter(|&d| d >= 1 && d <= variables.len())
+                                .ok_or_else(|| {
+                                    invalid(
+                                        &location,
+                                        format!(
+                                            "dependency \"{word}\" is not an index of ModelVariables"
+                                        ),
+                                    )
+                                })
+                        })
+                        .collect::<Result<Vec<_>, _>>()?,
+                ),
             };
-            outputs.push(Unknown {
-                index: raw.index,
+            outputs.push(output_unknown(
+                &location,
+                raw.index,
                 dependencies,
-            });
+                &variables,
+            )?);
         }
 
         Ok(ModelDescription {
@@ -687,27 +535,11 @@ impl RawModelDescription {
             generation_tool: self.generation_tool,
             generation_date_and_time: self.generation_date_and_time,
             co_simulation,
-            model_exchange: self.model_exchange.map(|me| me.model_identifier),
+            model_exchange: self.model_exchange,
             number_of_event_indicators: self.number_of_event_indicators.unwrap_or(0),
             unit_definitions,
-            log_categories: self
-                .log_categories
-                .map(|c| {
-                    c.categories
-                        .into_iter()
-                        .map(|c| LogCategory {
-                            name: c.name,
-                            description: c.description,
-                        })
-                        .collect()
-                })
-                .unwrap_or_default(),
-            default_experiment: self.default_experiment.map(|e| DefaultExperiment {
-                start_time: e.start_time,
-                stop_time: e.stop_time,
-                tolerance: e.tolerance,
-                step_size: e.step_size,
-            }),
+            log_categories: self.log_categories.unwrap_or_default(),
+            default_experiment: self.default_experiment,
             variables,
             outputs,
             by_name,
@@ -730,38 +562,21 @@ impl RawScalarVariable {
         let value_reference = self
             .value_reference
             .ok_or_else(|| invalid(&location, "the valueReference attribute is missing"))?;
-        let causality = match self.causality.as_deref() {
-            None => Causality::Local,
-            Some(text) => Causality::parse(text).ok_or_else(|| {
-                invalid(
-                    &location,
-                    format!(
-                        "causality \"{text}\" is not one of {}",
-                        list(Causality::ALL)
-                    ),
-                )
-            })?,
-        };
-        let variability = match self.variability.as_deref() {
-            None => Variability::Continuous,
-            Some(text) => Variability::parse(text).ok_or_else(|| {
-                invalid(
-                    &location,
-                    format!(
-                        "variability \"{text}\" is not one of {}",
-                        list(Variability::ALL)
-                    ),
-                )
-            })?,
-        };
+        let causality = choice(
+            self.causality.as_deref(),
+            Causality::Local,
+            &location,
+            "causality",
+        )?;
+        let variability = choice(
+            self.variability.as_deref(),
+            Variability::Continuous,
+            &location,
+            "variability",
+        )?;
         let initial = match self.initial.as_deref() {
             None => None,
-            Some(text) => Some(Initial::parse(text).ok_or_else(|| {
-                invalid(
-                    &location,
-                    format!("initial \"{text}\" is not one of {}", list(Initial::ALL)),
-                )
-            })?),
+            text => Some(choice(text, Initial::Exact, &location, "initial")?),
         };
         if !combination_allowed(causality, variability) {
             return Err(invalid(
@@ -772,14 +587,7 @@ impl RawScalarVariable {
 
         let mut kinds = Vec::with_capacity(1);
         if let Some(r) = self.real {
-            if let (Some(unit), Some(units)) = (&r.unit, units) {
-                if !units.iter().any(|u| u == unit) {
-                    return Err(invalid(
-                        &location,
-                        format!("unit \"{unit}\" is not defined in <UnitDefinitions>"),
-                    ));
-                }
-            }
+            check_unit(r.unit.as_deref(), units, &location)?;
             kinds.push(VariableKind::Real {
                 start: r.start,
                 unit: r.unit,
@@ -831,12 +639,4 @@ impl RawScalarVariable {
             kind,
         })
     }
-}
-
-fn list<T: fmt::Display>(items: &[T]) -> String {
-    items
-        .iter()
-        .map(|i| format!("\"{i}\""))
-        .collect::<Vec<_>>()
-        .join(", ")
 }

@@ -5,11 +5,13 @@
 //! experiment; the capabilities the host reads), and the root element is
 //! read here too, to pick the reader of its `fmiVersion`:
 //!
-//! - [`fmi2`]: FMI 2.0 (FMI 2.0.4 §2.2, §4.3.1), the one version read
-//!   today;
-//! - FMI 3.0 refused (`fmiVersion is "3.0", but only FMI 2.0 is
-//!   supported`) until its reader, `fmi3.rs`, joins `fmi2.rs` (issue 45;
-//!   see the crate's README).
+//! - [`fmi2`]: FMI 2.0 (FMI 2.0.4 §2.2, §4.3.1);
+//! - [`fmi3`]: FMI 3.0 (FMI 3.0.1 §2.4, §4.3.1), for its scalar variables
+//!   of the types that have an FMI 2.0 counterpart (`Float64`, `Int32`,
+//!   `Boolean`, `String`, `Enumeration`); an array, a structural
+//!   parameter or another type is refused by name. `fricsim info` shows
+//!   such an FMU; running one needs the FMI 3.0 calls, which the host does
+//!   not make yet ([`crate::instance`] refuses it with a message).
 //!
 //! Parsing is one pass of quick-xml's pull reader over the document
 //! (`xml.rs`: well-formedness, positions, attribute values), which the
@@ -18,6 +20,7 @@
 //! types below.
 
 pub mod fmi2;
+pub mod fmi3;
 mod xml;
 
 use crate::error::FmuError;
@@ -151,6 +154,17 @@ pub enum VariableKind {
 pub type ScalarVariable = Variable;
 
 impl VariableKind {
+    /// The type's name in FMI `version` ("2.0": `Real`, `Integer`,
+    /// `Boolean`, `String`, `Enumeration`; "3.0": `Float64` and `Int32`
+    /// for the first two).
+    pub fn type_name_in(&self, version: &str) -> &'static str {
+        match (version.trim(), self) {
+            ("3.0", VariableKind::Real { .. }) => "Float64",
+            ("3.0", VariableKind::Integer { .. }) => "Int32",
+            _ => self.type_name(),
+        }
+    }
+
     /// The FMI 2.0 XML element name: `Real`, `Integer`, `Boolean`,
     /// `String`, `Enumeration`.
     pub fn type_name(&self) -> &'static str {
@@ -218,7 +232,24 @@ macro_rules! xml_enum {
                 f.write_str(self.as_str())
             }
         }
+
+        impl Choice for $name {
+            fn all() -> &'static [Self] {
+                $name::ALL
+            }
+
+            fn parse(text: &str) -> Option<Self> {
+                $name::parse(text)
+            }
+        }
     };
+}
+
+/// An attribute with a fixed set of values ([`Causality`], …), as
+/// [`choice`] reads it.
+pub(super) trait Choice: Copy + fmt::Display + 'static {
+    fn all() -> &'static [Self];
+    fn parse(text: &str) -> Option<Self>;
 }
 
 xml_enum!(
@@ -286,7 +317,7 @@ impl ModelDescription {
             .to_string();
         match version.trim_matches(XML_SPACE) {
             "2.0" => fmi2::read(document, root, version),
-            // FMI 3.0 (issue 45): "3.0" => fmi3::read(document, root, version),
+            "3.0" => fmi3::read(document, root, version),
             _ => Err(FmuError::UnsupportedFmiVersion { found: version }),
         }
     }
@@ -301,4 +332,209 @@ impl ModelDescription {
                 model: self.model_name.clone(),
             })
     }
+}
+
+// ---- the rules both versions' readers apply ---------------------------
+
+pub(super) fn invalid(location: impl Into<String>, message: impl Into<String>) -> FmuError {
+    FmuError::InvalidModelDescription {
+        location: location.into(),
+        message: message.into(),
+    }
+}
+
+/// A valid C identifier: `modelIdentifier` names the binary and prefixes
+/// function names (FMI 2.0 §2.2.1, §4.3.1; FMI 3.0 §2.4.1), so anything
+/// else (a `/`, `..`) is refused.
+pub(super) fn is_c_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+/// The values of a choice, quoted, for a message.
+pub(super) fn list<T: fmt::Display>(items: &[T]) -> String {
+    items
+        .iter()
+        .map(|i| format!("\"{i}\""))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The value of the choice attribute `what` written `text`, `default` when
+/// it is absent; a value outside the choice is refused with the list.
+pub(super) fn choice<T: Choice>(
+    text: Option<&str>,
+    default: T,
+    location: &str,
+    what: &str,
+) -> Result<T, FmuError> {
+    match text {
+        None => Ok(default),
+        Some(text) => T::parse(text).ok_or_else(|| {
+            invalid(
+                location,
+                format!("{what} \"{text}\" is not one of {}", list(T::all())),
+            )
+        }),
+    }
+}
+
+/// The causality/variability combinations the standard allows (FMI 2.0
+/// §2.2.7; FMI 3.0 §2.4.7.4 has the same table, plus its structural
+/// parameters, which are not read).
+pub(super) fn combination_allowed(c: Causality, v: Variability) -> bool {
+    use Causality as C;
+    use Variability as V;
+    match v {
+        V::Constant => matches!(c, C::Output | C::Local),
+        V::Fixed | V::Tunable => matches!(c, C::Parameter | C::CalculatedParameter | C::Local),
+        V::Discrete => matches!(c, C::Input | C::Output | C::Local),
+        V::Continuous => matches!(c, C::Input | C::Output | C::Local | C::Independent),
+    }
+}
+
+/// A variable's unit must be one of `UnitDefinitions`, when there is that
+/// element.
+pub(super) fn check_unit(
+    unit: Option<&str>,
+    units: Option<&[String]>,
+    location: &str,
+) -> Result<(), FmuError> {
+    match (unit, units) {
+        (Some(unit), Some(units)) if !units.iter().any(|u| u == unit) => Err(invalid(
+            location,
+            format!("unit \"{unit}\" is not defined in <UnitDefinitions>"),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The variables in document order, checked for unique names and for
+/// `derivative` indices inside `ModelVariables`, with the index by name.
+pub(super) fn index_variables(
+    variables: Vec<Variable>,
+) -> Result<(Vec<Variable>, HashMap<String, usize>), FmuError> {
+    let mut by_name = HashMap::with_capacity(variables.len());
+    for (i, variable) in variables.iter().enumerate() {
+        if let Some(&first) = by_name.get(&variable.name) {
+            return Err(invalid(
+                format!("variable \"{}\" (index {})", variable.name, i + 1),
+                format!(
+                    "the name is already used by the variable at index {}",
+                    first + 1
+                ),
+            ));
+        }
+        by_name.insert(variable.name.clone(), i);
+    }
+    for v in &variables {
+        if let VariableKind::Real {
+            derivative: Some(d),
+            ..
+        } = v.kind
+        {
+            if d == 0 || d > variables.len() {
+                return Err(invalid(
+                    format!("variable \"{}\" (index {})", v.name, v.index),
+                    format!(
+                        "derivative=\"{d}\" is not an index of ModelVariables (1..={})",
+                        variables.len()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok((variables, by_name))
+}
+
+/// An output of `ModelStructure` at `location`: the variable at `index`
+/// (1-based) must exist and be an output; `dependencies` are indices
+/// already checked.
+pub(super) fn output_unknown(
+    location: &str,
+    index: usize,
+    dependencies: Option<Vec<usize>>,
+    variables: &[Variable],
+) -> Result<Unknown, FmuError> {
+    let variable = index
+        .checked_sub(1)
+        .and_then(|k| variables.get(k))
+        .ok_or_else(|| {
+            invalid(
+                location,
+                format!("not an index of ModelVariables (1..={})", variables.len()),
+            )
+        })?;
+    if variable.causality != Causality::Output {
+        return Err(invalid(
+            location,
+            format!(
+                "variable \"{}\" has causality \"{}\", expected \"output\"",
+                variable.name, variable.causality
+            ),
+        ));
+    }
+    Ok(Unknown {
+        index,
+        dependencies,
+    })
+}
+
+// ---- elements both versions write alike --------------------------------
+
+/// `DefaultExperiment` (FMI 2.0 §2.2.5; the same in FMI 3.0).
+fn default_experiment(
+    e: &quick_xml::events::BytesStart<'_>,
+    at: &xml::ElementAt<'_>,
+) -> Result<DefaultExperiment, FmuError> {
+    let mut d = DefaultExperiment::default();
+    at.attributes(e, |key, value| {
+        let field = match key {
+            "startTime" => &mut d.start_time,
+            "stopTime" => &mut d.stop_time,
+            "tolerance" => &mut d.tolerance,
+            "stepSize" => &mut d.step_size,
+            _ => return Ok(()),
+        };
+        *field = Some(at.number(key, &value)?);
+        Ok(())
+    })?;
+    Ok(d)
+}
+
+/// The attribute `key` of the element at `at`, which must have it
+/// (`Unit`'s `name`, `ModelExchange`'s `modelIdentifier`, …).
+fn required(
+    e: &quick_xml::events::BytesStart<'_>,
+    at: &xml::ElementAt<'_>,
+    key: &str,
+) -> Result<String, FmuError> {
+    let mut found = None;
+    at.attributes(e, |k, value| {
+        if k == key {
+            found = Some(value.into_owned());
+        }
+        Ok(())
+    })?;
+    found.ok_or_else(|| at.missing(key))
+}
+
+/// A `Category` of `LogCategories` (the same in both versions).
+fn log_category(
+    e: &quick_xml::events::BytesStart<'_>,
+    at: &xml::ElementAt<'_>,
+) -> Result<LogCategory, FmuError> {
+    let mut name = None;
+    let mut description = None;
+    at.attributes(e, |key, value| {
+        match key {
+            "name" => name = Some(value.into_owned()),
+            "description" => description = Some(value.into_owned()),
+            _ => {}
+        }
+        Ok(())
+    })?;
+    let name = name.ok_or_else(|| at.missing("name"))?;
+    Ok(LogCategory { name, description })
 }
