@@ -57,10 +57,16 @@ fn by_velocity(f: &Fmu, v: f64, _x: f64, _f_app: f64) {
     f.set("v", v);
 }
 
-fn lugre_curve(f: &Fmu, v: f64) -> f64 {
+/// `sgn v·(Fc + (Fs − Fc)·exp(−|v/vs|^δ)) + σ2·v` from the FMU's
+/// parameters, its exponent δ named `exponent`.
+fn stribeck_curve(f: &Fmu, v: f64, exponent: &str) -> f64 {
     let (fc, fs, vs, s2) = (f.get("Fc"), f.get("Fs"), f.get("vs"), f.get("sigma2"));
-    let d = f.get("stribeck_exponent");
+    let d = f.get(exponent);
     v.signum() * (fc + (fs - fc) * (-(v.abs() / vs).powf(d)).exp()) + s2 * v
+}
+
+fn lugre_curve(f: &Fmu, v: f64) -> f64 {
+    stribeck_curve(f, v, "stribeck_exponent")
 }
 
 const LAWS: &[Law] = &[
@@ -135,16 +141,7 @@ const LAWS: &[Law] = &[
             f.set("v", v);
             f.set("F_app", f_app);
         },
-        curve: |f, v| {
-            let (fc, fs, vs, s2, d) = (
-                f.get("Fc"),
-                f.get("Fs"),
-                f.get("vs"),
-                f.get("sigma2"),
-                f.get("delta"),
-            );
-            v.signum() * (fc + (fs - fc) * (-(v.abs() / vs).powf(d)).exp()) + s2 * v
-        },
+        curve: |f, v| stribeck_curve(f, v, "delta"),
         fc: |f| f.get("Fc"),
         energy_outputs: true,
         rate_independent: false,
@@ -200,16 +197,7 @@ const LAWS: &[Law] = &[
         name: "GMS",
         force: "F",
         drive: by_velocity,
-        curve: |f, v| {
-            let (fc, fs, vs, s2, d) = (
-                f.get("Fc"),
-                f.get("Fs"),
-                f.get("vs"),
-                f.get("sigma2"),
-                f.get("stribeck_exponent"),
-            );
-            v.signum() * (fc + (fs - fc) * (-(v.abs() / vs).powf(d)).exp()) + s2 * v
-        },
+        curve: |f, v| stribeck_curve(f, v, "stribeck_exponent"),
         fc: |f| f.get("Fc"),
         energy_outputs: true,
         rate_independent: false,

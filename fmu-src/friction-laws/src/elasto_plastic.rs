@@ -30,7 +30,7 @@
 //! its length, about 1e-7 of `Fs/σ0` over a step in the tests).
 
 use crate::error::{require_non_negative, require_positive};
-use crate::interval::{displacement, one_sign_pieces, sign_on};
+use crate::interval::{displacement, each_held_substep};
 use crate::state::one_value_state;
 use crate::{ParamError, Ramp};
 use std::f64::consts::PI;
@@ -116,10 +116,6 @@ pub struct ElastoPlastic {
     z: f64,
 }
 
-/// The most sub-steps a ramped velocity is cut into.
-const MAX_SUBSTEPS: usize = 1000;
-/// The largest relative change of `|v| + vs` over a sub-step.
-const KAPPA_V: f64 = 1e-3;
 /// Tolerance of the Runge–Kutta pair, relative to `w_ss`.
 const TOLERANCE: f64 = 1e-13;
 /// The shortest step of the pair, relative to `w_ss`: a floor that only a
@@ -249,30 +245,11 @@ impl ElastoPlastic {
     /// Advances over `[0, h]` with `v(τ) = v.value + v.slope·τ` (the
     /// module's documentation).
     pub fn step(&mut self, v: Ramp, h: f64) {
-        if h.is_nan() || h <= 0.0 {
-            return;
-        }
-        let (pieces, n) = one_sign_pieces(v, h);
-        for &(a, b) in &pieces[..n] {
-            let s = sign_on(v, a, b);
-            if s == 0.0 {
-                continue;
-            }
-            let mut count = 1;
-            if v.slope != 0.0 {
-                let least = v.at(a).abs().min(v.at(b).abs()) + self.p.vs;
-                let change = v.slope.abs() * (b - a);
-                count = ((change / (KAPPA_V * least)).ceil() as usize).clamp(1, MAX_SUBSTEPS);
-            }
-            let len = (b - a) / count as f64;
-            for k in 0..count {
-                let t0 = a + k as f64 * len;
-                let t1 = if k + 1 == count { b } else { t0 + len };
-                let u = displacement(v, t0, t1).abs();
-                let w_ss = self.level(v.at(0.5 * (t0 + t1))) / self.p.sigma0;
-                self.z = s * self.advance(s * self.z, u, w_ss);
-            }
-        }
+        each_held_substep(v, h, self.p.vs, |s, t0, t1| {
+            let u = displacement(v, t0, t1).abs();
+            let w_ss = self.level(v.at(0.5 * (t0 + t1))) / self.p.sigma0;
+            self.z = s * self.advance(s * self.z, u, w_ss);
+        });
     }
 
     /// `w` after the distance `u` at the held steady state `w_ss`.

@@ -52,3 +52,39 @@ pub(crate) fn each_one_sign_displacement(v: Ramp, h: f64, mut advance: impl FnMu
         }
     }
 }
+
+/// The most sub-steps [`each_held_substep`] cuts a ramped velocity into.
+const MAX_HELD_SUBSTEPS: usize = 1000;
+/// The largest relative change of `|v| + vs` over one of its sub-steps.
+const KAPPA_V: f64 = 1e-3;
+
+/// For a law whose level depends on the velocity (scale `vs`): calls
+/// `advance(s, t0, t1)` on sub-steps `[t0, t1]` of each piece of `[0, h]`
+/// on which `v` keeps the sign `s = ±1`, short enough that `|v| + vs`
+/// changes by at most 1e-3 of itself over each (at most 1000 a piece; one
+/// for a held `v`), so that the velocity can be held at its mean over a
+/// sub-step. None for a non-positive or NaN `h`, none where `v` vanishes.
+pub(crate) fn each_held_substep(v: Ramp, h: f64, vs: f64, mut advance: impl FnMut(f64, f64, f64)) {
+    if h.is_nan() || h <= 0.0 {
+        return;
+    }
+    let (pieces, n) = one_sign_pieces(v, h);
+    for &(a, b) in &pieces[..n] {
+        let s = sign_on(v, a, b);
+        if s == 0.0 {
+            continue;
+        }
+        let mut count = 1;
+        if v.slope != 0.0 {
+            let least = v.at(a).abs().min(v.at(b).abs()) + vs;
+            let change = v.slope.abs() * (b - a);
+            count = ((change / (KAPPA_V * least)).ceil() as usize).clamp(1, MAX_HELD_SUBSTEPS);
+        }
+        let len = (b - a) / count as f64;
+        for k in 0..count {
+            let t0 = a + k as f64 * len;
+            let t1 = if k + 1 == count { b } else { t0 + len };
+            advance(s, t0, t1);
+        }
+    }
+}

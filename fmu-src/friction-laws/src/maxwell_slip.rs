@@ -35,7 +35,7 @@
 //! inside a sub-step is an error of second order in its length.
 
 use crate::error::{require_non_negative, require_positive};
-use crate::interval::{displacement, one_sign_pieces, sign_on};
+use crate::interval::{displacement, each_held_substep};
 use crate::{ParamError, Ramp};
 
 /// The most elements a law holds (the FMUs declare this many).
@@ -434,11 +434,6 @@ impl GmsParams {
     }
 }
 
-/// The most sub-steps a ramped velocity is cut into.
-const MAX_SUBSTEPS: usize = 1000;
-/// The largest relative change of `|v| + vs` over a sub-step.
-const KAPPA_V: f64 = 1e-3;
-
 /// GMS state: element forces `F_i` (N) and each element's mode: 0
 /// sticking, `±1` slipping in that direction.
 #[derive(Clone, Debug)]
@@ -505,29 +500,10 @@ impl Gms {
     /// module's documentation): pieces of one sign, sub-steps of a held
     /// mean velocity, each element exact over each sub-step.
     pub fn step(&mut self, v: Ramp, h: f64) {
-        if h.is_nan() || h <= 0.0 {
-            return;
-        }
-        let (pieces, n) = one_sign_pieces(v, h);
-        for &(a, b) in &pieces[..n] {
-            let s = sign_on(v, a, b);
-            if s == 0.0 {
-                continue;
-            }
-            let mut count = 1;
-            if v.slope != 0.0 {
-                let least = v.at(a).abs().min(v.at(b).abs()) + self.p.vs;
-                let change = v.slope.abs() * (b - a);
-                count = ((change / (KAPPA_V * least)).ceil() as usize).clamp(1, MAX_SUBSTEPS);
-            }
-            let len = (b - a) / count as f64;
-            for k in 0..count {
-                let t0 = a + k as f64 * len;
-                let t1 = if k + 1 == count { b } else { t0 + len };
-                let dx = displacement(v, t0, t1);
-                self.advance_held(s, dx / (t1 - t0), t1 - t0);
-            }
-        }
+        each_held_substep(v, h, self.p.vs, |s, t0, t1| {
+            let dx = displacement(v, t0, t1);
+            self.advance_held(s, dx / (t1 - t0), t1 - t0);
+        });
     }
 
     /// Every element over `tau` seconds at the held velocity `v` of sign
