@@ -147,7 +147,10 @@ pub fn jacobi_run(
             .map_err(|e| e.to_string())?;
         // (`components` borrow the FMUs, which keep their binaries loaded
         // for the whole run)
-        let f = *fmu.library().functions();
+        let f = *fmu
+            .library()
+            .functions()
+            .ok_or_else(|| format!("{name}: the hand-written loop calls FMI 2.0 FMUs only"))?;
         // SAFETY: valid C strings and callbacks that outlive the instance
         let c = unsafe {
             (f.instantiate)(

@@ -454,7 +454,11 @@ impl System {
                     "component name `{name}` is used twice"
                 )));
             }
-            let instance = fmu.instantiate(&name)?;
+            let instance = if fmu.description().is_fmi3() {
+                ComponentInstance::Fmi3(fmu.instantiate_fmi3(&name)?)
+            } else {
+                ComponentInstance::Fmi2(fmu.instantiate(&name)?)
+            };
             let outputs: Vec<(String, ValueReference, RecordedType)> = fmu
                 .description()
                 .variables
@@ -466,7 +470,7 @@ impl System {
             let mut component = Component {
                 name,
                 fmu,
-                instance: ComponentInstance::Fmi2(instance),
+                instance,
                 output_vrs: Vec::new(),
                 integer_vrs: Vec::new(),
                 boolean_vrs: Vec::new(),

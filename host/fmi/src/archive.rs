@@ -11,7 +11,7 @@
 //! link is ever created, so no write can leave it.
 
 use crate::error::{ArchiveProblem, FmuError};
-use crate::library::PLATFORM;
+use crate::library::{PLATFORM, PLATFORM_FMI3};
 use std::collections::HashSet;
 use std::fs::{self, File};
 use std::io::{self, BufReader, Read, Seek, SeekFrom, Write};
@@ -38,7 +38,7 @@ pub struct UnpackOptions {
     /// system's temporary directory).
     pub temp_parent: Option<PathBuf>,
     /// Write only what an FMU running here can read: the model
-    /// description, `binaries/linux64/`, `resources/` and the other files
+    /// description, `binaries/linux64/` (FMI 3.0: `binaries/x86_64-linux/`), `resources/` and the other files
     /// outside `binaries/`, `documentation/` and `sources/`. The binaries
     /// of other platforms, the documentation and the sources are checked
     /// like every entry but not inflated (their folders are made, so the
@@ -246,7 +246,11 @@ fn used_when_running(relative: &Path) -> bool {
     let mut parts = relative.components().map(|c| c.as_os_str());
     match parts.next().and_then(|first| first.to_str()) {
         Some("documentation" | "sources") => false,
-        Some("binaries") => parts.next() == Some(std::ffi::OsStr::new(PLATFORM)),
+        // the platform as FMI 2.0 and as FMI 3.0 name it (the model
+        // description, which says which, is not read yet)
+        Some("binaries") => parts
+            .next()
+            .is_some_and(|p| p == PLATFORM || p == PLATFORM_FMI3),
         _ => true,
     }
 }

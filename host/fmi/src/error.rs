@@ -75,13 +75,15 @@ pub enum FmuError {
         message: String,
     },
 
-    #[error("modelDescription.xml: fmiVersion is \"{found}\", but only FMI 2.0 is supported")]
+    #[error(
+        "modelDescription.xml: fmiVersion is \"{found}\", but only FMI 2.0 and 3.0 are supported"
+    )]
     UnsupportedFmiVersion { found: String },
 
-    /// An FMI 3.0 FMU asked to run: its model description is read (what
-    /// `fricsim info` shows), its binary is not called.
-    #[error("an FMI 3.0 FMU (model \"{model}\"): fricsim reads its model description (`fricsim info`) but does not run FMI 3.0 FMUs yet; export it as FMI 2.0 to co-simulate it")]
-    Fmi3NotRunnable { model: String },
+    /// An instance of one FMI version asked of an FMU of another (e.g.
+    /// [`crate::Instance`], FMI 2.0's, of an FMI 3.0 FMU).
+    #[error("model \"{model}\" is an FMI {fmi_version} FMU: instantiate it with the instance type of that version (Fmu::instantiate for FMI 2.0, Fmu::instantiate_fmi3 for FMI 3.0)")]
+    WrongInstanceType { model: String, fmi_version: String },
 
     #[error("modelDescription.xml: not a co-simulation FMU (it has no <CoSimulation> element)")]
     NotCoSimulation,
@@ -104,7 +106,7 @@ pub enum FmuError {
     #[error("cannot load {path} as a shared library: {message}")]
     LoadLibrary { path: PathBuf, message: String },
 
-    #[error("{path} does not export the required FMI 2.0 functions: {}", symbols.join(", "))]
+    #[error("{path} does not export the required FMI functions: {}", symbols.join(", "))]
     MissingFunctions {
         path: PathBuf,
         symbols: Vec<&'static str>,
@@ -117,8 +119,12 @@ pub enum FmuError {
         symbols: Vec<&'static str>,
     },
 
-    #[error("{path}: fmi2GetVersion() returned \"{found}\", expected \"2.0\"")]
-    WrongFmiVersion { path: PathBuf, found: String },
+    #[error("{path}: fmi{}GetVersion() returned \"{found}\", expected \"{expected}\"", &expected[..1])]
+    WrongFmiVersion {
+        path: PathBuf,
+        expected: &'static str,
+        found: String,
+    },
 
     #[error("no variable named \"{name}\" in model {model}")]
     UnknownVariable { name: String, model: String },
@@ -154,7 +160,8 @@ pub enum FmuError {
     /// An FMU function returned Discard, Error, Fatal or Pending;
     /// `messages` are what the instance logged during the call.
     #[error(
-        "{function} failed for instance \"{instance}\" with {status}{}",
+        "{function} failed for instance \"{instance}\" with {}{}",
+        status.named_for(function),
         log_suffix(messages)
     )]
     Call {
@@ -164,7 +171,17 @@ pub enum FmuError {
         messages: Vec<String>,
     },
 
-    #[error("{function} refused for instance \"{instance}\": an earlier call returned fmi2Fatal, so the FMU may not be called again")]
+    /// A step after which the FMU asks to end the simulation (FMI 3.0's
+    /// `terminateSimulation`): the normal end of a run, not a failure, for
+    /// a master that takes it so.
+    #[error("{instance} asks to end the simulation at t = {time} ({function} returned terminateSimulation = true)")]
+    EndedSimulation {
+        function: &'static str,
+        instance: String,
+        time: f64,
+    },
+
+    #[error("{function} refused for instance \"{instance}\": an earlier call returned {}Fatal, so the FMU may not be called again", &function[..4])]
     AfterFatal {
         function: &'static str,
         instance: String,

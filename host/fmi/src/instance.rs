@@ -11,15 +11,15 @@
 //! value-access and step functions do not allocate unless they fail.
 
 use super::archive::{unpack, UnpackOptions};
-use super::library::{c_text, Declared, Library};
+use super::guard::{c_string, not_supported, same_length, Guard};
+use super::instance3::Fmi3Instance;
+use super::library::{c_text, Api, Declared, Library};
 use super::logger::{fricsim_fmi2_logger, Log, Sink};
 use super::model_description::{ModelDescription, ScalarVariable, ValueReference};
-use super::watchdog::Watched;
 use super::Status;
 use crate::blackbox::CallRecorder;
 use crate::error::FmuError;
 use crate::fmi2::*;
-use std::ffi::CString;
 use std::mem::ManuallyDrop;
 use std::os::raw::c_void;
 use std::path::{Path, PathBuf};
@@ -29,8 +29,6 @@ use std::sync::Arc;
 use std::time::Duration;
 use tempfile::TempDir;
 
-/// Error messages logged earlier are shown when a call logged nothing.
-const EARLIER_MESSAGES: usize = 3;
 /// The name of `fmi2DoStep` in errors (both halves of [`Instance::do_step`]).
 const DO_STEP: &str = "fmi2DoStep";
 /// Booleans are converted to `fmi2Boolean` through a stack buffer this long.
@@ -149,9 +147,16 @@ impl Fmu {
         &self.shared.library
     }
 
-    /// A new co-simulation instance called `name` (see [`Instance::instantiate`]).
+    /// A new co-simulation instance called `name` of an FMI 2.0 FMU (see
+    /// [`Instance::instantiate`]).
     pub fn instantiate(&self, name: &str) -> Result<Instance, FmuError> {
         Instance::instantiate(self, name)
+    }
+
+    /// A new co-simulation instance called `name` of an FMI 3.0 FMU (see
+    /// [`Fmi3Instance::instantiate`]).
+    pub fn instantiate_fmi3(&self, name: &str) -> Result<Fmi3Instance, FmuError> {
+        Fmi3Instance::instantiate(self, name)
     }
 }
 
@@ -160,8 +165,27 @@ impl Fmu {
 /// [`Instance::free_state`] or when the instance is dropped.
 #[derive(Debug)]
 pub struct FmuState {
-    pointer: fmi2FMUstate,
+    pointer: *mut c_void,
     owner: u64,
+}
+
+impl FmuState {
+    pub(crate) fn new(pointer: *mut c_void, owner: u64) -> FmuState {
+        FmuState { pointer, owner }
+    }
+
+    pub(crate) fn pointer(&self) -> *mut c_void {
+        self.pointer
+    }
+
+    pub(crate) fn set_pointer(&mut self, pointer: *mut c_void) {
+        self.pointer = pointer;
+    }
+
+    /// The id of the instance that made it.
+    pub(crate) fn owner(&self) -> u64 {
+        self.owner
+    }
 }
 
 /// Whether a master may restore a state saved before the end of the step
@@ -178,84 +202,39 @@ pub enum Rollback {
 
 static NEXT_INSTANCE_ID: AtomicU64 = AtomicU64::new(1);
 
+/// A new instance id, unique in the process (of either FMI version).
+pub(crate) fn next_instance_id() -> u64 {
+    NEXT_INSTANCE_ID.fetch_add(1, Ordering::Relaxed)
+}
+
 /// One FMU instance in co-simulation mode. Dropping it frees its states and
 /// calls `fmi2FreeInstance` — unless a call returned `fmi2Fatal`, after which
 /// §2.1.3 allows no further call and the instance is leaked.
 pub struct Instance {
-    fmu: Fmu,
     /// FMI 2.0's raw table, copied from the library: each call is one
     /// indirect call through it.
     functions: Functions,
     /// The optional groups the FMU declares: the others are refused.
     declared: Declared,
     component: fmi2Component,
-    name: String,
-    id: u64,
-    /// The logger's environment and the callbacks: the FMU may keep pointers
-    /// to both until it is freed (and forever after `fmi2Fatal`).
-    sink: ManuallyDrop<Box<Sink>>,
+    /// What every call goes through (logging, statuses, time limit, black
+    /// box), shared with FMI 3.0's instance; it holds the logger's sink.
+    guard: Guard,
+    /// The callbacks: the FMU may keep a pointer to them until it is freed
+    /// (and forever after `fmi2Fatal`).
     callbacks: ManuallyDrop<Box<CallbackFunctions>>,
     states: Vec<fmi2FMUstate>,
-    fatal: bool,
-    /// A call returned `fmi2Error` or `fmi2Fatal` since instantiation or
-    /// the last `fmi2Reset`: the instance is in the error state, from
-    /// which FMI 2.0 allows no `fmi2Terminate` (§4.2.4).
-    failed: bool,
-    /// `fatal`, a time limit or a black box set: every call goes through
-    /// [`Instance::begin_guarded`], the rest skip these checks with one test.
-    guarded: bool,
-    /// The time limit on each call, if one is set ([`Instance::set_call_time_limit`]).
-    limit: Option<Arc<Watched>>,
-    /// Where each call is recorded, in an isolated run ([`Instance::set_black_box`]).
-    black_box: Option<CallRecorder>,
-    /// Calls made so far that may have changed a value of the instance
-    /// (every call but `fmi2Get…`), see [`Instance::changes`].
-    changes: u64,
 }
 
 impl std::fmt::Debug for Instance {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Instance")
-            .field("name", &self.name)
-            .field("model", &self.fmu.description().model_name)
+            .field("name", &self.guard.name)
+            .field("model", &self.guard.fmu.description().model_name)
             .field("states", &self.states.len())
-            .field("fatal", &self.fatal)
+            .field("fatal", &self.guard.fatal)
             .finish_non_exhaustive()
     }
-}
-
-/// The error of a call the FMU does not declare, made only when needed.
-#[cold]
-fn not_supported(function: &'static str, capability: &'static str) -> FmuError {
-    FmuError::NotSupported {
-        function,
-        capability,
-    }
-}
-
-fn same_length(
-    function: &'static str,
-    what: &'static str,
-    expected: usize,
-    found: usize,
-) -> Result<(), FmuError> {
-    if expected == found {
-        Ok(())
-    } else {
-        Err(FmuError::LengthMismatch {
-            function,
-            what,
-            expected,
-            found,
-        })
-    }
-}
-
-fn c_string(what: &'static str, value: &str) -> Result<CString, FmuError> {
-    CString::new(value).map_err(|_| FmuError::NulInString {
-        what,
-        value: value.to_string(),
-    })
 }
 
 /// `file:///…` URI of a directory (§2.1.5 `fmuResourceLocation`), with
@@ -284,7 +263,7 @@ impl Instance {
             "the resource location",
             &file_uri(&fmu.dir().join("resources")),
         )?;
-        let id = NEXT_INSTANCE_ID.fetch_add(1, Ordering::Relaxed);
+        let id = next_instance_id();
         let sink = Box::new(Sink::new(fmu.log().clone(), name, id));
         let callbacks = Box::new(CallbackFunctions {
             logger: Some(fricsim_fmi2_logger),
@@ -293,7 +272,12 @@ impl Instance {
             step_finished: None,
             component_environment: &*sink as *const Sink as *mut c_void,
         });
-        let functions = fmu.shared.library.functions;
+        let Api::Fmi2(functions) = fmu.shared.library.api else {
+            return Err(FmuError::WrongInstanceType {
+                model: description.model_name.clone(),
+                fmi_version: description.fmi_version.clone(),
+            });
+        };
         let declared = fmu.shared.library.declared;
         // SAFETY: all strings are NUL-terminated and outlive the call; the
         // callbacks and their environment live as long as the instance.
@@ -315,26 +299,17 @@ impl Instance {
             });
         }
         Ok(Instance {
-            fmu: fmu.clone(),
             functions,
             declared,
             component,
-            name: name.to_string(),
-            id,
-            sink: ManuallyDrop::new(sink),
+            guard: Guard::new(fmu, name, id, sink),
             callbacks: ManuallyDrop::new(callbacks),
             states: Vec::new(),
-            fatal: false,
-            failed: false,
-            guarded: false,
-            limit: None,
-            black_box: None,
-            changes: 0,
         })
     }
 
     pub fn name(&self) -> &str {
-        &self.name
+        &self.guard.name
     }
 
     /// A count that moves with every call that may change a value of the
@@ -342,11 +317,11 @@ impl Instance {
     /// still, `fmi2GetReal` answers as it did, and a value read since can
     /// be used again instead of asking the FMU once more.
     pub fn changes(&self) -> u64 {
-        self.changes
+        self.guard.changes
     }
 
     pub fn fmu(&self) -> &Fmu {
-        &self.fmu
+        &self.guard.fmu
     }
 
     /// A time limit on every later FMI call of this instance (`None`: no
@@ -355,152 +330,40 @@ impl Instance {
     /// past it on stderr; a running call is never interrupted (see
     /// [`super::watchdog`]).
     pub fn set_call_time_limit(&mut self, limit: Option<Duration>) {
-        self.limit = limit.map(|l| Watched::new(&self.name, l));
-        self.guarded = self.fatal || self.limit.is_some() || self.black_box.is_some();
+        self.guard.set_call_time_limit(limit);
     }
 
     /// Record every later FMI call of this instance in an isolated run's
     /// black box (`None`: no longer), so that the parent process can name
     /// the call the FMU crashed or hung in ([`crate::blackbox`]).
     pub fn set_black_box(&mut self, recorder: Option<CallRecorder>) {
-        self.black_box = recorder;
-        self.guarded = self.fatal || self.limit.is_some() || self.black_box.is_some();
+        self.guard.set_black_box(recorder);
     }
 
-    /// Refuse any call after `fmi2Fatal`; otherwise the log mark before the
-    /// call (and the call's clock started, under a time limit). Every call
-    /// but a getter's counts as a change ([`Instance::changes`]).
-    #[inline]
-    fn begin(&mut self, function: &'static str) -> Result<u64, FmuError> {
-        self.count_change(function);
-        if self.guarded {
-            return self.begin_guarded(function);
-        }
-        Ok(self.sink.mark())
-    }
-
-    /// A call of `function` moves [`Instance::changes`] unless it is a
-    /// getter (`function` is a constant: the test folds away).
     #[inline(always)]
-    fn count_change(&mut self, function: &'static str) {
-        if !function.starts_with("fmi2Get") {
-            self.changes = self.changes.wrapping_add(1);
-        }
+    fn begin(&mut self, function: &'static str) -> Result<u64, FmuError> {
+        self.guard.begin(function)
     }
 
-    /// [`Instance::begin`] after `fmi2Fatal` or under a time limit.
-    #[cold]
-    #[inline(never)]
-    fn begin_guarded(&mut self, function: &'static str) -> Result<u64, FmuError> {
-        if self.fatal {
-            return Err(FmuError::AfterFatal {
-                function,
-                instance: self.name.clone(),
-            });
-        }
-        if let Some(w) = &self.limit {
-            w.start(function);
-        }
-        if let Some(b) = &self.black_box {
-            b.enter(function);
-        }
-        Ok(self.sink.mark())
-    }
-
-    /// The status of a call as a `Result`: `fmi2OK` (0) without a time limit
-    /// at once, anything else through [`Instance::finish_checked`].
-    #[inline]
+    #[inline(always)]
     fn finish(
         &mut self,
         function: &'static str,
         mark: u64,
         raw: fmi2Status,
     ) -> Result<Status, FmuError> {
-        if raw == 0 && !self.guarded {
-            return Ok(Status::Ok);
-        }
-        self.finish_checked(function, mark, raw)
+        self.guard.finish(function, mark, raw)
     }
 
-    /// One FMI call, [`Instance::begin`] and [`Instance::finish`] in one:
-    /// `ffi` checks its arguments (it may refuse, after the check for
-    /// `fmi2Fatal` as with `begin`) and calls the FMU on the component.
-    /// Whether the instance is guarded is asked once, before the call, and
-    /// each case has a path of its own: the unguarded one takes `fmi2OK`
-    /// at once, without reading the instance again after the call (one
-    /// path through `begin` holds more across the call: measured, a few
-    /// instructions more per call).
+    /// One FMI call through the guard ([`Guard::call`]) on this instance's
+    /// component.
     #[inline(always)]
     fn call(
         &mut self,
         function: &'static str,
         ffi: impl FnOnce(fmi2Component) -> Result<fmi2Status, FmuError>,
     ) -> Result<Status, FmuError> {
-        self.count_change(function);
-        if self.guarded {
-            let mark = self.begin_guarded(function)?;
-            let raw = ffi(self.component)?;
-            return self.finish_checked(function, mark, raw);
-        }
-        let mark = self.sink.mark();
-        match ffi(self.component)? {
-            0 => Ok(Status::Ok), // fmi2OK
-            raw => self.finish_checked(function, mark, raw),
-        }
-    }
-
-    #[cold]
-    #[inline(never)]
-    fn finish_checked(
-        &mut self,
-        function: &'static str,
-        mark: u64,
-        raw: fmi2Status,
-    ) -> Result<Status, FmuError> {
-        if let Some(b) = &self.black_box {
-            b.leave();
-        }
-        let overtime = self.limit.as_ref().and_then(|w| w.stop());
-        let status = Status::from_raw(raw);
-        if let (Some((elapsed, limit)), Status::Ok | Status::Warning) = (overtime, status) {
-            return Err(FmuError::TimeLimit {
-                function,
-                instance: self.name.clone(),
-                elapsed: elapsed.as_secs_f64(),
-                limit: limit.as_secs_f64(),
-            });
-        }
-        match status {
-            Status::Ok => Ok(Status::Ok),
-            Status::Warning => {
-                if self.sink.mark() == mark {
-                    self.sink.record(
-                        Status::Warning,
-                        "fricsim",
-                        format!("{function} returned fmi2Warning"),
-                    );
-                }
-                Ok(Status::Warning)
-            }
-            status => {
-                if matches!(status, Status::Error | Status::Fatal) {
-                    self.failed = true;
-                }
-                if status == Status::Fatal {
-                    self.fatal = true;
-                    self.guarded = true;
-                }
-                Err(FmuError::Call {
-                    function,
-                    instance: self.name.clone(),
-                    status,
-                    messages: self
-                        .fmu
-                        .log()
-                        .messages_since(&self.sink, mark, EARLIER_MESSAGES),
-                })
-            }
-        }
+        self.guard.call(function, self.component, ffi)
     }
 
     /// `fmi2SetDebugLogging`: switch the named log categories (all if empty).
@@ -584,7 +447,7 @@ impl Instance {
         let f = self.functions.reset;
         // SAFETY: the component is live.
         let status = self.component_call("fmi2Reset", |c| unsafe { f(c) })?;
-        self.failed = false;
+        self.guard.failed = false;
         Ok(status)
     }
 
@@ -593,7 +456,7 @@ impl Instance {
     /// then in FMI 2.0's error state, where `fmi2Terminate` is not allowed
     /// (only `fmi2Reset` and `fmi2FreeInstance`).
     pub fn has_failed(&self) -> bool {
-        self.failed
+        self.guard.failed
     }
 
     /// `fmi2CancelStep` (§4.2.2).
@@ -805,9 +668,7 @@ impl Instance {
     /// one that iterates a step (`newton`) says `Possible`.
     #[inline] // the hot path is a few instructions; the rest is in `step_failed`
     pub fn do_step_with(&mut self, t: f64, h: f64, rollback: Rollback) -> Result<Status, FmuError> {
-        if self.guarded {
-            self.record_step_time(t);
-        }
+        self.guard.record_step_time(t);
         let f = self.functions.do_step;
         let no_set_prior = match rollback {
             Rollback::Possible => fmi2False,
@@ -819,15 +680,6 @@ impl Instance {
         }) {
             Err(e) => self.step_failed(e),
             ok => ok,
-        }
-    }
-
-    /// The communication point of the step that begins, in the black box.
-    #[cold]
-    #[inline(never)]
-    fn record_step_time(&self, t: f64) {
-        if let Some(b) = &self.black_box {
-            b.at_time(t);
         }
     }
 
@@ -979,14 +831,7 @@ impl Instance {
     }
 
     fn own(&self, function: &'static str, state: &FmuState) -> Result<(), FmuError> {
-        if state.owner == self.id {
-            Ok(())
-        } else {
-            Err(FmuError::ForeignState {
-                function,
-                instance: self.name.clone(),
-            })
-        }
+        self.guard.own(function, state.owner)
     }
 
     /// `f` if its group is `declared`, else [`FmuError::NotSupported`].
@@ -1018,17 +863,11 @@ impl Instance {
         // SAFETY: `pointer` is a valid out-pointer, null asks for a new state.
         let raw = unsafe { f(self.component, &mut pointer) };
         self.finish(F, mark, raw)?;
-        if pointer.is_null() {
-            return Err(FmuError::NullPointer {
-                function: F,
-                instance: self.name.clone(),
-                what: "FMU state",
-            });
-        }
+        let pointer = self.guard.not_null(F, pointer)?;
         self.states.push(pointer);
         Ok(FmuState {
             pointer,
-            owner: self.id,
+            owner: self.guard.id,
         })
     }
 
@@ -1169,17 +1008,11 @@ impl Instance {
             )
         };
         self.finish(F, mark, raw)?;
-        if pointer.is_null() {
-            return Err(FmuError::NullPointer {
-                function: F,
-                instance: self.name.clone(),
-                what: "FMU state",
-            });
-        }
+        let pointer = self.guard.not_null(F, pointer)?;
         self.states.push(pointer);
         Ok(FmuState {
             pointer,
-            owner: self.id,
+            owner: self.guard.id,
         })
     }
 }
@@ -1195,7 +1028,7 @@ fn worst(a: Status, b: Status) -> Status {
 
 impl Drop for Instance {
     fn drop(&mut self) {
-        if self.fatal {
+        if self.guard.fatal {
             // §2.1.3: after fmi2Fatal no function may be called, not even
             // fmi2FreeInstance. The FMU may still hold the callbacks and the
             // sink, so both are leaked with it.
@@ -1213,7 +1046,7 @@ impl Drop for Instance {
         // SAFETY: the FMU is freed; nothing refers to these any more.
         unsafe {
             ManuallyDrop::drop(&mut self.callbacks);
-            ManuallyDrop::drop(&mut self.sink);
+            self.guard.drop_sink();
         }
     }
 }

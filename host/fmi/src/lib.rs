@@ -1,27 +1,39 @@
-//! The FMU importer: FMI 2.0 Co-Simulation FMUs built by anyone.
+//! The FMU importer: FMI 2.0 and FMI 3.0 Co-Simulation FMUs built by anyone.
 //!
 //! - [`archive`]: the `.fmu` zip unpacked safely into a temporary directory;
 //! - [`model_description`]: `modelDescription.xml` parsed and validated
 //!   into types that name no FMI version ([`model_description::fmi2`]
-//!   reads FMI 2.0's);
-//! - [`fmi2`]: FMI 2.0's raw layer, the binary's functions as a table of
-//!   typed pointers with no checks (also used by the misuse tests, the
-//!   fuzz targets and the benchmarks' hand-written loop);
-//! - [`library`]: the `linux64` binary loaded and its functions resolved;
-//! - [`logger`]: the FMU's log messages (callback in `logger.c`);
-//! - [`instance`]: [`Fmu`] and its [`Instance`]s, the safe API;
+//!   reads FMI 2.0's, [`model_description::fmi3`] FMI 3.0's);
+//! - [`fmi2`], [`fmi3`]: each version's raw layer, the binary's functions
+//!   as a table of typed pointers with no checks (FMI 2.0's is also used by
+//!   the misuse tests, the fuzz targets and the benchmarks' hand-written
+//!   loop), both built by one macro (`function_table.rs`);
+//! - [`library`]: the binary (`linux64`, FMI 3.0's `x86_64-linux`)
+//!   loaded and its functions resolved into the table of its version;
+//! - [`logger`]: the FMU's log messages (callbacks in `logger.c` for FMI
+//!   2.0, whose logger is variadic, and in Rust for FMI 3.0);
+//! - [`instance`]: [`Fmu`] and its FMI 2.0 [`Instance`]s, the safe API;
+//!   [`instance3`]: FMI 3.0's [`Fmi3Instance`]; both call through one
+//!   guard (`guard.rs`: statuses, messages, time limit, black box);
 //! - [`watchdog`]: the optional time limit on each call.
 //!
-//! The C types of the standard are those of `fmi2-types`, the crate the
-//! exporter of this repository (`fmi2-cs`) uses too; the host depends on
-//! that crate alone, not on the exporter. Where FMI 3.0 will join: the
-//! crate's README.
+//! The C types of the standards are those of `fmi2-types` and
+//! `fmi3-types`: the exporter of this repository (`fmi2-cs`) uses the
+//! first too; the host depends on these crates alone, not on the
+//! exporter. How FMI 3.0 came in and what is still to come: the crate's
+//! README.
+
+#[macro_use]
+mod function_table;
 
 pub mod archive;
 pub mod blackbox;
 pub mod error;
 pub mod fmi2;
+pub mod fmi3;
+mod guard;
 pub mod instance;
+pub mod instance3;
 pub mod library;
 pub mod logger;
 pub mod model_description;
@@ -34,6 +46,7 @@ pub mod xml_text;
 pub use archive::UnpackOptions;
 pub use error::{ArchiveProblem, FmuError};
 pub use instance::{Fmu, FmuState, Instance, Rollback};
+pub use instance3::{Fmi3Instance, StepOutcome};
 pub use library::Library;
 pub use logger::{Log, LogMessage};
 pub use model_description::{

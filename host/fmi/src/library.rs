@@ -1,22 +1,33 @@
-//! The FMU's shared library (FMI 2.0.4 §2.4: `binaries/<platform>/
-//! <modelIdentifier>.so`) loaded with libloading, and its FMI 2.0
-//! Co-Simulation functions (§2.1, §4.2) resolved into typed pointers.
+//! The FMU's shared library loaded with libloading, and its
+//! Co-Simulation functions resolved into typed pointers: FMI 2.0's
+//! (FMI 2.0.4 §2.4: `binaries/linux64/<modelIdentifier>.so`; §2.1, §4.2)
+//! into [`crate::fmi2::Functions`], FMI 3.0's (FMI 3.0.1 §2.5.1:
+//! `binaries/x86_64-linux/<modelIdentifier>.so`; §2.3, §4) into
+//! [`crate::fmi3::Functions`], by the model description's `fmiVersion`.
 //!
-//! The functions are looked up into FMI 2.0's raw table
-//! ([`crate::fmi2::Functions`]). Every function of the common and
-//! co-simulation API is required; the optional groups (FMU state §2.1.8,
-//! directional derivatives §2.1.9, input and output derivatives §4.2.1)
-//! are used only when the model description declares the capability, and
-//! then they must be there.
+//! Every function of the common and co-simulation API the host calls is
+//! required; the optional groups (FMU state, directional derivatives,
+//! input and output derivatives) are used only when the model description
+//! declares the capability, and then they must be there.
 
 use super::model_description::ModelDescription;
 use crate::error::FmuError;
 use crate::fmi2::{fmi2Version, Functions};
+use crate::fmi3;
 use std::ffi::CStr;
 use std::path::{Path, PathBuf};
 
-/// The only platform this host loads.
+/// The only platform this host loads, as FMI 2.0 names it.
 pub const PLATFORM: &str = "linux64";
+/// The same platform as FMI 3.0 names it (architecture-OS, §2.5.1.1).
+pub const PLATFORM_FMI3: &str = "x86_64-linux";
+
+/// The raw table of a binary, of its FMI version.
+#[derive(Clone, Copy)]
+pub(crate) enum Api {
+    Fmi2(Functions),
+    Fmi3(fmi3::Functions),
+}
 
 /// The optional groups of functions the model description declares
 /// (and which the binary therefore exports): a function of a group not
@@ -40,7 +51,7 @@ pub(crate) struct Declared {
 /// A loaded FMU binary. The function pointers stay valid as long as this
 /// value lives.
 pub struct Library {
-    pub(crate) functions: Functions,
+    pub(crate) api: Api,
     pub(crate) declared: Declared,
     path: PathBuf,
     version: String,
@@ -63,15 +74,17 @@ impl Library {
     /// `dir` and resolve its functions against the capabilities `description`
     /// declares.
     pub fn load(dir: &Path, description: &ModelDescription) -> Result<Library, FmuError> {
-        // before looking for the binary: FMI 3.0 keeps it elsewhere
-        // (binaries/x86_64-linux)
-        refuse_fmi3(description)?;
+        let platform = if description.is_fmi3() {
+            PLATFORM_FMI3
+        } else {
+            PLATFORM
+        };
         let identifier = &description.co_simulation.model_identifier;
-        let relative = format!("binaries/{PLATFORM}/{identifier}.so");
+        let relative = format!("binaries/{platform}/{identifier}.so");
         let path = dir.join(&relative);
         if !path.is_file() {
             return Err(FmuError::MissingBinary {
-                platform: PLATFORM,
+                platform,
                 expected: relative,
                 found: platforms(dir),
             });
@@ -82,7 +95,6 @@ impl Library {
     /// Load the shared library at `path` (see [`Library::load`]).
     pub fn load_file(path: &Path, description: &ModelDescription) -> Result<Library, FmuError> {
         use libloading::os::unix::{Library as UnixLibrary, RTLD_LOCAL, RTLD_NOW};
-        refuse_fmi3(description)?;
         // RTLD_NOW: an unresolved dependency fails here, not in mid-run.
         // SAFETY: loading runs the library's initialisers; importing an FMU
         // means trusting its binary to that extent.
@@ -93,6 +105,9 @@ impl Library {
                     message: with_execution_tool_hint(error_chain(&e), description),
                 })?
                 .into();
+        if description.is_fmi3() {
+            return Library::resolve_fmi3(library, path, description);
+        }
         // SAFETY: an FMI 2.0 binary (its version is checked below), kept
         // loaded with the table in this `Library`.
         let functions =
@@ -100,19 +115,21 @@ impl Library {
                 path: path.to_path_buf(),
                 symbols,
             })?;
-        let declared = check_capabilities(&functions, description, path)?;
+        let declared =
+            check_capabilities(description, path, &|s| functions.exports(s), FMI2_GROUPS)?;
 
         // SAFETY: both functions take no arguments and return a static string.
         let version = unsafe { c_text((functions.get_version)()) };
         if version.as_bytes() != fmi2Version.to_bytes() {
             return Err(FmuError::WrongFmiVersion {
                 path: path.to_path_buf(),
+                expected: "2.0",
                 found: version,
             });
         }
         let types_platform = unsafe { c_text((functions.get_types_platform)()) };
         Ok(Library {
-            functions,
+            api: Api::Fmi2(functions),
             declared,
             path: path.to_path_buf(),
             version,
@@ -121,82 +138,162 @@ impl Library {
         })
     }
 
+    /// [`Library::load_file`] of an FMI 3.0 binary.
+    fn resolve_fmi3(
+        library: libloading::Library,
+        path: &Path,
+        description: &ModelDescription,
+    ) -> Result<Library, FmuError> {
+        // SAFETY: an FMI 3.0 binary (its version is checked below), kept
+        // loaded with the table in this `Library`.
+        let functions = unsafe { fmi3::Functions::load(&library) }.map_err(|symbols| {
+            FmuError::MissingFunctions {
+                path: path.to_path_buf(),
+                symbols,
+            }
+        })?;
+        let declared =
+            check_capabilities(description, path, &|s| functions.exports(s), FMI3_GROUPS)?;
+        // SAFETY: no arguments, returns a static string.
+        let version = unsafe { c_text((functions.get_version)()) };
+        // "3.0", or a later minor version of 3 ("3.0.1" is still "3.0"'s ABI)
+        if !(version == "3.0" || version.starts_with("3.")) {
+            return Err(FmuError::WrongFmiVersion {
+                path: path.to_path_buf(),
+                expected: "3.0",
+                found: version,
+            });
+        }
+        Ok(Library {
+            api: Api::Fmi3(functions),
+            declared,
+            path: path.to_path_buf(),
+            version,
+            types_platform: String::new(),
+            _library: library,
+        })
+    }
+
     pub fn path(&self) -> &Path {
         &self.path
     }
 
-    /// The binary's functions, raw: FMI 2.0's table, valid as long as
-    /// this `Library` lives. Calling them is unchecked and `unsafe`; the
-    /// safe way is an [`Instance`](crate::Instance). (The hand-written
-    /// FMI loop of the benchmarks calls them.) An optional function the
-    /// model description does not declare may be a stand-in
-    /// ([`Functions::exports`]).
-    pub fn functions(&self) -> &Functions {
-        &self.functions
+    /// The binary's functions, raw, if it is an FMI 2.0 binary: FMI 2.0's
+    /// table, valid as long as this `Library` lives. Calling them is
+    /// unchecked and `unsafe`; the safe way is an
+    /// [`Instance`](crate::Instance). (The hand-written FMI loop of the
+    /// benchmarks calls them.) An optional function the model description
+    /// does not declare may be a stand-in ([`Functions::exports`]).
+    pub fn functions(&self) -> Option<&Functions> {
+        match &self.api {
+            Api::Fmi2(f) => Some(f),
+            Api::Fmi3(_) => None,
+        }
     }
 
-    /// What `fmi2GetVersion()` returned ("2.0").
+    /// FMI 3.0's table, if it is an FMI 3.0 binary (see [`Library::functions`]).
+    pub fn fmi3_functions(&self) -> Option<&fmi3::Functions> {
+        match &self.api {
+            Api::Fmi3(f) => Some(f),
+            Api::Fmi2(_) => None,
+        }
+    }
+
+    /// What `fmi2GetVersion()` or `fmi3GetVersion()` returned ("2.0", "3.0").
     pub fn version(&self) -> &str {
         &self.version
     }
 
-    /// What `fmi2GetTypesPlatform()` returned ("default" for standard FMUs).
+    /// What `fmi2GetTypesPlatform()` returned ("default" for standard
+    /// FMUs; "" for FMI 3.0, which has no such function).
     pub fn types_platform(&self) -> &str {
         &self.types_platform
     }
 }
 
-/// Each optional group must be exported if its capability is declared;
-/// the groups declared.
+/// An optional group of functions: the capability that declares it, and
+/// its symbols, of each FMI version.
+type Group = (&'static str, fn(&Declared) -> bool, &'static [&'static str]);
+
+const FMI2_GROUPS: &[Group] = &[
+    (
+        "canGetAndSetFMUstate=\"true\"",
+        |d| d.fmu_state,
+        &["fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate"],
+    ),
+    (
+        "canSerializeFMUstate=\"true\"",
+        |d| d.serialize_fmu_state,
+        &[
+            "fmi2SerializedFMUstateSize",
+            "fmi2SerializeFMUstate",
+            "fmi2DeSerializeFMUstate",
+        ],
+    ),
+    (
+        "providesDirectionalDerivative=\"true\"",
+        |d| d.directional_derivative,
+        &["fmi2GetDirectionalDerivative"],
+    ),
+    (
+        "canInterpolateInputs=\"true\"",
+        |d| d.input_derivatives,
+        &["fmi2SetRealInputDerivatives"],
+    ),
+    (
+        "maxOutputDerivativeOrder > 0",
+        |d| d.output_derivatives,
+        &["fmi2GetRealOutputDerivatives"],
+    ),
+];
+
+const FMI3_GROUPS: &[Group] = &[
+    (
+        "canGetAndSetFMUState=\"true\"",
+        |d| d.fmu_state,
+        &["fmi3GetFMUState", "fmi3SetFMUState", "fmi3FreeFMUState"],
+    ),
+    (
+        "canSerializeFMUState=\"true\"",
+        |d| d.serialize_fmu_state,
+        &[
+            "fmi3SerializedFMUStateSize",
+            "fmi3SerializeFMUState",
+            "fmi3DeserializeFMUState",
+        ],
+    ),
+    (
+        "providesDirectionalDerivatives=\"true\"",
+        |d| d.directional_derivative,
+        &["fmi3GetDirectionalDerivative"],
+    ),
+    (
+        "maxOutputDerivativeOrder > 0",
+        |d| d.output_derivatives,
+        &["fmi3GetOutputDerivatives"],
+    ),
+];
+
+/// Each optional group must be exported (`exports`) if its capability is
+/// declared; the groups declared.
 fn check_capabilities(
-    f: &Functions,
     d: &ModelDescription,
     path: &Path,
+    exports: &dyn Fn(&str) -> bool,
+    groups: &[Group],
 ) -> Result<Declared, FmuError> {
     let cs = &d.co_simulation;
     let declared = Declared {
         fmu_state: cs.can_get_and_set_fmu_state,
         serialize_fmu_state: cs.can_serialize_fmu_state,
         directional_derivative: cs.provides_directional_derivative,
-        input_derivatives: cs.can_interpolate_inputs,
+        // FMI 3.0 Co-Simulation has no input derivatives
+        input_derivatives: cs.can_interpolate_inputs && !d.is_fmi3(),
         output_derivatives: cs.max_output_derivative_order > 0,
     };
-    // (capability, declared, its functions)
-    let groups: [(&'static str, bool, &[&'static str]); 5] = [
-        (
-            "canGetAndSetFMUstate=\"true\"",
-            declared.fmu_state,
-            &["fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate"],
-        ),
-        (
-            "canSerializeFMUstate=\"true\"",
-            declared.serialize_fmu_state,
-            &[
-                "fmi2SerializedFMUstateSize",
-                "fmi2SerializeFMUstate",
-                "fmi2DeSerializeFMUstate",
-            ],
-        ),
-        (
-            "providesDirectionalDerivative=\"true\"",
-            declared.directional_derivative,
-            &["fmi2GetDirectionalDerivative"],
-        ),
-        (
-            "canInterpolateInputs=\"true\"",
-            declared.input_derivatives,
-            &["fmi2SetRealInputDerivatives"],
-        ),
-        (
-            "maxOutputDerivativeOrder > 0",
-            declared.output_derivatives,
-            &["fmi2GetRealOutputDerivatives"],
-        ),
-    ];
-    for (capability, declared, symbols) in groups {
-        let missing: Vec<&'static str> =
-            symbols.iter().copied().filter(|s| !f.exports(s)).collect();
-        if declared && !missing.is_empty() {
+    for (capability, is_declared, symbols) in groups {
+        let missing: Vec<&'static str> = symbols.iter().copied().filter(|s| !exports(s)).collect();
+        if is_declared(&declared) && !missing.is_empty() {
             return Err(FmuError::MissingCapabilityFunctions {
                 path: path.to_path_buf(),
                 capability,
@@ -262,15 +359,4 @@ pub fn platforms(dir: &Path) -> Vec<String> {
         .unwrap_or_default();
     found.sort();
     found
-}
-
-/// An FMI 3.0 FMU is described ([`ModelDescription`] reads it) but not
-/// run: its functions are `fmi3…`, with other signatures.
-fn refuse_fmi3(description: &ModelDescription) -> Result<(), FmuError> {
-    if description.fmi_version.trim() == "3.0" {
-        return Err(FmuError::Fmi3NotRunnable {
-            model: description.model_name.clone(),
-        });
-    }
-    Ok(())
 }

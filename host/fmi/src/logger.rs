@@ -1,5 +1,5 @@
 //! The messages FMU instances send to the importer's logger (FMI 2.0.4
-//! §2.1.5, `fmi2CallbackLogger`).
+//! §2.1.5, `fmi2CallbackLogger`; FMI 3.0.1 §2.3.1, `fmi3LogMessageCallback`).
 //!
 //! The callback itself is C (`logger.c`: it is variadic); it formats the
 //! message and hands the finished string to [`fricsim_log_sink`], which
@@ -26,6 +26,23 @@ extern "C" {
         message: *const c_char,
         ...
     );
+}
+
+/// The `fmi3LogMessageCallback` given to every FMI 3.0 instance (FMI
+/// 3.0.1 §2.3.1): not variadic, so written in Rust; its environment is
+/// the instance's [`Sink`], as for FMI 2.0, and the message goes the same
+/// way ([`fricsim_log_sink`]).
+///
+/// # Safety
+/// As [`fricsim_log_sink`]'s (with no instance name: FMI 3.0 passes none).
+pub(crate) unsafe extern "C" fn fricsim_fmi3_logger(
+    env: *mut c_void,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
+    // SAFETY: the caller's contract.
+    unsafe { fricsim_log_sink(env, std::ptr::null(), status, category, message) }
 }
 
 /// The oldest messages are dropped beyond this many.

@@ -1,4 +1,5 @@
-//! `fmi2Status` (FMI 2.0.4 §2.1.3) as a Rust value.
+//! `fmi2Status` (FMI 2.0.4 §2.1.3) and `fmi3Status` (FMI 3.0.1 §2.2.3,
+//! the same values without `Pending`) as a Rust value.
 
 use fmi2_types::{fmi2Discard, fmi2Error, fmi2Fatal, fmi2OK, fmi2Pending, fmi2Warning};
 use std::fmt;
@@ -31,6 +32,16 @@ impl Status {
             fmi2Fatal => Status::Fatal,
             fmi2Pending => Status::Pending,
             other => Status::Invalid(other),
+        }
+    }
+
+    /// The status's name in the FMI version of `function` (a call's
+    /// name, "fmi2DoStep" or "fmi3DoStep"): "fmi3Error" for FMI 3.0.
+    pub fn named_for(self, function: &str) -> String {
+        let name = self.to_string();
+        match function.get(..4) {
+            Some("fmi3") => name.replacen("fmi2", "fmi3", 1),
+            _ => name,
         }
     }
 

@@ -91,19 +91,43 @@ pub fn repacked(name: &str, out: &Path, edit: impl Fn(&str) -> String) -> PathBu
 /// `binaries/linux64/<identifier>.so`, zip it with
 /// `source_dir/modelDescription.xml` into `dir/<identifier>.fmu`.
 pub fn c_fmu(source_dir: &Path, c_file: &str, identifier: &str, dir: &Path) -> PathBuf {
-    let root = dir.join(identifier);
-    let binaries = root.join("binaries/linux64");
-    std::fs::create_dir_all(&binaries).unwrap();
-    std::fs::copy(
-        source_dir.join("modelDescription.xml"),
-        root.join("modelDescription.xml"),
-    )
-    .unwrap();
-    compile_shared(
+    c_fmu_as(
+        &source_dir.join("modelDescription.xml"),
         &source_dir.join(c_file),
-        &binaries.join(format!("{identifier}.so")),
-        &[],
-    );
+        identifier,
+        "linux64",
+        dir,
+    )
+}
+
+/// An FMI 3.0 Co-Simulation FMU from the C file `c_file` and the model
+/// description `description` in `host/tests/c/fmi3`, as [`c_fmu`] makes an
+/// FMI 2.0 one: `dir/<identifier>.fmu`, its binary in `x86_64-linux`.
+pub fn c_fmu3(c_file: &str, description: &str, identifier: &str, dir: &Path) -> PathBuf {
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/fmi3");
+    c_fmu_as(
+        &source.join(description),
+        &source.join(c_file),
+        identifier,
+        "x86_64-linux",
+        dir,
+    )
+}
+
+/// `dir/<identifier>.fmu` of `description` and the compiled `source`,
+/// its binary in `binaries/<platform>`.
+fn c_fmu_as(
+    description: &Path,
+    source: &Path,
+    identifier: &str,
+    platform: &str,
+    dir: &Path,
+) -> PathBuf {
+    let root = dir.join(identifier);
+    let binaries = root.join("binaries").join(platform);
+    std::fs::create_dir_all(&binaries).unwrap();
+    std::fs::copy(description, root.join("modelDescription.xml")).unwrap();
+    compile_shared(source, &binaries.join(format!("{identifier}.so")), &[]);
     let fmu = dir.join(format!("{identifier}.fmu"));
     zip_dir(&root, &fmu);
     fmu

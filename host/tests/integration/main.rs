@@ -33,6 +33,7 @@ mod diagnose_reexamine;
 mod diagnose_time_limit;
 mod docs;
 mod emps;
+mod fmi3_import;
 mod fmu_logging;
 mod fuzz_bounded;
 mod instance;

@@ -649,8 +649,14 @@ fn step_all<M: Advance + ?Sized, const BETWEEN_STEPS: bool>(
 #[cold]
 #[inline(never)]
 fn ended_by(system: &mut System, error: &FmuError) -> Option<Ended> {
+    if let FmuError::EndedSimulation { instance, time, .. } = error {
+        return Some(Ended {
+            instance: instance.clone(),
+            time: *time,
+        });
+    }
     let FmuError::Call {
-        function: "fmi2DoStep",
+        function: "fmi2DoStep" | "fmi3DoStep",
         instance,
         status: crate::fmu::Status::Discard,
         ..

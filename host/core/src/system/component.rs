@@ -1,20 +1,26 @@
 //! A component's FMU instance, behind one type: [`ComponentInstance`].
 //!
-//! This is the one place of the core that calls an FMI 2.0 instance
-//! ([`fricsim_fmi::Instance`]) for the system and, through
-//! [`super::coupling`], for the masters. Each method is one `match` on
-//! the FMI version (static dispatch, inlined: the per-step calls of the
-//! Jacobi master and the strong-coupling iterations go through here). FMI
-//! 3.0 import (issue 45) adds an `Fmi3` variant and an arm to each
-//! method; the system and the masters stay as they are.
+//! This is the one place of the core that calls an FMU instance, FMI 2.0
+//! ([`fricsim_fmi::Instance`]) or FMI 3.0 ([`fricsim_fmi::Fmi3Instance`]),
+//! for the system and, through [`super::coupling`], for the masters. Each
+//! method is one `match` on the FMI version (static dispatch, inlined:
+//! the per-step calls of the Jacobi master and the strong-coupling
+//! iterations go through here); the system and the masters name no
+//! version. FMI 3.0's Float64, Int32 and Boolean are FMI 2.0's Real,
+//! Integer and Boolean here.
 //!
 //! The [`ComponentInstance::initialize`] call is FMI 2.0's
 //! `fmi2SetupExperiment` + `fmi2EnterInitializationMode` (after
 //! `fmi2Reset`, to start over); FMI 3.0 has one call for both,
 //! `fmi3EnterInitializationMode`, which takes the start and stop times.
+//! A step after which an FMI 3.0 FMU asks to end the simulation
+//! (`fmi3DoStep`'s `terminateSimulation`) becomes
+//! [`FmuError::EndedSimulation`], which the run's loop takes for the
+//! normal end of the run, as it takes FMI 2.0's discarded step with
+//! `fmi2Terminated`.
 
 use crate::fmu::blackbox::CallRecorder;
-use crate::fmu::{FmuState, Instance, Rollback, ValueReference};
+use crate::fmu::{Fmi3Instance, FmuState, Instance, Rollback, ValueReference};
 use crate::FmuError;
 use std::time::Duration;
 
@@ -22,6 +28,8 @@ use std::time::Duration;
 pub enum ComponentInstance {
     /// An FMI 2.0 Co-Simulation instance.
     Fmi2(Instance),
+    /// An FMI 3.0 Co-Simulation instance.
+    Fmi3(Fmi3Instance),
 }
 
 impl ComponentInstance {
@@ -31,6 +39,7 @@ impl ComponentInstance {
     pub fn fmi2(&mut self) -> Option<&mut Instance> {
         match self {
             ComponentInstance::Fmi2(i) => Some(i),
+            ComponentInstance::Fmi3(_) => None,
         }
     }
 
@@ -40,6 +49,7 @@ impl ComponentInstance {
     pub fn changes(&self) -> u64 {
         match self {
             ComponentInstance::Fmi2(i) => i.changes(),
+            ComponentInstance::Fmi3(i) => i.changes(),
         }
     }
 
@@ -47,6 +57,7 @@ impl ComponentInstance {
     pub fn get_real(&mut self, vrs: &[ValueReference], values: &mut [f64]) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.get_real(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.get_float64(vrs, values).map(drop),
         }
     }
 
@@ -54,6 +65,7 @@ impl ComponentInstance {
     pub fn set_real(&mut self, vrs: &[ValueReference], values: &[f64]) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.set_real(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.set_float64(vrs, values).map(drop),
         }
     }
 
@@ -65,6 +77,7 @@ impl ComponentInstance {
     ) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.get_integer(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.get_int32(vrs, values).map(drop),
         }
     }
 
@@ -77,6 +90,7 @@ impl ComponentInstance {
     ) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.get_boolean_raw(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.get_boolean_raw(vrs, values).map(drop),
         }
     }
 
@@ -87,24 +101,28 @@ impl ComponentInstance {
     ) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.get_boolean(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.get_boolean(vrs, values).map(drop),
         }
     }
 
     pub fn set_integer(&mut self, vrs: &[ValueReference], values: &[i32]) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.set_integer(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.set_int32(vrs, values).map(drop),
         }
     }
 
     pub fn set_boolean(&mut self, vrs: &[ValueReference], values: &[bool]) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.set_boolean(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.set_boolean(vrs, values).map(drop),
         }
     }
 
     pub fn set_string(&mut self, vrs: &[ValueReference], values: &[&str]) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.set_string(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.set_string(vrs, values).map(drop),
         }
     }
 
@@ -121,17 +139,35 @@ impl ComponentInstance {
             ComponentInstance::Fmi2(i) => {
                 i.set_real_input_derivatives(vrs, orders, values).map(drop)
             }
+            // FMI 3.0 Co-Simulation has no input derivatives (its
+            // description never declares canInterpolateInputs to fricsim)
+            ComponentInstance::Fmi3(_) => Err(FmuError::NotSupported {
+                function: "fmi2SetRealInputDerivatives",
+                capability: "input derivatives, which FMI 3.0 Co-Simulation does not have",
+            }),
         }
     }
 
     /// Step from `t` over `h` ([`Instance::do_step_with`]). A step the
     /// FMU discards because it ends the simulation stays an error here
     /// (`fmi2Discard`), which the run's loop tells apart
-    /// ([`ComponentInstance::terminated_at`]).
+    /// ([`ComponentInstance::terminated_at`]); an FMI 3.0 step that asks
+    /// to end the simulation is [`FmuError::EndedSimulation`].
     #[inline(always)]
     pub fn do_step(&mut self, t: f64, h: f64, rollback: Rollback) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.do_step_with(t, h, rollback).map(drop),
+            ComponentInstance::Fmi3(i) => {
+                let outcome = i.do_step_with(t, h, rollback)?;
+                if outcome.terminate_simulation {
+                    return Err(FmuError::EndedSimulation {
+                        function: "fmi3DoStep",
+                        instance: i.name().to_string(),
+                        time: outcome.last_successful_time,
+                    });
+                }
+                Ok(())
+            }
         }
     }
 
@@ -146,6 +182,11 @@ impl ComponentInstance {
                     return None;
                 }
                 i.last_successful_time().ok()
+            }
+            ComponentInstance::Fmi3(i) => {
+                let step = i.last_step()?;
+                step.terminate_simulation
+                    .then_some(step.last_successful_time)
             }
         }
     }
@@ -162,12 +203,16 @@ impl ComponentInstance {
             ComponentInstance::Fmi2(i) => i
                 .get_directional_derivative(unknowns, knowns, seed, out)
                 .map(drop),
+            ComponentInstance::Fmi3(i) => i
+                .get_directional_derivative(unknowns, knowns, seed, out)
+                .map(drop),
         }
     }
 
     pub fn get_state(&mut self) -> Result<FmuState, FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.get_state(),
+            ComponentInstance::Fmi3(i) => i.get_state(),
         }
     }
 
@@ -175,6 +220,7 @@ impl ComponentInstance {
     pub fn update_state(&mut self, state: &mut FmuState) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.update_state(state).map(drop),
+            ComponentInstance::Fmi3(i) => i.update_state(state).map(drop),
         }
     }
 
@@ -182,6 +228,7 @@ impl ComponentInstance {
     pub fn set_state(&mut self, state: &FmuState) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.set_state(state).map(drop),
+            ComponentInstance::Fmi3(i) => i.set_state(state).map(drop),
         }
     }
 
@@ -202,12 +249,19 @@ impl ComponentInstance {
                 i.setup_experiment(start, stop)?;
                 i.enter_initialization_mode().map(drop)
             }
+            ComponentInstance::Fmi3(i) => {
+                if reset {
+                    i.reset()?;
+                }
+                i.enter_initialization_mode(start, stop).map(drop)
+            }
         }
     }
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.exit_initialization_mode().map(drop),
+            ComponentInstance::Fmi3(i) => i.exit_initialization_mode().map(drop),
         }
     }
 
@@ -216,12 +270,14 @@ impl ComponentInstance {
     pub fn has_failed(&self) -> bool {
         match self {
             ComponentInstance::Fmi2(i) => i.has_failed(),
+            ComponentInstance::Fmi3(i) => i.has_failed(),
         }
     }
 
     pub fn terminate(&mut self) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.terminate().map(drop),
+            ComponentInstance::Fmi3(i) => i.terminate().map(drop),
         }
     }
 
@@ -229,6 +285,7 @@ impl ComponentInstance {
     pub fn set_call_time_limit(&mut self, limit: Option<Duration>) {
         match self {
             ComponentInstance::Fmi2(i) => i.set_call_time_limit(limit),
+            ComponentInstance::Fmi3(i) => i.set_call_time_limit(limit),
         }
     }
 
@@ -237,6 +294,7 @@ impl ComponentInstance {
     pub fn set_black_box(&mut self, recorder: Option<CallRecorder>) {
         match self {
             ComponentInstance::Fmi2(i) => i.set_black_box(recorder),
+            ComponentInstance::Fmi3(i) => i.set_black_box(recorder),
         }
     }
 }

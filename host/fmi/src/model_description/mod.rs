@@ -285,6 +285,12 @@ xml_enum!(
 );
 
 impl ModelDescription {
+    /// Whether the FMU is an FMI 3.0 one (`fmiVersion="3.0"`): its binary
+    /// exports `fmi3…` functions and lives in `binaries/x86_64-linux`.
+    pub fn is_fmi3(&self) -> bool {
+        self.fmi_version.trim_matches(XML_SPACE) == "3.0"
+    }
+
     /// Read and parse the file at `path`.
     pub fn from_file(path: &Path) -> Result<ModelDescription, FmuError> {
         let bytes = std::fs::read(path).map_err(|source| FmuError::Io {
