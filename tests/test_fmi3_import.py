@@ -9,7 +9,9 @@ names, which cannot be fetched from these machines):
   fmi3DoStep in closed form;
 - Stair: an Int32 counter one higher every second, a Boolean and a
   Float64 output, and at the top (t = 9) fmi3DoStep sets
-  terminateSimulation.
+  terminateSimulation;
+- SpringMass: the stick-slip rig of Canudas de Wit et al. 1995 with the
+  friction force as its Float64 input.
 
 `fricsim cosim` of each must record exactly the rows FMPy's simulate_fmu
 records (FMPy's FMI 3.0 Co-Simulation loop), and an FMI 3.0 FMU and an FMI
@@ -51,10 +53,12 @@ def fmus(tmp_path_factory):
                             "BouncingBall", "x86_64-linux"),
         "stair": compile_fmu(work, C_FMI3 / "stair.c", C_FMI3 / "stair.xml", "Stair",
                              "x86_64-linux"),
+        "rig": compile_fmu(work, C_FMI3 / "spring_mass.c", C_FMI3 / "spring_mass.xml",
+                           "SpringMass", "x86_64-linux"),
     }
 
 
-@pytest.mark.parametrize("name", ["ball", "stair"])
+@pytest.mark.parametrize("name", ["ball", "stair", "rig"])
 def test_fmpy_validates_the_fmi3_test_fmus(fmus, name):
     assert validate_fmu(str(fmus[name])) == []
 
@@ -148,3 +152,28 @@ def test_an_isolated_run_and_the_python_package_record_the_same_rows(fmus, tmp_p
     result = fricsim.run(ssd, step=0.5, stop=10)
     assert list(result.dtype.names) == header
     np.testing.assert_array_equal(np.column_stack([result[c] for c in header]), rows)
+
+
+def test_an_fmi3_fmu_with_an_input_equals_simulate_fmu(fmus, tmp_path):
+    """SpringMass driven by a measured force (``--input``, held over each
+    step as FMPy holds it) records FMPy's rows, to 1e-12."""
+    t = np.linspace(0.0, 5.0, 501)
+    force = np.rec.fromarrays([t, 0.4 * np.sin(2.0 * t)], names=["time", "F"])
+    expected = simulate_fmu(str(fmus["rig"]), stop_time=5, step_size=0.01, output_interval=0.01,
+                            input=force)
+    table = tmp_path / "force.csv"
+    np.savetxt(table, np.column_stack([t, force["F"]]), delimiter=",", header="time,rig.F",
+               comments="", fmt="%.17g")
+    out = tmp_path / "rig.csv"
+    args = ["cosim", "--fmu", f"rig={fmus['rig']}", "--input", table, "--input-hold",
+            "--step", "0.01", "--stop", "5", "--out", out]
+    process = subprocess.run([str(ROOT / "target" / "release" / "fricsim"), *map(str, args)],
+                             capture_output=True, text=True)
+    assert process.returncode == 0, process.stdout + process.stderr
+    header = out.read_text().splitlines()[0].split(",")
+    rows = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
+    np.testing.assert_array_equal(rows[:, 0], expected["time"])
+    for name in ["x", "v"]:
+        column = rows[:, header.index(f"rig.{name}")]
+        assert np.abs(expected[name]).max() > 0.05
+        np.testing.assert_allclose(column, expected[name], rtol=1e-12, atol=1e-14, err_msg=name)

@@ -232,3 +232,117 @@ fn a_mixed_system_runs_under_every_master_with_the_fmi3_ball_rolled_back() {
         );
     }
 }
+
+/// The columns `names` of `run`, row by row.
+fn columns(run: &fricsim::master::Run, names: &[&str]) -> Vec<Vec<f64>> {
+    names
+        .iter()
+        .map(|name| {
+            let k = run.columns.iter().position(|c| c == name).unwrap();
+            (0..run.time.len()).map(|i| run.rows[i][k]).collect()
+        })
+        .collect()
+}
+
+/// The stick-slip benchmark of Canudas de Wit et al. 1995 (a mass pulled
+/// through a spring at 0.1 m/s against LuGre friction) as two systems:
+/// all FMI 2.0 (Rig1D.fmu + LuGre.fmu) and mixed (the FMI 3.0 SpringMass
+/// written in C for the tests + LuGre.fmu). Both rigs integrate exactly
+/// for a held friction force, so the two systems must agree to rounding,
+/// under the Jacobi master and under the Newton master (which asks the
+/// FMI 3.0 rig for its step sensitivity, `fmi3GetDirectionalDerivative`,
+/// and restores its FMU state while it iterates).
+#[test]
+fn a_fmi3_rig_with_the_fmi2_lugre_equals_the_all_fmi2_system() {
+    let dir = TempDir::new().unwrap();
+    let spring_mass = c_fmu3("spring_mass.c", "spring_mass.xml", "SpringMass", dir.path());
+    let rig1d = crate::common::repository().join("dist/Rig1D.fmu");
+    let connections = [
+        ("rig.v".to_string(), "friction.v".to_string()),
+        ("friction.F".to_string(), "rig.F".to_string()),
+    ];
+    for (master, h) in [("jacobi", 1e-4), ("newton", 1e-3)] {
+        let mut runs = Vec::new();
+        for rig in [&rig1d, &spring_mass] {
+            let fmus = vec![
+                ("rig".to_string(), Fmu::open(rig).unwrap()),
+                ("friction".to_string(), Fmu::open(lugre_fmu()).unwrap()),
+            ];
+            let mut system = System::from_fmus(fmus, &[], &connections, 0.0).unwrap();
+            let run = simulate(&mut system, by_name(master).unwrap().as_mut(), h, 10.0).unwrap();
+            assert!(run.error.is_none(), "{master}: {:?}", run.error);
+            runs.push(columns(&run, &["rig.x", "rig.v", "friction.F"]));
+        }
+        let (fmi2, mixed) = (&runs[0], &runs[1]);
+        // stick-slip: the mass sticks and slips, so friction swings
+        let f = &fmi2[2];
+        let swing =
+            f.iter().cloned().fold(f64::MIN, f64::max) - f.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(swing > 0.3, "{master}: friction swings {swing} N");
+        for (k, name) in ["x", "v", "F"].iter().enumerate() {
+            let scale = fmi2[k].iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            let worst = fmi2[k]
+                .iter()
+                .zip(&mixed[k])
+                .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+            eprintln!("{master}: {name} differs by at most {worst:.1e} (largest {scale:.2e})");
+            assert!(
+                worst <= 1e-9 * scale,
+                "{master}: {name} differs by {worst:e} (scale {scale:e})"
+            );
+        }
+    }
+}
+
+/// `fmi3GetDirectionalDerivative` through `Fmi3Instance`: the FMI 3.0
+/// rig's step sensitivity to its input equals the central difference of
+/// two steps from one saved FMU state, to 1e-7 relative; before a step
+/// (and once the input is set again) it is the feedthrough, none.
+#[test]
+fn fmi3_directional_derivatives_equal_differences_of_steps() {
+    const X: u32 = 1;
+    const F: u32 = 3;
+    let dir = TempDir::new().unwrap();
+    let fmu = Fmu::open(c_fmu3(
+        "spring_mass.c",
+        "spring_mass.xml",
+        "SpringMass",
+        dir.path(),
+    ))
+    .unwrap();
+    let mut rig = fmu.instantiate_fmi3("rig").unwrap();
+    rig.enter_initialization_mode(0.0, None).unwrap();
+    rig.exit_initialization_mode().unwrap();
+    let mut d = [f64::NAN; 2];
+    rig.get_directional_derivative(&[X, V], &[F], &[1.0], &mut d)
+        .unwrap();
+    assert_eq!(d, [0.0, 0.0], "no feedthrough before a step");
+    rig.set_float64(&[F], &[0.3]).unwrap();
+    rig.do_step_with(0.0, 0.5, Rollback::Possible).unwrap();
+    let saved = rig.get_state().unwrap();
+    let (h, eps) = (0.2, 1e-4);
+    let mut step_from_saved = |force: f64| {
+        rig.set_state(&saved).unwrap();
+        rig.set_float64(&[F], &[force]).unwrap();
+        rig.do_step_with(0.5, h, Rollback::Possible).unwrap();
+        let mut xv = [0.0; 2];
+        rig.get_float64(&[X, V], &mut xv).unwrap();
+        xv
+    };
+    let (up, down) = (step_from_saved(0.3 + eps), step_from_saved(0.3 - eps));
+    step_from_saved(0.3);
+    rig.get_directional_derivative(&[X, V], &[F], &[2.0], &mut d)
+        .unwrap();
+    for k in 0..2 {
+        let difference = 2.0 * (up[k] - down[k]) / (2.0 * eps);
+        assert!(
+            (d[k] - difference).abs() <= 1e-7 * difference.abs() && difference.abs() > 1e-3,
+            "output {k}: {} vs difference {difference}",
+            d[k]
+        );
+    }
+    rig.set_float64(&[F], &[0.3]).unwrap();
+    rig.get_directional_derivative(&[X, V], &[F], &[1.0], &mut d)
+        .unwrap();
+    assert_eq!(d, [0.0, 0.0], "the input set again: the feedthrough");
+}
