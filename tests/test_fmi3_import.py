@@ -27,7 +27,7 @@ from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
 from conftest import DIST, ROOT
-from test_foreign_fmu import cosim
+from test_foreign_fmu import cosim, fricsim
 
 C_FMI3 = ROOT / "host" / "tests" / "c" / "fmi3"
 
@@ -110,8 +110,7 @@ def test_an_fmi3_fmu_drives_an_fmi2_fmu_as_a_recorded_input_does(fmus, tmp_path)
     alone = tmp_path / "alone.csv"
     args = ["cosim", "--fmu", f"lugre={lugre}", "--input", recorded, "--input-hold",
             "--step", "0.01", "--stop", "3", "--out", alone]
-    process = subprocess.run([str(ROOT / "target" / "release" / "fricsim"), *map(str, args)],
-                             capture_output=True, text=True)
+    process = fricsim(*args)
     assert process.returncode == 0, process.stdout + process.stderr
     header_alone = alone.read_text().splitlines()[0].split(",")
     rows_alone = np.loadtxt(alone, delimiter=",", skiprows=1, ndmin=2)
@@ -123,7 +122,7 @@ def test_an_fmi3_fmu_drives_an_fmi2_fmu_as_a_recorded_input_does(fmus, tmp_path)
 def test_an_isolated_run_and_the_python_package_record_the_same_rows(fmus, tmp_path):
     """`--isolate` (the FMUs in a child process) and `fricsim.run` of the
     Python package load FMI 3.0 FMUs as `fricsim cosim` does."""
-    import fricsim
+    import fricsim as package
 
     plain = tmp_path / "plain.csv"
     process, header, rows = cosim([("ball", fmus["ball"]), ("stair", fmus["stair"])], {}, [],
@@ -132,8 +131,7 @@ def test_an_isolated_run_and_the_python_package_record_the_same_rows(fmus, tmp_p
     isolated = tmp_path / "isolated.csv"
     args = ["cosim", "--fmu", f"ball={fmus['ball']}", "--fmu", f"stair={fmus['stair']}",
             "--step", "0.5", "--stop", "10", "--out", isolated, "--isolate"]
-    process = subprocess.run([str(ROOT / "target" / "release" / "fricsim"), *map(str, args)],
-                             capture_output=True, text=True)
+    process = fricsim(*args)
     assert process.returncode == 0, process.stdout + process.stderr
     assert isolated.read_text() == plain.read_text()
 
@@ -149,7 +147,7 @@ def test_an_isolated_run_and_the_python_package_record_the_same_rows(fmus, tmp_p
   </ssd:System>
 </ssd:SystemStructureDescription>
 """)
-    result = fricsim.run(ssd, step=0.5, stop=10)
+    result = package.run(ssd, step=0.5, stop=10)
     assert list(result.dtype.names) == header
     np.testing.assert_array_equal(np.column_stack([result[c] for c in header]), rows)
 
@@ -167,8 +165,7 @@ def test_an_fmi3_fmu_with_an_input_equals_simulate_fmu(fmus, tmp_path):
     out = tmp_path / "rig.csv"
     args = ["cosim", "--fmu", f"rig={fmus['rig']}", "--input", table, "--input-hold",
             "--step", "0.01", "--stop", "5", "--out", out]
-    process = subprocess.run([str(ROOT / "target" / "release" / "fricsim"), *map(str, args)],
-                             capture_output=True, text=True)
+    process = fricsim(*args)
     assert process.returncode == 0, process.stdout + process.stderr
     header = out.read_text().splitlines()[0].split(",")
     rows = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)

@@ -34,29 +34,13 @@ typedef struct {
     State s;
 } Model;
 
-static void reset_values(State *s) {
+static void reset_values(Model *m) {
+    State *s = &m->s;
     *s = (State){.time = 0.0, .h = 1.0, .v = 0.0, .g = 9.81, .e = 0.7, .v_min = 0.1};
     strcpy(s->label, "ball");
 }
 
-EXPORT fmi3Instance fmi3InstantiateCoSimulation(
-    fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible, fmi3Boolean logging,
-    fmi3Boolean event_mode, fmi3Boolean early_return, const fmi3ValueReference required[],
-    size_t n_required, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,
-    fmi3IntermediateUpdateCallback update) {
-    (void)resources, (void)visible, (void)logging, (void)required, (void)n_required, (void)update;
-    Model *m = instantiate_base(sizeof(Model), name, token, event_mode, early_return, env, log);
-    if (m != NULL) reset_values(&m->s);
-    return m;
-}
-
-EXPORT void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
-
-EXPORT fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean on, size_t n, const fmi3String c[]) {
-    (void)on, (void)n, (void)c;
-    ENTER("fmi3SetDebugLogging", ANY);
-    return fmi3OK; /* errors are always logged */
-}
+COMMON_FUNCTIONS(reset_values)
 
 static fmi3Status check_parameters(Model *m) {
     State *s = &m->s;
@@ -94,7 +78,7 @@ EXPORT fmi3Status fmi3Terminate(fmi3Instance instance) {
 
 EXPORT fmi3Status fmi3Reset(fmi3Instance instance) {
     ENTER("fmi3Reset", ANY);
-    reset_values(&m->s);
+    reset_values(m);
     m->base.phase = INSTANTIATED;
     return fmi3OK;
 }
@@ -251,29 +235,7 @@ EXPORT fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 d
 
 /* ---- FMU state ------------------------------------------------------------ */
 
-EXPORT fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *state) {
-    ENTER("fmi3GetFMUState", GETTABLE | INSTANTIATED);
-    if (state == NULL) return fail(&m->base, "fmi3GetFMUState: NULL");
-    if (*state == NULL) *state = malloc(sizeof(State));
-    if (*state == NULL) return fail(&m->base, "fmi3GetFMUState: out of memory");
-    memcpy(*state, &m->s, sizeof(State));
-    return fmi3OK;
-}
-
-EXPORT fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState state) {
-    ENTER("fmi3SetFMUState", GETTABLE | INSTANTIATED);
-    if (state == NULL) return fail(&m->base, "fmi3SetFMUState: NULL");
-    memcpy(&m->s, state, sizeof(State));
-    return fmi3OK;
-}
-
-EXPORT fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *state) {
-    ENTER("fmi3FreeFMUState", ANY);
-    if (state == NULL) return fail(&m->base, "fmi3FreeFMUState: NULL");
-    free(*state);
-    *state = NULL;
-    return fmi3OK;
-}
+STATE_FUNCTIONS
 
 EXPORT fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState state, size_t *size) {
     ENTER("fmi3SerializedFMUStateSize", ANY);

@@ -7,7 +7,9 @@
  *
  * A model file (bouncing_ball.c, stair.c in this folder) defines
  * MODEL_IDENTIFIER and INSTANTIATION_TOKEN before including this header,
- * and a struct `Model` whose first member is a `Base`. Written for the
+ * and a struct `Model` whose first member is a `Base`; the functions every
+ * model writes alike are the macros at the end (COMMON_FUNCTIONS,
+ * STATE_FUNCTIONS). Written for the
  * tests of fricsim against the FMI 3.0 standard; both fricsim and FMPy
  * import them. */
 
@@ -253,5 +255,55 @@ static void *instantiate_base(size_t size, fmi3String name, fmi3String token, fm
     b->phase = INSTANTIATED;
     return b;
 }
+
+/* ---- What every model of these FMUs defines the same way ---------------- */
+
+/* fmi3InstantiateCoSimulation, fmi3FreeInstance and fmi3SetDebugLogging of
+ * a `Model` whose fields are set to their start values by
+ * `reset_values(Model *)`. */
+#define COMMON_FUNCTIONS(reset_values)                                                             \
+    EXPORT fmi3Instance fmi3InstantiateCoSimulation(                                               \
+        fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible,              \
+        fmi3Boolean logging, fmi3Boolean event_mode, fmi3Boolean early_return,                     \
+        const fmi3ValueReference required[], size_t n_required, fmi3InstanceEnvironment env,       \
+        fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {                       \
+        (void)resources, (void)visible, (void)logging, (void)required, (void)n_required,           \
+            (void)update;                                                                          \
+        Model *m = instantiate_base(sizeof(Model), name, token, event_mode, early_return, env, log); \
+        if (m != NULL) reset_values(m);                                                            \
+        return m;                                                                                  \
+    }                                                                                              \
+    EXPORT void fmi3FreeInstance(fmi3Instance instance) { free(instance); }                        \
+    EXPORT fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean on, size_t n,         \
+                                          const fmi3String c[]) {                                  \
+        (void)on, (void)n, (void)c;                                                                \
+        ENTER("fmi3SetDebugLogging", ANY);                                                         \
+        return fmi3OK; /* errors are always logged */                                              \
+    }
+
+/* fmi3GetFMUState, fmi3SetFMUState and fmi3FreeFMUState of a `Model` whose
+ * member `s` (a plain struct) is all its state: a state is a copy of it. */
+#define STATE_FUNCTIONS                                                                            \
+    EXPORT fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *state) {                \
+        ENTER("fmi3GetFMUState", GETTABLE | INSTANTIATED);                                         \
+        if (state == NULL) return fail(&m->base, "fmi3GetFMUState: NULL");                         \
+        if (*state == NULL) *state = malloc(sizeof m->s);                                          \
+        if (*state == NULL) return fail(&m->base, "fmi3GetFMUState: out of memory");               \
+        memcpy(*state, &m->s, sizeof m->s);                                                        \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    EXPORT fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState state) {                 \
+        ENTER("fmi3SetFMUState", GETTABLE | INSTANTIATED);                                         \
+        if (state == NULL) return fail(&m->base, "fmi3SetFMUState: NULL");                         \
+        memcpy(&m->s, state, sizeof m->s);                                                         \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    EXPORT fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *state) {               \
+        ENTER("fmi3FreeFMUState", ANY);                                                            \
+        if (state == NULL) return fail(&m->base, "fmi3FreeFMUState: NULL");                        \
+        free(*state);                                                                              \
+        *state = NULL;                                                                             \
+        return fmi3OK;                                                                             \
+    }
 
 #endif

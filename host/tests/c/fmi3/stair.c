@@ -34,24 +34,7 @@ static void reset_values(Model *m) {
     m->at_top = false;
 }
 
-EXPORT fmi3Instance fmi3InstantiateCoSimulation(
-    fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible, fmi3Boolean logging,
-    fmi3Boolean event_mode, fmi3Boolean early_return, const fmi3ValueReference required[],
-    size_t n_required, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,
-    fmi3IntermediateUpdateCallback update) {
-    (void)resources, (void)visible, (void)logging, (void)required, (void)n_required, (void)update;
-    Model *m = instantiate_base(sizeof(Model), name, token, event_mode, early_return, env, log);
-    if (m != NULL) reset_values(m);
-    return m;
-}
-
-EXPORT void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
-
-EXPORT fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean on, size_t n, const fmi3String c[]) {
-    (void)on, (void)n, (void)c;
-    ENTER("fmi3SetDebugLogging", ANY);
-    return fmi3OK;
-}
+COMMON_FUNCTIONS(reset_values)
 
 EXPORT fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolerance_defined,
                                               fmi3Float64 tolerance, fmi3Float64 start,
