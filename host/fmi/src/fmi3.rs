@@ -2,7 +2,7 @@
 //! pointers (FMI 3.0.1 §2.3 common, §4 Co-Simulation in [`Functions`]),
 //! with no checks at all: every pointer, length, status and call order is
 //! the caller's. The counterpart of [`crate::fmi2`], built by the same
-//! [`function_table!`] shape; the two share no functions or types.
+//! `function_table!` shape; the two share no functions or types.
 //!
 //! This is the one place that knows the FMI 3.0 symbol names. The safe
 //! importer ([`crate::Fmi3Instance`]) calls through it; so may tests that

@@ -1,6 +1,6 @@
 //! An FMI 3.0 Co-Simulation instance ([`Fmi3Instance`]): FMI 3.0.1 §2.3
 //! and §4 as safe methods, each a call through FMI 3.0's raw table
-//! ([`crate::fmi3::Functions`]) and through the same [`Guard`] as FMI
+//! ([`crate::fmi3::Functions`]) and through the same guard (`guard.rs`) as FMI
 //! 2.0's [`crate::Instance`] (statuses as `Result`, the log messages of a
 //! failed call in its error, the refusal after `fmi3Fatal`, the time limit
 //! and black box). What differs from FMI 2.0:

@@ -67,32 +67,49 @@ pub fn render(d: &ModelDescription, platforms: &[String]) -> String {
 
     let cs = &d.co_simulation;
     let _ = writeln!(w, "\nCapabilities\n");
-    let capabilities = [
-        (
-            "canHandleVariableCommunicationStepSize",
-            cs.can_handle_variable_communication_step_size.to_string(),
-        ),
-        (
+    // each version's spelling; FMI 3.0 Co-Simulation has no input
+    // derivatives (canInterpolateInputs)
+    let fmi3 = d.is_fmi3();
+    let mut capabilities = vec![(
+        "canHandleVariableCommunicationStepSize",
+        cs.can_handle_variable_communication_step_size.to_string(),
+    )];
+    if !fmi3 {
+        capabilities.push((
             "canInterpolateInputs",
             cs.can_interpolate_inputs.to_string(),
-        ),
+        ));
+    }
+    capabilities.extend([
         (
             "maxOutputDerivativeOrder",
             cs.max_output_derivative_order.to_string(),
         ),
         (
-            "canGetAndSetFMUstate",
+            if fmi3 {
+                "canGetAndSetFMUState"
+            } else {
+                "canGetAndSetFMUstate"
+            },
             cs.can_get_and_set_fmu_state.to_string(),
         ),
         (
-            "canSerializeFMUstate",
+            if fmi3 {
+                "canSerializeFMUState"
+            } else {
+                "canSerializeFMUstate"
+            },
             cs.can_serialize_fmu_state.to_string(),
         ),
         (
-            "providesDirectionalDerivative",
+            if fmi3 {
+                "providesDirectionalDerivatives"
+            } else {
+                "providesDirectionalDerivative"
+            },
             cs.provides_directional_derivative.to_string(),
         ),
-    ];
+    ]);
     for (key, value) in capabilities {
         let _ = writeln!(w, "  {key:<40} {value}");
     }
