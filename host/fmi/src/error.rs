@@ -181,6 +181,18 @@ pub enum FmuError {
         time: f64,
     },
 
+    /// `fmi3DoStep` ended before the step's end without being allowed to
+    /// (the instance was made with `earlyReturnAllowed = false`), or said
+    /// it did: the FMU broke the standard's contract (FMI 3.0.1 §4.2.1).
+    #[error("fmi3DoStep of instance \"{instance}\" from t = {from} over {step} returned early (earlyReturn = {early_return}, lastSuccessfulTime = {reached}), which fricsim does not allow (earlyReturnAllowed = false): the step's results cannot be used")]
+    EarlyReturn {
+        instance: String,
+        from: f64,
+        step: f64,
+        early_return: bool,
+        reached: f64,
+    },
+
     #[error("{function} refused for instance \"{instance}\": an earlier call returned {}Fatal, so the FMU may not be called again", &function[..4])]
     AfterFatal {
         function: &'static str,

@@ -433,7 +433,10 @@ impl Fmi3Instance {
     /// `noSetFMUStatePriorToCurrentPoint` as for FMI 2.0
     /// ([`crate::Instance::do_step_with`]). The answer besides the status
     /// is kept ([`Fmi3Instance::last_step`]) also when the step fails, so
-    /// that a discarded step can say how far it got.
+    /// that a discarded step can say how far it got. A successful step
+    /// that returned early, or whose `lastSuccessfulTime` is not `t + h`,
+    /// is [`FmuError::EarlyReturn`] unless it ends the simulation: the
+    /// instance is made without early return, and FMPy refuses it too.
     #[inline]
     pub fn do_step_with(
         &mut self,
@@ -473,6 +476,14 @@ impl Fmi3Instance {
             Ok(status) => {
                 let o = outcome(status);
                 self.last_step = Some(o);
+                // made without early return: a step that ends elsewhere
+                // than t + h (and does not end the simulation) broke the
+                // contract, and its outputs are not those of t + h
+                let complete = !o.early_return
+                    && (o.last_successful_time - (t + h)).abs() <= 1e-9 * (t + h).abs().max(h);
+                if !complete && !o.terminate_simulation {
+                    return Err(self.early_return(t, h, o));
+                }
                 Ok(o)
             }
             Err(mut e) => {
@@ -496,6 +507,17 @@ impl Fmi3Instance {
                 }
                 Err(e)
             }
+        }
+    }
+
+    #[cold]
+    fn early_return(&self, t: f64, h: f64, o: StepOutcome) -> FmuError {
+        FmuError::EarlyReturn {
+            instance: self.guard.name.clone(),
+            from: t,
+            step: h,
+            early_return: o.early_return,
+            reached: o.last_successful_time,
         }
     }
 

@@ -346,3 +346,40 @@ fn fmi3_directional_derivatives_equal_differences_of_steps() {
         .unwrap();
     assert_eq!(d, [0.0, 0.0], "the input set again: the feedthrough");
 }
+
+/// A step that returns early although the instance was made without
+/// early return (a broken FMI 3.0 FMU: Stair with STAIR_EARLY_RETURN set
+/// in the environment of `fricsim cosim`) stops the run with an error
+/// naming the instance, the step and where the FMU got to, instead of
+/// recording the half-step's values as the step's end; the rows before
+/// it are kept, marked incomplete.
+#[test]
+fn a_step_that_returns_early_unasked_is_an_error_and_the_rows_stand() {
+    let dir = TempDir::new().unwrap();
+    let stair = c_fmu3("stair.c", "stair.xml", "Stair", dir.path());
+    let out = dir.path().join("stair.csv");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_fricsim"))
+        .args(["cosim", "--fmu"])
+        .arg(format!("stair={}", stair.display()))
+        .args(["--step", "0.5", "--stop", "10", "--out"])
+        .arg(&out)
+        .env("STAIR_EARLY_RETURN", "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "{stderr}");
+    for part in [
+        "fmi3DoStep of instance \"stair\" from t = 0 over 0.5 returned early",
+        "earlyReturn = true",
+        "lastSuccessfulTime = 0.25",
+    ] {
+        assert!(stderr.contains(part), "missing {part:?} in {stderr}");
+    }
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let written = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        written
+            .starts_with("time,stair.height,stair.counter,stair.even\n0.0,1.0,1,0\n# INCOMPLETE"),
+        "{written}"
+    );
+}

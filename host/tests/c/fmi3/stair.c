@@ -10,7 +10,12 @@
  *
  * When counter reaches `top` (10: at t = 9) the step that gets there
  * completes and fmi3DoStep sets terminateSimulation (FMI 3.0.1 §4.2.1):
- * the importer should end the run; a later fmi3DoStep is an error. */
+ * the importer should end the run; a later fmi3DoStep is an error.
+ *
+ * For the tests of how an importer takes a broken step: with the
+ * environment variable STAIR_EARLY_RETURN set, fmi3DoStep stops half way
+ * through every step and says so (earlyReturn = true), although the
+ * importer did not allow early return. */
 
 #define MODEL_IDENTIFIER "Stair"
 #define INSTANTIATION_TOKEN "{6a2e4c8f-1b3d-4f5a-9c7e-0d2b4f6a8c1e}"
@@ -172,7 +177,7 @@ EXPORT fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 d
     if (!(dt > 0.0) || !isfinite(dt)) return fail(&m->base, "fmi3DoStep: communicationStepSize = %g", dt);
     if (fabs(t - m->time) > 1e-9 * fmax(1.0, fabs(t)))
         return fail(&m->base, "fmi3DoStep: currentCommunicationPoint = %.17g, but the FMU is at %.17g", t, m->time);
-    double end = t + dt;
+    double end = getenv("STAIR_EARLY_RETURN") != NULL ? t + dt / 2 : t + dt;
     while (m->next_stair <= end + 1e-9 * fmax(1.0, end) && m->counter < m->top) {
         m->counter += 1;
         m->next_stair += 1.0;
@@ -181,7 +186,7 @@ EXPORT fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 d
     m->at_top = m->counter >= m->top;
     *event_handling_needed = false;
     *terminate = m->at_top;
-    *early_return = false;
+    *early_return = end < t + dt;
     *last_time = end;
     return fmi3OK;
 }
