@@ -344,6 +344,78 @@ fn an_undefined_unit_is_refused() {
     ModelDescription::parse(&without).unwrap();
 }
 
+/// The unit of a variable is its own `unit`, else that of its declared
+/// type (FMI 2.0 §2.2.7: a `SimpleType`'s `Real`; FMI 3.0 §2.4.7: a
+/// `Float64Type`), as Modelica tools write it; a declared type that is
+/// not defined is refused, and so is the type's unit where the
+/// description's units do not define it.
+#[test]
+fn a_unit_comes_from_the_declared_type_unless_the_variable_gives_one() {
+    let unit_of = |d: &ModelDescription, name: &str| match &d.variable(name).unwrap().kind {
+        VariableKind::Real { unit, .. } => unit.clone(),
+        other => panic!("{name}: {other:?}"),
+    };
+    // FMI 2.0
+    let types = r#"<SimpleType name="Force"><Real quantity="Force" unit="N"/></SimpleType>
+    <SimpleType name="Mode">"#;
+    let fmi2 = VALID
+        .replace(r#"<SimpleType name="Mode">"#, types)
+        .replace(r#"<Real unit="N"/>"#, r#"<Real declaredType="Force"/>"#)
+        .replace(
+            r#"<Real start="100"/>"#,
+            r#"<Real declaredType="Force" unit="m" start="100"/>"#,
+        );
+    let d = ModelDescription::parse(&fmi2).unwrap();
+    assert_eq!(unit_of(&d, "F").as_deref(), Some("N"));
+    assert_eq!(unit_of(&d, "k").as_deref(), Some("m"), "its own unit wins");
+    refused(
+        &fmi2.replace(
+            r#"<Real declaredType="Force"/>"#,
+            r#"<Real declaredType="Torque"/>"#,
+        ),
+        &[
+            "variable \"F\" (index 2)",
+            "declaredType=\"Torque\"",
+            "TypeDefinitions",
+        ],
+    );
+    refused(
+        &fmi2.replace(r#"quantity="Force" unit="N""#, r#"unit="lbf""#),
+        &[
+            "variable \"F\" (index 2)",
+            "unit \"lbf\"",
+            "UnitDefinitions",
+        ],
+    );
+
+    // FMI 3.0
+    let fmi3 = VALID_FMI3
+        .replace(
+            r#"<EnumerationType name="Mode">"#,
+            r#"<Float64Type name="Time" quantity="Time" unit="s"/>
+    <EnumerationType name="Mode">"#,
+        )
+        .replace(
+            r#"<Float64 name="x1" valueReference="3" causality="output""#,
+            r#"<Float64 name="x1" valueReference="3" causality="output" declaredType="Time""#,
+        );
+    let d = ModelDescription::parse(&fmi3).unwrap();
+    assert_eq!(unit_of(&d, "x1").as_deref(), Some("s"));
+    assert_eq!(unit_of(&d, "x0"), None);
+    refused(
+        &fmi3.replace(r#"declaredType="Time""#, r#"declaredType="Angle""#),
+        &[
+            "variable \"x1\"",
+            "declaredType=\"Angle\"",
+            "TypeDefinitions",
+        ],
+    );
+    refused(
+        &fmi3.replace(r#"quantity="Time" unit="s""#, r#"unit="min""#),
+        &["variable \"x1\"", "unit \"min\"", "UnitDefinitions"],
+    );
+}
+
 #[test]
 fn a_missing_co_simulation_element_is_refused() {
     let start = VALID.find("<CoSimulation").unwrap();

@@ -14,10 +14,12 @@
 use super::xml::{Document, ElementAt, Root};
 use super::{
     check_unit, choice, combination_allowed, default_experiment, index_variables, invalid,
-    is_c_identifier, log_category, output_unknown, required, Causality, CoSimulation,
-    DefaultExperiment, Initial, LogCategory, ModelDescription, Variability, Variable, VariableKind,
+    is_c_identifier, log_category, output_unknown, required, unit_with_declared_type, Causality,
+    CoSimulation, DefaultExperiment, Initial, LogCategory, ModelDescription, Variability, Variable,
+    VariableKind,
 };
 use crate::error::FmuError;
+use std::collections::HashMap;
 
 /// The rest of an FMI 2.0 document whose root (`fmiVersion` = `version`)
 /// has been read: the root's other attributes, the elements inside it,
@@ -61,12 +63,15 @@ pub(super) fn read(
 enum Scope {
     Root,
     UnitDefinitions,
+    TypeDefinitions,
+    /// Inside a `SimpleType`: its `Real`, `Integer`, … element.
+    SimpleType,
     LogCategories,
     ModelVariables,
     ScalarVariable,
     ModelStructure,
     Outputs,
-    /// An element fricsim does not read (`TypeDefinitions`, annotations,
+    /// An element fricsim does not read (annotations,
     /// `BaseUnit`, …) or one without children of interest: what is inside
     /// is only checked for well-formedness.
     Skip,
@@ -105,6 +110,36 @@ fn element(
             once(raw.unit_definitions.is_some())?;
             raw.unit_definitions = Some(Vec::new());
             Scope::UnitDefinitions
+        }
+        (Scope::Root, "TypeDefinitions") => {
+            once(raw.types.is_some())?;
+            raw.types = Some(HashMap::new());
+            Scope::TypeDefinitions
+        }
+        (Scope::TypeDefinitions, "SimpleType") => {
+            let name = required(e, at, "name")?;
+            let types = raw.types.as_mut().expect("open");
+            if types.insert(name.clone(), None).is_some() {
+                return Err(at.error(format!(
+                    "a second <SimpleType> named \"{name}\" in <TypeDefinitions>"
+                )));
+            }
+            raw.open_type = Some(name);
+            Scope::SimpleType
+        }
+        (Scope::SimpleType, "Real") => {
+            // the unit a Real type gives the variables that declare it
+            // (FMI 2.0 §2.2.3)
+            let mut unit = None;
+            at.attributes(e, |key, value| {
+                if key == "unit" {
+                    unit = Some(value.into_owned());
+                }
+                Ok(())
+            })?;
+            let name = raw.open_type.as_ref().expect("open");
+            raw.types.as_mut().expect("open").insert(name.clone(), unit);
+            Scope::Skip
         }
         (Scope::Root, "LogCategories") => {
             once(raw.log_categories.is_some())?;
@@ -261,6 +296,10 @@ fn type_element(
                         r.unit = Some(value.into_owned());
                         return Ok(());
                     }
+                    "declaredType" => {
+                        r.declared_type = Some(value.into_owned());
+                        return Ok(());
+                    }
                     "derivative" => {
                         r.derivative = Some(at.number(key, &value)?);
                         return Ok(());
@@ -342,6 +381,11 @@ struct RawModelDescription {
     co_simulation: Option<RawCoSimulation>,
     /// The names of `UnitDefinitions`' units.
     unit_definitions: Option<Vec<String>>,
+    /// `TypeDefinitions`: each `SimpleType`'s name and, for a `Real` one,
+    /// its unit.
+    types: Option<HashMap<String, Option<String>>>,
+    /// The `SimpleType` being read.
+    open_type: Option<String>,
     log_categories: Option<Vec<LogCategory>>,
     default_experiment: Option<DefaultExperiment>,
     model_variables: Option<RawModelVariables>,
@@ -389,6 +433,7 @@ struct RawScalarVariable {
 struct RawReal {
     start: Option<f64>,
     unit: Option<String>,
+    declared_type: Option<String>,
     nominal: Option<f64>,
     min: Option<f64>,
     max: Option<f64>,
@@ -479,7 +524,7 @@ impl RawModelDescription {
         let variables = raw_variables
             .into_iter()
             .enumerate()
-            .map(|(i, raw)| raw.validate(i + 1, unit_definitions.as_deref()))
+            .map(|(i, raw)| raw.validate(i + 1, unit_definitions.as_deref(), self.types.as_ref()))
             .collect::<Result<Vec<_>, _>>()?;
         let (variables, by_name) = index_variables(variables)?;
 
@@ -548,7 +593,12 @@ impl RawModelDescription {
 }
 
 impl RawScalarVariable {
-    fn validate(self, index: usize, units: Option<&[String]>) -> Result<Variable, FmuError> {
+    fn validate(
+        self,
+        index: usize,
+        units: Option<&[String]>,
+        types: Option<&HashMap<String, Option<String>>>,
+    ) -> Result<Variable, FmuError> {
         let name = match self.name {
             Some(n) if !n.is_empty() => n,
             _ => {
@@ -587,10 +637,17 @@ impl RawScalarVariable {
 
         let mut kinds = Vec::with_capacity(1);
         if let Some(r) = self.real {
-            check_unit(r.unit.as_deref(), units, &location)?;
+            let unit = unit_with_declared_type(
+                r.unit,
+                r.declared_type.as_deref(),
+                types,
+                "<SimpleType>",
+                &location,
+            )?;
+            check_unit(unit.as_deref(), units, &location)?;
             kinds.push(VariableKind::Real {
                 start: r.start,
-                unit: r.unit,
+                unit,
                 nominal: r.nominal,
                 min: r.min,
                 max: r.max,

@@ -27,8 +27,8 @@
 use super::xml::{Document, ElementAt, Root};
 use super::{
     check_unit, choice, combination_allowed, default_experiment, index_variables, invalid,
-    is_c_identifier, log_category, output_unknown, required, Causality, CoSimulation, Initial,
-    ModelDescription, ValueReference, Variability, Variable, VariableKind,
+    is_c_identifier, log_category, output_unknown, required, unit_with_declared_type, Causality,
+    CoSimulation, Initial, ModelDescription, ValueReference, Variability, Variable, VariableKind,
 };
 use crate::error::FmuError;
 use std::collections::HashMap;
@@ -84,6 +84,7 @@ struct Header {
 enum Scope {
     Root,
     UnitDefinitions,
+    TypeDefinitions,
     LogCategories,
     ModelVariables,
     /// Inside a variable element: its `<Dimension>`, `<Start>`, `<Alias>`.
@@ -123,6 +124,32 @@ fn element(
             once(raw.units.is_some())?;
             raw.units = Some(Vec::new());
             Scope::UnitDefinitions
+        }
+        (Scope::Root, "TypeDefinitions") => {
+            once(raw.types.is_some())?;
+            raw.types = Some(HashMap::new());
+            Scope::TypeDefinitions
+        }
+        (Scope::TypeDefinitions, type_name) => {
+            // a type's name, and the unit a Float type gives the variables
+            // that declare it (FMI 3.0 §2.4.4)
+            let name = required(e, at, "name")?;
+            let mut unit = None;
+            if type_name.starts_with("Float") {
+                at.attributes(e, |key, value| {
+                    if key == "unit" {
+                        unit = Some(value.into_owned());
+                    }
+                    Ok(())
+                })?;
+            }
+            let types = raw.types.as_mut().expect("open");
+            if types.insert(name.clone(), unit).is_some() {
+                return Err(at.error(format!(
+                    "a second type named \"{name}\" in <TypeDefinitions>"
+                )));
+            }
+            Scope::Skip
         }
         (Scope::Root, "LogCategories") => {
             once(raw.log_categories.is_some())?;
@@ -290,6 +317,8 @@ struct Raw {
     model_exchange: Option<String>,
     co_simulation: Option<CoSimulation>,
     units: Option<Vec<String>>,
+    /// `TypeDefinitions`: each type's name and, for a Float type, its unit.
+    types: Option<HashMap<String, Option<String>>>,
     log_categories: Option<Vec<super::LogCategory>>,
     default_experiment: Option<super::DefaultExperiment>,
     variables: Option<Vec<RawVariable>>,
@@ -365,7 +394,7 @@ impl Raw {
         let variables = raw_variables
             .into_iter()
             .enumerate()
-            .map(|(i, raw)| raw.validate(i + 1, self.units.as_deref(), &by_vr))
+            .map(|(i, raw)| raw.validate(i + 1, self.units.as_deref(), self.types.as_ref(), &by_vr))
             .collect::<Result<Vec<_>, _>>()?;
         let (variables, by_name) = index_variables(variables)?;
 
@@ -427,6 +456,7 @@ impl RawVariable {
         self,
         index: usize,
         units: Option<&[String]>,
+        types: Option<&HashMap<String, Option<String>>>,
         by_vr: &HashMap<ValueReference, usize>,
     ) -> Result<Variable, FmuError> {
         let type_name = self.type_name.as_str();
@@ -524,9 +554,17 @@ impl RawVariable {
                 })
                 .transpose()
         };
+        // (every declared type must exist, FMI 3.0 §2.4.7)
+        let unit = unit_with_declared_type(
+            self.unit,
+            self.declared_type.as_deref(),
+            types,
+            "type",
+            &location,
+        )?;
         let kind = match type_name {
             "Float64" => {
-                check_unit(self.unit.as_deref(), units, &location)?;
+                check_unit(unit.as_deref(), units, &location)?;
                 let derivative = match self.derivative {
                     None => None,
                     Some(vr) => Some(by_vr.get(&vr).copied().ok_or_else(|| {
@@ -538,7 +576,7 @@ impl RawVariable {
                 };
                 VariableKind::Real {
                     start: number("start", &self.start)?,
-                    unit: self.unit,
+                    unit,
                     nominal: self.nominal,
                     min: number("min", &self.min)?,
                     max: number("max", &self.max)?,

@@ -416,6 +416,30 @@ pub(super) fn check_unit(
     }
 }
 
+/// A variable's unit: its own (`own`), else that of its declared type
+/// (`declared`, looked up in `types`: each type of `TypeDefinitions` and
+/// the unit it gives, FMI 2.0 §2.2.3, FMI 3.0 §2.4.4); a declared type
+/// that is not defined is refused (`kind`: what the version calls a type
+/// definition, for the message).
+pub(super) fn unit_with_declared_type(
+    own: Option<String>,
+    declared: Option<&str>,
+    types: Option<&HashMap<String, Option<String>>>,
+    kind: &str,
+    location: &str,
+) -> Result<Option<String>, FmuError> {
+    let Some(declared) = declared else {
+        return Ok(own);
+    };
+    match types.and_then(|types| types.get(declared)) {
+        Some(unit) => Ok(own.or_else(|| unit.clone())),
+        None => Err(invalid(
+            location,
+            format!("declaredType=\"{declared}\" is not a {kind} of <TypeDefinitions>"),
+        )),
+    }
+}
+
 /// The variables in document order, checked for unique names and for
 /// `derivative` indices inside `ModelVariables`, with the index by name.
 pub(super) fn index_variables(
