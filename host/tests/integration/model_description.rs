@@ -387,6 +387,14 @@ fn a_unit_comes_from_the_declared_type_unless_the_variable_gives_one() {
             "UnitDefinitions",
         ],
     );
+    refused(
+        &fmi2.replace(r#"declaredType="Mode""#, r#"declaredType="Gear""#),
+        &[
+            "variable \"mode\"",
+            "declaredType=\"Gear\"",
+            "TypeDefinitions",
+        ],
+    );
 
     // FMI 3.0
     let fmi3 = VALID_FMI3

@@ -654,6 +654,15 @@ impl RawScalarVariable {
                 derivative: r.derivative,
             });
         }
+        // an Integer's or Enumeration's declared type must exist too
+        // (their units are not read: fricsim checks units of Reals only)
+        for declared in [&self.integer, &self.enumeration]
+            .into_iter()
+            .flatten()
+            .filter_map(|i| i.declared_type.as_deref())
+        {
+            unit_with_declared_type(None, Some(declared), types, "<SimpleType>", &location)?;
+        }
         if let Some(i) = self.integer {
             kinds.push(VariableKind::Integer {
                 start: i.start,
