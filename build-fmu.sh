@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Build the FMU libraries (friction laws, rigs) in release mode, for Linux
-# and, cross-built with MinGW-w64, for Windows, and package one .fmu per
-# model into dist/: dist/<Name>.fmu holds modelDescription.xml (rendered
+# and, cross-built with MinGW-w64, for Windows, and package two .fmu per
+# model: dist/<Name>.fmu (FMI 2.0) holds modelDescription.xml (rendered
 # from the code's variable table), binaries/linux64/<modelIdentifier>.so and
-# binaries/win64/<modelIdentifier>.dll. Then every example system
+# binaries/win64/<modelIdentifier>.dll; dist/fmi3/<Name>.fmu (FMI 3.0) holds
+# the FMI 3.0 description of the same table and the same two libraries
+# (each exports both interfaces) under binaries/x86_64-linux/ and
+# binaries/x86_64-windows/. Then every example system
 # examples/<name>.ssd (sources ../dist/*.fmu) is checked and packed into a
 # self-contained dist/<name>.ssp (FMUs and .ssv under resources/).
 set -euo pipefail

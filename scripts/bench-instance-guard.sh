@@ -2,9 +2,9 @@
 # What the instance guard costs a single-threaded importer: the FMUs as
 # shipped (a call from a second thread is refused instead of corrupting
 # the instance; from the thread the guard is biased to, a call enters and
-# leaves by plain stores: fmu-src/fmi2-cs/src/guard.rs) against the same
+# leaves by plain stores: fmu-src/fmi-export/src/guard.rs) against the same
 # FMUs built with the guard
-# compiled out (fmi2-cs feature `unguarded-instances`, for this script
+# compiled out (fmi-export feature `unguarded-instances`, for this script
 # only), on the LuGre stick-slip benchmark (examples/stick_slip.ssd, 20 s
 # at 1e-4 s, Jacobi), measured in turns A B A B in one run:
 #   - the host's stepping, in process (`speed-table --only host`: its
@@ -26,7 +26,7 @@ cargo build --release -q -p fricsim-bench --bin speed-table
 # The unguarded libraries, in a target directory of their own, packed into
 # a root of their own (the examples refer to ../dist/).
 CARGO_TARGET_DIR=target/unguarded cargo build --release -q -p friction-fmu-c -p rig-fmu-c \
-    --features fmi2-cs/unguarded-instances
+    --features fmi-export/unguarded-instances
 unguarded=target/bench-guard/unguarded
 rm -rf "$unguarded" && mkdir -p "$unguarded"
 cp -r examples "$unguarded/"

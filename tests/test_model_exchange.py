@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Model, FMU2Slave
+from fmpy.fmi3 import FMU3Model
 from fmpy.sundials import CVodeSolver
 
 from conftest import DIST, ROOT, fmu_path
@@ -40,6 +41,40 @@ class _NoInput:
         pass
 
 
+class Fmi3Model:
+    """An FMI 3.0 Model Exchange FMU (FMPy's `FMU3Model`) behind the calls
+    `MeRun` makes of FMI 2.0's `FMU2Model`, each mapped to its FMI 3.0
+    function: the same run drives either version."""
+
+    def __init__(self, md, unzipdir):
+        # (FMPy keeps the instantiation token as `guid`)
+        self.fmu = FMU3Model(guid=md.guid, unzipDirectory=unzipdir,
+                             modelIdentifier=md.modelExchange.modelIdentifier, instanceName="me")
+        self.start = 0.0
+
+    def __getattr__(self, name):
+        # instantiate, exitInitializationMode, enterEventMode, setTime, ...
+        return getattr(self.fmu, name)
+
+    def setupExperiment(self, startTime):
+        self.start = startTime
+
+    def enterInitializationMode(self):
+        self.fmu.enterInitializationMode(startTime=self.start)
+
+    def setReal(self, vr, values):
+        self.fmu.setFloat64(vr, values)
+
+    def getReal(self, vr):
+        return self.fmu.getFloat64(vr)
+
+    def newDiscreteStates(self):
+        return self.fmu.updateDiscreteStates()
+
+    def getDerivatives(self, px, n):
+        self.fmu.getContinuousStateDerivatives(px, n)
+
+
 class MeRun:
     """An FMU in Model Exchange (FMPy's `FMU2Model`) integrated by CVode
     together with states of its environment: the combined state is
@@ -51,13 +86,18 @@ class MeRun:
     (time, roots, indicators after the event)."""
 
     def __init__(self, name, tmp_path, parameters, inputs, outputs, x0=(), nominals=(), rhs=None,
-                 rtol=1e-9):
-        self.md = read_model_description(str(fmu_path(name)))
+                 rtol=1e-9, path=None):
+        path = str(path or fmu_path(name))
+        self.md = read_model_description(path)
         assert self.md.modelExchange is not None, f"{name} has no Model Exchange interface"
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        self.unzipdir = extract(str(fmu_path(name)), unzipdir=str(tmp_path / f"{name}_me"))
-        self.fmu = FMU2Model(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                             modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName="me")
+        self.unzipdir = extract(path, unzipdir=str(tmp_path / f"{name}_me"))
+        if self.md.fmiVersion == "3.0":
+            self.fmu = Fmi3Model(self.md, self.unzipdir)
+        else:
+            self.fmu = FMU2Model(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                                 modelIdentifier=self.md.modelExchange.modelIdentifier,
+                                 instanceName="me")
         self.inputs, self.outputs, self.rhs = inputs, list(outputs), rhs
         self.ne = len(x0)
         self.nf = self.md.numberOfContinuousStates
@@ -298,8 +338,11 @@ def stick_slip_reference(tmp_path_factory):
     return data["time"], data["rigv"], data["frictionF"]
 
 
-def test_lugre_stick_slip_in_model_exchange_matches_the_monolithic_reference(tmp_path,
+@pytest.mark.parametrize("fmi_version", ["2.0", "3.0"])
+def test_lugre_stick_slip_in_model_exchange_matches_the_monolithic_reference(tmp_path, fmi_version,
                                                                                stick_slip_reference):
+    """LuGre.fmu and its FMI 3.0 twin, dist/fmi3/LuGre.fmu, each in Model
+    Exchange under CVode."""
     m, k, c, v_a = 1.0, 2.0, 0.0, 0.1  # the rig of examples/stick_slip.ssd (Rig1D's defaults)
 
     def rig(t, xe, y):
@@ -307,8 +350,10 @@ def test_lugre_stick_slip_in_model_exchange_matches_the_monolithic_reference(tmp
         return [v, (k * (v_a * t - x) - c * v - y["F"]) / m]
 
     # LuGre at its defaults, the 1995 parameters of examples/lugre_1995.ssv
+    path = fmu_path("LuGre") if fmi_version == "2.0" else DIST / "fmi3" / "LuGre.fmu"
     run = MeRun("LuGre", tmp_path, {}, inputs=lambda t, xe: {"v": xe[1]}, outputs=["F", "z"],
-                x0=[0.0, 0.0], nominals=[1.0, 0.1], rhs=rig, rtol=1e-9)
+                x0=[0.0, 0.0], nominals=[1.0, 0.1], rhs=rig, rtol=1e-9, path=path)
+    assert run.md.fmiVersion == fmi_version
     times = np.round(np.arange(0, 30001) * 1e-3, 10)
     rows = run.run(times)
     run.close()

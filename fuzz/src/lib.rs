@@ -7,7 +7,7 @@
 #[path = "../../host/tests/fmi/mod.rs"]
 pub mod fmi;
 
-use fmi2_cs::ModelFactory;
+use fmi_export::ModelFactory;
 use std::ffi::c_void;
 use std::sync::LazyLock;
 
@@ -24,7 +24,7 @@ pub static ALL: LazyLock<Vec<ModelFactory>> = LazyLock::new(|| {
         .collect()
 });
 
-fmi2_cs::export_fmi2!(&ALL[..]);
+fmi_export::export_fmi2!(&ALL[..]);
 
 macro_rules! lookup {
     ($name:expr; $($symbol:ident),*) => {

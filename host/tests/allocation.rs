@@ -7,7 +7,7 @@ mod common;
 
 use fricsim::fmu::{Fmu, Instance};
 
-#[path = "../../fmu-src/fmi2-cs/tests/support/counting_alloc.rs"]
+#[path = "../../fmu-src/fmi-export/tests/support/counting_alloc.rs"]
 mod counting_alloc;
 use counting_alloc::{allocations, Counting};
 

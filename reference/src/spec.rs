@@ -3,7 +3,7 @@
 //! `component.output → component.input`. The host fills it from an SSP file;
 //! tests and other tools can write it directly.
 
-use fmi2_cs::{Causality, Model, ModelInfo, Values, VarType};
+use fmi_export::{Causality, Model, ModelInfo, Values, VarType};
 use std::fmt;
 
 /// A parameter (or input start) value, as a system file gives it.

@@ -1,6 +1,6 @@
 //! The C types of the FMI 2.0 standard (`fmi2TypesPlatform.h`,
 //! `fmi2FunctionTypes.h`; FMI 2.0.4 §2.1.2–§2.1.5, §3.2 and §4.2), written once
-//! for both sides of the C ABI: the exporter (`fmi2-cs`, which the FMUs of
+//! for both sides of the C ABI: the exporter (`fmi-export`, which the FMUs of
 //! this repository are built on) and the importer (`fricsim`, host/), which
 //! imports FMUs built by anyone and so depends on this crate, not on the
 //! exporter. Types and constants only: no code, no dependencies, `no_std`.
@@ -9,7 +9,7 @@
 //! the C `enum` does: an importer must accept whatever integer an FMU
 //! returns, and an out-of-range value in a `#[repr(C)] enum` would be
 //! undefined behaviour. An exporter, which only ever returns values it
-//! made, may use an enum of its own on its side of the ABI (`fmi2-cs`
+//! made, may use an enum of its own on its side of the ABI (`fmi-export`
 //! does, checked against [`fmi2OK`] … [`fmi2Pending`] at compile time).
 #![no_std]
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]

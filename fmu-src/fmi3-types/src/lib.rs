@@ -39,6 +39,8 @@ pub type fmi3String = *const fmi3Char;
 pub type fmi3Byte = u8;
 pub type fmi3Binary = *const fmi3Byte;
 pub type fmi3Clock = bool;
+/// `fmi3DependencyKind` (§2.2.10), an enumeration passed as `int`.
+pub type fmi3DependencyKind = c_int;
 
 pub const fmi3True: fmi3Boolean = true;
 pub const fmi3False: fmi3Boolean = false;

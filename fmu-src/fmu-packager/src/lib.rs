@@ -1,7 +1,7 @@
 //! Packaging: every model of every FMU library of this project, rendered and
 //! zipped. The model descriptions come from the variable tables only.
 
-use fmi2_cs::ModelInfo;
+use fmi_export::ModelInfo;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -69,18 +69,60 @@ pub fn library_of(info: &ModelInfo) -> &'static str {
         .expect("listed")
 }
 
-/// The model description of `info`, as shipped.
-pub fn render(info: &ModelInfo) -> Result<String, String> {
-    let tool = libraries()
-        .into_iter()
-        .find(|(_, _, m)| m.iter().any(|i| i.guid == info.guid))
-        .map(|(_, t, _)| t);
-    fmi2_cs::model_description::render(info, tool.unwrap_or("unknown"))
+/// The version of the FMI standard an FMU is packaged for: every model is
+/// shipped as both, from the same binary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FmiVersion {
+    /// FMI 2.0: `dist/<Name>.fmu`, `modelDescription/<Name>.xml`.
+    Fmi2,
+    /// FMI 3.0: `dist/fmi3/<Name>.fmu`, `modelDescription/fmi3/<Name>.xml`.
+    Fmi3,
 }
 
-/// Path of the checked-in description of `info` under `dir`.
+impl FmiVersion {
+    pub const ALL: [FmiVersion; 2] = [FmiVersion::Fmi2, FmiVersion::Fmi3];
+
+    /// The subdirectory of this version's FMUs and descriptions, under
+    /// `dist/` and `modelDescription/`.
+    pub fn subdirectory(self) -> &'static str {
+        match self {
+            FmiVersion::Fmi2 => "",
+            FmiVersion::Fmi3 => "fmi3",
+        }
+    }
+}
+
+fn generation_tool(info: &ModelInfo) -> &'static str {
+    libraries()
+        .into_iter()
+        .find(|(_, _, m)| m.iter().any(|i| i.guid == info.guid))
+        .map_or("unknown", |(_, t, _)| t)
+}
+
+/// The FMI 2.0 model description of `info`, as shipped.
+pub fn render(info: &ModelInfo) -> Result<String, String> {
+    render_version(info, FmiVersion::Fmi2)
+}
+
+/// The model description of `info` for `version`, as shipped.
+pub fn render_version(info: &ModelInfo, version: FmiVersion) -> Result<String, String> {
+    match version {
+        FmiVersion::Fmi2 => fmi_export::model_description::render(info, generation_tool(info)),
+        FmiVersion::Fmi3 => {
+            fmi_export::fmi3::model_description::render(info, generation_tool(info))
+        }
+    }
+}
+
+/// Path of the checked-in FMI 2.0 description of `info` under `dir`.
 pub fn description_path(dir: &Path, info: &ModelInfo) -> PathBuf {
-    dir.join(format!("{}.xml", info.model_name))
+    description_path_version(dir, info, FmiVersion::Fmi2)
+}
+
+/// Path of the checked-in description of `info` for `version` under `dir`.
+pub fn description_path_version(dir: &Path, info: &ModelInfo, version: FmiVersion) -> PathBuf {
+    dir.join(version.subdirectory())
+        .join(format!("{}.xml", info.model_name))
 }
 
 /// The platform folders of FMI 2.0 (FMI 2.0.4 §2.4: `binaries/<platform>/`)
@@ -95,6 +137,20 @@ pub const PLATFORMS: &[(&str, &str, &str)] = &[
     ("darwin32", "lib", "dylib"),
     ("darwin64", "lib", "dylib"),
 ];
+
+/// The FMI 3.0 platform tuple (FMI 3.0 section 2.5.1.1) of an FMI 2.0
+/// platform folder, where one is determined: `linux64` is `x86_64-linux`,
+/// `win64` `x86_64-windows`; `darwin64` is left out, as it does not say
+/// whether the Mac is an Intel or an Arm one.
+pub fn fmi3_platform(name: &str) -> Option<&'static str> {
+    match name {
+        "linux32" => Some("x86-linux"),
+        "linux64" => Some("x86_64-linux"),
+        "win32" => Some("x86-windows"),
+        "win64" => Some("x86_64-windows"),
+        _ => None,
+    }
+}
 
 fn platform(name: &str) -> Result<&'static (&'static str, &'static str, &'static str), String> {
     PLATFORMS
@@ -151,15 +207,52 @@ pub fn binary_entry(platform: &str, model_identifier: &str) -> Result<String, St
     Ok(format!("binaries/{name}/{model_identifier}.{extension}"))
 }
 
-/// Write `dist/<Name>.fmu`: `modelDescription.xml` and, for every
-/// platform of `platforms` (in that order, no platform twice), the
-/// library of `info`'s crate built for it, as
-/// `binaries/<platform>/<modelIdentifier>.<so|dll|dylib>`.
+/// The archive entry of `model_identifier`'s binary for `platform` in an
+/// FMU of `version`: `binaries/win64/LuGre.dll` (FMI 2.0),
+/// `binaries/x86_64-windows/LuGre.dll` (FMI 3.0).
+pub fn binary_entry_version(
+    platform: &str,
+    model_identifier: &str,
+    version: FmiVersion,
+) -> Result<String, String> {
+    let entry = binary_entry(platform, model_identifier)?;
+    match version {
+        FmiVersion::Fmi2 => Ok(entry),
+        FmiVersion::Fmi3 => {
+            let tuple = fmi3_platform(platform).ok_or_else(|| {
+                format!("platform {platform} has no FMI 3.0 platform tuple this packager knows")
+            })?;
+            Ok(entry.replacen(
+                &format!("binaries/{platform}/"),
+                &format!("binaries/{tuple}/"),
+                1,
+            ))
+        }
+    }
+}
+
+/// Write `dist/<Name>.fmu`, the FMI 2.0 FMU ([`package_version`]).
 pub fn package(
     info: &ModelInfo,
     platforms: &[Platform],
     out_dir: &Path,
 ) -> Result<PathBuf, String> {
+    package_version(info, platforms, out_dir, FmiVersion::Fmi2)
+}
+
+/// Write `<out_dir>/<Name>.fmu` (FMI 2.0) or `<out_dir>/fmi3/<Name>.fmu`
+/// (FMI 3.0): `modelDescription.xml` of `version` and, for every platform
+/// of `platforms` (in that order, no platform twice), the library of
+/// `info`'s crate built for it, as
+/// `binaries/<platform>/<modelIdentifier>.<so|dll|dylib>` (the platform
+/// folder of the version: `linux64` or `x86_64-linux`).
+pub fn package_version(
+    info: &ModelInfo,
+    platforms: &[Platform],
+    out_dir: &Path,
+    version: FmiVersion,
+) -> Result<PathBuf, String> {
+    let out_dir = &out_dir.join(version.subdirectory());
     if platforms.is_empty() {
         return Err("no platform to package".into());
     }
@@ -171,9 +264,12 @@ pub fn package(
         let library = p.built_library(library_of(info));
         let binary = std::fs::read(&library)
             .map_err(|e| format!("cannot read {} ({}): {e}", library.display(), p.name))?;
-        binaries.push((binary_entry(p.name, info.model_identifier)?, binary));
+        binaries.push((
+            binary_entry_version(p.name, info.model_identifier, version)?,
+            binary,
+        ));
     }
-    let xml = render(info)?;
+    let xml = render_version(info, version)?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
     let path = out_dir.join(format!("{}.fmu", info.model_name));
@@ -209,7 +305,7 @@ pub fn package(
 /// (arrays such as `x_table[1]`…`x_table[32]` collapse into one row
 /// `x_table[i]`).
 pub fn variables_markdown() -> String {
-    use fmi2_cs::{Causality, VarType};
+    use fmi_export::{Causality, VarType};
     let mut md = String::new();
     for info in all_models() {
         md.push_str(&format!("### {} — {}\n\n", info.model_name, info.source));

@@ -2,7 +2,9 @@
 //! and package FMUs. Used by `build-fmu.sh`.
 
 use clap::{Parser, Subcommand};
-use fmu_packager::{all_models, description_path, package, render, Platform};
+use fmu_packager::{
+    all_models, description_path_version, package_version, render_version, FmiVersion, Platform,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -15,21 +17,23 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Write <dir>/<Name>.xml for every model from its variable table, and
-    /// <dir>/shipped.txt, the list of shipped models.
+    /// Write <dir>/<Name>.xml (FMI 2.0) and <dir>/fmi3/<Name>.xml (FMI 3.0)
+    /// for every model from its variable table, and <dir>/shipped.txt, the
+    /// list of shipped models.
     Render {
         #[arg(default_value = "modelDescription")]
         dir: PathBuf,
     },
-    /// Fail if any checked-in <dir>/<Name>.xml or <dir>/shipped.txt differs
-    /// from the rendering.
+    /// Fail if any checked-in <dir>/<Name>.xml, <dir>/fmi3/<Name>.xml or
+    /// <dir>/shipped.txt differs from the rendering.
     Check {
         #[arg(default_value = "modelDescription")]
         dir: PathBuf,
     },
     /// Print the variable tables of docs/fmu-reference.md (Markdown).
     VariablesMd,
-    /// Package every model: <out>/<Name>.fmu from the shared libraries.
+    /// Package every model: <out>/<Name>.fmu (FMI 2.0) and
+    /// <out>/fmi3/<Name>.fmu (FMI 3.0) from the same shared libraries.
     Build {
         /// PLATFORM=DIR: binaries/PLATFORM/ of every FMU from the cdylibs
         /// built for it in DIR (lib<crate>.so for linux32/64, <crate>.dll
@@ -50,12 +54,15 @@ enum Command {
 fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
         Command::Render { dir } => {
-            std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-            for info in all_models() {
-                let path = description_path(&dir, info);
-                std::fs::write(&path, render(info)?)
-                    .map_err(|e| format!("{}: {e}", path.display()))?;
-                println!("wrote {}", path.display());
+            for version in FmiVersion::ALL {
+                let sub = dir.join(version.subdirectory());
+                std::fs::create_dir_all(&sub).map_err(|e| format!("{}: {e}", sub.display()))?;
+                for info in all_models() {
+                    let path = description_path_version(&dir, info, version);
+                    std::fs::write(&path, render_version(info, version)?)
+                        .map_err(|e| format!("{}: {e}", path.display()))?;
+                    println!("wrote {}", path.display());
+                }
             }
             let path = fmu_packager::shipped_list_path(&dir);
             std::fs::write(&path, fmu_packager::shipped_list())
@@ -64,11 +71,13 @@ fn run(cli: Cli) -> Result<(), String> {
         }
         Command::Check { dir } => {
             let mut stale = Vec::new();
-            for info in all_models() {
-                let path = description_path(&dir, info);
-                let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
-                if on_disk != render(info)? {
-                    stale.push(path.display().to_string());
+            for version in FmiVersion::ALL {
+                for info in all_models() {
+                    let path = description_path_version(&dir, info, version);
+                    let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
+                    if on_disk != render_version(info, version)? {
+                        stale.push(path.display().to_string());
+                    }
                 }
             }
             let path = fmu_packager::shipped_list_path(&dir);
@@ -86,12 +95,14 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::VariablesMd => print!("{}", fmu_packager::variables_markdown()),
         Command::Build { platforms, out } => {
             let names: Vec<&str> = platforms.iter().map(|p| p.name).collect();
-            for info in all_models() {
-                println!(
-                    "wrote {} ({})",
-                    package(info, &platforms, &out)?.display(),
-                    names.join(", ")
-                );
+            for version in FmiVersion::ALL {
+                for info in all_models() {
+                    println!(
+                        "wrote {} ({})",
+                        package_version(info, &platforms, &out, version)?.display(),
+                        names.join(", ")
+                    );
+                }
             }
         }
     }

@@ -1,21 +1,58 @@
-//! The checked-in `modelDescription/*.xml` must equal the rendering of the
+//! The checked-in `modelDescription/*.xml` (FMI 2.0) and
+//! `modelDescription/fmi3/*.xml` (FMI 3.0) must equal the rendering of the
 //! variable tables: nobody edits the XML by hand.
 
-use fmu_packager::{all_models, description_path, render};
+use fmu_packager::{all_models, description_path_version, render_version, FmiVersion};
 use std::path::Path;
 
 #[test]
 fn checked_in_model_descriptions_match_the_code() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../modelDescription");
+    for version in FmiVersion::ALL {
+        for info in all_models() {
+            let path = description_path_version(&dir, info, version);
+            let on_disk = std::fs::read_to_string(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(
+                on_disk == render_version(info, version).unwrap(),
+                "{} differs from the variable table of {}: run `cargo run -p fmu-packager -- render`",
+                path.display(),
+                info.model_name
+            );
+        }
+    }
+}
+
+/// The two descriptions of a model declare the same variables under the
+/// same value references, in FMI 3.0's types, and FMI 3.0's adds `time`
+/// and the event indicators after them.
+#[test]
+fn the_fmi3_description_declares_the_fmi2_variables() {
     for info in all_models() {
-        let path = description_path(&dir, info);
-        let on_disk =
-            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert!(
-            on_disk == render(info).unwrap(),
-            "{} differs from the variable table of {}: run `cargo run -p fmu-packager -- render`",
-            path.display(),
-            info.model_name
+        let two = render_version(info, FmiVersion::Fmi2).unwrap();
+        let three = render_version(info, FmiVersion::Fmi3).unwrap();
+        assert!(three.contains(r#"fmiVersion="3.0""#));
+        assert!(three.contains(&format!(r#"instantiationToken="{}""#, info.guid)));
+        for v in info.variables {
+            let element = match v.var_type {
+                fmi_export::VarType::Real => "Float64",
+                fmi_export::VarType::Integer => "Int32",
+                fmi_export::VarType::Boolean => "Boolean",
+            };
+            let declared = format!(r#"<{element} name="{}" valueReference="{}""#, v.name, v.vr);
+            assert!(three.contains(&declared), "{}: {declared}", info.model_name);
+            assert!(two.contains(&format!(r#"name="{}" valueReference="{}""#, v.name, v.vr)));
+        }
+        let time = format!(
+            r#"<Float64 name="time" valueReference="{}" causality="independent""#,
+            info.variables.len()
+        );
+        assert!(three.contains(&time), "{}", info.model_name);
+        let ni = info.model_exchange.map_or(0, |me| me.event_indicators);
+        assert_eq!(three.matches("<EventIndicator ").count(), ni);
+        assert_eq!(
+            three.contains("<ModelExchange "),
+            two.contains("<ModelExchange ")
         );
     }
 }

@@ -147,3 +147,52 @@ fn a_missing_library_or_a_platform_given_twice_is_refused() {
         "no platform to package"
     );
 }
+
+/// The FMI 3.0 FMU of a model: `<out>/fmi3/<Name>.fmu`, the same libraries
+/// under FMI 3.0's platform tuples, its FMI 3.0 description; a platform
+/// without a tuple this packager can name (darwin64: Intel or Arm?) is
+/// refused, naming it.
+#[test]
+fn the_fmi3_fmu_holds_the_same_libraries_under_platform_tuples() {
+    use fmu_packager::{package_version, render_version, FmiVersion};
+    let root = scratch("fmi3");
+    let lugre = all_models()
+        .into_iter()
+        .find(|m| m.model_name == "LuGre")
+        .unwrap();
+    let crate_name = library_of(lugre);
+    let mut platforms = Vec::new();
+    for (name, file) in [
+        ("linux64", format!("lib{crate_name}.so")),
+        ("win64", format!("{crate_name}.dll")),
+        ("darwin64", format!("lib{crate_name}.dylib")),
+    ] {
+        let dir = root.join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join(file), format!("the {name} library")).unwrap();
+        platforms.push(Platform { name, dir });
+    }
+    let out = root.join("dist");
+    let fmu = package_version(lugre, &platforms[..2], &out, FmiVersion::Fmi3).unwrap();
+    assert_eq!(fmu, out.join("fmi3").join("LuGre.fmu"));
+    let names = entries(&fmu);
+    let listed: Vec<&str> = names.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        listed,
+        [
+            "modelDescription.xml",
+            "binaries/x86_64-linux/LuGre.so",
+            "binaries/x86_64-windows/LuGre.dll",
+        ]
+    );
+    assert_eq!(names[1].1, b"the linux64 library");
+    assert_eq!(
+        String::from_utf8(names[0].1.clone()).unwrap(),
+        render_version(lugre, FmiVersion::Fmi3).unwrap()
+    );
+    let e = package_version(lugre, &platforms, &out, FmiVersion::Fmi3).unwrap_err();
+    assert_eq!(
+        e,
+        "platform darwin64 has no FMI 3.0 platform tuple this packager knows"
+    );
+}

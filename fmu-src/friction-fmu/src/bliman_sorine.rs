@@ -7,7 +7,7 @@
 //! of a hysteresis loop Sun et al. identify them from.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
-use fmi2_cs::{
+use fmi_export::{
     Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
     Variable,
 };
@@ -275,7 +275,7 @@ impl Model for BlimanSorineFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    fmi_export::delegate_state!(law);
 
     /// Directional derivatives of a step by replaying it.
     fn supplies_partial_derivatives(&self) -> bool {
@@ -296,13 +296,13 @@ impl Model for BlimanSorineFmu {
         dx[1] = r2;
     }
 
-    fmi2_cs::ode_is_self!();
+    fmi_export::ode_is_self!();
 }
 
 /// Model Exchange: the states are `x1`, `x2`; the one event indicator is
 /// `v`, where `|v|` puts a kink in both rates; no discrete state.
 impl Ode for BlimanSorineFmu {
-    fmi2_cs::delegate_continuous_states!(law);
+    fmi_export::delegate_continuous_states!(law);
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         z[0] = values.real(vr::V);

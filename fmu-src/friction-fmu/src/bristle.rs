@@ -6,7 +6,7 @@
 //! committing the move; `fmi2DoStep` commits it.
 
 use crate::{input_ramp, param_err};
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi_export::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use friction_laws::bristle::{Bristle, BristleParams};
 
 pub mod vr {
@@ -163,7 +163,7 @@ impl Model for BristleFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    fmi_export::delegate_state!(law);
 
     /// ∂F/∂x is the tangent stiffness n_connected·σb at the current input,
     /// exact between disconnection events, whether or not a step preceded.

@@ -7,7 +7,7 @@
 //! too ([`Bristle2DMe`]).
 
 use crate::{input_ramp, param_err};
-use fmi2_cs::{
+use fmi_export::{
     Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
     Variable,
 };
@@ -236,7 +236,7 @@ impl Model for Bristle2DFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    fmi_export::delegate_state!(law);
 
     /// Directional derivatives by replaying the step: no partial derivatives.
     fn supplies_partial_derivatives(&self) -> bool {
@@ -351,7 +351,7 @@ impl Model for Bristle2DMe {
         dx.copy_from_slice(&self.law.z_rate(self.z, slip(values), self.on_boundary));
     }
 
-    fmi2_cs::ode_is_self!();
+    fmi_export::ode_is_self!();
 }
 
 /// The states `z1`, `z2`; one event indicator, the switching function of

@@ -7,7 +7,7 @@
 //! contact holds up to `Fs`.
 
 use crate::param_err;
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi_export::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use friction_laws::classical::{Classical, ClassicalParams};
 
 pub mod vr {
@@ -184,7 +184,7 @@ impl Model for ClassicalFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    fmi_export::delegate_state!(law);
 
     /// `∂F/∂v`, `∂F/∂F_app` ([`Classical::force_partials`]) and those of
     /// `P_diss = F·v`.

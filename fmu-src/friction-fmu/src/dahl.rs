@@ -6,7 +6,7 @@
 //! `F = F_dahl + F_offset`.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
-use fmi2_cs::{
+use fmi_export::{
     Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
     Variable,
 };
@@ -182,7 +182,7 @@ impl Model for DahlFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    fmi_export::delegate_state!(law);
 
     /// Directional derivatives by replaying the step: no partial derivatives.
     fn supplies_partial_derivatives(&self) -> bool {
@@ -210,14 +210,14 @@ impl Model for DahlFmu {
             .force_rate(self.law.dahl_force(), values.real(vr::V));
     }
 
-    fmi2_cs::ode_is_self!();
+    fmi_export::ode_is_self!();
 }
 
 /// Model Exchange: the state is `F_dahl`; the one event indicator is `v`,
 /// where `sgn v` switches the law's branch (the rate has a kink there); no
 /// discrete state, so an event changes nothing.
 impl Ode for DahlFmu {
-    fmi2_cs::delegate_continuous_states!(law);
+    fmi_export::delegate_continuous_states!(law);
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         z[0] = values.real(vr::V);

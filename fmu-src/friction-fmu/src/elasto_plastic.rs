@@ -7,7 +7,7 @@
 //! indicators where `α(z, v)` changes branch.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
-use fmi2_cs::{
+use fmi_export::{
     Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
     Variable,
 };
@@ -187,7 +187,7 @@ impl Model for ElastoPlasticFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    fmi_export::delegate_state!(law);
 
     /// Directional derivatives of a step by replaying it.
     fn supplies_partial_derivatives(&self) -> bool {
@@ -216,7 +216,7 @@ impl Model for ElastoPlasticFmu {
         dx[0] = self.law.z_rate(self.law.z(), values.real(vr::V));
     }
 
-    fmi2_cs::ode_is_self!();
+    fmi_export::ode_is_self!();
 }
 
 /// Model Exchange: the state is `z`; the event indicators are `v`,
@@ -224,7 +224,7 @@ impl Model for ElastoPlasticFmu {
 /// continuous, with a continuous slope, at each of them, but its second
 /// derivative jumps); no discrete state.
 impl Ode for ElastoPlasticFmu {
-    fmi2_cs::delegate_continuous_states!(law);
+    fmi_export::delegate_continuous_states!(law);
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         let v = values.real(vr::V);

@@ -1,7 +1,7 @@
 //! Running a model in process, without the C ABI: the reference the FMU is
 //! compared against (FMPy through the C ABI must give the same numbers).
 
-use fmi2_cs::{Causality, Model, ModelInfo, Values};
+use fmi_export::{Causality, Model, ModelInfo, Values};
 
 /// Inputs at each communication point: `time[n]`, and per input its value
 /// and slope `du/dt` at that point (slope 0 when not interpolated).

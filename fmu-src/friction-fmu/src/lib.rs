@@ -1,12 +1,12 @@
 //! The friction FMUs. Each module binds one law of `friction-laws` to the FMI
 //! layer: its variable table (the single source of the model description)
-//! and a [`fmi2_cs::Model`] implementation. The same binary is packaged as
+//! and a [`fmi_export::Model`] implementation. The same binary is packaged as
 //! `Dahl.fmu`, `LuGre.fmu`, `ResetIntegrator.fmu`, `Bristle.fmu`,
 //! `Bristle2D.fmu`, `Classical.fmu`, `BlimanSorine.fmu` and
 //! `ElastoPlastic.fmu`;
 //! `fmi2Instantiate` picks the law by GUID. Every law but the bristle one
 //! and the stateless classical one is also an ODE and is offered for Model
-//! Exchange too ([`fmi2_cs::Ode`]), from the same equations.
+//! Exchange too ([`fmi_export::Ode`]), from the same equations.
 #![forbid(unsafe_code)]
 
 pub mod bliman_sorine;
@@ -20,7 +20,7 @@ pub mod lugre;
 pub mod maxwell_slip;
 pub mod reset_integrator;
 
-use fmi2_cs::{Model, ModelFactory, ModelInfo, Values, Variable};
+use fmi_export::{Model, ModelFactory, ModelInfo, Values, Variable};
 use friction_laws::Ramp;
 use std::sync::LazyLock;
 

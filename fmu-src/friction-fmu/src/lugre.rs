@@ -8,7 +8,7 @@
 //! derivative.
 
 use crate::{param_err, sliding_velocity_input};
-use fmi2_cs::{
+use fmi_export::{
     Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
     Variable,
 };
@@ -438,7 +438,7 @@ impl Model for LuGreFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    fmi_export::delegate_state!(law);
 
     /// Directional derivatives by replaying the step (or, after a held
     /// step, from the closed form below): no partial derivatives.
@@ -564,7 +564,7 @@ impl Model for LuGreFmu {
         dx[0] = self.law.z_dot(v, x, fn_);
     }
 
-    fmi2_cs::ode_is_self!();
+    fmi_export::ode_is_self!();
 }
 
 /// The parameter of value reference `vr` as a [`Parameter`] whose

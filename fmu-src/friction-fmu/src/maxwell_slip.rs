@@ -16,7 +16,7 @@
 //! generic model, [`ElementsFmu`], over the two laws ([`ElementLaw`]).
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
-use fmi2_cs::{
+use fmi_export::{
     Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
     Variable,
 };
@@ -599,7 +599,7 @@ impl<L: ElementLaw> Model for ElementsFmu<L> {
         }
     }
 
-    fmi2_cs::ode_is_self!();
+    fmi_export::ode_is_self!();
 }
 
 /// Model Exchange: the states are the element forces; indicator 0 is

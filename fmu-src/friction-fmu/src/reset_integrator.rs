@@ -6,7 +6,7 @@
 //! where a reversal releases it.
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
-use fmi2_cs::{
+use fmi_export::{
     Capabilities, ContinuousState, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values,
     Variable,
 };
@@ -159,7 +159,7 @@ impl Model for ResetFmu {
         Ok(())
     }
 
-    fmi2_cs::delegate_state!(law);
+    fmi_export::delegate_state!(law);
 
     /// Directional derivatives by replaying the step: no partial derivatives.
     fn supplies_partial_derivatives(&self) -> bool {
@@ -275,11 +275,11 @@ impl Model for ResetMe {
         dx[0] = self.law.z_rate(values.real(vr::V), self.contact);
     }
 
-    fmi2_cs::ode_is_self!();
+    fmi_export::ode_is_self!();
 }
 
 impl Ode for ResetMe {
-    fmi2_cs::delegate_continuous_states!(law);
+    fmi_export::delegate_continuous_states!(law);
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         let v = values.real(vr::V);

@@ -197,7 +197,7 @@ fn lugre_options() -> Vec<(&'static str, f64)> {
 /// The law the LuGre FMU runs with `params` set (by name).
 fn lugre_law(params: &[(&str, f64)]) -> LuGre {
     let info = &*friction_fmu::lugre::INFO;
-    let mut values = fmi2_cs::Values::from_start(info.variables);
+    let mut values = fmi_export::Values::from_start(info.variables);
     for (name, value) in params {
         let v = info.variables.iter().find(|v| v.name == *name).unwrap();
         values.set(v.vr, *value);
@@ -479,7 +479,7 @@ fn dahl_offset_shifts_the_force_and_not_its_derivatives() {
         let fmu = Fmu::instantiated("Dahl", &[]);
         assert_eq!(
             fmu.set_any("F_offset", bad),
-            fmi2_cs::ffi::fmi2Status::fmi2Error
+            fmi_export::ffi::fmi2Status::fmi2Error
         );
         let m = common::last_error();
         assert!(

@@ -6,7 +6,7 @@
 
 mod common;
 use common::*;
-use fmi2_cs::ffi::*;
+use fmi_export::ffi::*;
 use std::ffi::{c_void, CStr, CString};
 use std::os::raw::{c_char, c_int};
 use std::ptr::{null, null_mut};

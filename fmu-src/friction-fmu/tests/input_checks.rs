@@ -3,16 +3,21 @@
 //! and step mode, and nothing is set; the inputs it does not check take
 //! any finite value (the layer skips the model's check for them).
 
-use fmi2_cs::instance::Instance;
-use fmi2_cs::logger::Logger;
-use fmi2_cs::VarType;
+use fmi_export::instance::Instance;
+use fmi_export::logger::Logger;
+use fmi_export::VarType;
 
 fn lugre() -> Instance {
     let factory = friction_fmu::REGISTRY
         .iter()
         .find(|f| f.info.model_name == "LuGre")
         .expect("LuGre");
-    let logger = Logger::new(None, std::ptr::null_mut(), "probe", false);
+    let logger = Logger::new(
+        fmi_export::logger::Callback::Fmi2(None),
+        std::ptr::null_mut(),
+        "probe",
+        false,
+    );
     Instance::new(factory.info, (factory.create)(), "probe", logger)
 }
 

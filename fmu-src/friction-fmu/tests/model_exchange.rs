@@ -11,12 +11,12 @@
 
 mod common;
 use common::*;
-use fmi2_cs::ffi::*;
+use fmi_export::ffi::*;
 
 /// A Model Exchange instance of one of the friction FMUs.
 struct Me {
     c: fmi2Component,
-    info: &'static fmi2_cs::ModelInfo,
+    info: &'static fmi_export::ModelInfo,
 }
 
 impl Me {
@@ -51,9 +51,9 @@ impl Me {
         let v = self.info.by_name(name).unwrap();
         let status = unsafe {
             match v.var_type {
-                fmi2_cs::VarType::Real => fmi2SetReal(self.c, &v.vr, 1, &value),
-                fmi2_cs::VarType::Integer => fmi2SetInteger(self.c, &v.vr, 1, &(value as i32)),
-                fmi2_cs::VarType::Boolean => {
+                fmi_export::VarType::Real => fmi2SetReal(self.c, &v.vr, 1, &value),
+                fmi_export::VarType::Integer => fmi2SetInteger(self.c, &v.vr, 1, &(value as i32)),
+                fmi_export::VarType::Boolean => {
                     fmi2SetBoolean(self.c, &v.vr, 1, &((value != 0.0) as i32))
                 }
             }

@@ -8,7 +8,7 @@
 
 mod common;
 use common::*;
-use fmi2_cs::ffi::*;
+use fmi_export::ffi::*;
 use std::ptr::{null, null_mut};
 
 const ERR: fmi2Status = fmi2Status::fmi2Error;

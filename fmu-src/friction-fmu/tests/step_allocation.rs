@@ -5,11 +5,11 @@
 //! derivatives included). A counting global allocator sees every
 //! allocation of the thread that steps the FMU.
 
-use fmi2_cs::instance::Instance;
-use fmi2_cs::logger::Logger;
-use fmi2_cs::{Causality, VarType};
+use fmi_export::instance::Instance;
+use fmi_export::logger::Logger;
+use fmi_export::{Causality, VarType};
 
-#[path = "../../fmi2-cs/tests/support/counting_alloc.rs"]
+#[path = "../../fmi-export/tests/support/counting_alloc.rs"]
 mod counting_alloc;
 use counting_alloc::{allocations, Counting};
 
@@ -20,7 +20,12 @@ static GLOBAL: Counting = Counting;
 fn set_step_get_do_not_allocate_in_any_friction_fmu() {
     for factory in friction_fmu::REGISTRY.iter() {
         let info = factory.info;
-        let logger = Logger::new(None, std::ptr::null_mut(), "probe", false);
+        let logger = Logger::new(
+            fmi_export::logger::Callback::Fmi2(None),
+            std::ptr::null_mut(),
+            "probe",
+            false,
+        );
         let mut fmu = Instance::new(info, (factory.create)(), "probe", logger);
         // every Real input but LuGre's normal force (which must stay >= 0)
         let of = |causality| -> Vec<u32> {

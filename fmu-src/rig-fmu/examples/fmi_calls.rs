@@ -1,7 +1,7 @@
 //! The FMI calls of the stick-slip benchmark (`examples/stick_slip.ssd`:
 //! Rig1D pulled at 0.1 m/s, LuGre friction with Canudas de Wit's 1995
 //! parameters, h = 1e-4) through the FMU side of the C edge
-//! (`fmi2_cs::exports`), linked statically: a profiler sees the FMI layer
+//! (`fmi_export::exports`), linked statically: a profiler sees the FMI layer
 //! line by line, which it cannot in an FMU library loaded from a temporary
 //! directory. The call sequence per macro step is the host's:
 //!
@@ -20,9 +20,9 @@
 //! It prints the final friction force, which must not change with the FMI
 //! layer's implementation.
 
-use fmi2_cs::exports as x;
-use fmi2_cs::ffi::*;
-use fmi2_cs::{Causality, ModelFactory, ModelInfo, VarType};
+use fmi_export::exports as x;
+use fmi_export::ffi::*;
+use fmi_export::{Causality, ModelFactory, ModelInfo, VarType};
 use std::ffi::CString;
 
 fn real_outputs(info: &ModelInfo) -> Vec<u32> {

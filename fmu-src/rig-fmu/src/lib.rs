@@ -9,7 +9,7 @@
 pub mod rig1d;
 pub mod rig2d;
 
-use fmi2_cs::{ModelFactory, ModelInfo};
+use fmi_export::{ModelFactory, ModelInfo};
 use std::sync::LazyLock;
 
 pub static REGISTRY: LazyLock<[ModelFactory; 2]> = LazyLock::new(|| {

@@ -7,7 +7,7 @@
 //! Value references 0–14 are those of the first version (ramp actuator
 //! only); the modes' variables follow.
 
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi_export::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use rig_dynamics::rig1d::{
     Actuator, Control, Controller, DriveForce, Reference, Rig1D, Rig1DInputs, Rig1DParams,
 };
@@ -552,7 +552,7 @@ impl Model for Rig1DFmu {
         }
     }
 
-    fmi2_cs::delegate_state!(rig);
+    fmi_export::delegate_state!(rig);
 
     /// Directional derivatives by replaying the step (or, after a held
     /// step in the plain mode, from the closed form below): no partial
@@ -628,7 +628,7 @@ mod tests {
         let slopes = vec![0.0; VARIABLES.len()];
         let outputs: Vec<u32> = VARIABLES
             .iter()
-            .filter(|v| v.causality == fmi2_cs::Causality::Output)
+            .filter(|v| v.causality == fmi_export::Causality::Output)
             .map(|v| v.vr)
             .collect();
         for k in 0..50 {

@@ -4,7 +4,7 @@
 //! `rig_dynamics::rig2d`). Connect `v1, v2 → Bristle2D.v1, v2` and
 //! `Bristle2D.F1, F2 → F1, F2`.
 
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi_export::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use rig_dynamics::rig2d::{Rig2D, Rig2DInputs, Rig2DParams};
 use rig_dynamics::signals::Sinusoid;
 
@@ -306,7 +306,7 @@ impl Model for Rig2DFmu {
         })
     }
 
-    fmi2_cs::delegate_state!(rig);
+    fmi_export::delegate_state!(rig);
 
     /// Directional derivatives by replaying the step: no partial derivatives.
     fn supplies_partial_derivatives(&self) -> bool {

@@ -4,12 +4,17 @@
 //! alone and every output read after it are bit for bit those of an
 //! instance that reads every output at once.
 
-use fmi2_cs::instance::Instance;
-use fmi2_cs::logger::Logger;
-use fmi2_cs::{Causality, ModelFactory, VarType};
+use fmi_export::instance::Instance;
+use fmi_export::logger::Logger;
+use fmi_export::{Causality, ModelFactory, VarType};
 
 fn instance(factory: &ModelFactory) -> Instance {
-    let logger = Logger::new(None, std::ptr::null_mut(), "probe", false);
+    let logger = Logger::new(
+        fmi_export::logger::Callback::Fmi2(None),
+        std::ptr::null_mut(),
+        "probe",
+        false,
+    );
     let mut fmu = Instance::new(factory.info, (factory.create)(), "probe", logger);
     fmu.setup_experiment(0.0, None).unwrap();
     fmu.enter_initialization_mode().unwrap();

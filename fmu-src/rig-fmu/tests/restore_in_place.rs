@@ -7,7 +7,7 @@
 
 mod common;
 use common::*;
-use fmi2_cs::ffi::*;
+use fmi_export::ffi::*;
 use std::ptr::null_mut;
 
 #[test]

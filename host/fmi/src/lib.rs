@@ -18,7 +18,7 @@
 //! - [`watchdog`]: the optional time limit on each call.
 //!
 //! The C types of the standards are those of `fmi2-types` and
-//! `fmi3-types`: the exporter of this repository (`fmi2-cs`) uses the
+//! `fmi3-types`: the exporter of this repository (`fmi-export`) uses the
 //! first too; the host depends on these crates alone, not on the
 //! exporter. How FMI 3.0 came in and what is still to come: the crate's
 //! README.

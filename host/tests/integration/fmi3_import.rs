@@ -294,6 +294,63 @@ fn a_fmi3_rig_with_the_fmi2_lugre_equals_the_all_fmi2_system() {
     }
 }
 
+/// Our own FMUs as FMI 3.0 (`dist/fmi3/`, the same binary as `dist/`):
+/// the stick-slip benchmark with the FMI 3.0 LuGre and the FMI 2.0 rig
+/// (the reverse of the mixed system above), and with both as FMI 3.0,
+/// equals the all-FMI 2.0 system to the last bit under the Jacobi and the
+/// Newton master (which restores FMU states and asks for directional
+/// derivatives through FMI 3.0 here).
+#[test]
+fn our_fmi3_fmus_in_any_mix_equal_the_all_fmi2_system() {
+    let dist = crate::common::repository().join("dist");
+    let fmi2 = |name: &str| dist.join(format!("{name}.fmu"));
+    let fmi3 = |name: &str| dist.join("fmi3").join(format!("{name}.fmu"));
+    let connections = [
+        ("rig.v".to_string(), "friction.v".to_string()),
+        ("friction.F".to_string(), "rig.F".to_string()),
+    ];
+    let systems = [
+        ("FMI 2.0 rig + FMI 2.0 LuGre", fmi2("Rig1D"), fmi2("LuGre")),
+        ("FMI 2.0 rig + FMI 3.0 LuGre", fmi2("Rig1D"), fmi3("LuGre")),
+        ("FMI 3.0 rig + FMI 3.0 LuGre", fmi3("Rig1D"), fmi3("LuGre")),
+    ];
+    for (master, h) in [("jacobi", 1e-4), ("newton", 1e-3)] {
+        let mut runs = Vec::new();
+        for (what, rig, lugre) in &systems {
+            let fmus = vec![
+                ("rig".to_string(), Fmu::open(rig).unwrap()),
+                ("friction".to_string(), Fmu::open(lugre).unwrap()),
+            ];
+            let versions: Vec<bool> = fmus
+                .iter()
+                .map(|(_, f)| f.description().is_fmi3())
+                .collect();
+            assert_eq!(
+                versions,
+                [what.starts_with("FMI 3.0"), what.ends_with("FMI 3.0 LuGre")],
+                "{what}"
+            );
+            let mut system = System::from_fmus(fmus, &[], &connections, 0.0).unwrap();
+            let run = simulate(&mut system, by_name(master).unwrap().as_mut(), h, 10.0).unwrap();
+            assert!(run.error.is_none(), "{master}, {what}: {:?}", run.error);
+            runs.push(columns(
+                &run,
+                &["rig.x", "rig.v", "friction.F", "friction.z"],
+            ));
+        }
+        let f = &runs[0][2];
+        let swing =
+            f.iter().cloned().fold(f64::MIN, f64::max) - f.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(swing > 0.3, "{master}: friction swings {swing} N");
+        for (k, (what, _, _)) in systems.iter().enumerate().skip(1) {
+            assert_eq!(
+                runs[k], runs[0],
+                "{master}: {what} differs from the all-FMI 2.0 system"
+            );
+        }
+    }
+}
+
 /// `fmi3GetDirectionalDerivative` through `Fmi3Instance`: the FMI 3.0
 /// rig's step sensitivity to its input equals the central difference of
 /// two steps from one saved FMU state, to 1e-7 relative; before a step

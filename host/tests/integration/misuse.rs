@@ -11,7 +11,7 @@
 //!
 //! The state table below is written from FMI 2.0.4 §4.2.4 (the state
 //! machine of the Co-Simulation calling sequence), independently of the
-//! FMUs' own table in `fmi2-cs/src/state_machine.rs`.
+//! FMUs' own table in `fmi-export/src/state_machine.rs`.
 
 use crate::fmi;
 use fmi::*;
@@ -21,7 +21,7 @@ use std::ptr::{null, null_mut};
 /// The states of FMI 2.0.4 §4.2.4 an importer can reach with our FMUs
 /// (`stepInProgress`, `stepFailed` and `stepCanceled` need asynchronous or
 /// failing steps, `error`/`fatal` a failing model: the toy model of
-/// `fmi2-cs/tests/c_abi.rs` covers those).
+/// `fmi-export/tests/c_abi.rs` covers those).
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum St {
     Instantiated,

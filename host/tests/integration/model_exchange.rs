@@ -11,7 +11,7 @@
 //! The table below is written from FMI 2.0.4 §3.2.3 (the Model Exchange
 //! state machine; where the standard's table leaves room, the masks of the
 //! Modelica Reference FMUs), independently of the FMUs' own table in
-//! `fmi2-cs/src/state_machine.rs`.
+//! `fmi-export/src/state_machine.rs`.
 
 use crate::fmi;
 use fmi::*;

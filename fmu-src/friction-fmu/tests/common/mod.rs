@@ -1,9 +1,9 @@
-//! The C driver of `fmi2-cs/tests/support/c_driver.rs` over the exported C
+//! The C driver of `fmi-export/tests/support/c_driver.rs` over the exported C
 //! functions of the friction FMU library.
 #![allow(dead_code)]
 
 // The same exports the shipped library has, generated into this test binary.
-fmi2_cs::export_fmi2!(&friction_fmu::REGISTRY[..]);
+fmi_export::export_fmi2!(&friction_fmu::REGISTRY[..]);
 pub use fmi2_exports::*;
 
 /// LuGre's levels scaled by a position table of three points (the
@@ -19,8 +19,8 @@ pub const LUGRE_TABLE: &[(&str, f64)] = &[
     ("scale_pos[3]", 0.8),
 ];
 
-fn models() -> Vec<&'static fmi2_cs::ModelInfo> {
+fn models() -> Vec<&'static fmi_export::ModelInfo> {
     friction_fmu::models()
 }
 
-include!("../../../fmi2-cs/tests/support/c_driver.rs");
+include!("../../../fmi-export/tests/support/c_driver.rs");

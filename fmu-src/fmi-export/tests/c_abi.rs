@@ -2,8 +2,10 @@
 //! with a toy model: the state table, null pointers, unknown pointers,
 //! panics, NaN, serialized-state corruption and logging.
 
-use fmi2_cs::ffi::*;
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelFactory, ModelInfo, Values, Variable};
+use fmi_export::ffi::*;
+use fmi_export::{
+    Capabilities, DefaultExperiment, Model, ModelFactory, ModelInfo, Values, Variable,
+};
 use std::ffi::CString;
 use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
@@ -90,7 +92,7 @@ static REGISTRY: [ModelFactory; 1] = [ModelFactory {
     create: || Box::new(Toy { k: 1.0, s: 0.0 }),
     create_model_exchange: None,
 }];
-fmi2_cs::export_fmi2!(&REGISTRY[..]);
+fmi_export::export_fmi2!(&REGISTRY[..]);
 use fmi2_exports::*;
 
 #[path = "support/recording_logger.rs"]
@@ -308,7 +310,7 @@ fn invalid_parameter_is_refused_at_exit_initialization() {
 /// sequence".
 #[test]
 fn state_table_is_enforced() {
-    use fmi2_cs::state_machine::{is_allowed, State};
+    use fmi_export::state_machine::{is_allowed, State};
     let reach = |state: State| -> fmi2Component {
         let c = new_instance("states");
         unsafe {

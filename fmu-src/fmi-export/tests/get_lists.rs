@@ -8,8 +8,8 @@
 //! non-finite value is refused with the message naming the variable,
 //! also right after a valid list was remembered.
 
-use fmi2_cs::instance::Instance;
-use fmi2_cs::{Model, ModelInfo, Values, VarType, Variable};
+use fmi_export::instance::Instance;
+use fmi_export::{Model, ModelInfo, Values, VarType, Variable};
 
 #[path = "support/toy_instance.rs"]
 mod toy_instance;

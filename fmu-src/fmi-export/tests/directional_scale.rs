@@ -4,8 +4,8 @@
 //! bit for bit on a linear toy, whose derivative by differences shows ε in
 //! its last bits.
 
-use fmi2_cs::instance::Instance;
-use fmi2_cs::{Model, ModelInfo, Values, Variable};
+use fmi_export::instance::Instance;
+use fmi_export::{Model, ModelInfo, Values, Variable};
 
 #[path = "support/toy_instance.rs"]
 mod toy_instance;
@@ -76,7 +76,7 @@ fn the_perturbation_scales_with_the_larger_of_the_input_and_its_nominal() {
     for nominal in nominals {
         for (u, dv) in [(2.0, 1.0), (-2.0, 3.0), (0.7, -0.25), (1e-3, 1e3)] {
             let mut fmu = instance(nominal);
-            fmu.set(fmi2_cs::VarType::Real, &[U], &[u]).unwrap();
+            fmu.set(fmi_export::VarType::Real, &[U], &[u]).unwrap();
             let mut d = [f64::NAN];
             fmu.directional_derivative(&[Y], &[U], &[dv], &mut d)
                 .unwrap();

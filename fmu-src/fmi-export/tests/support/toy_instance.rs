@@ -1,13 +1,13 @@
 //! The description and an initialized instance of a toy model, for the
 //! tests of the layer on a model of their own
-//! (`fmi2-cs/tests/directional_scale.rs`, `get_lists.rs`,
+//! (`fmi-export/tests/directional_scale.rs`, `get_lists.rs`,
 //! `step_derivatives.rs`, `step_size.rs`; its state macro also
 //! `resource_location.rs`).
 //! Included with `#[path]`.
 
-use fmi2_cs::instance::Instance;
-use fmi2_cs::logger::Logger;
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelInfo, Variable};
+use fmi_export::instance::Instance;
+use fmi_export::logger::Logger;
+use fmi_export::{Capabilities, DefaultExperiment, Model, ModelInfo, Variable};
 
 /// A model description of `variables` named `name` (kept for the
 /// process, as a model's static description is).
@@ -19,7 +19,7 @@ pub fn toy_info(name: &'static str, variables: Vec<Variable>) -> &'static ModelI
 pub fn toy_info_with(
     name: &'static str,
     variables: Vec<Variable>,
-    model_exchange: Option<fmi2_cs::ModelExchange>,
+    model_exchange: Option<fmi_export::ModelExchange>,
 ) -> &'static ModelInfo {
     Box::leak(Box::new(ModelInfo {
         model_name: name,
@@ -41,7 +41,12 @@ pub fn toy_info_with(
 /// An instance of `model` (of `info`), through initialization mode into
 /// step mode at t = 0.
 pub fn initialized(info: &'static ModelInfo, model: Box<dyn Model>) -> Instance {
-    let logger = Logger::new(None, std::ptr::null_mut(), "probe", false);
+    let logger = Logger::new(
+        fmi_export::logger::Callback::Fmi2(None),
+        std::ptr::null_mut(),
+        "probe",
+        false,
+    );
     let mut fmu = Instance::new(info, model, "probe", logger);
     fmu.setup_experiment(0.0, None).unwrap();
     fmu.enter_initialization_mode().unwrap();

@@ -6,7 +6,7 @@
 use crate::ffi::*;
 use crate::guard::{Admission, Guard};
 use crate::instance::Instance;
-use crate::logger::{Logger, Reporter};
+use crate::logger::{Callback, Logger, Reporter};
 use crate::model::ModelFactory;
 use crate::resource_location;
 use crate::serialize::Snapshot;
@@ -81,45 +81,81 @@ fn concurrent_call(slot: &Slot, function: &str) -> fmi2Status {
     fmi2Status::fmi2Error
 }
 
-/// Addresses of the instances this library created and has not freed.
-static LIVE: Mutex<BTreeSet<usize>> = Mutex::new(BTreeSet::new());
+/// The instances of one interface (FMI 2.0 or FMI 3.0) this library
+/// created and has not freed, by address: a pointer is used only if it is
+/// in the set of the interface called, so an `fmi3Instance` passed to an
+/// `fmi2…` function (or a pointer this library never made) is refused.
+pub struct LiveSet {
+    /// Every live instance.
+    all: Mutex<BTreeSet<usize>>,
+    /// Addresses found in `all` recently (0: empty), so that the step loop
+    /// of a co-simulation, which calls the same few instances over and
+    /// over, checks its pointer with a few loads instead of the lock.
+    /// Written only with `all` locked; an address leaves it, with the lock
+    /// held, before its instance is freed.
+    recent: [AtomicUsize; RECENT],
+    /// The slot of `recent` the next address found goes to.
+    next_slot: AtomicUsize,
+}
+
+impl LiveSet {
+    const fn new() -> LiveSet {
+        LiveSet {
+            all: Mutex::new(BTreeSet::new()),
+            recent: [const { AtomicUsize::new(0) }; RECENT],
+            next_slot: AtomicUsize::new(0),
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, BTreeSet<usize>> {
+        self.all.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Whether `c` is an instance of this set that has not been freed:
+    /// from `recent`, else from `all`. (Freeing an instance while another
+    /// thread is inside a call on it is a caller's error the lock never
+    /// prevented either.)
+    #[inline]
+    fn contains(&self, c: usize) -> bool {
+        self.recently_contains(c) || self.contains_locked(c)
+    }
+
+    /// Whether `c` (not 0) is in `recent`: a few loads, no lock.
+    #[inline(always)]
+    fn recently_contains(&self, c: usize) -> bool {
+        c != 0 && self.recent.iter().any(|s| s.load(Ordering::Acquire) == c)
+    }
+
+    /// [`LiveSet::contains`] from `all`, noting a live `c` in `recent`.
+    #[cold]
+    #[inline(never)]
+    fn contains_locked(&self, c: usize) -> bool {
+        let all = self.lock();
+        let found = all.contains(&c);
+        if found {
+            let slot = self.next_slot.fetch_add(1, Ordering::Relaxed) % RECENT;
+            self.recent[slot].store(c, Ordering::Release);
+        }
+        drop(all);
+        found
+    }
+}
+
+/// The instances made by `fmi2Instantiate`.
+pub static FMI2_LIVE: LiveSet = LiveSet::new();
+/// The instances made by `fmi3InstantiateCoSimulation` and
+/// `fmi3InstantiateModelExchange`.
+pub static FMI3_LIVE: LiveSet = LiveSet::new();
+
 /// Larger array lengths are refused outright: no model has that many
 /// variables, and reading that far would only run past the caller's arrays.
-const MAX_ARRAY_LENGTH: usize = 1 << 20;
+pub(crate) const MAX_ARRAY_LENGTH: usize = 1 << 20;
 
-fn live() -> std::sync::MutexGuard<'static, BTreeSet<usize>> {
-    LIVE.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// Slots of [`RECENTLY_LIVE`].
+/// Slots of [`LiveSet::recent`].
 const RECENT: usize = 8;
 
-/// Addresses found in [`LIVE`] recently (0: empty), so that the step loop
-/// of a co-simulation, which calls the same few instances over and over,
-/// checks its pointer with a few loads instead of the lock. Written only
-/// with [`LIVE`] locked; an address leaves it, with the lock held, before
-/// its instance is freed.
-static RECENTLY_LIVE: [AtomicUsize; RECENT] = [const { AtomicUsize::new(0) }; RECENT];
-/// The slot of [`RECENTLY_LIVE`] the next address found goes to.
-static NEXT_SLOT: AtomicUsize = AtomicUsize::new(0);
-
-/// Whether `c` is an instance of this library that has not been freed:
-/// from [`RECENTLY_LIVE`], else from [`LIVE`]. (Freeing an instance while
-/// another thread is inside a call on it is a caller's error the lock never
-/// prevented either.)
-#[inline]
-fn is_live(c: usize) -> bool {
-    recently_live(c) || is_live_locked(c)
-}
-
-/// Whether `c` (not 0) is in [`RECENTLY_LIVE`]: a few loads, no lock.
-#[inline(always)]
-fn recently_live(c: usize) -> bool {
-    c != 0 && RECENTLY_LIVE.iter().any(|s| s.load(Ordering::Acquire) == c)
-}
-
 /// A call admitted into a slot ([`Slot::admit`]): released when dropped.
-struct Admitted<'a>(&'a Slot, Admission);
+pub(crate) struct Admitted<'a>(&'a Slot, Admission);
 
 impl Drop for Admitted<'_> {
     #[inline(always)]
@@ -129,7 +165,7 @@ impl Drop for Admitted<'_> {
 }
 
 /// The instance behind `c` for a call's fast path, admitted, if `c` is in
-/// [`RECENTLY_LIVE`] (no lock), no other call is running on it, its state
+/// [`LiveSet::recent`] of `live` (no lock), no other call is running on it, its state
 /// is in `allowed` and calls are not logged; else `None`, and the call
 /// takes [`call_allowed`], which checks again and reports. The instance
 /// is the caller's until the [`Admitted`] is dropped; what the caller
@@ -138,12 +174,13 @@ impl Drop for Admitted<'_> {
 /// # Safety
 /// As [`call_allowed`]: `c` is dereferenced only if recently live.
 #[inline(always)]
-unsafe fn recent_instance<'a>(
+pub(crate) unsafe fn recent_instance<'a>(
+    live: &'static LiveSet,
     c: fmi2Component,
     allowed: u32,
 ) -> Option<(Admitted<'a>, &'a mut Instance)> {
     let c = c as usize;
-    if !recently_live(c) {
+    if !live.recently_contains(c) {
         return None;
     }
     // SAFETY: a recently live address is a live slot, created by
@@ -156,20 +193,6 @@ unsafe fn recent_instance<'a>(
     let instance = unsafe { &mut *instance };
     (allowed & instance.state as u32 != 0 && !instance.logger.logs_calls())
         .then_some((admitted, instance))
-}
-
-/// [`is_live`] from [`LIVE`], noting a live `c` in [`RECENTLY_LIVE`].
-#[cold]
-#[inline(never)]
-fn is_live_locked(c: usize) -> bool {
-    let live = live();
-    let found = live.contains(&c);
-    if found {
-        let slot = NEXT_SLOT.fetch_add(1, Ordering::Relaxed) % RECENT;
-        RECENTLY_LIVE[slot].store(c, Ordering::Release);
-    }
-    drop(live);
-    found
 }
 
 fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
@@ -189,6 +212,7 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 macro_rules! call {
     ($c:expr, $function:literal, $body:expr) => {
         call_named(
+            &FMI2_LIVE,
             $c,
             || $function,
             const { crate::state_machine::allowed_mask($function) },
@@ -210,7 +234,7 @@ pub unsafe fn call_allowed(
     allowed: u32,
     body: impl FnOnce(&mut Instance) -> Result<fmi2Status, String>,
 ) -> fmi2Status {
-    unsafe { call_named(c, move || function, allowed, body) }
+    unsafe { call_named(&FMI2_LIVE, c, move || function, allowed, body) }
 }
 
 /// [`call_allowed`] with the function's name from `function` (asked on the
@@ -219,13 +243,14 @@ pub unsafe fn call_allowed(
 /// # Safety
 /// As [`call_allowed`].
 #[inline(always)]
-unsafe fn call_named(
+pub(crate) unsafe fn call_named(
+    live: &'static LiveSet,
     c: fmi2Component,
     function: impl Fn() -> &'static str + Copy,
     allowed: u32,
     body: impl FnOnce(&mut Instance) -> Result<fmi2Status, String>,
 ) -> fmi2Status {
-    if c.is_null() || !is_live(c as usize) {
+    if c.is_null() || !live.contains(c as usize) {
         // No instance, so no logger to report to: the status says it.
         return fmi2Status::fmi2Error;
     }
@@ -290,7 +315,7 @@ fn panicked(
 fn illegal_call(instance: &mut Instance, function: &str) -> fmi2Status {
     instance.logger.error(&format!(
         "{function}: illegal call sequence: not allowed in state {}",
-        instance.state.name()
+        instance.state_name()
     ));
     fmi2Status::fmi2Error
 }
@@ -301,7 +326,7 @@ fn illegal_call(instance: &mut Instance, function: &str) -> fmi2Status {
 fn log_call(instance: &mut Instance, function: &str) {
     let message = format!(
         "{function} (state {}, t = {})",
-        instance.state.name(),
+        instance.state_name(),
         instance.time
     );
     instance.logger.call(|| message);
@@ -352,7 +377,7 @@ pub unsafe fn out_slice<'a, T>(ptr: *mut T, n: usize, what: &str) -> Result<&'a 
 /// [`in_slice`] and [`out_slice`] check them: the alignment bits of both
 /// in one test, then each address against NULL.
 #[inline(always)]
-fn both_usable<A, B>(a: *const A, b: *const B) -> bool {
+pub(crate) fn both_usable<A, B>(a: *const A, b: *const B) -> bool {
     let (a, b) = (a as usize, b as usize);
     let misaligned = (a & (std::mem::align_of::<A>() - 1)) | (b & (std::mem::align_of::<B>() - 1));
     misaligned == 0 && a != 0 && b != 0
@@ -374,7 +399,7 @@ fn slice_error(address: usize, null: bool, n: usize, what: &str) -> String {
 
 /// # Safety
 /// `s` is NULL or a NUL-terminated string.
-unsafe fn c_str(s: fmi2String, what: &str) -> Result<String, String> {
+pub(crate) unsafe fn c_str(s: fmi2String, what: &str) -> Result<String, String> {
     if s.is_null() {
         return Err(format!("argument {what} is NULL"));
     }
@@ -414,109 +439,165 @@ pub unsafe fn instantiate(
         // SAFETY: non-null and aligned; the importer owns it for the call.
         let functions = unsafe { &*functions };
         let name = unsafe { c_str(instance_name, "instanceName") };
-        let mut logger = Logger::new(
-            functions.logger,
+        let logger = Logger::new(
+            Callback::Fmi2(functions.logger),
             functions.componentEnvironment,
             name.as_deref().unwrap_or("?"),
             logging_on != fmi2False,
         );
-        let name = match name {
-            Ok(n) => n,
-            Err(e) => {
-                logger.error(&format!("fmi2Instantiate: {e}"));
-                return std::ptr::null_mut();
-            }
-        };
         let model_exchange = match fmu_type {
             t if t == fmi2CoSimulation => false,
             t if t == fmi2ModelExchange => true,
             other => {
+                let mut logger = logger;
                 logger.error(&format!(
                     "fmi2Instantiate: fmuType = {other} is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)"
                 ));
                 return std::ptr::null_mut();
             }
         };
-        let guid = match unsafe { c_str(guid, "fmuGUID") } {
-            Ok(g) => g,
-            Err(e) => {
-                logger.error(&format!("fmi2Instantiate: {e}"));
-                return std::ptr::null_mut();
-            }
-        };
-        let Some(factory) = registry.iter().find(|f| f.info.guid == guid) else {
-            let known: Vec<String> = registry
-                .iter()
-                .map(|f| format!("{} {}", f.info.model_name, f.info.guid))
-                .collect();
-            logger.error(&format!(
-                "fmi2Instantiate: unknown fmuGUID {guid}; this binary holds {}",
-                known.join(", ")
-            ));
-            return std::ptr::null_mut();
-        };
-        let create = if model_exchange {
-            match factory.create_model_exchange {
-                Some(create) if factory.info.model_exchange.is_some() => create,
-                _ => {
-                    logger.error(&format!(
-                        "fmi2Instantiate: fmuType = 0 (Model Exchange) is not supported by {}: it implements Co-Simulation (1) only (see its model description: no <ModelExchange> element)",
-                        factory.info.model_name
-                    ));
-                    return std::ptr::null_mut();
-                }
-            }
-        } else {
-            factory.create
-        };
-        let mut model = create();
         // SAFETY: NULL or NUL-terminated by the FMI contract.
         let location = unsafe { c_str(resource_location, "fmuResourceLocation") };
         let directory = match &location {
             Ok(uri) => resource_location::to_path(uri, resource_location::PathStyle::NATIVE)
+                .map(|dir| (format!("fmuResourceLocation \"{uri}\""), dir))
                 .map_err(|e| format!("fmuResourceLocation \"{uri}\" {e}")),
             Err(e) => Err(e.clone()),
         };
-        match directory {
-            Ok(dir) => {
-                logger.call(|| {
-                    format!(
-                        "fmi2Instantiate: fmuResourceLocation \"{}\" is the directory \"{dir}\"{}",
-                        location.as_deref().unwrap_or(""),
-                        if model.needs_resources() {
-                            ""
-                        } else {
-                            " (not read: this model uses no resources)"
-                        }
-                    )
-                });
-                if model.needs_resources() {
-                    model.set_resource_dir(&dir);
-                }
-            }
-            Err(e) if model.needs_resources() => {
+        let request = Request {
+            function: "fmi2Instantiate",
+            registry,
+            name,
+            token: guid,
+            token_name: "fmuGUID",
+            model_exchange,
+            directory,
+            fmi3: false,
+        };
+        // SAFETY: NULL or NUL-terminated by the FMI contract.
+        unsafe { create(request, logger, &FMI2_LIVE) }
+    }));
+    outcome.unwrap_or(std::ptr::null_mut())
+}
+
+/// What an importer asked to instantiate, in either interface's terms.
+pub(crate) struct Request {
+    /// `fmi2Instantiate`, `fmi3InstantiateCoSimulation`, …: the prefix of
+    /// every message.
+    pub function: &'static str,
+    pub registry: &'static [ModelFactory],
+    /// The instance name, or why it could not be read.
+    pub name: Result<String, String>,
+    /// The GUID (FMI 2.0) or instantiation token (FMI 3.0) that picks the
+    /// model, as the importer passed it.
+    pub token: fmi2String,
+    /// `fmuGUID` or `instantiationToken`, for the messages.
+    pub token_name: &'static str,
+    pub model_exchange: bool,
+    /// The FMU's `resources/` directory as a native path, with how the
+    /// importer gave it (for the log); or why there is none.
+    pub directory: Result<(String, String), String>,
+    pub fmi3: bool,
+}
+
+/// Create the instance `request` asks for, or log why not and return
+/// NULL: the model is picked by its token from the registry, given its
+/// resources if it reads any, and the instance enters `live`.
+///
+/// # Safety
+/// `request.token` is NULL or NUL-terminated.
+pub(crate) unsafe fn create(
+    request: Request,
+    mut logger: Logger,
+    live: &'static LiveSet,
+) -> fmi2Component {
+    let function = request.function;
+    let name = match request.name {
+        Ok(n) => n,
+        Err(e) => {
+            logger.error(&format!("{function}: {e}"));
+            return std::ptr::null_mut();
+        }
+    };
+    let token = match unsafe { c_str(request.token, request.token_name) } {
+        Ok(g) => g,
+        Err(e) => {
+            logger.error(&format!("{function}: {e}"));
+            return std::ptr::null_mut();
+        }
+    };
+    let registry = request.registry;
+    let Some(factory) = registry.iter().find(|f| f.info.guid == token) else {
+        let known: Vec<String> = registry
+            .iter()
+            .map(|f| format!("{} {}", f.info.model_name, f.info.guid))
+            .collect();
+        logger.error(&format!(
+            "{function}: unknown {} {token}; this binary holds {}",
+            request.token_name,
+            known.join(", ")
+        ));
+        return std::ptr::null_mut();
+    };
+    let create = if request.model_exchange {
+        match factory.create_model_exchange {
+            Some(create) if factory.info.model_exchange.is_some() => create,
+            _ => {
+                let (asked, offered) = if request.fmi3 {
+                    ("Model Exchange", "Co-Simulation")
+                } else {
+                    ("fmuType = 0 (Model Exchange)", "Co-Simulation (1)")
+                };
                 logger.error(&format!(
-                    "fmi2Instantiate: {e}; {} reads its resources from there, so it needs the URI of a directory (file:///C:/dir/resources, file:///home/dir/resources)",
+                    "{function}: {asked} is not supported by {}: it implements {offered} only (see its model description: no <ModelExchange> element)",
                     factory.info.model_name
                 ));
                 return std::ptr::null_mut();
             }
-            Err(e) => logger
-                .call(|| format!("fmi2Instantiate: {e}; accepted: this model uses no resources")),
         }
-        let mut instance = Instance::new(factory.info, model, &name, logger);
-        if model_exchange {
-            if let Err(e) = instance.make_model_exchange() {
-                instance.logger.error(&format!("fmi2Instantiate: {e}"));
-                return std::ptr::null_mut();
+    } else {
+        factory.create
+    };
+    let mut model = create();
+    match request.directory {
+        Ok((given, dir)) => {
+            logger.call(|| {
+                format!(
+                    "{function}: {given} is the directory \"{dir}\"{}",
+                    if model.needs_resources() {
+                        ""
+                    } else {
+                        " (not read: this model uses no resources)"
+                    }
+                )
+            });
+            if model.needs_resources() {
+                model.set_resource_dir(&dir);
             }
         }
-        crate::guard::prepare_barrier();
-        let address = Box::into_raw(Box::new(Slot::new(instance)));
-        live().insert(address as usize);
-        address as fmi2Component
-    }));
-    outcome.unwrap_or(std::ptr::null_mut())
+        Err(e) if model.needs_resources() => {
+            logger.error(&format!(
+                "{function}: {e}; {} reads its resources from there, so it needs the location of a directory",
+                factory.info.model_name
+            ));
+            return std::ptr::null_mut();
+        }
+        Err(e) => {
+            logger.call(|| format!("{function}: {e}; accepted: this model uses no resources"))
+        }
+    }
+    let mut instance = Instance::new(factory.info, model, &name, logger);
+    instance.fmi3 = request.fmi3;
+    if request.model_exchange {
+        if let Err(e) = instance.make_model_exchange() {
+            instance.logger.error(&format!("{function}: {e}"));
+            return std::ptr::null_mut();
+        }
+    }
+    crate::guard::prepare_barrier();
+    let address = Box::into_raw(Box::new(Slot::new(instance)));
+    live.lock().insert(address as usize);
+    address as fmi2Component
 }
 
 /// `fmi2FreeInstance`. An instance another thread is inside a call on is
@@ -530,29 +611,37 @@ pub unsafe fn instantiate(
 /// # Safety
 /// `c` is checked against the live set before use.
 pub unsafe fn free_instance(c: fmi2Component) {
+    unsafe { free_instance_of(&FMI2_LIVE, "fmi2FreeInstance", c) }
+}
+
+/// [`free_instance`] of an instance of `live`.
+///
+/// # Safety
+/// As [`free_instance`].
+pub(crate) unsafe fn free_instance_of(live: &'static LiveSet, function: &str, c: fmi2Component) {
     let _ = catch_unwind(AssertUnwindSafe(|| {
         if c.is_null() {
             return;
         }
-        let mut live = live();
-        if !live.contains(&(c as usize)) {
+        let mut all = live.lock();
+        if !all.contains(&(c as usize)) {
             return;
         }
         // SAFETY: live, so a slot created by `instantiate` and not freed.
         let slot = unsafe { &*(c as *const Slot) };
         if slot.admit().is_none() {
-            drop(live);
-            concurrent_call(slot, "fmi2FreeInstance");
+            drop(all);
+            concurrent_call(slot, function);
             return;
         }
-        live.remove(&(c as usize));
-        for recent in &RECENTLY_LIVE {
+        all.remove(&(c as usize));
+        for recent in &live.recent {
             // only with the lock held, as every store into the slots
             if recent.load(Ordering::Acquire) == c as usize {
                 recent.store(0, Ordering::Release);
             }
         }
-        drop(live);
+        drop(all);
         // SAFETY: was live, so it came from Box::into_raw and is freed
         // once (removed from the live set above, under the lock); admitted,
         // so no call is running on it.
@@ -733,7 +822,7 @@ unsafe fn get_converted<T>(
         // SAFETY: non-null and aligned, one element (FMI contract)
         let vr = unsafe { *vr };
         // SAFETY: as `call_allowed`
-        if let Some((admitted, inst)) = unsafe { recent_instance(c, allowed) } {
+        if let Some((admitted, inst)) = unsafe { recent_instance(&FMI2_LIVE, c, allowed) } {
             let x = inst.get_plain(t, vr);
             drop(admitted);
             if let Some(x) = x {
@@ -745,6 +834,7 @@ unsafe fn get_converted<T>(
     }
     unsafe {
         call_named(
+            &FMI2_LIVE,
             c,
             move || function,
             allowed,
@@ -825,7 +915,7 @@ pub unsafe fn set_real(
         // SAFETY: non-null and aligned, one element each (FMI contract)
         let (vr, value) = unsafe { (*vr, *value) };
         // SAFETY: as `call_allowed`
-        if let Some((admitted, inst)) = unsafe { recent_instance(c, ALLOWED) } {
+        if let Some((admitted, inst)) = unsafe { recent_instance(&FMI2_LIVE, c, ALLOWED) } {
             let done = inst.set_real_plain(vr, value);
             drop(admitted);
             if done {

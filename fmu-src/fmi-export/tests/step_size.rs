@@ -3,8 +3,8 @@
 //! negative, infinite and NaN sizes are refused with the message, and the
 //! instance stays where it was.
 
-use fmi2_cs::instance::Instance;
-use fmi2_cs::{Model, ModelInfo, Values, Variable};
+use fmi_export::instance::Instance;
+use fmi_export::{Model, ModelInfo, Values, Variable};
 
 #[path = "support/toy_instance.rs"]
 mod toy_instance;
@@ -98,7 +98,12 @@ fn no_step_past_a_defined_stop_time() {
             Variable::output(1, "y", "", "the state", &[]),
         ],
     );
-    let logger = fmi2_cs::logger::Logger::new(None, std::ptr::null_mut(), "probe", false);
+    let logger = fmi_export::logger::Logger::new(
+        fmi_export::logger::Callback::Fmi2(None),
+        std::ptr::null_mut(),
+        "probe",
+        false,
+    );
     let mut fmu = Instance::new(info, Box::new(Still { info, s: 0.0 }), "probe", logger);
     fmu.setup_experiment(0.0, Some(1.0)).unwrap();
     fmu.enter_initialization_mode().unwrap();

@@ -5,8 +5,10 @@
 //! refused a location that names no directory, with the reason, and gets
 //! the directory of a good one as a path of this platform.
 
-use fmi2_cs::ffi::*;
-use fmi2_cs::{Capabilities, DefaultExperiment, Model, ModelFactory, ModelInfo, Values, Variable};
+use fmi_export::ffi::*;
+use fmi_export::{
+    Capabilities, DefaultExperiment, Model, ModelFactory, ModelInfo, Values, Variable,
+};
 use std::cell::RefCell;
 use std::ffi::{CStr, CString};
 use std::ptr::null;
@@ -104,7 +106,7 @@ static REGISTRY: [ModelFactory; 2] = [
         create_model_exchange: None,
     },
 ];
-fmi2_cs::export_fmi2!(&REGISTRY[..]);
+fmi_export::export_fmi2!(&REGISTRY[..]);
 use fmi2_exports::*;
 
 #[path = "support/toy_instance.rs"]

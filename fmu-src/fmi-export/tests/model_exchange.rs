@@ -10,8 +10,8 @@
 //! `1 - s`, and at an event a state `s >= 1` is put back to 0. A
 //! derivative that would use `u = 7` is NaN, and `u = 13` panics.
 
-use fmi2_cs::ffi::*;
-use fmi2_cs::{
+use fmi_export::ffi::*;
+use fmi_export::{
     ContinuousState, Model, ModelExchange, ModelFactory, ModelInfo, Ode, Values, Variable,
 };
 use std::os::raw::c_char;
@@ -160,7 +160,7 @@ static REGISTRY: std::sync::LazyLock<[ModelFactory; 2]> = std::sync::LazyLock::n
         },
     ]
 });
-fmi2_cs::export_fmi2!(&REGISTRY[..]);
+fmi_export::export_fmi2!(&REGISTRY[..]);
 use fmi2_exports::*;
 
 // ---- the C driver's recording logger and instantiation ---------------------
@@ -175,7 +175,7 @@ use toy_instance::one_value_toy_state;
 #[allow(dead_code)]
 mod driver {
     pub use crate::fmi2_exports::*;
-    fn models() -> Vec<&'static fmi2_cs::ModelInfo> {
+    fn models() -> Vec<&'static fmi_export::ModelInfo> {
         vec![*crate::ME_INFO, *crate::CS_INFO]
     }
     include!("support/c_driver.rs");
@@ -212,7 +212,7 @@ fn instantiate(kind: fmi2Type, model: &str) -> fmi2Component {
     driver::instantiate(model, kind).0
 }
 
-use fmi2_cs::state_machine::State;
+use fmi_export::state_machine::State;
 use State::{ContinuousTimeMode, EventMode};
 /// The Model Exchange states an importer reaches (the layer's names).
 const INSTANTIATED: State = State::MeInstantiated;
@@ -396,7 +396,7 @@ fn every_function_in_every_model_exchange_state_follows_the_table() {
             let c = me_instance_in(state);
             let status = probe(c);
             let context = format!("{function} in {state:?}");
-            let allowed = fmi2_cs::state_machine::is_allowed(function, state);
+            let allowed = fmi_export::state_machine::is_allowed(function, state);
             assert!(!(allowed && cs_only.contains(&function)), "{context}");
             if allowed {
                 assert!(

@@ -6,8 +6,8 @@
 //! step, input slopes over it, a model that supplies none), bit for bit
 //! as before.
 
-use fmi2_cs::instance::Instance;
-use fmi2_cs::{Model, ModelInfo, Values, VarType, Variable};
+use fmi_export::instance::Instance;
+use fmi_export::{Model, ModelInfo, Values, VarType, Variable};
 use std::sync::{Arc, Mutex};
 
 #[path = "support/toy_instance.rs"]

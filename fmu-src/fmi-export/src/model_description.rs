@@ -31,7 +31,7 @@ const UNITS: &[(&str, [i32; 4])] = &[
     ("N/V", [0, -1, 1, 1]),
 ];
 
-fn escape(s: &str) -> String {
+pub(crate) fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
@@ -39,11 +39,11 @@ fn escape(s: &str) -> String {
 }
 
 /// Shortest representation that parses back to the same `f64`.
-fn number(x: f64) -> String {
+pub(crate) fn number(x: f64) -> String {
     format!("{x:?}")
 }
 
-fn causality(c: Causality) -> &'static str {
+pub(crate) fn causality(c: Causality) -> &'static str {
     match c {
         Causality::Parameter => "parameter",
         Causality::Input => "input",
@@ -52,7 +52,7 @@ fn causality(c: Causality) -> &'static str {
     }
 }
 
-fn variability(v: Variability) -> &'static str {
+pub(crate) fn variability(v: Variability) -> &'static str {
     match v {
         Variability::Fixed => "fixed",
         Variability::Tunable => "tunable",
@@ -107,55 +107,9 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
         caps.provides_directional_derivative
     );
 
-    let mut used: Vec<&str> = info.variables.iter().filter_map(|v| v.unit).collect();
-    used.sort();
-    used.dedup();
-    if !used.is_empty() {
-        let _ = writeln!(w, "  <UnitDefinitions>");
-        for unit in used {
-            let (_, [kg, m, s, a]) =
-                UNITS
-                    .iter()
-                    .find(|(name, _)| *name == unit)
-                    .ok_or_else(|| {
-                        format!(
-                            "{}: unit {unit} has no base-unit definition",
-                            info.model_name
-                        )
-                    })?;
-            let mut base = String::new();
-            for (name, e) in [("kg", kg), ("m", m), ("s", s), ("A", a)] {
-                if *e != 0 {
-                    let _ = write!(base, r#" {name}="{e}""#);
-                }
-            }
-            let _ = writeln!(
-                w,
-                r#"    <Unit name="{}"><BaseUnit{base}/></Unit>"#,
-                escape(unit)
-            );
-        }
-        let _ = writeln!(w, "  </UnitDefinitions>");
-    }
-
-    let _ = writeln!(w, "  <LogCategories>");
-    for (name, description) in LOG_CATEGORIES {
-        let _ = writeln!(
-            w,
-            r#"    <Category name="{name}" description="{}"/>"#,
-            escape(description)
-        );
-    }
-    let _ = writeln!(w, "  </LogCategories>");
-
-    let e = &info.default_experiment;
-    let _ = writeln!(
-        w,
-        r#"  <DefaultExperiment startTime="{}" stopTime="{}" stepSize="{}"/>"#,
-        number(e.start_time),
-        number(e.stop_time),
-        number(e.step_size)
-    );
+    unit_definitions(w, info, &[])?;
+    log_categories(w);
+    default_experiment(w, info);
 
     let _ = writeln!(w, "  <ModelVariables>");
     for (i, v) in info.variables.iter().enumerate() {
@@ -276,4 +230,71 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     let _ = writeln!(w, "  </ModelStructure>");
     let _ = writeln!(w, "</fmiModelDescription>");
     Ok(x)
+}
+
+/// `<UnitDefinitions>` of the units the variables use, each with its SI
+/// base-unit exponents (the same element in FMI 2.0 and 3.0).
+pub(crate) fn unit_definitions(
+    w: &mut String,
+    info: &ModelInfo,
+    more: &[&'static str],
+) -> Result<(), String> {
+    let mut used: Vec<&str> = info.variables.iter().filter_map(|v| v.unit).collect();
+    used.extend(more);
+    used.sort();
+    used.dedup();
+    if !used.is_empty() {
+        let _ = writeln!(w, "  <UnitDefinitions>");
+        for unit in used {
+            let (_, [kg, m, s, a]) =
+                UNITS
+                    .iter()
+                    .find(|(name, _)| *name == unit)
+                    .ok_or_else(|| {
+                        format!(
+                            "{}: unit {unit} has no base-unit definition",
+                            info.model_name
+                        )
+                    })?;
+            let mut base = String::new();
+            for (name, e) in [("kg", kg), ("m", m), ("s", s), ("A", a)] {
+                if *e != 0 {
+                    let _ = write!(base, r#" {name}="{e}""#);
+                }
+            }
+            let _ = writeln!(
+                w,
+                r#"    <Unit name="{}"><BaseUnit{base}/></Unit>"#,
+                escape(unit)
+            );
+        }
+        let _ = writeln!(w, "  </UnitDefinitions>");
+    }
+
+    Ok(())
+}
+
+/// `<LogCategories>` (the same element in FMI 2.0 and 3.0).
+pub(crate) fn log_categories(w: &mut String) {
+    let _ = writeln!(w, "  <LogCategories>");
+    for (name, description) in LOG_CATEGORIES {
+        let _ = writeln!(
+            w,
+            r#"    <Category name="{name}" description="{}"/>"#,
+            escape(description)
+        );
+    }
+    let _ = writeln!(w, "  </LogCategories>");
+}
+
+/// `<DefaultExperiment>` (the same element in FMI 2.0 and 3.0).
+pub(crate) fn default_experiment(w: &mut String, info: &ModelInfo) {
+    let e = &info.default_experiment;
+    let _ = writeln!(
+        w,
+        r#"  <DefaultExperiment startTime="{}" stopTime="{}" stepSize="{}"/>"#,
+        number(e.start_time),
+        number(e.stop_time),
+        number(e.step_size)
+    );
 }

@@ -1,11 +1,11 @@
 // A small safe driver over the exported FMI 2.0 C functions of an FMU
 // library, for tests that go through the real C ABI in process. Included
 // (`include!`) by a test's `common` module, which first generates the
-// exports with `fmi2_cs::export_fmi2!`, re-exports them (`pub use
+// exports with `fmi_export::export_fmi2!`, re-exports them (`pub use
 // fmi2_exports::*`) and defines `fn models() -> Vec<&'static ModelInfo>`.
 
-use fmi2_cs::ffi::*;
-use fmi2_cs::{VarType, Variable};
+use fmi_export::ffi::*;
+use fmi_export::{VarType, Variable};
 use std::cell::RefCell;
 use std::ffi::{c_void, CStr, CString};
 use std::os::raw::{c_char, c_int};
@@ -77,7 +77,7 @@ pub const OK: fmi2Status = fmi2Status::fmi2OK;
 /// `fmi2Instantiate` of `model` for `fmu_type` with the recording logger:
 /// the instance (NULL if refused, the reason in the log) and the model's
 /// description.
-pub fn instantiate(model: &str, fmu_type: fmi2Type) -> (fmi2Component, &'static fmi2_cs::ModelInfo) {
+pub fn instantiate(model: &str, fmu_type: fmi2Type) -> (fmi2Component, &'static fmi_export::ModelInfo) {
     let info = models()
         .into_iter()
         .find(|m| m.model_name == model)

@@ -99,6 +99,9 @@ pub struct Instance {
     /// are those of the Model Exchange machine, its model answers
     /// [`Model::ode`].
     model_exchange: bool,
+    /// Created through the FMI 3.0 interface (`fmi3Instantiate…`): its
+    /// messages name FMI 3.0's functions and states.
+    pub fmi3: bool,
 }
 
 /// Bits of [`Instance::flags`].
@@ -283,6 +286,17 @@ impl Instance {
             nominals,
             checked_get: (VarType::Real, Vec::new(), false),
             model_exchange: false,
+            fmi3: false,
+        }
+    }
+
+    /// The name of the instance's state in the terms of the interface it
+    /// was created through (FMI 3.0 calls Co-Simulation's `StepComplete`
+    /// `StepMode`).
+    pub fn state_name(&self) -> &'static str {
+        match self.state {
+            State::StepComplete if self.fmi3 => "StepMode",
+            s => s.name(),
         }
     }
 
@@ -877,8 +891,9 @@ impl Instance {
         if let Some(stop) = self.stop_time {
             if t + h > stop + TIME_TOLERANCE * stop.abs().max(1.0) {
                 return Err(format!(
-                    "fmi2DoStep: the step from {t} by {h} ends at {}, past stopTime = {stop} defined by fmi2SetupExperiment (FMI 2.0 section 2.1.6: an FMU must not compute past it)",
-                    t + h
+                    "the step from {t} by {h} ends at {}, past stopTime = {stop} defined by {} (an FMU must not compute past it: FMI 2.0 section 2.1.6, FMI 3.0 section 2.3.2)",
+                    t + h,
+                    if self.fmi3 { "fmi3EnterInitializationMode" } else { "fmi2SetupExperiment" }
                 ));
             }
         }

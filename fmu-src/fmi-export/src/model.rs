@@ -261,7 +261,7 @@ pub struct ModelFactory {
 /// field `$law` of a `Clone` model (`save_state` appends what
 /// `write_state_into` writes; `state_is_finite` answers after every step
 /// without a copy of the state):
-/// write `fmi2_cs::delegate_state!(law);` inside the `impl Model`.
+/// write `fmi_export::delegate_state!(law);` inside the `impl Model`.
 #[macro_export]
 macro_rules! delegate_state {
     ($law:ident) => {
@@ -294,7 +294,7 @@ macro_rules! delegate_state {
 }
 
 /// [`Model::ode`] and [`Model::ode_mut`] of a model that implements
-/// [`Ode`] itself: write `fmi2_cs::ode_is_self!();` inside its
+/// [`Ode`] itself: write `fmi_export::ode_is_self!();` inside its
 /// `impl Model`.
 #[macro_export]
 macro_rules! ode_is_self {
@@ -313,7 +313,7 @@ macro_rules! ode_is_self {
 /// model whose continuous states are the whole state of the law in field
 /// `$law` (its `write_state_into` and `state_from_slice`, as
 /// [`delegate_state!`](crate::delegate_state) uses them): write
-/// `fmi2_cs::delegate_continuous_states!(law);` inside the `impl Ode`.
+/// `fmi_export::delegate_continuous_states!(law);` inside the `impl Ode`.
 #[macro_export]
 macro_rules! delegate_continuous_states {
     ($law:ident) => {

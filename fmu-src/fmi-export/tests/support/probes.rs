@@ -2,12 +2,12 @@
 //! Model Exchange, with arguments that are valid apart from the state: the
 //! probes of the state-table tests (`c_abi.rs` for Co-Simulation,
 //! `model_exchange.rs` for Model Exchange). Included with `#[path]` into a
-//! test whose crate root holds the exports of `fmi2_cs::export_fmi2!`. In
+//! test whose crate root holds the exports of `fmi_export::export_fmi2!`. In
 //! both toy models value reference 0 is an input and 1 an output; in the
 //! Model Exchange toy 2 is the state and 4 its derivative.
 
 use crate::fmi2_exports::*;
-use fmi2_cs::ffi::*;
+use fmi_export::ffi::*;
 use std::ptr::null;
 
 /// A function's name and a call of it.

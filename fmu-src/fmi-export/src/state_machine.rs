@@ -203,6 +203,47 @@ pub const ALLOWED: &[(&str, u32)] = &[
         "fmi2GetStringStatus",
         mask(&[StepComplete, StepInProgress, StepFailed, Terminated]),
     ),
+    // ---- FMI 3.0 Co-Simulation (FMI 3.0 section 4.3.1), on the same
+    // states: StepMode is StepComplete, and an instance of this layer
+    // never enters Event Mode, Configuration Mode or Intermediate Update
+    // Mode in Co-Simulation (it offers none of them)
+    ("fmi3SetDebugLogging", ANY_LIVE),
+    ("fmi3FreeInstance", ANY_LIVE),
+    ("fmi3EnterInitializationMode", Instantiated as u32),
+    ("fmi3ExitInitializationMode", InitializationMode as u32),
+    ("fmi3Terminate", mask(&[StepComplete, StepFailed])),
+    ("fmi3Reset", ANY_LIVE),
+    ("fmi3GetFloat64", AFTER_INSTANTIATE),
+    ("fmi3GetInt32", AFTER_INSTANTIATE),
+    ("fmi3GetBoolean", AFTER_INSTANTIATE),
+    ("fmi3GetOther", ANY_LIVE),
+    (
+        "fmi3SetFloat64",
+        mask(&[Instantiated, InitializationMode, StepComplete]),
+    ),
+    (
+        "fmi3SetInt32",
+        mask(&[Instantiated, InitializationMode, StepComplete]),
+    ),
+    (
+        "fmi3SetBoolean",
+        mask(&[Instantiated, InitializationMode, StepComplete]),
+    ),
+    ("fmi3GetFMUState", ANY_LIVE),
+    ("fmi3SetFMUState", ANY_LIVE),
+    ("fmi3FreeFMUState", ANY_LIVE),
+    ("fmi3SerializedFMUStateSize", ANY_LIVE),
+    ("fmi3SerializeFMUState", ANY_LIVE),
+    ("fmi3DeserializeFMUState", ANY_LIVE),
+    ("fmi3GetDirectionalDerivative", AFTER_INSTANTIATE),
+    ("fmi3GetAdjointDerivative", AFTER_INSTANTIATE),
+    (
+        "fmi3GetOutputDerivatives",
+        mask(&[StepComplete, StepFailed, StepCanceled, Terminated, Error]),
+    ),
+    ("fmi3DoStep", StepComplete as u32),
+    // what this layer does not offer: refused by name in any state
+    ("fmi3Unsupported", ANY_LIVE),
 ];
 
 const ME_ANY_LIVE: u32 = mask(&[
@@ -280,6 +321,65 @@ pub const ME_ALLOWED: &[(&str, u32)] = &[
         "fmi2GetNominalsOfContinuousStates",
         mask(&[MeInstantiated, EventMode, ContinuousTimeMode, MeTerminated]),
     ),
+    // ---- FMI 3.0 Model Exchange (FMI 3.0 section 3.3.1)
+    ("fmi3SetDebugLogging", ME_ANY_LIVE),
+    ("fmi3FreeInstance", ME_ANY_LIVE),
+    ("fmi3EnterInitializationMode", MeInstantiated as u32),
+    ("fmi3ExitInitializationMode", MeInitializationMode as u32),
+    ("fmi3Terminate", mask(&[EventMode, ContinuousTimeMode])),
+    ("fmi3Reset", ME_ANY_LIVE),
+    ("fmi3GetFloat64", ME_AFTER_INSTANTIATE),
+    ("fmi3GetInt32", ME_AFTER_INSTANTIATE),
+    ("fmi3GetBoolean", ME_AFTER_INSTANTIATE),
+    ("fmi3GetOther", ME_ANY_LIVE),
+    (
+        "fmi3SetFloat64",
+        mask(&[
+            MeInstantiated,
+            MeInitializationMode,
+            EventMode,
+            ContinuousTimeMode,
+        ]),
+    ),
+    (
+        "fmi3SetInt32",
+        mask(&[MeInstantiated, MeInitializationMode, EventMode]),
+    ),
+    (
+        "fmi3SetBoolean",
+        mask(&[MeInstantiated, MeInitializationMode, EventMode]),
+    ),
+    ("fmi3GetFMUState", ME_ANY_LIVE),
+    ("fmi3SetFMUState", ME_ANY_LIVE),
+    ("fmi3FreeFMUState", ME_ANY_LIVE),
+    ("fmi3SerializedFMUStateSize", ME_ANY_LIVE),
+    ("fmi3SerializeFMUState", ME_ANY_LIVE),
+    ("fmi3DeserializeFMUState", ME_ANY_LIVE),
+    ("fmi3GetDirectionalDerivative", ME_AFTER_INSTANTIATE),
+    ("fmi3GetAdjointDerivative", ME_AFTER_INSTANTIATE),
+    ("fmi3EnterEventMode", mask(&[EventMode, ContinuousTimeMode])),
+    ("fmi3UpdateDiscreteStates", EventMode as u32),
+    (
+        "fmi3EvaluateDiscreteStates",
+        mask(&[MeInitializationMode, EventMode, ContinuousTimeMode]),
+    ),
+    ("fmi3EnterContinuousTimeMode", EventMode as u32),
+    ("fmi3CompletedIntegratorStep", ContinuousTimeMode as u32),
+    ("fmi3SetTime", mask(&[EventMode, ContinuousTimeMode])),
+    ("fmi3SetContinuousStates", ContinuousTimeMode as u32),
+    ("fmi3GetEventIndicators", ME_AFTER_INSTANTIATE),
+    ("fmi3GetContinuousStates", ME_AFTER_INSTANTIATE),
+    (
+        "fmi3GetContinuousStateDerivatives",
+        mask(&[EventMode, ContinuousTimeMode, MeTerminated]),
+    ),
+    (
+        "fmi3GetNominalsOfContinuousStates",
+        mask(&[MeInstantiated, EventMode, ContinuousTimeMode, MeTerminated]),
+    ),
+    ("fmi3GetNumberOfEventIndicators", ME_ANY_LIVE),
+    ("fmi3GetNumberOfContinuousStates", ME_ANY_LIVE),
+    ("fmi3Unsupported", ME_ANY_LIVE),
 ];
 
 /// The mask of `function` in `table`, `None` if it is not there.

@@ -1,9 +1,9 @@
 //! A logger that records every message the FMU sends (status, category,
 //! message), for the tests that call the exported functions of a toy
-//! model (`fmi2-cs/tests/c_abi.rs`, `resource_location.rs`). Included with
+//! model (`fmi-export/tests/c_abi.rs`, `resource_location.rs`). Included with
 //! `#[path]`.
 
-use fmi2_cs::ffi::{fmi2CallbackFunctions, fmi2String};
+use fmi_export::ffi::{fmi2CallbackFunctions, fmi2String};
 use std::cell::RefCell;
 use std::ffi::{c_void, CStr};
 use std::os::raw::{c_char, c_int};

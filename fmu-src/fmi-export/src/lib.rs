@@ -22,6 +22,7 @@
 
 pub mod exports;
 pub mod ffi;
+pub mod fmi3;
 pub mod guard;
 pub mod instance;
 pub mod logger;
