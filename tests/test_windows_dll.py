@@ -10,6 +10,14 @@ wrong GUID). fmuResourceLocation is given as Windows file URIs
 (file:///C:/..., file:/C:/..., percent-encoded) to the DLL and as Linux
 ones to the .so.
 
+FMI 3.0 (issue 45): dist/fmi3/<Name>.fmu holds the same two libraries
+under binaries/x86_64-windows/ and binaries/x86_64-linux/, which export
+every FMI 3.0 function; tests/windows/fmi3_driver.c, the FMI 3.0 twin of
+the driver, runs the same plans through both, under Wine and natively:
+the same outputs to 1e-12 relative, the same calls refused (wrong state,
+NULL instance, unknown value reference, NaN, nValues that does not match,
+wrong instantiation token), and on Linux the same bits as the FMI 2.0 run.
+
 The tools (x86_64-w64-mingw32-gcc and -objdump, wine) are installed by
 scripts/setup-windows.sh, which build-fmu.sh runs. Wine runs in a prefix of
 its own under target/windows-test/ (created on the first run, without the
@@ -62,6 +70,33 @@ FMI2_CS_FUNCTIONS = {
     "fmi2DoStep", "fmi2CancelStep", "fmi2GetStatus", "fmi2GetRealStatus", "fmi2GetIntegerStatus",
     "fmi2GetBooleanStatus", "fmi2GetStringStatus",
 }
+
+# The FMI 3.0 functions an importer of Co-Simulation and Model Exchange
+# looks up (FMI 3.0 sections 2.3, 3.2, 4.2; FMPy looks them all up).
+FMI3_FUNCTIONS = {
+    "fmi3GetVersion", "fmi3SetDebugLogging", "fmi3InstantiateModelExchange",
+    "fmi3InstantiateCoSimulation", "fmi3InstantiateScheduledExecution", "fmi3FreeInstance",
+    "fmi3EnterInitializationMode", "fmi3ExitInitializationMode", "fmi3EnterEventMode",
+    "fmi3Terminate", "fmi3Reset", "fmi3GetFloat32", "fmi3GetFloat64", "fmi3GetInt8",
+    "fmi3GetUInt8", "fmi3GetInt16", "fmi3GetUInt16", "fmi3GetInt32", "fmi3GetUInt32",
+    "fmi3GetInt64", "fmi3GetUInt64", "fmi3GetBoolean", "fmi3GetString", "fmi3GetBinary",
+    "fmi3GetClock", "fmi3SetFloat32", "fmi3SetFloat64", "fmi3SetInt8", "fmi3SetUInt8",
+    "fmi3SetInt16", "fmi3SetUInt16", "fmi3SetInt32", "fmi3SetUInt32", "fmi3SetInt64",
+    "fmi3SetUInt64", "fmi3SetBoolean", "fmi3SetString", "fmi3SetBinary", "fmi3SetClock",
+    "fmi3GetNumberOfVariableDependencies", "fmi3GetVariableDependencies", "fmi3GetFMUState",
+    "fmi3SetFMUState", "fmi3FreeFMUState", "fmi3SerializedFMUStateSize", "fmi3SerializeFMUState",
+    "fmi3DeserializeFMUState", "fmi3GetDirectionalDerivative", "fmi3GetAdjointDerivative",
+    "fmi3EnterConfigurationMode", "fmi3ExitConfigurationMode", "fmi3GetIntervalDecimal",
+    "fmi3GetIntervalFraction", "fmi3GetShiftDecimal", "fmi3GetShiftFraction",
+    "fmi3SetIntervalDecimal", "fmi3SetIntervalFraction", "fmi3SetShiftDecimal",
+    "fmi3SetShiftFraction", "fmi3EvaluateDiscreteStates", "fmi3UpdateDiscreteStates",
+    "fmi3EnterContinuousTimeMode", "fmi3CompletedIntegratorStep", "fmi3SetTime",
+    "fmi3SetContinuousStates", "fmi3GetContinuousStateDerivatives", "fmi3GetEventIndicators",
+    "fmi3GetContinuousStates", "fmi3GetNominalsOfContinuousStates",
+    "fmi3GetNumberOfEventIndicators", "fmi3GetNumberOfContinuousStates", "fmi3EnterStepMode",
+    "fmi3GetOutputDerivatives", "fmi3DoStep", "fmi3ActivateModelPartition",
+}
+DRIVER3_SOURCE = ROOT / "tests" / "windows" / "fmi3_driver.c"
 
 STEP = 1e-3
 STOP = 4.0
@@ -321,8 +356,10 @@ def test_dll_imports_only_windows_system_dlls_and_exports_the_fmi_functions(name
     so = tmp_path / "binaries" / "linux64" / f"{identifier}.so"
     so_exports = {line.split()[-1] for line in subprocess.run(
         ["nm", "-D", "--defined-only", str(so)], capture_output=True, text=True, check=True).stdout.splitlines()}
-    # the same FMI functions on both platforms, and nothing else exported
-    assert {f for f in so_exports if f.startswith("fmi2")} == exported
+    # the same FMI functions on both platforms (FMI 2.0's and FMI 3.0's: the
+    # library serves dist/fmi3/ too), and nothing else exported
+    assert {f for f in so_exports if f.startswith(("fmi2", "fmi3"))} == exported
+    assert FMI3_FUNCTIONS <= exported, sorted(FMI3_FUNCTIONS - exported)
 
 
 def test_every_fmu_has_a_case():
@@ -436,3 +473,113 @@ def test_resource_locations(fmu):
 
 def test_every_shipped_fmu_has_a_case():
     shipped.covers({fmu for fmu, _, _ in CASES.values()}, shipped.SHIPPED, "CASES")
+
+
+# ---- FMI 3.0: dist/fmi3/<Name>.fmu, the same libraries ---------------------------
+
+@lru_cache(maxsize=None)
+def tools3():
+    """The FMI 3.0 driver compiled for both platforms (and the Wine prefix)."""
+    tools()
+    native, windows = WORK / "fmi3_driver", WORK / "fmi3_driver.exe"
+    flags = ["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror"]
+    subprocess.run(["gcc", *flags, "-o", str(native), str(DRIVER3_SOURCE), "-ldl"], check=True)
+    subprocess.run(["x86_64-w64-mingw32-gcc", *flags, "-o", str(windows), str(DRIVER3_SOURCE)],
+                   check=True)
+    return native, windows
+
+
+def fmi3_description(name):
+    with zipfile.ZipFile(DIST / "fmi3" / f"{name}.fmu") as z:
+        return ET.fromstring(z.read("modelDescription.xml"))
+
+
+@pytest.mark.parametrize("name", FMU_NAMES)
+def test_fmi3_fmu_holds_the_same_libraries_under_fmi3_platform_tuples(name):
+    identifier = fmi3_description(name).find("CoSimulation").get("modelIdentifier")
+    with zipfile.ZipFile(DIST / "fmi3" / f"{name}.fmu") as z3, zipfile.ZipFile(DIST / f"{name}.fmu") as z2:
+        assert sorted(z3.namelist()) == sorted(["modelDescription.xml",
+                                                f"binaries/x86_64-linux/{identifier}.so",
+                                                f"binaries/x86_64-windows/{identifier}.dll"])
+        assert z3.read(f"binaries/x86_64-linux/{identifier}.so") == z2.read(f"binaries/linux64/{identifier}.so")
+        assert z3.read(f"binaries/x86_64-windows/{identifier}.dll") == z2.read(f"binaries/win64/{identifier}.dll")
+    # the same value references: the FMI 2.0 plan drives the FMI 3.0 FMU
+    three = {v.get("name"): int(v.get("valueReference")) for v in fmi3_description(name).find("ModelVariables")}
+    assert all(three[n] == vr for n, (vr, _, _, _) in variables(name).items())
+    assert fmi3_description(name).get("instantiationToken") == model_description(name).get("guid")
+
+
+@lru_cache(maxsize=None)
+def unpack3(name, folder):
+    """The FMI 3.0 FMU unpacked to C:\\fmu tests\\<folder>\\, afresh once per
+    session (as `unpack`)."""
+    target = DRIVE_C_DIR / folder
+    shutil.rmtree(target, ignore_errors=True)
+    with zipfile.ZipFile(DIST / "fmi3" / f"{name}.fmu") as z:
+        z.extractall(target)
+    return target
+
+
+@lru_cache(maxsize=None)
+def run3(case, windows):
+    native, exe = tools3()
+    fmu = CASES[case][0]
+    folder = f"fmi3-{fmu}"
+    root = unpack3(fmu, folder)
+    identifier = fmi3_description(fmu).find("CoSimulation").get("modelIdentifier")
+    text, names, types = plan_text(case)
+    plan = root / f"plan-{case}.txt"
+    plan.write_text(text)
+    if windows:
+        windows_dir = f"C:\\fmu tests\\{folder}"
+        command = ["wine", str(exe), f"{windows_dir}\\binaries\\x86_64-windows\\{identifier}.dll",
+                   f"{windows_dir}\\{plan.name}", f"{windows_dir}\\resources\\"]
+        status, out, err = run_to_files(command, f"{case}-fmi3-win64", wine_env())
+    else:
+        command = [str(native), str(root / "binaries" / "x86_64-linux" / f"{identifier}.so"), str(plan),
+                   str(root / "resources") + "/"]
+        status, out, err = run_to_files(command, f"{case}-fmi3-linux64")
+    rows, checks, logs, other = parse(out)
+    return {"status": status, "stdout": out, "stderr": err, "rows": rows, "checks": checks, "logs": logs,
+            "other": other, "names": names, "types": types}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_fmi3_windows_dll_under_wine_equals_linux_so_and_the_fmi2_run(case):
+    win, lin = run3(case, True), run3(case, False)
+    for platform, r in (("x86_64-windows", win), ("x86_64-linux", lin)):
+        failed = [c for c in r["checks"] if c[-1] != "ok"]
+        tail = "\n".join(r["stdout"].splitlines()[-5:])
+        assert r["status"] == 0 and not failed, (
+            f"{platform}: exit {r['status']}, {failed}, {r['other']}\nstdout ends:\n{tail}\nstderr:\n{r['stderr']}")
+        assert r["other"]["version"] == "3.0", r["other"]
+        assert len(r["rows"]) == round(STOP / STEP)
+    assert [c[:3] for c in win["checks"]] == [c[:3] for c in lin["checks"]]
+    refused = {c[0] for c in win["checks"] if c[2] == "3"}
+    assert refused == {"do_step_before_initialization", "exit_initialization_before_enter",
+                       "set_float64_unknown_vr", "get_float64_unknown_vr", "get_float64_nvalues_mismatch",
+                       "get_float64_null_instance", "do_step_null_instance", "set_float64_nan_input"}, refused
+    assert ["instantiate_wrong_token_is_null", "1", "1", "ok"] in win["checks"]
+    assert ["nan_left_input_unchanged", "1", "1", "ok"] in win["checks"]
+    errors = [(s, m) for s, c, m in win["logs"] if s == 3]
+    assert errors == [(s, m) for s, c, m in lin["logs"] if s == 3]
+    assert any("unknown instantiationToken" in m for _, m in errors), errors
+    assert any("fmi3DoStep" in m and "Instantiated" in m for _, m in errors), errors
+    assert any("nValues = 2 for 1 value references" in m for _, m in errors), errors
+    # the same numbers on both platforms, and the same as the FMI 2.0 run of
+    # the same plan, bit for bit on Linux
+    fmi2 = run(case, False)
+    assert lin["rows"] == fmi2["rows"], f"{case}: the FMI 3.0 run differs from the FMI 2.0 run"
+    for i, (name, typ) in enumerate(zip(win["names"], win["types"])):
+        a = [row[i + 1] for row in win["rows"]]
+        b = [row[i + 1] for row in lin["rows"]]
+        if typ != "Real":
+            assert a == b, f"{case}.{name}"
+            continue
+        a, b = np.array([real(x) for x in a]), np.array([real(x) for x in b])
+        assert np.all(np.isfinite(a)), f"{case}.{name}"
+        err = np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-300)
+        assert err <= 1e-12, f"{case}.{name}: Windows vs Linux relative difference {err:.3e}"
+    first = np.array([real(row[1]) for row in lin["rows"]])
+    assert np.ptp(first) > 0, f"{case}.{win['names'][0]} never moved"
+
