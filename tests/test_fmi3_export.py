@@ -373,3 +373,105 @@ def test_model_exchange_event_indicators_are_variables(tmp_path):
     assert z[0] == -2e-3
     p.fmu.terminate()
     p.close()
+
+
+# ---- intermediate update and early return ---------------------------------------
+
+def maxwell_slip_switch_times(p, v):
+    """Maxwell-slip from rest under a held velocity `v` (Lampaert, Swevers,
+    Al-Bender 2002): element i sticks and loads at k_i·v until its force
+    reaches W_i, so it starts to slip at W_i/(k_i·v)."""
+    md = p.md
+    start = {v_.name: v_.start for v_ in md.modelVariables}
+    n = int(start["n_elements"])
+    return sorted(float(start[f"W[{i}]"]) / (float(start[f"k[{i}]"]) * v) for i in range(1, n + 1))
+
+
+def test_each_switch_inside_a_step_is_reported_where_the_closed_form_puts_it(tmp_path):
+    reported = []
+
+    def update(env, time, set_requested, get_allowed, step_finished, can_return_early,
+               early_return_requested, early_return_time):
+        reported.append((time, bool(can_return_early)))
+
+    p = Probe("MaxwellSlip", tmp_path, intermediateUpdate=update, earlyReturnAllowed=False)
+    assert p.md.coSimulation.providesIntermediateUpdate
+    p.initialize()
+    v = 1e-3
+    expected = maxwell_slip_switch_times(p, v)
+    h = 1.5 * expected[-1]
+    p.fmu.setFloat64([p.vr["v"]], [v])
+    event, terminate, early, last = p.fmu.doStep(0.0, h)
+    assert (event, terminate, early, last) == (False, False, False, h)
+    times = [t for t, _ in reported]
+    assert len(times) == len(expected) >= 5, (times, expected)
+    for got, want in zip(times, expected):
+        assert abs(got - want) <= 1e-11 * h, (got, want)
+    assert not any(can for _, can in reported)  # early return not allowed at instantiation
+    # every element slips at the end, as without the reports
+    assert p.fmu.getInt32([p.vr["n_slipping"]]) == [len(expected)]
+    p.close()
+
+
+def test_early_return_at_each_switch_ends_the_step_there_and_loses_nothing(tmp_path):
+    """The importer asks to end the step at every switch and steps on from
+    there to the end of the original step: it sees each element begin to
+    slip, one at a time, and ends where an importer that never asked
+    ends."""
+    def update(env, time, set_requested, get_allowed, step_finished, can_return_early,
+               early_return_requested, early_return_time):
+        assert can_return_early
+        early_return_requested[0] = True
+        early_return_time[0] = time
+
+    split = Probe("MaxwellSlip", tmp_path / "a", intermediateUpdate=update, earlyReturnAllowed=True)
+    whole = Probe("MaxwellSlip", tmp_path / "b")
+    v = -2e-3
+    expected = maxwell_slip_switch_times(split, abs(v))
+    h = 1.25 * expected[-1]
+    for p in (split, whole):
+        p.initialize()
+        p.fmu.setFloat64([p.vr["v"]], [v])
+    t, ends, counts = 0.0, [], []
+    while t < h:
+        event, terminate, early, last = split.fmu.doStep(t, h - t)
+        assert not event and not terminate
+        if early:
+            ends.append(last)
+            counts.append(split.fmu.getInt32([split.vr["n_slipping"]])[0])
+        else:
+            assert last == h
+        assert split.fmu.getFloat64([split.vr["time"]]) == [last]
+        t = last
+    assert len(ends) == len(expected)
+    for got, want in zip(ends, expected):
+        assert abs(got - want) <= 1e-11 * h, (got, want)
+    # one more element slips at each early return
+    assert counts == list(range(1, len(expected) + 1))
+    whole.fmu.doStep(0.0, h)
+    a, b = split.floats(["F", "E_stored"]), whole.floats(["F", "E_stored"])
+    assert np.allclose(a, b, rtol=1e-12, atol=0), (a, b)
+    split.close()
+    whole.close()
+
+
+def test_no_report_without_a_switch_and_none_from_a_rig(tmp_path):
+    reported = []
+
+    def update(env, time, set_requested, get_allowed, step_finished, can_return_early,
+               early_return_requested, early_return_time):
+        reported.append(time)
+        early_return_requested[0] = True
+        early_return_time[0] = time
+
+    p = Probe("LuGre", tmp_path / "l", intermediateUpdate=update, earlyReturnAllowed=True)
+    p.initialize()
+    p.fmu.setFloat64([p.vr["v"]], [1e-3])
+    p.fmu.doStep(0.0, 1e-4)   # still sticking
+    assert reported == [] and p.fmu.getBoolean([p.vr["sliding"]]) == [False]
+    _, _, early, last = p.fmu.doStep(1e-4, 0.1)  # breaks away inside the step
+    assert len(reported) == 1 and 1e-4 < reported[0] < 0.1001
+    assert early and last == reported[0] and p.fmu.getBoolean([p.vr["sliding"]]) == [True]
+    p.close()
+    rig = read_model_description(str(fmi3_path("Rig1D")))
+    assert not rig.coSimulation.providesIntermediateUpdate

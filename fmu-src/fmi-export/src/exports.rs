@@ -473,6 +473,7 @@ pub unsafe fn instantiate(
             model_exchange,
             directory,
             fmi3: false,
+            intermediate_update: None,
         };
         // SAFETY: NULL or NUL-terminated by the FMI contract.
         unsafe { create(request, logger, &FMI2_LIVE) }
@@ -498,6 +499,8 @@ pub(crate) struct Request {
     /// importer gave it (for the log); or why there is none.
     pub directory: Result<(String, String), String>,
     pub fmi3: bool,
+    /// FMI 3.0 Co-Simulation: the importer's intermediate-update callback.
+    pub intermediate_update: Option<crate::fmi3::exports::IntermediateUpdate>,
 }
 
 /// Create the instance `request` asks for, or log why not and return
@@ -588,6 +591,7 @@ pub(crate) unsafe fn create(
     }
     let mut instance = Instance::new(factory.info, model, &name, logger);
     instance.fmi3 = request.fmi3;
+    instance.intermediate_update = request.intermediate_update;
     if request.model_exchange {
         if let Err(e) = instance.make_model_exchange() {
             instance.logger.error(&format!("{function}: {e}"));

@@ -17,6 +17,9 @@ use crate::variables::{Causality, ModelInfo, VarType, Variable};
 use crate::Values;
 
 mod model_exchange;
+mod switches;
+
+pub use switches::RESOLUTION as SWITCH_RESOLUTION;
 
 /// Relative tolerance on communication points (time is taken from the
 /// master at every step, never summed inside the FMU).
@@ -102,6 +105,10 @@ pub struct Instance {
     /// Created through the FMI 3.0 interface (`fmi3Instantiate…`): its
     /// messages name FMI 3.0's functions and states.
     pub fmi3: bool,
+    /// FMI 3.0 Co-Simulation: the importer's intermediate-update callback,
+    /// to which each stick/slip switch inside a step is reported
+    /// ([`Instance::do_step_locating_switches`]).
+    pub intermediate_update: Option<crate::fmi3::exports::IntermediateUpdate>,
 }
 
 /// Bits of [`Instance::flags`].
@@ -287,6 +294,7 @@ impl Instance {
             checked_get: (VarType::Real, Vec::new(), false),
             model_exchange: false,
             fmi3: false,
+            intermediate_update: None,
         }
     }
 

@@ -46,8 +46,63 @@ pub enum Interface {
     CoSimulation {
         event_mode_used: BoolByte,
         early_return_allowed: BoolByte,
+        intermediate_update: fmi3IntermediateUpdateCallback,
     },
     ScheduledExecution,
+}
+
+/// The importer's `fmi3IntermediateUpdateCallback` of a Co-Simulation
+/// instance, with its environment and whether it allowed early returns
+/// (FMI 3.0 section 4.2.2): each stick/slip switch inside a step is
+/// reported to it ([`IntermediateUpdate::report`]).
+pub struct IntermediateUpdate {
+    callback: unsafe extern "C" fn(
+        fmi3InstanceEnvironment,
+        fmi3Float64,
+        fmi3Boolean,
+        fmi3Boolean,
+        fmi3Boolean,
+        fmi3Boolean,
+        *mut fmi3Boolean,
+        *mut fmi3Float64,
+    ),
+    environment: fmi3InstanceEnvironment,
+    early_return_allowed: bool,
+}
+
+// The environment pointer belongs to the importer, which calls into the
+// instance (and so is called back) from one thread at a time.
+unsafe impl Send for IntermediateUpdate {}
+
+impl IntermediateUpdate {
+    /// Report a switch at `time`; the time to end the step at if the
+    /// importer asks for an early return (allowed at instantiation), the
+    /// switch itself if its time is not a number.
+    pub fn report(&self, time: f64) -> Option<f64> {
+        // the answer is read as bytes: any non-zero byte is true
+        let mut requested: u8 = 0;
+        let mut early_time = time;
+        // SAFETY: the importer's callback, with the arguments of FMI 3.0
+        // section 4.2.2; the two out-pointers are ours and live across
+        // the call (a byte for the bool).
+        unsafe {
+            (self.callback)(
+                self.environment,
+                time,
+                false, // no intermediate variables to set
+                false, // none to get: the FMU declares none
+                true,  // the switch ends a stretch of the step
+                self.early_return_allowed,
+                &mut requested as *mut u8 as *mut fmi3Boolean,
+                &mut early_time,
+            );
+        }
+        (self.early_return_allowed && requested != 0).then_some(if early_time.is_finite() {
+            early_time
+        } else {
+            time
+        })
+    }
 }
 
 fn status(s: fmi2Status) -> fmi3Status {
@@ -123,6 +178,7 @@ pub unsafe fn instantiate(
             name.as_deref().unwrap_or("?"),
             logging_on != 0,
         );
+        let mut intermediate_update = None;
         let model_exchange = match interface {
             Interface::ModelExchange => true,
             Interface::CoSimulation {
@@ -133,12 +189,20 @@ pub unsafe fn instantiate(
                 ));
                 return std::ptr::null_mut();
             }
-            // early return is allowed but never taken: the FMU completes
-            // every step (mightReturnEarlyFromDoStep="false")
+            // switches inside a step go to the importer's callback, if it
+            // gave one; an early return only if it allowed them
             Interface::CoSimulation {
-                early_return_allowed: _,
+                early_return_allowed,
+                intermediate_update: callback,
                 ..
-            } => false,
+            } => {
+                intermediate_update = callback.map(|callback| IntermediateUpdate {
+                    callback,
+                    environment,
+                    early_return_allowed: early_return_allowed != 0,
+                });
+                false
+            }
             Interface::ScheduledExecution => {
                 logger.error(&format!(
                     "{function}: this FMU offers Co-Simulation and Model Exchange, not Scheduled Execution (no <ScheduledExecution> element in its model description)"
@@ -163,6 +227,7 @@ pub unsafe fn instantiate(
             model_exchange,
             directory,
             fmi3: true,
+            intermediate_update,
         };
         unsafe { create(request, logger, &FMI3_LIVE) }
     }));
@@ -812,9 +877,13 @@ pub unsafe fn get_output_derivatives(
     }
 }
 
-/// `fmi3DoStep`: the step of FMI 2.0's `fmi2DoStep`; these FMUs complete
-/// every step, so no event, no termination, no early return, and the
-/// last successful time is the step's end.
+/// `fmi3DoStep`: the step of FMI 2.0's `fmi2DoStep`, with each stick/slip
+/// switch inside it reported to the importer's intermediate-update
+/// callback if it gave one
+/// ([`Instance::do_step_locating_switches`]); it ends early at a switch
+/// if the importer asks (`earlyReturn`, `lastSuccessfulTime` the switch).
+/// No event and no termination: these FMUs have no Event Mode in
+/// Co-Simulation and run as long as they are stepped.
 ///
 /// # Safety
 /// See [`call`]; the flags and the time are written through after the
@@ -833,13 +902,23 @@ pub unsafe fn do_step(
                 out_slice(*flag, 1, name)?;
             }
             let last = out_slice(last_successful_time, 1, "lastSuccessfulTime")?;
-            let outcome = inst.do_step(t, h);
+            let outcome = match inst.intermediate_update.take() {
+                None => inst.do_step(t, h).map(|_| None),
+                Some(update) => {
+                    let outcome =
+                        inst.do_step_locating_switches(t, h, &mut |time| update.report(time));
+                    inst.intermediate_update = Some(update);
+                    outcome
+                }
+            };
             // written whatever the outcome: the time the FMU reached
             last[0] = inst.time;
             for flag in flags {
                 *flag = false;
             }
-            outcome
+            let [_, _, early_return] = flags;
+            *early_return = matches!(outcome, Ok(Some(_)));
+            outcome.map(|_| fmi2Status::fmi2OK)
         })
     }
 }

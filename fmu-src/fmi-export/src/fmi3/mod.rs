@@ -15,8 +15,9 @@
 //! - scalars only: every array length (`nValues`, `nSeed`, …) must equal
 //!   the number of value references;
 //! - `fmi3GetAdjointDerivative` (from the directional derivatives);
-//! - `fmi3DoStep` reports no event, no early return, and its last
-//!   successful time;
+//! - `fmi3DoStep` reports each stick/slip switch inside the step to the
+//!   importer's intermediate-update callback, and ends the step there if
+//!   the importer asks (early return); its last successful time;
 //! - the functions of what these FMUs do not offer (clocks, configuration
 //!   mode, event mode in Co-Simulation, Scheduled Execution, types other
 //!   than Float64, Int32 and Boolean) refuse by name.
@@ -108,7 +109,7 @@ macro_rules! export_fmi3 {
                 _n_required_intermediate: usize,
                 environment: fmi3InstanceEnvironment,
                 log: fmi3LogMessageCallback,
-                _intermediate_update: fmi3IntermediateUpdateCallback,
+                intermediate_update: fmi3IntermediateUpdateCallback,
             ) -> fmi3Instance {
                 unsafe {
                     x::instantiate(
@@ -116,6 +117,7 @@ macro_rules! export_fmi3 {
                         x::Interface::CoSimulation {
                             event_mode_used,
                             early_return_allowed,
+                            intermediate_update,
                         },
                         name,
                         token,

@@ -67,9 +67,15 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
             caps.provides_directional_derivative,
         );
     }
+    // a law with a stick/slip indicator (an Integer or Boolean output)
+    // reports its switches inside a step and can end the step at one
+    let switches = info
+        .variables
+        .iter()
+        .any(|v| v.causality == Causality::Output && v.var_type != VarType::Real);
     let _ = writeln!(
         w,
-        r#"  <CoSimulation modelIdentifier="{}" needsExecutionTool="false" canBeInstantiatedOnlyOncePerProcess="false" canGetAndSetFMUState="{}" canSerializeFMUState="{}" providesDirectionalDerivatives="{}" providesAdjointDerivatives="{}" providesPerElementDependencies="false" canHandleVariableCommunicationStepSize="{}" maxOutputDerivativeOrder="{}" providesIntermediateUpdate="false" mightReturnEarlyFromDoStep="false" canReturnEarlyAfterIntermediateUpdate="false" hasEventMode="false" providesEvaluateDiscreteStates="false"/>"#,
+        r#"  <CoSimulation modelIdentifier="{}" needsExecutionTool="false" canBeInstantiatedOnlyOncePerProcess="false" canGetAndSetFMUState="{}" canSerializeFMUState="{}" providesDirectionalDerivatives="{}" providesAdjointDerivatives="{}" providesPerElementDependencies="false" canHandleVariableCommunicationStepSize="{}" maxOutputDerivativeOrder="{}" providesIntermediateUpdate="{switches}" mightReturnEarlyFromDoStep="{switches}" canReturnEarlyAfterIntermediateUpdate="{switches}" hasEventMode="false" providesEvaluateDiscreteStates="false"/>"#,
         escape(info.model_identifier),
         caps.can_get_and_set_state,
         caps.can_serialize_state,
