@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Build tests/fmi-crate/ (`fmi-crate-drive`: our FMUs loaded and stepped
-# through the `fmi` crate's FMI 2.0 import API, for tests/test_fmi_crate.py)
+# through the `fmi` crate's FMI 2.0 or FMI 3.0 Co-Simulation import API, by
+# the FMU's version, for tests/test_fmi_crate.py)
 # into target/fmi-crate/debug/ (the dev profile builds in half the CPU
 # time of a release build). The crate's fmi-sys generates its bindings with
 # bindgen at build time, which needs libclang: libclang-dev is installed

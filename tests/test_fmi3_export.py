@@ -44,6 +44,42 @@ def fmi3_path(name):
     return path
 
 
+def elements(md):
+    """The FMI 3.0 variables of `md` as the FMI 2.0 description's scalars:
+    an array `x` of n as `x[1]` ... `x[n]`, `der(x)` as `der(x[1])` ...,
+    each with its value reference (the array's plus its offset) and start
+    value."""
+    out = {}
+    for v in md.modelVariables:
+        if not v.shape:
+            out[v.name] = (v.type, v.valueReference, v.causality, v.start)
+            continue
+        (n,) = v.shape
+        starts = v.start.split() if v.start is not None else [None] * n
+        inner = v.name[4:-1] if v.name.startswith("der(") else None
+        for i in range(n):
+            name = f"der({inner}[{i + 1}])" if inner else f"{v.name}[{i + 1}]"
+            out[name] = (v.type, v.valueReference + i, v.causality, starts[i])
+    return out
+
+
+def fmi3_start_values(path, parameters):
+    """FMI 2.0 start values by element name (`x_table[2]`) as FMI 3.0 ones:
+    each array whose elements are named set as a whole, from its start
+    values with those elements changed."""
+    md = read_model_description(str(path))
+    arrays = {v.name: v for v in md.modelVariables if v.shape}
+    out = {}
+    for name, value in parameters.items():
+        base, _, index = name.partition("[")
+        if base in arrays and index:
+            array = out.setdefault(base, [float(x) for x in arrays[base].start.split()])
+            array[int(index[:-1]) - 1] = value
+        else:
+            out[name] = value
+    return out
+
+
 def outputs_of(md):
     return [v.name for v in md.modelVariables if v.causality == "output"]
 
@@ -69,12 +105,22 @@ def test_fmpy_validates_every_fmi3_fmu(name):
     md2 = read_model_description(str(fmu_path(name)))
     assert md.fmiVersion == "3.0" and md.coSimulation is not None
     assert (md.modelExchange is not None) == (name in shipped.MODEL_EXCHANGE)
-    # the same variables, by name, type and value reference (time added)
+    # the same variables, by name, type, value reference and start (time
+    # and the event indicators added, numbered scalars as arrays)
     kinds = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
-    two = {v.name: (kinds[v.type], v.valueReference, v.causality) for v in md2.modelVariables}
-    three = {v.name: (v.type, v.valueReference, v.causality) for v in md.modelVariables
-             if v.name != "time" and not v.name.startswith("eventIndicator[")}
+
+    def start(x):
+        return None if x is None else float(x) if x not in ("true", "false") else x == "true"
+    two = {v.name: (kinds[v.type], v.valueReference, v.causality, start(v.start))
+           for v in md2.modelVariables}
+    three = {n: (t, vr, c, start(s)) for n, (t, vr, c, s) in elements(md).items()
+             if n != "time" and not n.startswith("eventIndicator[")}
     assert three == two
+    arrays = {v.name: v.shape for v in md.modelVariables if v.shape}
+    expected = {"LuGre": {"x_table": (32,), "scale_pos": (32,), "scale_neg": (32,)},
+                "MaxwellSlip": {"k": (100,), "W": (100,), "F_element": (100,), "der(F_element)": (100,)},
+                "GMS": {"k": (100,), "alpha": (100,), "F_element": (100,), "der(F_element)": (100,)}}
+    assert arrays == expected.get(name, {})
     time = [v for v in md.modelVariables if v.causality == "independent"]
     assert [v.name for v in time] == ["time"]
     assert md.numberOfEventIndicators == md2.numberOfEventIndicators
@@ -90,6 +136,8 @@ def run_case(name, path, fmi_type, tmp_path):
         md = read_model_description(str(path))
         stop = float(md.defaultExperiment.stopTime)
         step = float(md.defaultExperiment.stepSize)
+    if read_model_description(str(path)).fmiVersion == "3.0":
+        parameters = fmi3_start_values(path, parameters)
     kwargs = dict(fmi_type=fmi_type, stop_time=stop, output_interval=step, input=sig,
                   start_values=parameters)
     if fmi_type == "ModelExchange":
@@ -325,7 +373,49 @@ def test_adjoint_is_the_transpose_of_the_directional_derivative(tmp_path):
     # lengths that do not fit the scalars are refused, naming them
     assert p.status("fmi3GetAdjointDerivative", c, vrs(*unknowns), c_size_t(3), vrs(*knowns),
                     c_size_t(3), doubles(*seed), c_size_t(2), out, c_size_t(3)) == 3
-    assert "nSeed = 2 but nUnknowns = 3" in p.last()
+    assert "nSeed = 2 but the unknowns hold 3 values" in p.last()
+    p.close()
+
+
+def test_arrays_are_read_and_written_whole(tmp_path):
+    """LuGre's position table is three arrays of 32 in FMI 3.0 (FMI 2.0:
+    96 numbered scalars): read and written as a whole through the array's
+    value reference, an element's own value reference refused by name,
+    and nValues counting the elements."""
+    p = Probe("LuGre", tmp_path)
+    c = p.fmu.component
+    x_table = p.vr["x_table"]
+    table = np.linspace(0.0, 0.62, 32)
+    p.fmu.setFloat64([x_table], list(table))
+    p.fmu.setBoolean([p.vr["position_dependent"]], [True])
+    p.fmu.setInt32([p.vr["n_table"]], [32])
+    scale = np.full(32, 1.0)
+    scale[16:] = 2.0
+    p.fmu.setFloat64([p.vr["scale_pos"], p.vr["scale_neg"]], list(scale) + list(scale))
+    p.initialize()
+    assert p.fmu.getFloat64([x_table], 32) == list(table)
+    both = p.fmu.getFloat64([p.vr["Fc"], x_table], 33)
+    assert both[1:] == list(table)
+    # element 2 of the array is not an FMI 3.0 variable of its own
+    out = doubles(0.0)
+    assert p.status("fmi3GetFloat64", c, vrs(x_table + 1), c_size_t(1), out, c_size_t(1)) == 3
+    assert "element 2 of the array x_table (value reference 20)" in p.last(), p.last()
+    # nValues must count the elements
+    assert p.status("fmi3GetFloat64", c, vrs(x_table), c_size_t(1), out, c_size_t(1)) == 3
+    assert "hold 32 values" in p.last(), p.last()
+    # the table acts: at x = 0.5 the levels are doubled, at 0.1 they are not
+    forces = []
+    for x in (0.1, 0.5):
+        q = Probe("LuGre", tmp_path / f"x{x}")
+        q.fmu.setFloat64([q.vr["x_table"]], list(table))
+        q.fmu.setFloat64([q.vr["scale_pos"], q.vr["scale_neg"]], list(scale) + list(scale))
+        q.fmu.setBoolean([q.vr["position_dependent"]], [True])
+        q.initialize()
+        q.fmu.setFloat64([q.vr["v"], q.vr["x"]], [0.05, x])
+        q.fmu.doStep(0.0, 1.0)
+        forces.append(q.floats(["F"])[0])
+        q.close()
+    assert 1.9 < (forces[1] - 0.4 * 0.05) / (forces[0] - 0.4 * 0.05) < 2.1, forces
     p.close()
 
 
@@ -381,8 +471,7 @@ def maxwell_slip_switch_times(p, v):
     """Maxwell-slip from rest under a held velocity `v` (Lampaert, Swevers,
     Al-Bender 2002): element i sticks and loads at k_i·v until its force
     reaches W_i, so it starts to slip at W_i/(k_i·v)."""
-    md = p.md
-    start = {v_.name: v_.start for v_ in md.modelVariables}
+    start = {name: s for name, (_, _, _, s) in elements(p.md).items()}
     n = int(start["n_elements"])
     return sorted(float(start[f"W[{i}]"]) / (float(start[f"k[{i}]"]) * v) for i in range(1, n + 1))
 

@@ -504,9 +504,43 @@ def test_fmi3_fmu_holds_the_same_libraries_under_fmi3_platform_tuples(name):
         assert z3.read(f"binaries/x86_64-linux/{identifier}.so") == z2.read(f"binaries/linux64/{identifier}.so")
         assert z3.read(f"binaries/x86_64-windows/{identifier}.dll") == z2.read(f"binaries/win64/{identifier}.dll")
     # the same value references: the FMI 2.0 plan drives the FMI 3.0 FMU
-    three = {v.get("name"): int(v.get("valueReference")) for v in fmi3_description(name).find("ModelVariables")}
+    # (an FMI 3.0 array is its FMI 2.0 elements, from its value reference on)
+    three = {}
+    for v in fmi3_description(name).find("ModelVariables"):
+        vr, dimension = int(v.get("valueReference")), v.find("Dimension")
+        if dimension is None:
+            three[v.get("name")] = vr
+            continue
+        inner = v.get("name")[4:-1] if v.get("name").startswith("der(") else None
+        for i in range(int(dimension.get("start"))):
+            three[f"der({inner}[{i + 1}])" if inner else f"{v.get('name')}[{i + 1}]"] = vr + i
     assert all(three[n] == vr for n, (vr, _, _, _) in variables(name).items())
     assert fmi3_description(name).get("instantiationToken") == model_description(name).get("guid")
+
+
+def plan_text3(case):
+    """`plan_text` for the FMI 3.0 FMU: a parameter that is an element of
+    an FMI 3.0 array (`x_table[2]`) is set with its whole array, from the
+    array's start values with the plan's elements changed (`reals`)."""
+    text, names, types = plan_text(case)
+    fmu, parameters, _ = CASES[case]
+    arrays = {}
+    for v in fmi3_description(fmu).find("ModelVariables"):
+        if v.find("Dimension") is not None and v.get("start") is not None:
+            arrays[v.get("name")] = (int(v.get("valueReference")), [float(x) for x in v.get("start").split()])
+    table = variables(fmu)
+    lines = text.splitlines()
+    changed = {}
+    for pname, value in parameters.items():
+        base, _, index = pname.partition("[")
+        if base in arrays and index:
+            head, values = changed.setdefault(base, (arrays[base][0], list(arrays[base][1])))
+            values[int(index[:-1]) - 1] = float(value)
+            lines.remove(f"real {table[pname][0]} {bits(value)}")
+    at = 1  # after the guid
+    for head, values in changed.values():
+        lines.insert(at, f"reals {head} {len(values)} " + " ".join(bits(x) for x in values))
+    return "\n".join(lines) + "\n", names, types
 
 
 @lru_cache(maxsize=None)
@@ -527,7 +561,7 @@ def run3(case, windows):
     folder = f"fmi3-{fmu}"
     root = unpack3(fmu, folder)
     identifier = fmi3_description(fmu).find("CoSimulation").get("modelIdentifier")
-    text, names, types = plan_text(case)
+    text, names, types = plan_text3(case)
     plan = root / f"plan-{case}.txt"
     plan.write_text(text)
     if windows:

@@ -10,7 +10,11 @@
  *
  * PLAN is fmi_driver.c's plan (the value references of the FMI 2.0 and
  * FMI 3.0 descriptions are the same; `guid` is the instantiation token,
- * `real` a Float64, `integer` an Int32). Printed on stdout: `o T Y1 ... Ym`
+ * `real` a Float64, `integer` an Int32), and one more directive:
+ *
+ *   reals VR N BITS1 ... BITSN    a Float64 array parameter of N elements
+ *
+ * Printed on stdout: `o T Y1 ... Ym`
  * (reals as the 16 hexadecimal digits of their bits) after each step, each
  * log message as `log STATUS CATEGORY MESSAGE`, each misuse as
  * `check NAME GOT EXPECTED ok|FAILED`. A few calls are made wrongly on
@@ -230,6 +234,16 @@ int main(int argc, char **argv) {
                 s = fmi.set_boolean(c, &vr, 1, &b, 1);
             }
             check("set_parameter", s, fmi3OK);
+        } else if (!strcmp(word, "reals")) {
+            fmi3ValueReference vr = (fmi3ValueReference)strtoul(strtok(NULL, " \t\r\n"), NULL, 10);
+            size_t n = (size_t)strtoul(strtok(NULL, " \t\r\n"), NULL, 10);
+            double x[MAX_VARS];
+            if (n > MAX_VARS) {
+                fprintf(stderr, "%s:%ld: more than %d elements\n", argv[2], line_no, MAX_VARS);
+                return 2;
+            }
+            for (size_t i = 0; i < n; i++) x[i] = real_of(strtok(NULL, " \t\r\n"));
+            check("set_array_parameter", fmi.set_float64(c, &vr, 1, x, n), fmi3OK);
         } else if (!strcmp(word, "input")) {
             inputs[n_inputs++] = (fmi3ValueReference)strtoul(strtok(NULL, " \t\r\n"), NULL, 10);
         } else if (!strcmp(word, "output")) {

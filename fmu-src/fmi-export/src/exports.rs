@@ -592,6 +592,9 @@ pub(crate) unsafe fn create(
     let mut instance = Instance::new(factory.info, model, &name, logger);
     instance.fmi3 = request.fmi3;
     instance.intermediate_update = request.intermediate_update;
+    if request.fmi3 {
+        instance.fmi3_layout = Some(crate::fmi3::arrays::Layout::of(factory.info));
+    }
     if request.model_exchange {
         if let Err(e) = instance.make_model_exchange() {
             instance.logger.error(&format!("{function}: {e}"));

@@ -109,6 +109,9 @@ pub struct Instance {
     /// to which each stick/slip switch inside a step is reported
     /// ([`Instance::do_step_locating_switches`]).
     pub intermediate_update: Option<crate::fmi3::exports::IntermediateUpdate>,
+    /// FMI 3.0: the variables as FMI 3.0 declares them, the table's
+    /// numbered scalars as arrays ([`crate::fmi3::arrays`]).
+    pub fmi3_layout: Option<&'static crate::fmi3::arrays::Layout>,
 }
 
 /// Bits of [`Instance::flags`].
@@ -295,6 +298,7 @@ impl Instance {
             model_exchange: false,
             fmi3: false,
             intermediate_update: None,
+            fmi3_layout: None,
         }
     }
 

@@ -345,15 +345,39 @@ pub unsafe fn unsupported(
     unsafe { call!(c, function, row "fmi3Unsupported", |_| Err(why.to_string())) }
 }
 
-/// The scalar arrays of a get or set: `n` value references and `n_values`
-/// values, which must be as many (these FMUs have no arrays).
-fn same_count(n: usize, n_values: usize) -> Result<(), String> {
-    if n == n_values {
-        return Ok(());
+/// The table's value references of the FMI 3.0 value references `vrs`
+/// of a get or set of `n_values` values: `vrs` itself when the model has
+/// no arrays, else each array as its elements, in `buffer`
+/// ([`crate::fmi3::arrays::Layout::expand`]). `n_values` must be their
+/// number.
+fn table_vrs<'a>(
+    inst: &Instance,
+    vrs: &'a [u32],
+    n_values: usize,
+    buffer: &'a mut Vec<u32>,
+) -> Result<&'a [u32], String> {
+    let table = match inst.fmi3_layout {
+        Some(layout) if layout.has_arrays => {
+            layout.expand(vrs, buffer)?;
+            &buffer[..]
+        }
+        _ => vrs,
+    };
+    if table.len() == n_values {
+        return Ok(table);
     }
-    Err(format!(
-        "nValues = {n_values} for {n} value references: every variable of this FMU is a scalar, so they must be equal"
-    ))
+    Err(if table.len() == vrs.len() {
+        format!(
+            "nValues = {n_values} for {} value references of scalars: they must be equal",
+            vrs.len()
+        )
+    } else {
+        format!(
+            "nValues = {n_values}, but the {} value references hold {} values (an array counts its elements)",
+            vrs.len(),
+            table.len()
+        )
+    })
 }
 
 /// Read one value of a variable FMI 3.0 adds to the table: `time`, or an
@@ -413,9 +437,10 @@ pub unsafe fn get_float64(
 ) -> fmi3Status {
     unsafe {
         call!(c, "fmi3GetFloat64", |inst| {
-            same_count(n, n_values)?;
             let vrs = in_slice(vr, n, "valueReferences[]")?;
-            let out = out_slice(value, n, "values[]")?;
+            let mut buffer = Vec::new();
+            let vrs = table_vrs(inst, vrs, n_values, &mut buffer)?;
+            let out = out_slice(value, n_values, "values[]")?;
             get_values(inst, VarType::Real, vrs, out)?;
             ok()
         })
@@ -437,10 +462,11 @@ unsafe fn get_converted<T>(
 ) -> fmi3Status {
     unsafe {
         call_mask(c, function, mask, |inst| {
-            same_count(n, n_values)?;
             let vrs = in_slice(vr, n, "valueReferences[]")?;
-            let out = out_slice(value, n, "values[]")?;
-            let mut reals = vec![0.0; n];
+            let mut buffer = Vec::new();
+            let vrs = table_vrs(inst, vrs, n_values, &mut buffer)?;
+            let out = out_slice(value, n_values, "values[]")?;
+            let mut reals = vec![0.0; n_values];
             inst.get(t, vrs, &mut reals)?;
             for (o, x) in out.iter_mut().zip(reals) {
                 *o = convert(x);
@@ -533,13 +559,14 @@ unsafe fn set_converted<T: Copy>(
 ) -> fmi3Status {
     unsafe {
         call_mask(c, function, mask, |inst| {
-            same_count(n, n_values)?;
             let vrs = in_slice(vr, n, "valueReferences[]")?;
+            let mut buffer = Vec::new();
+            let vrs = table_vrs(inst, vrs, n_values, &mut buffer)?;
             let n_table = inst.info.variables.len() as u32;
             if let Some(&vr) = vrs.iter().find(|&&vr| vr >= n_table) {
                 return Err(set_added(inst, vr));
             }
-            let values: Vec<f64> = in_slice(value, n, "values[]")?
+            let values: Vec<f64> = in_slice(value, n_values, "values[]")?
                 .iter()
                 .map(|x| convert(*x))
                 .collect();
@@ -776,9 +803,11 @@ pub unsafe fn get_directional_derivative(
 ) -> fmi3Status {
     unsafe {
         call!(c, "fmi3GetDirectionalDerivative", |inst| {
-            derivative_lengths(n_unknown, n_known, n_seed, n_sensitivity, false)?;
             let unknowns = in_slice(unknown, n_unknown, "unknowns[]")?;
             let knowns = in_slice(known, n_known, "knowns[]")?;
+            let (mut u, mut k) = (Vec::new(), Vec::new());
+            let (unknowns, knowns) = elements(inst, (unknowns, &mut u), (knowns, &mut k))?;
+            derivative_lengths(unknowns.len(), knowns.len(), n_seed, n_sensitivity, false)?;
             let seeds = in_slice(seed, n_seed, "seed[]")?;
             let out = out_slice(sensitivity, n_sensitivity, "sensitivity[]")?;
             inst.directional_derivative(unknowns, knowns, seeds, out)?;
@@ -787,9 +816,26 @@ pub unsafe fn get_directional_derivative(
     }
 }
 
-/// The lengths of a derivative call: for scalars the seed has one value
-/// per known (per unknown for the adjoint), the sensitivity one per
-/// unknown (per known).
+/// The unknowns and knowns of a derivative call as the table's scalars
+/// (an array as its elements).
+fn elements<'a>(
+    inst: &Instance,
+    (unknowns, u): (&'a [u32], &'a mut Vec<u32>),
+    (knowns, k): (&'a [u32], &'a mut Vec<u32>),
+) -> Result<(&'a [u32], &'a [u32]), String> {
+    match inst.fmi3_layout {
+        Some(layout) if layout.has_arrays => {
+            layout.expand(unknowns, u)?;
+            layout.expand(knowns, k)?;
+            Ok((&u[..], &k[..]))
+        }
+        _ => Ok((unknowns, knowns)),
+    }
+}
+
+/// The lengths of a derivative call: the seed has one value per element
+/// of the knowns (of the unknowns for the adjoint), the sensitivity one
+/// per element of the unknowns (of the knowns).
 fn derivative_lengths(
     n_unknown: usize,
     n_known: usize,
@@ -798,19 +844,19 @@ fn derivative_lengths(
     adjoint: bool,
 ) -> Result<(), String> {
     let (seeds_for, sensitivities_for) = if adjoint {
-        (("nUnknowns", n_unknown), ("nKnowns", n_known))
+        (("unknowns", n_unknown), ("knowns", n_known))
     } else {
-        (("nKnowns", n_known), ("nUnknowns", n_unknown))
+        (("knowns", n_known), ("unknowns", n_unknown))
     };
     if n_seed != seeds_for.1 {
         return Err(format!(
-            "nSeed = {n_seed} but {} = {}: every variable of this FMU is a scalar",
+            "nSeed = {n_seed} but the {} hold {} values (an array counts its elements)",
             seeds_for.0, seeds_for.1
         ));
     }
     if n_sensitivity != sensitivities_for.1 {
         return Err(format!(
-            "nSensitivity = {n_sensitivity} but {} = {}: every variable of this FMU is a scalar",
+            "nSensitivity = {n_sensitivity} but the {} hold {} values (an array counts its elements)",
             sensitivities_for.0, sensitivities_for.1
         ));
     }
@@ -832,9 +878,11 @@ pub unsafe fn get_adjoint_derivative(
 ) -> fmi3Status {
     unsafe {
         call!(c, "fmi3GetAdjointDerivative", |inst| {
-            derivative_lengths(n_unknown, n_known, n_seed, n_sensitivity, true)?;
             let unknowns = in_slice(unknown, n_unknown, "unknowns[]")?;
             let knowns = in_slice(known, n_known, "knowns[]")?;
+            let (mut u, mut k) = (Vec::new(), Vec::new());
+            let (unknowns, knowns) = elements(inst, (unknowns, &mut u), (knowns, &mut k))?;
+            derivative_lengths(unknowns.len(), knowns.len(), n_seed, n_sensitivity, true)?;
             let seeds = in_slice(seed, n_seed, "seed[]")?;
             if let Some((k, s)) = seeds.iter().enumerate().find(|(_, s)| !s.is_finite()) {
                 return Err(format!("seed[{k}] must be finite but was {s}"));
@@ -867,7 +915,12 @@ pub unsafe fn get_output_derivatives(
 ) -> fmi3Status {
     unsafe {
         call!(c, "fmi3GetOutputDerivatives", |inst| {
-            same_count(n, n_values)?;
+            // (outputs are scalars: no array to expand)
+            if n != n_values {
+                return Err(format!(
+                    "nValues = {n_values} for {n} value references of scalars: they must be equal"
+                ));
+            }
             let vrs = in_slice(vr, n, "valueReferences[]")?;
             let orders = in_slice(order, n, "orders[]")?;
             let out = out_slice(value, n, "values[]")?;

@@ -27,6 +27,7 @@
 //!
 //! [`Instance`]: crate::instance::Instance
 
+pub mod arrays;
 pub mod exports;
 pub mod model_description;
 

@@ -8,16 +8,19 @@
 //! - the independent variable `time` is declared, and the event indicators
 //!   of Model Exchange are variables, with value references after the
 //!   table's ([`super::time_vr`], [`super::event_indicator_vr`]);
+//! - the table's numbered scalars `x[1]` … `x[n]` are one array `x` with a
+//!   `<Dimension>` ([`super::arrays`]);
 //! - the model structure names value references, not indices, and a
 //!   derivative names its state by value reference;
 //! - `instantiationToken` for `guid`, and the capability flags' FMI 3.0
 //!   names.
 
+use super::arrays::{Fmi3Variable, Layout};
 use super::{event_indicator_vr, time_vr};
 use crate::model_description::{
     causality, default_experiment, escape, log_categories, number, unit_definitions, variability,
 };
-use crate::variables::{Causality, Initial, ModelInfo, VarType, Variable};
+use crate::variables::{Causality, Initial, ModelInfo, VarType};
 use std::fmt::Write;
 
 /// The FMI 3.0 element of a variable type.
@@ -95,8 +98,9 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
         r#"    <Float64 name="time" valueReference="{}" causality="independent" variability="continuous" description="Simulation time" unit="s"/>"#,
         time_vr(info)
     );
-    for v in info.variables {
-        let _ = writeln!(w, "    {}", variable(info, v));
+    let layout = Layout::new(info);
+    for v in &layout.variables {
+        let _ = writeln!(w, "    {}", variable(info, &layout, v));
     }
     let ni = info.model_exchange.map_or(0, |me| me.event_indicators);
     for k in 0..ni {
@@ -112,21 +116,31 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
 
     let _ = writeln!(w, "  <ModelStructure>");
     let mut initial_unknowns: Vec<u32> = Vec::new();
-    for v in info.variables {
-        if v.causality == Causality::Output {
-            let _ = writeln!(w, "    {}", unknown("Output", v));
+    for v in &layout.variables {
+        let first = &info.variables[v.vr as usize];
+        if first.causality == Causality::Output {
+            let _ = writeln!(w, "    {}", unknown("Output", &layout, v, info));
             initial_unknowns.push(v.vr);
         }
     }
     if let Some(me) = &info.model_exchange {
+        // one element per derivative variable (an array of derivatives
+        // is one: FMI 3.0 counts the states by its elements)
+        for v in &layout.variables {
+            if me.is_derivative(v.vr) {
+                let _ = writeln!(
+                    w,
+                    "    {}",
+                    unknown("ContinuousStateDerivative", &layout, v, info)
+                );
+            }
+        }
         for s in me.states {
-            let d = &info.variables[s.derivative as usize];
-            let _ = writeln!(w, "    {}", unknown("ContinuousStateDerivative", d));
             // the derivatives and the states, all `initial="calculated"`
             // (FMI 3.0 section 2.4.8): a state that is an output is listed
             // once
-            initial_unknowns.push(s.derivative);
-            initial_unknowns.push(s.state);
+            initial_unknowns.push(layout.head_of(s.derivative));
+            initial_unknowns.push(layout.head_of(s.state));
         }
     }
     initial_unknowns.sort_unstable();
@@ -146,8 +160,12 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     Ok(x)
 }
 
-/// One variable of the table as its FMI 3.0 element.
-fn variable(info: &ModelInfo, v: &Variable) -> String {
+/// One FMI 3.0 variable as its element: a scalar of the table, or an
+/// array of its numbered scalars with their start values in order and a
+/// `<Dimension>`.
+fn variable(info: &ModelInfo, layout: &Layout, fmi3: &Fmi3Variable) -> String {
+    let v = &info.variables[fmi3.vr as usize];
+    let elements = &info.variables[fmi3.vr as usize..(fmi3.vr + fmi3.len) as usize];
     let initial = match (v.initial(), v.causality) {
         (Some(Initial::Exact), _) => r#" initial="exact""#,
         (Some(Initial::Approx), _) => r#" initial="approx""#,
@@ -159,7 +177,7 @@ fn variable(info: &ModelInfo, v: &Variable) -> String {
     let mut e = format!(
         r#"<{} name="{}" valueReference="{}" description="{}" causality="{}" variability="{}"{initial}"#,
         type_name(v.var_type),
-        escape(v.name),
+        escape(&fmi3.name),
         v.vr,
         escape(v.description),
         causality(v.causality),
@@ -182,35 +200,47 @@ fn variable(info: &ModelInfo, v: &Variable) -> String {
     if let Some(n) = v.nominal {
         let _ = write!(e, r#" nominal="{}""#, number(n));
     }
-    let start = match v.var_type {
-        VarType::Real => v.start.map(number),
-        VarType::Integer => v.start.map(|s| format!("{}", s as i64)),
-        VarType::Boolean => v.start.map(|s| (s != 0.0).to_string()),
+    let start = |x: f64| match v.var_type {
+        VarType::Real => number(x),
+        VarType::Integer => format!("{}", x as i64),
+        VarType::Boolean => (x != 0.0).to_string(),
     };
-    if let Some(s) = start {
-        let _ = write!(e, r#" start="{s}""#);
+    // every element's start, separated by spaces (all or none have one)
+    let starts: Option<Vec<String>> = elements.iter().map(|e| e.start.map(start)).collect();
+    if let Some(starts) = starts {
+        let _ = write!(e, r#" start="{}""#, starts.join(" "));
     }
     if let Some(me) = &info.model_exchange {
-        // a derivative names its state by value reference
+        // a derivative names its state (array) by value reference
         if let Some(s) = me.states.iter().find(|s| s.derivative == v.vr) {
-            let _ = write!(e, r#" derivative="{}""#, s.state);
+            let _ = write!(e, r#" derivative="{}""#, layout.head_of(s.state));
         }
         if me.states_jump_at_events && me.is_state(v.vr) {
             let _ = write!(e, r#" reinit="true""#);
         }
     }
-    e.push_str("/>");
+    if fmi3.is_array {
+        let _ = write!(
+            e,
+            r#"><Dimension start="{}"/></{}>"#,
+            fmi3.len,
+            type_name(v.var_type)
+        );
+    } else {
+        e.push_str("/>");
+    }
     e
 }
 
-/// An element of the model structure with the knowns `v` depends on: its
-/// inputs and states, by value reference, ascending.
-fn unknown(element: &str, v: &Variable) -> String {
-    let mut deps: Vec<u32> = v
-        .depends_on
+/// An element of the model structure with the knowns `v` depends on (any
+/// of its elements): their inputs and states, by the value reference of
+/// their FMI 3.0 variable, ascending.
+fn unknown(element: &str, layout: &Layout, v: &Fmi3Variable, info: &ModelInfo) -> String {
+    let elements = &info.variables[v.vr as usize..(v.vr + v.len) as usize];
+    let mut deps: Vec<u32> = elements
         .iter()
-        .chain(v.depends_on_states)
-        .copied()
+        .flat_map(|e| e.depends_on.iter().chain(e.depends_on_states))
+        .map(|&d| layout.head_of(d))
         .collect();
     deps.sort_unstable();
     deps.dedup();
