@@ -96,6 +96,25 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::Build { platforms, out } => {
             let names: Vec<&str> = platforms.iter().map(|p| p.name).collect();
             for version in FmiVersion::ALL {
+                // FMI 3.0 names a platform by its processor too: a folder
+                // without a tuple (darwin64: Intel or Arm?) is left out of
+                // the FMI 3.0 FMUs, and they are not written without any
+                let platforms: Vec<Platform> = match version {
+                    FmiVersion::Fmi2 => platforms.clone(),
+                    FmiVersion::Fmi3 => platforms
+                        .iter()
+                        .filter(|p| fmu_packager::fmi3_platform(p.name).is_some())
+                        .cloned()
+                        .collect(),
+                };
+                if platforms.is_empty() {
+                    println!(
+                        "no FMI 3.0 FMUs: none of {} has an FMI 3.0 platform tuple",
+                        names.join(", ")
+                    );
+                    continue;
+                }
+                let names: Vec<&str> = platforms.iter().map(|p| p.name).collect();
                 for info in all_models() {
                     println!(
                         "wrote {} ({})",
