@@ -466,10 +466,17 @@ unsafe fn get_converted<T>(
             let mut buffer = Vec::new();
             let vrs = table_vrs(inst, vrs, n_values, &mut buffer)?;
             let out = out_slice(value, n_values, "values[]")?;
-            let mut reals = vec![0.0; n_values];
-            inst.get(t, vrs, &mut reals)?;
-            for (o, x) in out.iter_mut().zip(reals) {
-                *o = convert(x);
+            // through a stack buffer, a chunk at a time: a master records
+            // a Boolean or Int32 output at every step, and allocates
+            // nothing for it
+            const CHUNK: usize = 32;
+            let mut reals = [0.0; CHUNK];
+            for (vrs, out) in vrs.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+                let reals = &mut reals[..vrs.len()];
+                inst.get(t, vrs, reals)?;
+                for (o, &x) in out.iter_mut().zip(reals.iter()) {
+                    *o = convert(x);
+                }
             }
             ok()
         })
