@@ -3,7 +3,9 @@
 //! Exchange interface gets both `<ModelExchange>` and `<CoSimulation>`
 //! under one model identifier (one binary serves both).
 
-use crate::variables::{Causality, Initial, ModelInfo, VarType, Variability, LOG_CATEGORIES};
+use crate::variables::{
+    Causality, Initial, ModelInfo, VarType, Variability, Variable, LOG_CATEGORIES,
+};
 use std::fmt::Write;
 
 /// SI base-unit exponents (kg, m, s, A) of the units our models use.
@@ -131,29 +133,13 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
             causality(v.causality),
             variability(v.variability)
         );
-        let mut attrs = String::new();
-        if let Some(u) = v.unit {
-            let _ = write!(attrs, r#" unit="{}""#, escape(u));
-        }
-        if let Some(n) = v.nominal {
-            let _ = write!(attrs, r#" nominal="{}""#, number(n));
-        }
-        // bounds in the variable's own type (an Integer's min is "0", not "0.0")
-        let bound = |b: f64| match v.var_type {
-            VarType::Integer => format!("{}", b as i64),
-            _ => number(b),
+        let mut attrs = value_attributes(v);
+        let tag = match v.var_type {
+            VarType::Real => "Real",
+            VarType::Integer => "Integer",
+            VarType::Boolean => "Boolean",
         };
-        if let Some(m) = v.min {
-            let _ = write!(attrs, r#" min="{}""#, bound(m));
-        }
-        if let Some(m) = v.max {
-            let _ = write!(attrs, r#" max="{}""#, bound(m));
-        }
-        let (tag, start) = match v.var_type {
-            VarType::Real => ("Real", v.start.map(number)),
-            VarType::Integer => ("Integer", v.start.map(|s| format!("{}", s as i64))),
-            VarType::Boolean => ("Boolean", v.start.map(|s| (s != 0.0).to_string())),
-        };
+        let start = v.start.map(|s| value(v, s));
         if let Some(s) = start {
             let _ = write!(attrs, r#" start="{s}""#);
         }
@@ -297,4 +283,34 @@ pub(crate) fn default_experiment(w: &mut String, info: &ModelInfo) {
         number(e.stop_time),
         number(e.step_size)
     );
+}
+
+/// ` unit=… nominal=… min=… max=…` of a variable, those it has (the same
+/// attributes in FMI 2.0 and 3.0); bounds in the variable's own type (an
+/// Integer's min is "0", not "0.0").
+pub(crate) fn value_attributes(v: &Variable) -> String {
+    let mut attrs = String::new();
+    if let Some(u) = v.unit {
+        let _ = write!(attrs, r#" unit="{}""#, escape(u));
+    }
+    if let Some(n) = v.nominal {
+        let _ = write!(attrs, r#" nominal="{}""#, number(n));
+    }
+    if let Some(m) = v.min {
+        let _ = write!(attrs, r#" min="{}""#, value(v, m));
+    }
+    if let Some(m) = v.max {
+        let _ = write!(attrs, r#" max="{}""#, value(v, m));
+    }
+    attrs
+}
+
+/// A value of variable `v` as the XML writes it: a Real's shortest
+/// round-trip form, an Integer's digits, a Boolean's `true`/`false`.
+pub(crate) fn value(v: &Variable, x: f64) -> String {
+    match v.var_type {
+        VarType::Real => number(x),
+        VarType::Integer => format!("{}", x as i64),
+        VarType::Boolean => (x != 0.0).to_string(),
+    }
 }

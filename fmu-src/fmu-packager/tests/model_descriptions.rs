@@ -24,8 +24,9 @@ fn checked_in_model_descriptions_match_the_code() {
 }
 
 /// The two descriptions of a model declare the same variables under the
-/// same value references, in FMI 3.0's types, and FMI 3.0's adds `time`
-/// and the event indicators after them.
+/// same value references, in FMI 3.0's types (FMI 2.0's numbered scalars
+/// as one array from the first element's value reference on), and FMI
+/// 3.0's adds `time` and the event indicators after them.
 #[test]
 fn the_fmi3_description_declares_the_fmi2_variables() {
     for info in all_models() {
@@ -33,16 +34,30 @@ fn the_fmi3_description_declares_the_fmi2_variables() {
         let three = render_version(info, FmiVersion::Fmi3).unwrap();
         assert!(three.contains(r#"fmiVersion="3.0""#));
         assert!(three.contains(&format!(r#"instantiationToken="{}""#, info.guid)));
+        // every table variable, as itself or as an element of its array
+        let layout = fmi_export::fmi3::arrays::Layout::new(info);
         for v in info.variables {
+            assert!(two.contains(&format!(r#"name="{}" valueReference="{}""#, v.name, v.vr)));
+            let fmi3 = layout.variable_of(v.vr).unwrap();
             let element = match v.var_type {
                 fmi_export::VarType::Real => "Float64",
                 fmi_export::VarType::Integer => "Int32",
                 fmi_export::VarType::Boolean => "Boolean",
             };
-            let declared = format!(r#"<{element} name="{}" valueReference="{}""#, v.name, v.vr);
+            let declared = format!(
+                r#"<{element} name="{}" valueReference="{}""#,
+                fmi3.name, fmi3.vr
+            );
             assert!(three.contains(&declared), "{}: {declared}", info.model_name);
-            assert!(two.contains(&format!(r#"name="{}" valueReference="{}""#, v.name, v.vr)));
+            if fmi3.is_array {
+                assert!(v.name.starts_with(&fmi3.name[..fmi3.name.len() - 1]));
+                assert!((fmi3.vr..fmi3.vr + fmi3.len).contains(&v.vr));
+            } else {
+                assert_eq!((fmi3.name.as_str(), fmi3.vr), (v.name, v.vr));
+            }
         }
+        let arrays = layout.variables.iter().filter(|v| v.is_array).count();
+        assert_eq!(three.matches("<Dimension start=").count(), arrays);
         let time = format!(
             r#"<Float64 name="time" valueReference="{}" causality="independent""#,
             info.variables.len()

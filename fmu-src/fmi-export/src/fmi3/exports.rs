@@ -803,21 +803,80 @@ type Arrays<T> = (*const T, usize);
 /// See [`call`] and [`in_slice`].
 pub unsafe fn get_directional_derivative(
     c: fmi3Instance,
+    unknowns: Arrays<fmi3ValueReference>,
+    knowns: Arrays<fmi3ValueReference>,
+    seed: Arrays<f64>,
+    sensitivity: (*mut f64, usize),
+) -> fmi3Status {
+    unsafe { derivative(c, false, unknowns, knowns, seed, sensitivity) }
+}
+
+/// `fmi3GetAdjointDerivative`: `sensitivity = seedᵀ·J` (FMI 3.0 section
+/// 2.2.11), one column of `J` per known from
+/// [`Instance::directional_derivative`].
+///
+/// # Safety
+/// See [`call`] and [`in_slice`].
+pub unsafe fn get_adjoint_derivative(
+    c: fmi3Instance,
+    unknowns: Arrays<fmi3ValueReference>,
+    knowns: Arrays<fmi3ValueReference>,
+    seed: Arrays<f64>,
+    sensitivity: (*mut f64, usize),
+) -> fmi3Status {
+    unsafe { derivative(c, true, unknowns, knowns, seed, sensitivity) }
+}
+
+/// The two derivative calls: the arrays checked and expanded to the
+/// table's scalars, then `J·seed` or, for the adjoint, `seedᵀ·J`.
+///
+/// # Safety
+/// See [`call`] and [`in_slice`].
+unsafe fn derivative(
+    c: fmi3Instance,
+    adjoint: bool,
     (unknown, n_unknown): Arrays<fmi3ValueReference>,
     (known, n_known): Arrays<fmi3ValueReference>,
     (seed, n_seed): Arrays<f64>,
     (sensitivity, n_sensitivity): (*mut f64, usize),
 ) -> fmi3Status {
+    let (function, mask) = if adjoint {
+        (
+            "fmi3GetAdjointDerivative",
+            const { allowed_mask("fmi3GetAdjointDerivative") },
+        )
+    } else {
+        (
+            "fmi3GetDirectionalDerivative",
+            const { allowed_mask("fmi3GetDirectionalDerivative") },
+        )
+    };
     unsafe {
-        call!(c, "fmi3GetDirectionalDerivative", |inst| {
+        call_mask(c, function, mask, |inst| {
             let unknowns = in_slice(unknown, n_unknown, "unknowns[]")?;
             let knowns = in_slice(known, n_known, "knowns[]")?;
             let (mut u, mut k) = (Vec::new(), Vec::new());
             let (unknowns, knowns) = elements(inst, (unknowns, &mut u), (knowns, &mut k))?;
-            derivative_lengths(unknowns.len(), knowns.len(), n_seed, n_sensitivity, false)?;
+            derivative_lengths(unknowns.len(), knowns.len(), n_seed, n_sensitivity, adjoint)?;
             let seeds = in_slice(seed, n_seed, "seed[]")?;
             let out = out_slice(sensitivity, n_sensitivity, "sensitivity[]")?;
-            inst.directional_derivative(unknowns, knowns, seeds, out)?;
+            if !adjoint {
+                inst.directional_derivative(unknowns, knowns, seeds, out)?;
+                return ok();
+            }
+            if let Some((k, s)) = seeds.iter().enumerate().find(|(_, s)| !s.is_finite()) {
+                return Err(format!("seed[{k}] must be finite but was {s}"));
+            }
+            let mut column = vec![0.0; unknowns.len()];
+            for (o, &k) in out.iter_mut().zip(knowns) {
+                inst.directional_derivative(unknowns, &[k], &[1.0], &mut column)?;
+                *o = column
+                    .iter()
+                    .zip(seeds)
+                    .filter(|(_, s)| **s != 0.0)
+                    .map(|(d, s)| d * s)
+                    .sum();
+            }
             ok()
         })
     }
@@ -868,46 +927,6 @@ fn derivative_lengths(
         ));
     }
     Ok(())
-}
-
-/// `fmi3GetAdjointDerivative`: `sensitivity = seedᵀ·J` (FMI 3.0 section
-/// 2.2.11), one column of `J` per known from
-/// [`Instance::directional_derivative`].
-///
-/// # Safety
-/// See [`call`] and [`in_slice`].
-pub unsafe fn get_adjoint_derivative(
-    c: fmi3Instance,
-    (unknown, n_unknown): Arrays<fmi3ValueReference>,
-    (known, n_known): Arrays<fmi3ValueReference>,
-    (seed, n_seed): Arrays<f64>,
-    (sensitivity, n_sensitivity): (*mut f64, usize),
-) -> fmi3Status {
-    unsafe {
-        call!(c, "fmi3GetAdjointDerivative", |inst| {
-            let unknowns = in_slice(unknown, n_unknown, "unknowns[]")?;
-            let knowns = in_slice(known, n_known, "knowns[]")?;
-            let (mut u, mut k) = (Vec::new(), Vec::new());
-            let (unknowns, knowns) = elements(inst, (unknowns, &mut u), (knowns, &mut k))?;
-            derivative_lengths(unknowns.len(), knowns.len(), n_seed, n_sensitivity, true)?;
-            let seeds = in_slice(seed, n_seed, "seed[]")?;
-            if let Some((k, s)) = seeds.iter().enumerate().find(|(_, s)| !s.is_finite()) {
-                return Err(format!("seed[{k}] must be finite but was {s}"));
-            }
-            let out = out_slice(sensitivity, n_sensitivity, "sensitivity[]")?;
-            let mut column = vec![0.0; unknowns.len()];
-            for (o, &k) in out.iter_mut().zip(knowns) {
-                inst.directional_derivative(unknowns, &[k], &[1.0], &mut column)?;
-                *o = column
-                    .iter()
-                    .zip(seeds)
-                    .filter(|(_, s)| **s != 0.0)
-                    .map(|(d, s)| d * s)
-                    .sum();
-            }
-            ok()
-        })
-    }
 }
 
 /// # Safety

@@ -18,7 +18,8 @@
 use super::arrays::{Fmi3Variable, Layout};
 use super::{event_indicator_vr, time_vr};
 use crate::model_description::{
-    causality, default_experiment, escape, log_categories, number, unit_definitions, variability,
+    causality, default_experiment, escape, log_categories, unit_definitions, value,
+    value_attributes, variability,
 };
 use crate::variables::{Causality, Initial, ModelInfo, VarType};
 use std::fmt::Write;
@@ -183,30 +184,12 @@ fn variable(info: &ModelInfo, layout: &Layout, fmi3: &Fmi3Variable) -> String {
         causality(v.causality),
         variability(v.variability)
     );
-    if let Some(u) = v.unit {
-        let _ = write!(e, r#" unit="{}""#, escape(u));
-    }
-    // bounds in the variable's own type (an Int32's min is "0", not "0.0")
-    let bound = |b: f64| match v.var_type {
-        VarType::Integer => format!("{}", b as i64),
-        _ => number(b),
-    };
-    if let Some(m) = v.min {
-        let _ = write!(e, r#" min="{}""#, bound(m));
-    }
-    if let Some(m) = v.max {
-        let _ = write!(e, r#" max="{}""#, bound(m));
-    }
-    if let Some(n) = v.nominal {
-        let _ = write!(e, r#" nominal="{}""#, number(n));
-    }
-    let start = |x: f64| match v.var_type {
-        VarType::Real => number(x),
-        VarType::Integer => format!("{}", x as i64),
-        VarType::Boolean => (x != 0.0).to_string(),
-    };
+    e.push_str(&value_attributes(v));
     // every element's start, separated by spaces (all or none have one)
-    let starts: Option<Vec<String>> = elements.iter().map(|e| e.start.map(start)).collect();
+    let starts: Option<Vec<String>> = elements
+        .iter()
+        .map(|e| e.start.map(|x| value(v, x)))
+        .collect();
     if let Some(starts) = starts {
         let _ = write!(e, r#" start="{}""#, starts.join(" "));
     }
