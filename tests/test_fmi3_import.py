@@ -1,6 +1,6 @@
 """FMI 3.0 Co-Simulation FMUs imported by fricsim, against FMPy.
 
-Two FMUs written by hand in C for these tests against the FMI 3.0
+FMUs written by hand in C for these tests against the FMI 3.0
 standard (host/tests/c/fmi3, like the Modelica Reference-FMUs of the same
 names, which cannot be fetched from these machines):
 
@@ -11,13 +11,20 @@ names, which cannot be fetched from these machines):
   Float64 output, and at the top (t = 9) fmi3DoStep sets
   terminateSimulation;
 - SpringMass: the stick-slip rig of Canudas de Wit et al. 1995 with the
-  friction force as its Float64 input.
+  friction force as its Float64 input;
+- Gains: FMI 3.0 arrays (Float64, Int32 and Boolean, one 2-D) as
+  parameters, an input and outputs, which fricsim reads element by
+  element (`k[2]`, `A[1,3]`) and FMPy as arrays;
+- Feedthrough: an input of every FMI 3.0 type (Float32, the integers
+  of every width, Boolean, Enumeration, and a Float32 array) fed through
+  to an output, each through the getter and setter of its type.
 
 `fricsim cosim` of each must record exactly the rows FMPy's simulate_fmu
 records (FMPy's FMI 3.0 Co-Simulation loop), and an FMI 3.0 FMU and an FMI
 2.0 one must work in one system: LuGre.fmu (FMI 2.0) driven by the FMI 3.0
 BouncingBall equals LuGre.fmu driven by the ball's recorded velocity."""
 
+import csv
 import subprocess
 import zipfile
 
@@ -55,10 +62,14 @@ def fmus(tmp_path_factory):
                              "x86_64-linux"),
         "rig": compile_fmu(work, C_FMI3 / "spring_mass.c", C_FMI3 / "spring_mass.xml",
                            "SpringMass", "x86_64-linux"),
+        "gains": compile_fmu(work, C_FMI3 / "gains.c", C_FMI3 / "gains.xml", "Gains",
+                             "x86_64-linux"),
+        "feedthrough": compile_fmu(work, C_FMI3 / "feedthrough.c", C_FMI3 / "feedthrough.xml",
+                                   "Feedthrough", "x86_64-linux"),
     }
 
 
-@pytest.mark.parametrize("name", ["ball", "stair", "rig"])
+@pytest.mark.parametrize("name", ["ball", "stair", "rig", "gains", "feedthrough"])
 def test_fmpy_validates_the_fmi3_test_fmus(fmus, name):
     assert validate_fmu(str(fmus[name])) == []
 
@@ -232,3 +243,138 @@ def test_a_sweep_over_an_fmi3_parameter_equals_single_runs(fmus, tmp_path):
     np.testing.assert_allclose(swept["finalrigx"], finals, rtol=1e-12)
     # the stiffer spring breaks the contact loose within 5 s, the softer does not
     assert finals[1] > 100 * finals[0]
+
+
+def read_csv(path):
+    """Header (quoted names unquoted, as a CSV reader takes them) and rows."""
+    with open(path, newline="") as f:
+        header = next(csv.reader(f))
+    return header, np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+
+
+def test_fmi3_arrays_in_fricsim_equal_simulate_fmu(fmus, tmp_path):
+    """Gains, its arrays given element by element in fricsim and whole in
+    FMPy: parameters changed in some elements (`--set g.k[2]=…`, a 2-D
+    one, an Int32 and a Boolean one), the input array driven by a table
+    (held over each step, as FMPy holds it), every element of every output
+    array recorded: fricsim's rows are FMPy's, to 1e-12."""
+    t = np.linspace(0.0, 2.0, 21)
+    u = np.zeros(t.size, dtype=[("time", float), ("u", float, (3,))])
+    u["time"] = t
+    u["u"][:, 0] = np.sin(3.0 * t)
+    u["u"][:, 1] = 1.0 - t
+    u["u"][:, 2] = 0.25 * t * t
+    changed = {"k[2]": -2.0, "k[3]": 4.0, "enable[3]": True, "A[2,1]": 3.5, "offset[2]": -4}
+    starts = {"k": [1.0, -2.0, 4.0], "enable": [True, True, True],
+              "A": [1.0, 0.0, 0.5, 3.5, 1.0, -1.0], "offset": [10, -4]}
+    expected = simulate_fmu(str(fmus["gains"]), stop_time=2, step_size=0.1, output_interval=0.1,
+                            input=u, start_values=starts)
+
+    table = tmp_path / "u.csv"
+    np.savetxt(table, np.column_stack([t, u["u"]]), delimiter=",",
+               header="time,g.u[1],g.u[2],g.u[3]", comments="", fmt="%.17g")
+    out = tmp_path / "gains.csv"
+    args = ["cosim", "--fmu", f"g={fmus['gains']}", "--input", table, "--input-hold",
+            "--step", "0.1", "--stop", "2", "--out", out]
+    for name, value in changed.items():
+        args += ["--set", f"g.{name}={str(value).lower() if isinstance(value, bool) else value}"]
+    process = fricsim(*args)
+    assert process.returncode == 0, process.stdout + process.stderr
+    header, rows = read_csv(out)
+    # every element of every output array, and the scalar, in a column
+    elements = ([f"y[{i}]" for i in (1, 2, 3)] + [f"yd[{i}]" for i in (1, 2, 3)]
+                + [f"z[{r},{c}]" for r in (1, 2) for c in (1, 2, 3)] + ["total"]
+                + ["count[1]", "count[2]"] + [f"positive[{i}]" for i in (1, 2, 3)])
+    assert header == ["time"] + [f"g.{e}" for e in elements]
+    assert out.read_text().startswith('time,g.y[1],g.y[2],g.y[3],g.yd[1],g.yd[2],g.yd[3],"g.z[1,1]"')
+    assert len(rows) == len(expected) == 21
+    np.testing.assert_array_equal(rows[:, 0], expected["time"])
+    for column, name in enumerate(elements, start=1):
+        array, _, index = name.partition("[")
+        values = expected[array].astype(float)
+        if index:
+            values = values[(slice(None), *(int(i) - 1 for i in index.rstrip("]").split(",")))]
+        np.testing.assert_allclose(rows[:, column], values, rtol=1e-12, atol=1e-15, err_msg=name)
+    # the changed elements took: the third integrator runs, with gain 4,
+    # and the 2-D weight and the Int32 offset are the ones set
+    assert rows[-1, header.index("g.y[3]")] > 0.5
+    z21 = rows[:, header.index("g.z[2,1]")]
+    np.testing.assert_allclose(z21, 3.5 * rows[:, header.index("g.y[1]")], rtol=1e-15)
+    np.testing.assert_array_equal(rows[:, header.index("g.count[2]")], -4 + 2 * np.arange(21))
+
+
+def test_an_fmi3_array_element_is_recorded_and_connected_by_name_in_the_python_package(fmus,
+                                                                                      tmp_path):
+    """`fricsim.run` of an SSP system connecting one Gains' output element
+    to another's input element: the columns are the elements' names, and
+    the connected input follows the output it is connected to."""
+    import fricsim as package
+
+    ssd = tmp_path / "pair.ssd"
+    ssd.write_text(f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription version="1.0" name="pair"
+    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription">
+  <ssd:System name="pair">
+    <ssd:Elements>
+      <ssd:Component name="a" source="{fmus['gains']}">
+        <ssd:Connectors><ssd:Connector name="z[2,2]" kind="output"/></ssd:Connectors>
+      </ssd:Component>
+      <ssd:Component name="b" source="{fmus['gains']}">
+        <ssd:Connectors><ssd:Connector name="u[2]" kind="input"/></ssd:Connectors>
+      </ssd:Component>
+    </ssd:Elements>
+    <ssd:Connections>
+      <ssd:Connection startElement="a" startConnector="z[2,2]" endElement="b" endConnector="u[2]"/>
+    </ssd:Connections>
+  </ssd:System>
+</ssd:SystemStructureDescription>
+""")
+    result = package.run(ssd, step=0.1, stop=1)
+    names = list(result.dtype.names)
+    assert "a.z[2,2]" in names and "b.yd[2]" in names and "b.count[2]" in names
+    # b.yd[2] = k[2]·u[2] = 2·a.z[2,2] (from the row before: Jacobi)
+    np.testing.assert_allclose(result["b.yd[2]"][1:], 2.0 * result["a.z[2,2]"][:-1], rtol=1e-15)
+    assert result["a.z[2,2]"][-1] < -1.5
+
+
+def test_every_fmi3_type_fed_through_in_fricsim_equals_simulate_fmu(fmus, tmp_path):
+    """Feedthrough with an input of every type set (`--set`; FMPy's start
+    values), a Float32 one to a value it rounds and the 64-bit ones to
+    values beyond 32 bits: fricsim records every output as FMPy does,
+    exactly, the narrow integers and Booleans as whole numbers."""
+    values = {
+        "Float32_input": 0.3, "Float64_input": -1.25, "Int8_input": 127, "UInt8_input": 0,
+        "Int16_input": -300, "UInt16_input": 40000, "Int32_input": 123456789,
+        "UInt32_input": 3000000000, "Int64_input": -5000000000, "UInt64_input": 2 ** 52 + 1,
+        "Boolean_input": False, "Enumeration_input": 3,
+    }
+    expected = simulate_fmu(str(fmus["feedthrough"]), stop_time=1, step_size=0.25,
+                            output_interval=0.25,
+                            start_values={**values, "Float32_array_input": [-0.1, 4.0]})
+    out = tmp_path / "feedthrough.csv"
+    args = ["cosim", "--fmu", f"f={fmus['feedthrough']}", "--step", "0.25", "--stop", "1",
+            "--out", out, "--set", "f.Float32_array_input[1]=-0.1",
+            "--set", "f.Float32_array_input[2]=4"]
+    for name, value in values.items():
+        args += ["--set", f"f.{name}={str(value).lower() if isinstance(value, bool) else value}"]
+    process = fricsim(*args)
+    assert process.returncode == 0, process.stdout + process.stderr
+    header, rows = read_csv(out)
+    outputs = [name.replace("_input", "_output") for name in values]
+    assert sorted(header[1:]) == sorted(
+        [f"f.{o}" for o in outputs] + ["f.Float32_array_output[1]", "f.Float32_array_output[2]"])
+    np.testing.assert_array_equal(rows[:, 0], expected["time"])
+    for name in outputs:
+        column = rows[:, header.index(f"f.{name}")]
+        np.testing.assert_array_equal(column, expected[name].astype(float), err_msg=name)
+    for i in (1, 2):
+        column = rows[:, header.index(f"f.Float32_array_output[{i}]")]
+        np.testing.assert_array_equal(column,
+                                      expected["Float32_array_output"][:, i - 1].astype(float))
+    # what went in came out, as each type holds it (0.3 as a Float32)
+    assert rows[-1, header.index("f.Float32_output")] == float(np.float32(0.3)) != 0.3
+    assert rows[-1, header.index("f.UInt64_output")] == 2 ** 52 + 1
+    # the narrow integers and the Booleans written as whole numbers
+    text = out.read_text().splitlines()[1].split(",")
+    assert text[header.index("f.Int16_output")] == "-300"
+    assert text[header.index("f.Boolean_output")] == "0"

@@ -24,7 +24,9 @@ Examples left out, with the reason:
 - stick_slip_sigma1e7: its friction component has two ParameterBindings
   (the .ssv, then the stiffer contact), and libcosim applies only the
   first binding of a component; tested below: libcosim runs it as
-  stick_slip (the .ssv alone).
+  stick_slip (the .ssv alone);
+- stick_slip_fmi3: its FMUs are FMI 3.0, which libcosim 0.11 does not
+  import (stick_slip, the same system in FMI 2.0, is run).
 """
 
 import ctypes
@@ -59,8 +61,10 @@ RUNS = {
     "planar_stick_slip": None,
     "planar_dither": 1.0,  # 40 000 steps of 25 µs
 }
+# (stick_slip_fmi3: libcosim 0.11 has no FMI 3.0 import; its FMI 2.0 twin,
+# stick_slip, is run)
 LEFT_OUT = {"emps_nominal", "emps_symmetric_2019", "emps_asymmetric_2019", "slider_breakaway",
-            "stick_slip_sigma1e7"}
+            "stick_slip_sigma1e7", "stick_slip_fmi3"}
 
 
 def archive(name):

@@ -1,5 +1,6 @@
 //! CSV result files: [`CsvFile`], the writer of a run's rows (`time`
-//! first, then `component.variable` columns, FMPy's convention), and the
+//! first, then `component.variable` columns, FMPy's convention; a name
+//! with a comma, the element `c.A[1,2]` of a 2-D array, quoted), and the
 //! number text of every CSV file the host writes (`push_number`: the
 //! result files and the sweep's table alike), written so that each
 //! number parses back to the same `f64`. A run that stopped early keeps
@@ -122,12 +123,28 @@ impl CsvFile {
 }
 
 /// The header line: `time`, then the columns, comma-separated (`time`
-/// alone when nothing else is recorded, not `time,`).
+/// alone when nothing else is recorded, not `time,`), each a
+/// [`header_field`].
 fn header(columns: &[String]) -> String {
     std::iter::once("time")
         .chain(columns.iter().map(String::as_str))
+        .map(header_field)
         .collect::<Vec<_>>()
         .join(",")
+}
+
+/// A column name as a field of a CSV header: as it is, unless it holds a
+/// comma, a quote or a line break (the element of a 2-D array, `c.A[1,2]`,
+/// in FMI's structured naming), which is quoted as RFC 4180 quotes it
+/// (`"c.A[1,2]"`, an inner quote doubled), as FMPy's `write_csv` quotes
+/// every name; the input tables are read back with a CSV reader that
+/// takes it either way.
+pub(crate) fn header_field(name: &str) -> std::borrow::Cow<'_, str> {
+    if name.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", name.replace('"', "\"\"")).into()
+    } else {
+        name.into()
+    }
 }
 
 /// Append `x` to `text` as [`put_number`] writes it: the number text of

@@ -591,8 +591,12 @@ fn variable_of<'a>(fmus: &'a [(String, Fmu)], port: &str) -> Result<&'a ScalarVa
             names.join(", ")
         )
     })?;
-    fmu.variable(v)
-        .map_err(|_| format!("start value `{port}`: `{c}` has no variable `{v}`"))
+    fmu.variable(v).map_err(|_| {
+        format!(
+            "start value `{port}`: `{c}` has no variable `{v}`{}",
+            fmu.description().array_hint(v)
+        )
+    })
 }
 
 /// `value` for the variable `var` (named `port`) as it will be set: the

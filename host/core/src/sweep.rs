@@ -91,8 +91,9 @@ pub fn check_axes(file: &SystemFile, axes: &[Axis]) -> Result<(), String> {
         };
         let var = fmu.variable(variable).map_err(|_| {
             format!(
-                "`{}`: `{component}` has no variable `{variable}`",
-                axis.port
+                "`{}`: `{component}` has no variable `{variable}`{}",
+                axis.port,
+                fmu.description().array_hint(variable)
             )
         })?;
         if !matches!(var.causality, Causality::Parameter | Causality::Input) {
@@ -273,7 +274,12 @@ fn table_text(outcomes: &[Outcome]) -> Vec<u8> {
     header.extend(["status".into(), "points".into(), "wall_s".into()]);
     header.extend(columns.iter().map(|c| format!("final:{c}")));
     header.extend(columns.iter().map(|c| format!("rms:{c}")));
-    let mut text = header.join(",").into_bytes();
+    let mut text = header
+        .iter()
+        .map(|h| crate::csvfile::header_field(h))
+        .collect::<Vec<_>>()
+        .join(",")
+        .into_bytes();
     text.push(b'\n');
     let mut digits = zmij::Buffer::new();
     for (i, o) in outcomes.iter().enumerate() {

@@ -364,8 +364,10 @@ fn find(list: &[Component], port: &str) -> Result<(usize, String), SystemError> 
 }
 
 /// A value for [`System::from_fmus`]: a number is converted to the
-/// variable's type (Real as is, Integer rounded toward zero, Boolean
-/// non-zero = true); text sets a String variable.
+/// variable's type (Real as is; Integer only if it is a whole number that
+/// an `i32` holds, else refused; Boolean non-zero = true); text sets a
+/// String variable. (An FMI 3.0 variable's own type may hold less, a
+/// UInt8 300 say: its instance refuses it, naming it.)
 #[derive(Clone, Debug, PartialEq)]
 pub enum ParameterValue {
     Number(f64),
@@ -501,14 +503,16 @@ impl System {
             let (ti, tv) = find(&system.components, to)?;
             let out = system.components[fi].fmu.variable(&fv).map_err(|_| {
                 SystemError::Invalid(format!(
-                    "connection {from} -> {to}: `{}` has no variable `{fv}`",
-                    system.components[fi].name
+                    "connection {from} -> {to}: `{}` has no variable `{fv}`{}",
+                    system.components[fi].name,
+                    system.components[fi].fmu.description().array_hint(&fv)
                 ))
             })?;
             let inp = system.components[ti].fmu.variable(&tv).map_err(|_| {
                 SystemError::Invalid(format!(
-                    "connection {from} -> {to}: `{}` has no variable `{tv}`",
-                    system.components[ti].name
+                    "connection {from} -> {to}: `{}` has no variable `{tv}`{}",
+                    system.components[ti].name,
+                    system.components[ti].fmu.description().array_hint(&tv)
                 ))
             })?;
             if out.causality != Causality::Output {
@@ -616,7 +620,11 @@ impl System {
             let (i, v) = find(&self.components, port)?;
             let c = &mut self.components[i];
             let var = c.fmu.variable(&v).map_err(|_| {
-                SystemError::Invalid(format!("`{port}`: `{}` has no variable `{v}`", c.name))
+                SystemError::Invalid(format!(
+                    "`{port}`: `{}` has no variable `{v}`{}",
+                    c.name,
+                    c.fmu.description().array_hint(&v)
+                ))
             })?;
             let vr = var.value_reference;
             match (&var.kind, value) {
@@ -626,7 +634,16 @@ impl System {
                 (
                     VariableKind::Integer { .. } | VariableKind::Enumeration { .. },
                     &ParameterValue::Number(x),
-                ) => c.instance.set_integer(&[vr], &[x as i32])?,
+                ) => {
+                    // not truncated: 2.5 is no Integer value
+                    if x.fract() != 0.0 || !(f64::from(i32::MIN)..=f64::from(i32::MAX)).contains(&x)
+                    {
+                        return Err(SystemError::Invalid(format!(
+                            "`{port}` is an Integer variable; it cannot be set to {x}, which is not a 32-bit integer"
+                        )));
+                    }
+                    c.instance.set_integer(&[vr], &[x as i32])?
+                }
                 (VariableKind::Boolean { .. }, &ParameterValue::Number(x)) => {
                     c.instance.set_boolean(&[vr], &[x != 0.0])?
                 }
@@ -772,7 +789,8 @@ impl System {
         let component = &mut self.components[i];
         let var = component.fmu.variable(v).map_err(|_| {
             SystemError::Invalid(format!(
-                "cannot record `{port}`: `{c}` has no variable `{v}`"
+                "cannot record `{port}`: `{c}` has no variable `{v}`{}",
+                component.fmu.description().array_hint(v)
             ))
         })?;
         let Some(ty) = recorded_type(&var.kind) else {
@@ -803,10 +821,12 @@ impl System {
                     names.join(", ")
                 ))
             })?;
-        let var = self.components[i]
-            .fmu
-            .variable(v)
-            .map_err(|_| SystemError::Invalid(format!("`{port}`: `{c}` has no variable `{v}`")))?;
+        let var = self.components[i].fmu.variable(v).map_err(|_| {
+            SystemError::Invalid(format!(
+                "`{port}`: `{c}` has no variable `{v}`{}",
+                self.components[i].fmu.description().array_hint(v)
+            ))
+        })?;
         Ok((i, var))
     }
 

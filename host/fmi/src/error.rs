@@ -207,6 +207,19 @@ pub enum FmuError {
         found: usize,
     },
 
+    /// An FMI 3.0 value that the variable's type and the core's kind do
+    /// not both hold (a `UInt8` set to 300, an `Int64` beyond what an
+    /// `f64` holds exactly): refused, not rounded or wrapped.
+    #[error("{function} for instance \"{instance}\": variable {variable} ({type_name}) {problem}")]
+    ValueConversion {
+        function: &'static str,
+        instance: String,
+        /// `"name"` in quotes, or `with value reference …`.
+        variable: String,
+        type_name: &'static str,
+        problem: String,
+    },
+
     #[error("{function}: the FMU state belongs to another instance than \"{instance}\"")]
     ForeignState {
         function: &'static str,

@@ -12,10 +12,14 @@
 //! §2.3.11, output derivatives §4.2.3) may be missing from a binary whose
 //! model description does not declare them: a missing one is
 //! [`absent`](Functions::exports), and its pointer a stand-in that
-//! returns `fmi3Error` without reading its arguments. What fricsim does not
-//! call (Model Exchange, Scheduled Execution, clocks, configuration mode,
-//! the types other than Float64, Int32, Boolean and String) is not in the
-//! table: a binary need not export it for fricsim to run it.
+//! returns `fmi3Error` without reading its arguments. The getters and
+//! setters of the types other than Float64, Int32, Boolean and String are
+//! optional too: the standard has every binary export them, but fricsim
+//! needs them only for an FMU with variables of those types, and checks
+//! that such an FMU's binary has them when it loads it
+//! ([`crate::library`]). What fricsim does not call (Model Exchange,
+//! Scheduled Execution, clocks, configuration mode, `Binary`) is not in
+//! the table: a binary need not export it for fricsim to run it.
 //!
 //! The C types are those of `fmi3-types`, re-exported here.
 
@@ -72,6 +76,38 @@ function_table! {
             *mut fmi3Float64,
             usize
         ),
+        get_float32: GetTYPE<fmi3Float32> =
+            fmi3GetFloat32(fmi3Instance, *const fmi3ValueReference, usize, *mut fmi3Float32, usize),
+        set_float32: SetTYPE<fmi3Float32> =
+            fmi3SetFloat32(fmi3Instance, *const fmi3ValueReference, usize, *const fmi3Float32, usize),
+        get_int8: GetTYPE<fmi3Int8> =
+            fmi3GetInt8(fmi3Instance, *const fmi3ValueReference, usize, *mut fmi3Int8, usize),
+        set_int8: SetTYPE<fmi3Int8> =
+            fmi3SetInt8(fmi3Instance, *const fmi3ValueReference, usize, *const fmi3Int8, usize),
+        get_uint8: GetTYPE<fmi3UInt8> =
+            fmi3GetUInt8(fmi3Instance, *const fmi3ValueReference, usize, *mut fmi3UInt8, usize),
+        set_uint8: SetTYPE<fmi3UInt8> =
+            fmi3SetUInt8(fmi3Instance, *const fmi3ValueReference, usize, *const fmi3UInt8, usize),
+        get_int16: GetTYPE<fmi3Int16> =
+            fmi3GetInt16(fmi3Instance, *const fmi3ValueReference, usize, *mut fmi3Int16, usize),
+        set_int16: SetTYPE<fmi3Int16> =
+            fmi3SetInt16(fmi3Instance, *const fmi3ValueReference, usize, *const fmi3Int16, usize),
+        get_uint16: GetTYPE<fmi3UInt16> =
+            fmi3GetUInt16(fmi3Instance, *const fmi3ValueReference, usize, *mut fmi3UInt16, usize),
+        set_uint16: SetTYPE<fmi3UInt16> =
+            fmi3SetUInt16(fmi3Instance, *const fmi3ValueReference, usize, *const fmi3UInt16, usize),
+        get_uint32: GetTYPE<fmi3UInt32> =
+            fmi3GetUInt32(fmi3Instance, *const fmi3ValueReference, usize, *mut fmi3UInt32, usize),
+        set_uint32: SetTYPE<fmi3UInt32> =
+            fmi3SetUInt32(fmi3Instance, *const fmi3ValueReference, usize, *const fmi3UInt32, usize),
+        get_int64: GetTYPE<fmi3Int64> =
+            fmi3GetInt64(fmi3Instance, *const fmi3ValueReference, usize, *mut fmi3Int64, usize),
+        set_int64: SetTYPE<fmi3Int64> =
+            fmi3SetInt64(fmi3Instance, *const fmi3ValueReference, usize, *const fmi3Int64, usize),
+        get_uint64: GetTYPE<fmi3UInt64> =
+            fmi3GetUInt64(fmi3Instance, *const fmi3ValueReference, usize, *mut fmi3UInt64, usize),
+        set_uint64: SetTYPE<fmi3UInt64> =
+            fmi3SetUInt64(fmi3Instance, *const fmi3ValueReference, usize, *const fmi3UInt64, usize),
     }
 }
 

@@ -19,7 +19,16 @@
 //! - `fmi3Boolean` is C's `bool`: Booleans the FMU writes are read as
 //!   bytes (any non-zero byte is true), never as a Rust `bool`.
 //!
-//! Scalar variables only: the model description reader refuses arrays.
+//! Two ways to name values: the methods named by FMI 3.0's types
+//! (`get_float64`, `set_float64`, `get_int32`, `set_int32`,
+//! `get_string`, `set_string`) pass the FMU's own value references of
+//! scalars on as they are; those named by the core's kinds (`get_real`,
+//! `set_real`, `get_integer`, `set_integer`, `get_boolean_raw`,
+//! `get_boolean`, `set_boolean`) and `get_directional_derivative` take the
+//! value references of the model description as fricsim reads it, where
+//! an array is its elements and a variable may be of any FMI 3.0 type
+//! that the core's kind holds, and reach each where the FMU holds it
+//! (`values.rs`).
 
 use super::guard::{c_string, not_supported, same_length, Guard};
 use super::instance::{FmuState, Rollback};
@@ -33,6 +42,9 @@ use crate::fmi3::*;
 use std::os::raw::c_void;
 use std::ptr::null_mut;
 use std::time::Duration;
+
+mod values;
+pub(crate) use values::optional_functions;
 
 /// The name of `fmi3DoStep` in errors.
 const DO_STEP: &str = "fmi3DoStep";
@@ -66,6 +78,12 @@ pub struct Fmi3Instance {
     states: Vec<fmi3FMUState>,
     /// The last `fmi3DoStep`'s answer (`None` before the first step).
     last_step: Option<StepOutcome>,
+    /// Where the description's variables are in the FMU: array elements,
+    /// the types the core holds in another (`values.rs`).
+    layout: values::Layout,
+    /// Whether the FMU may be asked for its values (FMI 3.0.1 §2.3.3: from
+    /// initialization mode on, not just after instantiation or a reset).
+    values_readable: bool,
 }
 
 impl std::fmt::Debug for Fmi3Instance {
@@ -130,6 +148,8 @@ impl Fmi3Instance {
             guard: Guard::new(fmu, name, id, sink),
             states: Vec::new(),
             last_step: None,
+            layout: values::Layout::new(description),
+            values_readable: false,
         })
     }
 
@@ -198,9 +218,11 @@ impl Fmi3Instance {
             None => (false, 0.0),
         };
         // SAFETY: plain values.
-        self.call("fmi3EnterInitializationMode", |i| {
+        let status = self.call("fmi3EnterInitializationMode", |i| {
             Ok(unsafe { f(i, false, 0.0, start, stop_defined, stop) })
-        })
+        })?;
+        self.values_readable = true;
+        Ok(status)
     }
 
     /// `fmi3ExitInitializationMode`: without event mode, the instance is
@@ -225,10 +247,14 @@ impl Fmi3Instance {
         let status = self.call("fmi3Reset", |i| Ok(unsafe { f(i) }))?;
         self.guard.failed = false;
         self.last_step = None;
+        self.values_readable = false;
+        self.layout.restart();
         Ok(status)
     }
 
-    /// `fmi3GetFloat64` of scalars: `values[i]` = value of `vrs[i]`.
+    /// `fmi3GetFloat64` of the FMU's own scalars, as they are: `values[i]`
+    /// = value of `vrs[i]` (the description's Real variables, array
+    /// elements and other types included: [`Fmi3Instance::get_real`]).
     #[inline]
     pub fn get_float64(
         &mut self,
@@ -252,7 +278,8 @@ impl Fmi3Instance {
         })
     }
 
-    /// `fmi3SetFloat64` of scalars.
+    /// `fmi3SetFloat64` of the FMU's own scalars, as they are
+    /// ([`Fmi3Instance::set_real`] for any Real variable).
     #[inline]
     pub fn set_float64(
         &mut self,
@@ -268,7 +295,8 @@ impl Fmi3Instance {
         })
     }
 
-    /// `fmi3GetInt32` of scalars.
+    /// `fmi3GetInt32` of the FMU's own scalars, as they are
+    /// ([`Fmi3Instance::get_integer`] for any Integer variable).
     #[inline]
     pub fn get_int32(
         &mut self,
@@ -292,7 +320,8 @@ impl Fmi3Instance {
         })
     }
 
-    /// `fmi3SetInt32` of scalars.
+    /// `fmi3SetInt32` of the FMU's own scalars, as they are
+    /// ([`Fmi3Instance::set_integer`] for any Integer variable).
     pub fn set_int32(
         &mut self,
         vrs: &[ValueReference],
@@ -307,11 +336,10 @@ impl Fmi3Instance {
         })
     }
 
-    /// `fmi3GetBoolean` of scalars, each as a C int (0 false, 1 true), the
-    /// form FMI 2.0's Booleans take ([`crate::Instance::get_boolean_raw`]).
-    /// Does not allocate: the FMU writes bytes into a stack buffer.
+    /// `fmi3GetBoolean` of the FMU's scalars, each as a C int (0 false, 1
+    /// true). Does not allocate: the FMU writes bytes into a stack buffer.
     #[inline]
-    pub fn get_boolean_raw(
+    fn get_boolean_bytes(
         &mut self,
         vrs: &[ValueReference],
         values: &mut [i32],
@@ -349,7 +377,8 @@ impl Fmi3Instance {
         Ok(status)
     }
 
-    /// `fmi3GetBoolean` of scalars.
+    /// The Boolean values of the description's variables `vrs` (scalars or
+    /// array elements, [`Fmi3Instance::get_boolean_raw`]).
     pub fn get_boolean(
         &mut self,
         vrs: &[ValueReference],
@@ -364,8 +393,8 @@ impl Fmi3Instance {
         Ok(status)
     }
 
-    /// `fmi3SetBoolean` of scalars.
-    pub fn set_boolean(
+    /// `fmi3SetBoolean` of the FMU's scalars.
+    fn set_boolean_scalars(
         &mut self,
         vrs: &[ValueReference],
         values: &[bool],
@@ -379,7 +408,7 @@ impl Fmi3Instance {
         })
     }
 
-    /// `fmi3GetString` of scalars: copied out at once (the FMU's pointers
+    /// `fmi3GetString` of scalars (fricsim reads no String arrays): copied out at once (the FMU's pointers
     /// are only valid until its next call).
     pub fn get_string(&mut self, vrs: &[ValueReference]) -> Result<Vec<String>, FmuError> {
         const F: &str = "fmi3GetString";
@@ -526,9 +555,12 @@ impl Fmi3Instance {
         self.last_step
     }
 
-    /// `fmi3GetDirectionalDerivative` (§2.3.11): `out` = ∂unknowns/∂knowns · `seed`.
+    /// `fmi3GetDirectionalDerivative` of the FMU's own value references
+    /// (an array's value reference takes or gives all its elements: `seed`
+    /// and `out` are as long as the elements of `knowns` and `unknowns`);
+    /// the public method is [`Fmi3Instance::get_directional_derivative`].
     #[inline]
-    pub fn get_directional_derivative(
+    fn directional_derivative_of(
         &mut self,
         unknowns: &[ValueReference],
         knowns: &[ValueReference],
@@ -536,13 +568,8 @@ impl Fmi3Instance {
         out: &mut [f64],
     ) -> Result<Status, FmuError> {
         const F: &str = "fmi3GetDirectionalDerivative";
-        if !self.declared.directional_derivative {
-            return Err(not_supported(F, "providesDirectionalDerivatives=\"true\""));
-        }
         let f = self.functions.get_directional_derivative;
         self.call(F, |i| {
-            same_length(F, "seed", knowns.len(), seed.len())?;
-            same_length(F, "out", unknowns.len(), out.len())?;
             // SAFETY: each array holds as many elements as its length argument says.
             Ok(unsafe {
                 f(

@@ -3,7 +3,8 @@
 //! - [`archive`]: the `.fmu` zip unpacked safely into a temporary directory;
 //! - [`model_description`]: `modelDescription.xml` parsed and validated
 //!   into types that name no FMI version ([`model_description::fmi2`]
-//!   reads FMI 2.0's, [`model_description::fmi3`] FMI 3.0's);
+//!   reads FMI 2.0's, [`model_description::fmi3`] FMI 3.0's, its arrays
+//!   as their elements);
 //! - [`fmi2`], [`fmi3`]: each version's raw layer, the binary's functions
 //!   as a table of typed pointers with no checks (FMI 2.0's is also used by
 //!   the misuse tests, the fuzz targets and the benchmarks' hand-written
@@ -13,8 +14,10 @@
 //! - [`logger`]: the FMU's log messages (callbacks in `logger.c` for FMI
 //!   2.0, whose logger is variadic, and in Rust for FMI 3.0);
 //! - [`instance`]: [`Fmu`] and its FMI 2.0 [`Instance`]s, the safe API;
-//!   [`instance3`]: FMI 3.0's [`Fmi3Instance`]; both call through one
-//!   guard (`guard.rs`: statuses, messages, time limit, black box);
+//!   [`instance3`]: FMI 3.0's [`Fmi3Instance`], which also takes the
+//!   elements of arrays and the types the core holds in another kind to
+//!   where the FMU holds them (`instance3/values.rs`); both call through
+//!   one guard (`guard.rs`: statuses, messages, time limit, black box);
 //! - [`watchdog`]: the optional time limit on each call.
 //!
 //! The C types of the standards are those of `fmi2-types` and
@@ -50,7 +53,7 @@ pub use instance3::{Fmi3Instance, StepOutcome};
 pub use library::Library;
 pub use logger::{Log, LogMessage};
 pub use model_description::{
-    Causality, CoSimulation, DefaultExperiment, Initial, ModelDescription, ScalarVariable,
-    ValueReference, Variability, Variable, VariableKind,
+    Array, Causality, CoSimulation, DefaultExperiment, Fmi3Type, Initial, ModelDescription,
+    ScalarVariable, ValueReference, Variability, Variable, VariableKind,
 };
 pub use status::Status;

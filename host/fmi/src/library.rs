@@ -154,6 +154,7 @@ impl Library {
         })?;
         let declared =
             check_capabilities(description, path, &|s| functions.exports(s), FMI3_GROUPS)?;
+        check_value_types(description, path, &functions)?;
         // SAFETY: no arguments, returns a static string.
         let version = unsafe { c_text((functions.get_version)()) };
         // "3.0", or a later minor version of 3 ("3.0.1" is still "3.0"'s ABI)
@@ -302,6 +303,37 @@ fn check_capabilities(
         }
     }
     Ok(declared)
+}
+
+/// Each FMI 3.0 type of the description's variables whose getter and
+/// setter a binary may leave out for fricsim (`Float32`, the integers but
+/// `Int32`, `Enumeration` as `Int64`) must have them exported.
+fn check_value_types(
+    d: &ModelDescription,
+    path: &Path,
+    functions: &fmi3::Functions,
+) -> Result<(), FmuError> {
+    let mut checked = Vec::new();
+    for t in d.variables.iter().filter_map(|v| v.fmi3_type) {
+        if checked.contains(&t) {
+            continue;
+        }
+        checked.push(t);
+        if let Some((capability, symbols)) = crate::instance3::optional_functions(t) {
+            let missing: Vec<&'static str> = symbols
+                .into_iter()
+                .filter(|s| !functions.exports(s))
+                .collect();
+            if !missing.is_empty() {
+                return Err(FmuError::MissingCapabilityFunctions {
+                    path: path.to_path_buf(),
+                    capability,
+                    symbols: missing,
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// An error and its sources, e.g. "dlopen failed: <dlerror text>".

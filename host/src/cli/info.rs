@@ -1,5 +1,7 @@
 //! `fricsim info FMU`: what `fmpy info` shows — the model, its
-//! capabilities, the default experiment and a table of all variables. Only
+//! capabilities, the default experiment and a table of all variables (an
+//! FMI 3.0 array as its elements, `k[1]`, …, which a table of the arrays
+//! after it sums up), each with its type in its FMI version. Only
 //! the model description is unpacked (every entry of the archive is
 //! checked, no other written, no binary loaded), so FMUs for other
 //! platforms can be inspected too.
@@ -150,7 +152,7 @@ pub fn render(d: &ModelDescription, platforms: &[String]) -> String {
             v.name.clone(),
             v.causality.to_string(),
             v.variability.to_string(),
-            v.kind.type_name_in(&d.fmi_version).to_string(),
+            v.type_name().to_string(),
             v.kind.start_text().unwrap_or_default(),
             v.kind.unit().unwrap_or_default().to_string(),
             v.description.clone().unwrap_or_default(),
@@ -170,5 +172,55 @@ pub fn render(d: &ModelDescription, platforms: &[String]) -> String {
         let _ = write!(line, " {}", row[6]);
         let _ = writeln!(w, "{}", line.trim_end());
     }
+    arrays(w, d);
     out
+}
+
+/// FMI 3.0's arrays, which the variables list element by element: name,
+/// type, dimensions and the first and last element.
+fn arrays(w: &mut String, d: &ModelDescription) {
+    if d.arrays.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        w,
+        "
+Arrays (above as their elements)
+"
+    );
+    let mut table = vec![[
+        "Name".to_string(),
+        "Type".to_string(),
+        "Dimensions".to_string(),
+        "Elements".to_string(),
+    ]];
+    for a in &d.arrays {
+        let elements = &d.variables[a.first_index - 1..][..a.len()];
+        table.push([
+            a.name.clone(),
+            a.value_type.to_string(),
+            a.dimensions
+                .iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(" × "),
+            match (elements.first(), elements.last()) {
+                (Some(first), Some(last)) => format!("{} … {}", first.name, last.name),
+                _ => "none".to_string(),
+            },
+        ]);
+    }
+    let mut widths = [0usize; 3];
+    for row in &table {
+        for (width, cell) in widths.iter_mut().zip(row) {
+            *width = (*width).max(cell.chars().count());
+        }
+    }
+    for row in &table {
+        let mut line = String::from(" ");
+        for (width, cell) in widths.iter().zip(row) {
+            let _ = write!(line, " {cell:<width$}");
+        }
+        let _ = writeln!(w, "{} {}", line, row[3]);
+    }
 }

@@ -774,16 +774,51 @@ fn what_fmi3_has_and_fricsim_does_not_read_yet_is_refused_by_name() {
         VALID_FMI3.replace(old, new)
     };
     let mu = r#"<Float64 name="mu" valueReference="5" causality="parameter" variability="fixed" initial="exact" start="1" min="0"/>"#;
-    // an array
+    let array = |start: &str, dimensions: &str| {
+        with(
+            mu,
+            &format!(
+                r#"<Float64 name="mu" valueReference="5" causality="parameter" variability="fixed" start="{start}">{dimensions}</Float64>"#
+            ),
+        )
+    };
+    // an array sized by a structural parameter, an array of String
+    refused(
+        &array("1 2", r#"<Dimension valueReference="10"/>"#),
+        &[
+            "variable \"mu\" (index 6)",
+            "size is the structural parameter with valueReference 10",
+            "not read yet",
+        ],
+    );
     refused(
         &with(
-            mu,
-            r#"<Float64 name="mu" valueReference="5" causality="parameter" variability="fixed" start="1 2"><Dimension start="2"/></Float64>"#,
+            r#"<Start value="van der Pol"/>"#,
+            r#"<Dimension start="2"/><Start value="a"/><Start value="b"/>"#,
         ),
-        &["variable \"mu\" (index 6)", "array", "not read yet"],
+        &["variable \"label\"", "String array", "not read yet"],
     );
-    // the types without an FMI 2.0 counterpart
-    for t in ["Float32", "Int8", "UInt64", "Binary"] {
+    // what no array can be
+    refused(
+        &array("1 2 3", r#"<Dimension start="2"/>"#),
+        &[
+            "variable \"mu\"",
+            "start has 3 values for the 2 elements of the array (dimensions 2)",
+        ],
+    );
+    refused(
+        &array("1 2", r#"<Dimension start="2"/><Dimension/>"#),
+        &["<Dimension> has either a start or a valueReference attribute"],
+    );
+    refused(
+        &array("1", r#"<Dimension start="1000"/><Dimension start="1000"/>"#),
+        &[
+            "1000000 elements (dimensions 1000 × 1000)",
+            "at most 100000 array elements",
+        ],
+    );
+    // the types fricsim does not read
+    for t in ["Binary", "Clock"] {
         refused(
             &with(
                 mu,
@@ -794,7 +829,7 @@ fn what_fmi3_has_and_fricsim_does_not_read_yet_is_refused_by_name() {
             &[
                 "variable \"mu\"",
                 &format!("<{t}> is not read yet"),
-                "Float64, Int32",
+                "Float32, Float64, Int8, UInt8",
             ],
         );
     }
@@ -802,12 +837,32 @@ fn what_fmi3_has_and_fricsim_does_not_read_yet_is_refused_by_name() {
         &with(mu, r#"<Float65 name="mu" valueReference="5"/>"#),
         &["<Float65> is not a variable type of FMI 3.0"],
     );
+    // a value outside its type, or one an f64 cannot hold exactly
+    for (t, start, parts) in [
+        ("UInt8", "256", "start=\"256\" is not a value of type UInt8 (whole numbers from 0 to 255)"),
+        ("Int8", "1.5", "start=\"1.5\" is not a value of type Int8 (whole numbers from -128 to 127)"),
+        (
+            "Int64",
+            "9007199254740993",
+            "start=\"9007199254740993\": fricsim holds Int64 values as 64-bit floats, which cannot hold this one exactly",
+        ),
+    ] {
+        refused(
+            &with(
+                mu,
+                &format!(
+                    r#"<{t} name="mu" valueReference="5" causality="parameter" variability="fixed" start="{start}"/>"#
+                ),
+            ),
+            &["variable \"mu\"", parts],
+        );
+    }
     refused(
         &with(
             mu,
             r#"<UInt32 name="n" valueReference="5" causality="structuralParameter" variability="fixed" start="2"/>"#,
         ),
-        &["<UInt32> is not read yet"],
+        &["variable \"n\"", "structural parameters"],
     );
     refused(
         &with(
@@ -870,7 +925,7 @@ fn what_fmi3_has_and_fricsim_does_not_read_yet_is_refused_by_name() {
     );
     refused(
         &with(r#"start="-3""#, r#"start="3000000000""#),
-        &["start=\"3000000000\" is not a 32-bit integer"],
+        &["start=\"3000000000\" is not a value of type Int32"],
     );
     refused(
         &with(
@@ -911,4 +966,267 @@ fn an_fmi3_description_cut_or_changed_anywhere_never_panics() {
             let _ = ModelDescription::parse(text).map_err(|e| e.to_string());
         }
     }
+}
+
+/// FMI 3.0 arrays of fixed size, and the types without an FMI 2.0
+/// counterpart: the value reference 4000000000 is the FMU's largest, so
+/// the elements are numbered above it.
+const ARRAYS_FMI3: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="Arrays" instantiationToken="{a}">
+  <CoSimulation modelIdentifier="Arrays"/>
+  <ModelVariables>
+    <Float64 name="x" valueReference="3" causality="output" initial="exact" start="1 2"><Dimension start="2"/></Float64>
+    <Float64 name="der(x)" valueReference="7" causality="local" derivative="3"><Dimension start="2"/></Float64>
+    <Float64 name="u" valueReference="1" causality="input" start="0"/>
+    <Int16 name="M" valueReference="4000000000" causality="parameter" variability="fixed" start="1 2 3&#10;4 5 6" min="-5">
+      <Dimension start="2"/><Dimension start="3"/>
+    </Int16>
+    <Boolean name="on" valueReference="9" causality="parameter" variability="fixed" start="true false 1"><Dimension start="3"/></Boolean>
+    <Float32 name="f" valueReference="10" causality="parameter" variability="fixed" start="0.5"/>
+    <UInt64 name="big" valueReference="11" causality="parameter" variability="fixed" start="9007199254740992"/>
+    <UInt8 name="bytes" valueReference="12" causality="parameter" variability="tunable" start="255 0"><Dimension start="2"/></UInt8>
+    <Float64 name="none" valueReference="13" causality="parameter" variability="fixed"><Dimension start="0"/></Float64>
+  </ModelVariables>
+  <ModelStructure>
+    <Output valueReference="3" dependencies="1 4000000000"/>
+    <ContinuousStateDerivative valueReference="7"/>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+
+#[test]
+fn fmi3_arrays_are_read_per_element_and_every_type_as_the_kind_that_holds_it() {
+    use fricsim::fmu::model_description::Fmi3Type;
+    let d = ModelDescription::parse(ARRAYS_FMI3).unwrap();
+    let names: Vec<&str> = d.variables.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "x[1]",
+            "x[2]",
+            // the elements of der(x) as FMI 2.0 names them
+            "der(x[1])",
+            "der(x[2])",
+            "u",
+            // row-major: the last index runs fastest
+            "M[1,1]",
+            "M[1,2]",
+            "M[1,3]",
+            "M[2,1]",
+            "M[2,2]",
+            "M[2,3]",
+            "on[1]",
+            "on[2]",
+            "on[3]",
+            "f",
+            "big",
+            "bytes[1]",
+            "bytes[2]",
+        ]
+    );
+    for (i, v) in d.variables.iter().enumerate() {
+        assert_eq!(v.index, i + 1, "{}", v.name);
+    }
+    // each element its own start value, the array's attributes
+    let m21 = d.variable("M[2,1]").unwrap();
+    assert_eq!(
+        m21.kind,
+        VariableKind::Integer {
+            start: Some(4),
+            min: Some(-5),
+            max: None
+        }
+    );
+    assert_eq!(m21.causality, Causality::Parameter);
+    assert_eq!(m21.type_name(), "Int16");
+    let on: Vec<_> = (1..=3)
+        .map(|i| d.variable(&format!("on[{i}]")).unwrap().kind.clone())
+        .collect();
+    assert_eq!(
+        on,
+        [true, false, true].map(|b| VariableKind::Boolean { start: Some(b) })
+    );
+    // the other types as the kind that holds their values
+    let f = d.variable("f").unwrap();
+    assert!(matches!(f.kind, VariableKind::Real { start: Some(s), .. } if s == 0.5));
+    assert_eq!(
+        (f.fmi3_type, f.type_name(), f.element.is_none()),
+        (Some(Fmi3Type::Float32), "Float32", true)
+    );
+    let big = d.variable("big").unwrap();
+    assert!(
+        matches!(big.kind, VariableKind::Real { start: Some(s), .. } if s == 9007199254740992.0)
+    );
+    assert_eq!(big.type_name(), "UInt64");
+    assert!(matches!(
+        d.variable("bytes[1]").unwrap().kind,
+        VariableKind::Integer {
+            start: Some(255),
+            ..
+        }
+    ));
+
+    // the elements' value references are above the FMU's largest, in
+    // order; the FMU's own scalars keep theirs
+    let vrs: Vec<u32> = d.variables.iter().map(|v| v.value_reference).collect();
+    assert_eq!(&vrs[..4], [4000000001, 4000000002, 4000000003, 4000000004]);
+    assert_eq!(vrs[4], 1);
+    assert_eq!(vrs[5..14], (4000000005..4000000014).collect::<Vec<_>>()[..]);
+    assert_eq!(&vrs[14..], [10, 11, 4000000014, 4000000015]);
+    assert_eq!(
+        d.variable_by_value_reference(4000000009).unwrap().name,
+        "M[2,2]"
+    );
+
+    // the arrays, the empty one too
+    let shapes: Vec<(&str, u32, Vec<usize>, u32, usize)> = d
+        .arrays
+        .iter()
+        .map(|a| {
+            (
+                a.name.as_str(),
+                a.value_reference,
+                a.dimensions.clone(),
+                a.first_element,
+                a.first_index,
+            )
+        })
+        .collect();
+    assert_eq!(
+        shapes,
+        [
+            ("x", 3, vec![2], 4000000001, 1),
+            ("der(x)", 7, vec![2], 4000000003, 3),
+            ("M", 4000000000, vec![2, 3], 4000000005, 6),
+            ("on", 9, vec![3], 4000000011, 12),
+            ("bytes", 12, vec![2], 4000000014, 17),
+            ("none", 13, vec![0], 4000000016, 19),
+        ]
+    );
+    let m = &d.arrays[2];
+    assert_eq!((m.len(), m.value_type), (6, Fmi3Type::Int16));
+    assert_eq!(m.element_position(4000000010), Some(5));
+    assert_eq!(m.element_position(4000000011), None);
+    assert_eq!(
+        d.variable("M[1,3]")
+            .unwrap()
+            .element
+            .as_ref()
+            .map(|e| (e.array, e.position)),
+        Some((2, 2))
+    );
+    // the array's name is no variable; the message can say what to name
+    assert!(d.variable("M").is_err());
+    assert_eq!(
+        d.array_hint("M"),
+        "; `M` is an FMI 3.0 array of 6 elements, which are variables one by one: `M[1,1]` … `M[2,3]`"
+    );
+    assert_eq!(d.array_hint("u"), "");
+
+    // der(x[i]) is the derivative of x[i]
+    for i in 1..=2 {
+        assert!(matches!(
+            d.variable(&format!("der(x[{i}])")).unwrap().kind,
+            VariableKind::Real { derivative: Some(k), .. } if k == i
+        ));
+    }
+    // each element of an output is one, depending on every element of
+    // the arrays its array depends on
+    let m_indices: Vec<usize> = (6..=11).collect();
+    let dependencies: Vec<usize> = std::iter::once(5).chain(m_indices).collect();
+    assert_eq!(
+        d.outputs,
+        [1, 2].map(|index| Unknown {
+            index,
+            dependencies: Some(dependencies.clone())
+        })
+    );
+
+    // a derivative must be what its state is, an array or a scalar
+    refused(
+        &ARRAYS_FMI3.replace(
+            r#"<Float64 name="der(x)" valueReference="7" causality="local" derivative="3"><Dimension start="2"/></Float64>"#,
+            r#"<Float64 name="der(x)" valueReference="7" causality="local" derivative="3"/>"#,
+        ),
+        &[
+            "variable \"der(x)\" (index 2)",
+            "derivative=\"3\" names an array of 2 elements, but this variable is a scalar",
+        ],
+    );
+}
+
+/// The element value references start at 2³¹ when the FMU's own are
+/// below it, and where the FMU's reach the top, nothing is left for them.
+#[test]
+fn fmi3_element_value_references_never_meet_the_fmus() {
+    let low = ARRAYS_FMI3.replace("4000000000", "40");
+    let d = ModelDescription::parse(&low).unwrap();
+    assert_eq!(d.arrays[0].first_element, 1 << 31);
+    assert_eq!(d.variable("x[1]").unwrap().value_reference, 1 << 31);
+    assert_eq!(d.variable("M[1,1]").unwrap().value_reference, (1 << 31) + 4);
+    refused(
+        &ARRAYS_FMI3.replace("4000000000", "4294967290"),
+        &[
+            "the FMU's value references reach 4294967290",
+            "no room for the value references fricsim gives the 15 array elements",
+        ],
+    );
+}
+
+/// An FMI 3.0 description at the limits is read or refused, never runs
+/// the reader out of memory or into an overflow: a size 0 next to sizes
+/// whose product passes `usize` is an empty array; the element limit
+/// counts all arrays together; outputs whose dependencies would be more
+/// than the reader keeps (an output of 3000 elements depending on an
+/// input of 3000) keep none, which says they may depend on everything.
+#[test]
+fn fmi3_arrays_at_the_limits_are_read_or_refused_without_running_out() {
+    let description = |variables: &str, structure: &str| {
+        format!(
+            r#"<fmiModelDescription fmiVersion="3.0" modelName="M" instantiationToken="{{t}}">
+  <CoSimulation modelIdentifier="M"/>
+  <ModelVariables>{variables}</ModelVariables>
+  <ModelStructure>{structure}</ModelStructure>
+</fmiModelDescription>"#
+        )
+    };
+    let empty = description(
+        r#"<Float64 name="e" valueReference="1" causality="parameter" variability="fixed">
+             <Dimension start="100000"/><Dimension start="100000"/><Dimension start="100000"/>
+             <Dimension start="100000"/><Dimension start="0"/></Float64>
+           <Float64 name="after" valueReference="2" causality="parameter" variability="fixed" start="1"/>"#,
+        "",
+    );
+    let d = ModelDescription::parse(&empty).unwrap();
+    assert_eq!((d.arrays[0].len(), d.variables.len()), (0, 1));
+    assert_eq!(d.variables[0].name, "after");
+
+    let two = description(
+        r#"<Float64 name="a" valueReference="1" causality="parameter" variability="fixed"><Dimension start="60000"/></Float64>
+           <Float64 name="b" valueReference="2" causality="parameter" variability="fixed"><Dimension start="60000"/></Float64>"#,
+        "",
+    );
+    refused(
+        &two,
+        &[
+            "variable \"b\" (index 2)",
+            "the array has 60000 elements",
+            "at most 100000 array elements per FMU",
+        ],
+    );
+
+    let wide = description(
+        r#"<Float64 name="u" valueReference="1" causality="input"><Dimension start="3000"/></Float64>
+           <Float64 name="y" valueReference="2" causality="output"><Dimension start="3000"/></Float64>
+           <Float64 name="s" valueReference="3" causality="output"/>"#,
+        r#"<Output valueReference="2" dependencies="1"/><Output valueReference="3" dependencies="1"/>"#,
+    );
+    let d = ModelDescription::parse(&wide).unwrap();
+    assert_eq!(d.outputs.len(), 3001);
+    assert!(d.outputs[..3000].iter().all(|o| o.dependencies.is_none()));
+    // what is within the limit is kept
+    assert_eq!(
+        d.outputs[3000].dependencies.as_deref(),
+        Some(&(1..=3000).collect::<Vec<usize>>()[..])
+    );
 }

@@ -246,7 +246,8 @@ fn check_signal(signal: &str, fmus: &[(String, Fmu)], names: &[String]) -> Resul
     })?;
     let var = fmu.variable(v).map_err(|_| {
         format!(
-            "signal `{signal}`: `{c}` has no variable `{v}` (outputs: {}; inputs: {})",
+            "signal `{signal}`: `{c}` has no variable `{v}`{} (outputs: {}; inputs: {})",
+            fmu.description().array_hint(v),
             names_with(fmu, Causality::Output),
             names_with(fmu, Causality::Input)
         )
@@ -266,9 +267,10 @@ fn check_connector(c: &ComponentDef, k: &ConnectorDef, fmu: &Fmu) -> Result<(), 
         error(
             &k.location,
             format!(
-                "{} has no variable `{}` ({}s: {})",
+                "{} has no variable `{}`{} ({}s: {})",
                 c.source_text,
                 k.name,
+                fmu.description().array_hint(&k.name),
                 k.kind.as_str(),
                 names_with(fmu, k.kind.causality())
             ),
@@ -326,10 +328,11 @@ fn check_parameter(p: &ParameterDef, c: &ComponentDef, fmu: &Fmu) -> Result<(), 
         error(
             &p.location,
             format!(
-                "component `{}` ({}) has no variable `{}` (parameters: {}; inputs: {})",
+                "component `{}` ({}) has no variable `{}`{} (parameters: {}; inputs: {})",
                 c.name,
                 c.source_text,
                 p.variable,
+                fmu.description().array_hint(&p.variable),
                 names_with(fmu, Causality::Parameter),
                 names_with(fmu, Causality::Input)
             ),

@@ -6,8 +6,12 @@
 //! method is one `match` on the FMI version (static dispatch, inlined:
 //! the per-step calls of the Jacobi master and the strong-coupling
 //! iterations go through here); the system and the masters name no
-//! version. FMI 3.0's Float64, Int32 and Boolean are FMI 2.0's Real,
-//! Integer and Boolean here.
+//! version. Value references are the model description's: an FMI 3.0
+//! instance takes its arrays as their elements and every FMI 3.0 type as
+//! the kind that holds it (`Float64`, `Float32`, … as Real; `Int8` …
+//! `Int32` and `Enumeration` as Integer; see
+//! [`crate::fmu::model_description::Fmi3Type::kind_name`]), and finds
+//! where the FMU holds each.
 //!
 //! The [`ComponentInstance::initialize`] call is FMI 2.0's
 //! `fmi2SetupExperiment` + `fmi2EnterInitializationMode` (after
@@ -57,7 +61,7 @@ impl ComponentInstance {
     pub fn get_real(&mut self, vrs: &[ValueReference], values: &mut [f64]) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.get_real(vrs, values).map(drop),
-            ComponentInstance::Fmi3(i) => i.get_float64(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.get_real(vrs, values).map(drop),
         }
     }
 
@@ -65,7 +69,7 @@ impl ComponentInstance {
     pub fn set_real(&mut self, vrs: &[ValueReference], values: &[f64]) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.set_real(vrs, values).map(drop),
-            ComponentInstance::Fmi3(i) => i.set_float64(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.set_real(vrs, values).map(drop),
         }
     }
 
@@ -77,7 +81,7 @@ impl ComponentInstance {
     ) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.get_integer(vrs, values).map(drop),
-            ComponentInstance::Fmi3(i) => i.get_int32(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.get_integer(vrs, values).map(drop),
         }
     }
 
@@ -108,7 +112,7 @@ impl ComponentInstance {
     pub fn set_integer(&mut self, vrs: &[ValueReference], values: &[i32]) -> Result<(), FmuError> {
         match self {
             ComponentInstance::Fmi2(i) => i.set_integer(vrs, values).map(drop),
-            ComponentInstance::Fmi3(i) => i.set_int32(vrs, values).map(drop),
+            ComponentInstance::Fmi3(i) => i.set_integer(vrs, values).map(drop),
         }
     }
 

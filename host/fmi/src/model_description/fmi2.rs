@@ -587,6 +587,7 @@ impl RawModelDescription {
             default_experiment: self.default_experiment,
             variables,
             outputs,
+            arrays: Vec::new(),
             by_name,
         })
     }
@@ -703,6 +704,8 @@ impl RawScalarVariable {
             variability,
             initial,
             kind,
+            fmi3_type: None,
+            element: None,
         })
     }
 }

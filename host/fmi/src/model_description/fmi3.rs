@@ -1,13 +1,27 @@
 //! FMI 3.0's `modelDescription.xml` (FMI 3.0.1 §2.4; §4.3.1 for the
 //! `CoSimulation` element), read into the version-neutral types of
-//! [`super`], as far as they reach: scalar variables of the types that
-//! have an FMI 2.0 counterpart (`Float64` as `Real`, `Int32` as
-//! `Integer`, `Boolean`, `String`, `Enumeration`), the Co-Simulation
-//! capabilities, units, log categories, the default experiment and the
-//! outputs of `ModelStructure`. What has no counterpart yet is refused by
-//! name rather than read wrongly: an array (a `<Dimension>`), a structural
-//! parameter, and the types `Float32`, `Int8`…`UInt64` but `Int32`,
-//! `Binary` and `Clock`.
+//! [`super`]: the variables of every type but `Binary` and `Clock`, each
+//! as the FMI 2.0 kind that holds its values (`Float64` and `Float32` as
+//! `Real`, `Int8` … `Int32` as `Integer`, `UInt32`, `Int64` and `UInt64`
+//! as `Real`, which holds a 64-bit value only if it is exact in an `f64`:
+//! [`Fmi3Type::kind_name`]), with the FMI 3.0 type in
+//! [`Variable::fmi3_type`]; the Co-Simulation capabilities, units, log
+//! categories, the default experiment and the outputs of
+//! `ModelStructure`.
+//!
+//! Arrays of fixed size (`<Dimension start="…"/>`) are expanded here into
+//! one variable per element, named by FMI's structured naming (`k[1]`,
+//! `A[2,3]`: 1-based, row-major; the elements of `der(x)` are
+//! `der(x[1])`, … as FMI 2.0 names them), each with its start value from
+//! the array's space-separated `start` list and with a value reference
+//! of fricsim's that cannot be one of the FMU's ([`Array`]); what names
+//! the array (`derivative`, `ModelStructure`) names each element. The
+//! rest of fricsim sees scalars; the instance maps an element back to its
+//! array ([`crate::Fmi3Instance`]).
+//!
+//! Refused by name rather than read wrongly: a structural parameter, an
+//! array sized by one (`<Dimension valueReference="…"/>`), an array of
+//! `String`, and the types `Binary` and `Clock`.
 //!
 //! Where FMI 3.0 differs from FMI 2.0 in what is read here:
 //! - the root's `instantiationToken` is FMI 2.0's `guid`;
@@ -24,20 +38,31 @@
 //!   gone (read as false);
 //! - event indicators are `<EventIndicator>` elements of `ModelStructure`.
 
+use super::element_count;
 use super::xml::{Document, ElementAt, Root};
 use super::{
     check_unit, choice, combination_allowed, default_experiment, index_variables, invalid,
-    is_c_identifier, log_category, output_unknown, required, unit_with_declared_type, Causality,
-    CoSimulation, Initial, ModelDescription, ValueReference, Variability, Variable, VariableKind,
+    is_c_identifier, list, log_category, output_unknown, required, unit_with_declared_type, Array,
+    ArrayElement, Causality, CoSimulation, Fmi3Type, Initial, ModelDescription, ValueReference,
+    Variability, Variable, VariableKind, ELEMENT_VALUE_REFERENCES,
 };
 use crate::error::FmuError;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
-/// The types of FMI 3.0 variables, and whether they are read.
-const READ_TYPES: &[&str] = &["Float64", "Int32", "Boolean", "String", "Enumeration"];
-const OTHER_TYPES: &[&str] = &[
-    "Float32", "Int8", "UInt8", "Int16", "UInt16", "UInt32", "Int64", "UInt64", "Binary", "Clock",
-];
+/// The types of FMI 3.0 variables that are not read.
+const OTHER_TYPES: &[&str] = &["Binary", "Clock"];
+
+/// The most array elements one model description may expand into: each
+/// is a variable of its own, so a `<Dimension start="…"/>` of a billion
+/// is refused here, not as an allocation failure.
+pub const MAX_ARRAY_ELEMENTS: usize = 100_000;
+
+/// The most dependencies the outputs keep, all together: an output array
+/// of n elements that depends on arrays of m elements has n·m. Past it an
+/// output's dependencies are left out (`None`: it may depend on every
+/// known, what is assumed of an output that does not list them), rather
+/// than filling the memory.
+pub const MAX_DEPENDENCIES: usize = 4_000_000;
 
 /// The rest of an FMI 3.0 document whose root (`fmiVersion` = `version`)
 /// has been read.
@@ -187,7 +212,8 @@ fn element(
             Scope::Variable
         }
         (Scope::Variable, "Dimension") => {
-            last_variable(raw).dimensions += 1;
+            let dimension = dimension(e, at)?;
+            last_variable(raw).dimensions.push(dimension);
             Scope::Skip
         }
         (Scope::Variable, "Start") => {
@@ -213,11 +239,37 @@ fn element(
             Scope::Skip
         }
         (Scope::ModelStructure, "EventIndicator") => {
-            raw.event_indicators += 1;
+            let vr = required(e, at, "valueReference")?;
+            raw.event_indicators.push(at.number("valueReference", &vr)?);
             Scope::Skip
         }
         _ => Scope::Skip,
     })
+}
+
+/// A `<Dimension>` (FMI 3.0.1 §2.4.7.4): its size given as `start`, or
+/// by the structural parameter whose `valueReference` it names.
+fn dimension(
+    e: &quick_xml::events::BytesStart<'_>,
+    at: &ElementAt<'_>,
+) -> Result<RawDimension, FmuError> {
+    let (mut start, mut vr) = (None, None);
+    at.attributes(e, |key, value| {
+        match key {
+            "start" => start = Some(at.number::<u64>(key, &value)?),
+            "valueReference" => vr = Some(at.number(key, &value)?),
+            _ => {}
+        }
+        Ok(())
+    })?;
+    match (start, vr) {
+        (Some(size), None) => Ok(RawDimension::Fixed(size)),
+        (None, Some(vr)) => Ok(RawDimension::Structural(vr)),
+        _ => Err(at.error(
+            "a <Dimension> has either a start or a valueReference attribute (FMI 3.0.1 §2.4.7.4)"
+                .to_string(),
+        )),
+    }
 }
 
 fn last_variable(raw: &mut Raw) -> &mut RawVariable {
@@ -325,7 +377,17 @@ struct Raw {
     structure_seen: bool,
     /// `<Output>`s: value reference and `dependencies` as written.
     outputs: Vec<(ValueReference, Option<String>)>,
-    event_indicators: u32,
+    /// `<EventIndicator>`s: value references.
+    event_indicators: Vec<ValueReference>,
+}
+
+/// A `<Dimension>` as written.
+#[derive(Clone, Copy)]
+enum RawDimension {
+    /// `start="n"`: a fixed size.
+    Fixed(u64),
+    /// `valueReference="vr"`: the size is the structural parameter `vr`.
+    Structural(ValueReference),
 }
 
 #[derive(Default)]
@@ -346,8 +408,8 @@ struct RawVariable {
     /// `derivative`: the value reference of the state this is the
     /// derivative of.
     derivative: Option<ValueReference>,
-    /// `<Dimension>` children: an array when there is one.
-    dimensions: usize,
+    /// `<Dimension>` children, outermost first: an array when there is one.
+    dimensions: Vec<RawDimension>,
     /// `<Start value="…"/>` children (`String`, `Binary`).
     start_elements: Vec<String>,
 }
@@ -376,7 +438,7 @@ impl Raw {
                 "the <ModelVariables> element is missing",
             )
         })?;
-        // value reference → 1-based index, for derivative and ModelStructure
+        // value reference → 1-based index in ModelVariables as written
         let mut by_vr = HashMap::with_capacity(raw_variables.len());
         for (i, v) in raw_variables.iter().enumerate() {
             if let Some(vr) = v.value_reference {
@@ -391,43 +453,83 @@ impl Raw {
                 }
             }
         }
-        let variables = raw_variables
+        let context = Context {
+            units: self.units.as_deref(),
+            types: self.types.as_ref(),
+            by_vr: &by_vr,
+        };
+        let mut elements_left = MAX_ARRAY_ELEMENTS;
+        let declared = raw_variables
             .into_iter()
             .enumerate()
-            .map(|(i, raw)| raw.validate(i + 1, self.units.as_deref(), self.types.as_ref(), &by_vr))
+            .map(|(i, raw)| raw.validate(i + 1, &context, &mut elements_left))
             .collect::<Result<Vec<_>, _>>()?;
+        let Expanded {
+            variables,
+            arrays,
+            indices,
+        } = expand(declared)?;
         let (variables, by_name) = index_variables(variables)?;
 
         let mut outputs = Vec::with_capacity(self.outputs.len());
+        let mut dependencies_left = MAX_DEPENDENCIES;
         for (i, (vr, dependencies)) in self.outputs.into_iter().enumerate() {
             let location = format!("ModelStructure/Output[{}] (valueReference {vr})", i + 1);
-            let index = |vr: ValueReference, what: &str| {
-                by_vr.get(&vr).copied().ok_or_else(|| {
+            let indices_of = |vr: ValueReference, what: &str| {
+                indices.get(&vr).cloned().ok_or_else(|| {
                     invalid(
                         &location,
                         format!("{what} {vr} is not the value reference of a variable"),
                     )
                 })
             };
-            let own = index(vr, "valueReference")?;
+            let own = indices_of(vr, "valueReference")?;
+            // an array's dependencies are those of each element (FMI 3.0
+            // says which arrays, not which of their elements)
             let dependencies = match dependencies {
                 None => None,
-                Some(text) => Some(
-                    text.split_whitespace()
-                        .map(|word| {
-                            let vr = word.parse().map_err(|_| {
-                                invalid(
-                                    &location,
-                                    format!("dependency \"{word}\" is not a value reference"),
-                                )
-                            })?;
-                            index(vr, "dependency")
-                        })
-                        .collect::<Result<Vec<_>, _>>()?,
-                ),
+                Some(text) => {
+                    let mut all = Some(Vec::new());
+                    for word in text.split_whitespace() {
+                        let vr = word.parse().map_err(|_| {
+                            invalid(
+                                &location,
+                                format!("dependency \"{word}\" is not a value reference"),
+                            )
+                        })?;
+                        let range = indices_of(vr, "dependency")?;
+                        if let Some(kept) = &mut all {
+                            if kept.len() + range.len() > dependencies_left {
+                                all = None;
+                            } else {
+                                kept.extend(range);
+                            }
+                        }
+                    }
+                    match all {
+                        Some(all) if all.len() * own.len() <= dependencies_left => {
+                            dependencies_left -= all.len() * own.len();
+                            Some(all)
+                        }
+                        _ => None,
+                    }
+                }
             };
-            outputs.push(output_unknown(&location, own, dependencies, &variables)?);
+            for index in own {
+                outputs.push(output_unknown(
+                    &location,
+                    index,
+                    dependencies.clone(),
+                    &variables,
+                )?);
+            }
         }
+        // an array of event indicators counts its elements
+        let number_of_event_indicators = self
+            .event_indicators
+            .iter()
+            .map(|vr| indices.get(vr).map_or(1, |i| i.len()))
+            .sum::<usize>();
 
         Ok(ModelDescription {
             fmi_version: header.fmi_version,
@@ -440,25 +542,177 @@ impl Raw {
             generation_date_and_time: header.generation_date_and_time,
             co_simulation,
             model_exchange: self.model_exchange,
-            number_of_event_indicators: self.event_indicators,
+            number_of_event_indicators: u32::try_from(number_of_event_indicators)
+                .unwrap_or(u32::MAX),
             unit_definitions: self.units,
             log_categories: self.log_categories.unwrap_or_default(),
             default_experiment: self.default_experiment,
             variables,
             outputs,
+            arrays,
             by_name,
         })
     }
+}
+
+/// What the variables are checked against: the units and types defined,
+/// and every value reference (→ 1-based index as written).
+struct Context<'a> {
+    units: Option<&'a [String]>,
+    /// `TypeDefinitions`: each type's name and, for a Float type, its unit.
+    types: Option<&'a HashMap<String, Option<String>>>,
+    by_vr: &'a HashMap<ValueReference, usize>,
+}
+
+/// One variable element, checked, with the variables fricsim makes of
+/// it: itself for a scalar, its elements for an array (their indices and
+/// value references are given by [`expand`]).
+struct Declared {
+    name: String,
+    location: String,
+    value_reference: ValueReference,
+    value_type: Fmi3Type,
+    /// `Some`: an array of these sizes, `variables` its elements in
+    /// row-major order.
+    dimensions: Option<Vec<usize>>,
+    /// `derivative`: the FMU's value reference of the state this is the
+    /// derivative of.
+    derivative: Option<ValueReference>,
+    variables: Vec<Variable>,
+}
+
+/// The variables of a description, arrays expanded.
+struct Expanded {
+    variables: Vec<Variable>,
+    arrays: Vec<Array>,
+    /// Each FMU value reference → the 1-based indices of the variables
+    /// it became (one for a scalar, the elements of an array).
+    indices: HashMap<ValueReference, std::ops::Range<usize>>,
+}
+
+/// The declared variables in document order, each array replaced by its
+/// elements, which get their value references (from
+/// [`ELEMENT_VALUE_REFERENCES`], or above the FMU's largest, so that none
+/// is the FMU's); `derivative` resolved element by element.
+fn expand(declared: Vec<Declared>) -> Result<Expanded, FmuError> {
+    let mut indices = HashMap::with_capacity(declared.len());
+    let mut next_index = 1;
+    for d in &declared {
+        let n = d.variables.len();
+        indices.insert(d.value_reference, next_index..next_index + n);
+        next_index += n;
+    }
+    let largest = declared.iter().map(|d| d.value_reference).max();
+    let elements: usize = declared
+        .iter()
+        .filter(|d| d.dimensions.is_some())
+        .map(|d| d.variables.len())
+        .sum();
+    let first = u64::from(ELEMENT_VALUE_REFERENCES).max(largest.map_or(0, |l| u64::from(l) + 1));
+    if first + elements as u64 > u64::from(u32::MAX) + 1 {
+        return Err(invalid(
+            "<ModelVariables>",
+            format!(
+                "the FMU's value references reach {}, which leaves no room for the value \
+                 references fricsim gives the {elements} array elements (above the FMU's own)",
+                largest.unwrap_or(0)
+            ),
+        ));
+    }
+    // (u64: after the last element it may be 2³², one past the last value reference)
+    let mut next_element = first;
+    let array_vrs: HashSet<ValueReference> = declared
+        .iter()
+        .filter(|d| d.dimensions.is_some())
+        .map(|d| d.value_reference)
+        .collect();
+
+    let mut variables = Vec::with_capacity(next_index - 1);
+    let mut arrays = Vec::new();
+    for d in declared {
+        let first_index = variables.len() + 1;
+        let derivatives = match d.derivative {
+            None => None,
+            Some(vr) => Some(derivative_indices(&d, vr, &indices, &array_vrs)?),
+        };
+        let array = d.dimensions.map(|dimensions| {
+            arrays.push(Array {
+                name: d.name.clone(),
+                value_reference: d.value_reference,
+                value_type: d.value_type,
+                dimensions,
+                first_element: next_element as ValueReference,
+                first_index,
+            });
+            arrays.len() - 1
+        });
+        for (position, mut v) in d.variables.into_iter().enumerate() {
+            v.index = first_index + position;
+            if let (Some(states), VariableKind::Real { derivative, .. }) =
+                (&derivatives, &mut v.kind)
+            {
+                *derivative = Some(states.start + position);
+            }
+            if let Some(array) = array {
+                v.value_reference = (next_element + position as u64) as ValueReference;
+                v.element = Some(ArrayElement { array, position });
+            }
+            variables.push(v);
+        }
+        if let Some(array) = array {
+            next_element += arrays[array].len() as u64;
+        }
+    }
+    Ok(Expanded {
+        variables,
+        arrays,
+        indices,
+    })
+}
+
+/// The indices of the state(s) the variable `d` is the derivative of
+/// (`derivative="vr"`): a scalar's state is a scalar, an array's an array
+/// of as many elements, element by element.
+fn derivative_indices(
+    d: &Declared,
+    vr: ValueReference,
+    indices: &HashMap<ValueReference, std::ops::Range<usize>>,
+    array_vrs: &HashSet<ValueReference>,
+) -> Result<std::ops::Range<usize>, FmuError> {
+    let states = indices.get(&vr).cloned().ok_or_else(|| {
+        invalid(
+            &d.location,
+            format!("derivative=\"{vr}\" is not the value reference of a variable"),
+        )
+    })?;
+    let describe = |array: bool, n: usize| {
+        if array {
+            format!("an array of {n} elements")
+        } else {
+            "a scalar".to_string()
+        }
+    };
+    let (own_array, state_array) = (d.dimensions.is_some(), array_vrs.contains(&vr));
+    if own_array != state_array || states.len() != d.variables.len() {
+        return Err(invalid(
+            &d.location,
+            format!(
+                "derivative=\"{vr}\" names {}, but this variable is {}",
+                describe(state_array, states.len()),
+                describe(own_array, d.variables.len())
+            ),
+        ));
+    }
+    Ok(states)
 }
 
 impl RawVariable {
     fn validate(
         self,
         index: usize,
-        units: Option<&[String]>,
-        types: Option<&HashMap<String, Option<String>>>,
-        by_vr: &HashMap<ValueReference, usize>,
-    ) -> Result<Variable, FmuError> {
+        context: &Context<'_>,
+        elements_left: &mut usize,
+    ) -> Result<Declared, FmuError> {
         let type_name = self.type_name.as_str();
         let name = match self.name {
             Some(n) if !n.is_empty() => n,
@@ -475,22 +729,20 @@ impl RawVariable {
                 &location,
                 format!(
                     "its type <{type_name}> is not read yet (fricsim reads FMI 3.0's {})",
-                    READ_TYPES.join(", ")
+                    Fmi3Type::ALL
+                        .iter()
+                        .map(|t| t.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
             ));
         }
-        if !READ_TYPES.contains(&type_name) {
+        let Some(value_type) = Fmi3Type::parse(type_name) else {
             return Err(invalid(
                 &location,
                 format!("<{type_name}> is not a variable type of FMI 3.0"),
             ));
-        }
-        if self.dimensions > 0 {
-            return Err(invalid(
-                &location,
-                "it is an array (<Dimension>); FMI 3.0 arrays are not read yet",
-            ));
-        }
+        };
         let value_reference = self
             .value_reference
             .ok_or_else(|| invalid(&location, "the valueReference attribute is missing"))?;
@@ -500,13 +752,20 @@ impl RawVariable {
                 "structural parameters (the sizes of arrays) are not read yet",
             ));
         }
+        let dimensions = fixed_dimensions(&self.dimensions, &location, elements_left)?;
+        if dimensions.is_some() && value_type == Fmi3Type::String {
+            return Err(invalid(
+                &location,
+                "it is a String array; FMI 3.0 arrays of String are not read yet",
+            ));
+        }
         let causality = choice(
             self.causality.as_deref(),
             Causality::Local,
             &location,
             "causality",
         )?;
-        let float = type_name == "Float64";
+        let float = matches!(value_type, Fmi3Type::Float64 | Fmi3Type::Float32);
         let default_variability = if float {
             Variability::Continuous
         } else {
@@ -536,92 +795,313 @@ impl RawVariable {
                 ),
             ));
         }
-        let number = |what: &str, text: &Option<String>| -> Result<Option<f64>, FmuError> {
-            text.as_deref()
-                .map(|t| {
-                    t.trim()
-                        .parse::<f64>()
-                        .map_err(|_| invalid(&location, format!("{what}=\"{t}\" is not a number")))
-                })
-                .transpose()
-        };
-        let integer = |what: &str, text: &Option<String>| -> Result<Option<i32>, FmuError> {
-            text.as_deref()
-                .map(|t| {
-                    t.trim().parse::<i32>().map_err(|_| {
-                        invalid(&location, format!("{what}=\"{t}\" is not a 32-bit integer"))
-                    })
-                })
-                .transpose()
-        };
         // (every declared type must exist, FMI 3.0 §2.4.7)
         let unit = unit_with_declared_type(
             self.unit,
             self.declared_type.as_deref(),
-            types,
+            context.types,
             "type",
             &location,
         )?;
-        let kind = match type_name {
-            "Float64" => {
-                check_unit(unit.as_deref(), units, &location)?;
-                let derivative = match self.derivative {
-                    None => None,
-                    Some(vr) => Some(by_vr.get(&vr).copied().ok_or_else(|| {
-                        invalid(
-                            &location,
-                            format!("derivative=\"{vr}\" is not the value reference of a variable"),
-                        )
-                    })?),
-                };
-                VariableKind::Real {
-                    start: number("start", &self.start)?,
-                    unit,
-                    nominal: self.nominal,
-                    min: number("min", &self.min)?,
-                    max: number("max", &self.max)?,
-                    derivative,
+        let mut derivative = None;
+        if float {
+            check_unit(unit.as_deref(), context.units, &location)?;
+            if let Some(vr) = self.derivative {
+                if !context.by_vr.contains_key(&vr) {
+                    return Err(invalid(
+                        &location,
+                        format!("derivative=\"{vr}\" is not the value reference of a variable"),
+                    ));
                 }
+                derivative = Some(vr);
             }
-            "Int32" => VariableKind::Integer {
-                start: integer("start", &self.start)?,
-                min: integer("min", &self.min)?,
-                max: integer("max", &self.max)?,
-            },
-            "Boolean" => VariableKind::Boolean {
-                start: match self.start.as_deref().map(str::trim) {
-                    None => None,
-                    Some("true" | "1") => Some(true),
-                    Some("false" | "0") => Some(false),
-                    Some(t) => {
-                        return Err(invalid(
-                            &location,
-                            format!("start=\"{t}\" is not a boolean"),
-                        ))
-                    }
-                },
-            },
-            "String" => VariableKind::String {
-                start: self.start_elements.into_iter().next(),
-            },
-            _ => VariableKind::Enumeration {
-                declared_type: self.declared_type.ok_or_else(|| {
-                    invalid(&location, "an <Enumeration> needs a declaredType attribute")
-                })?,
-                start: integer("start", &self.start)?,
-                min: integer("min", &self.min)?,
-                max: integer("max", &self.max)?,
-            },
+        }
+        let values = ValueText {
+            location: &location,
+            value_type,
         };
-        Ok(Variable {
+        // the kind of the variable (or of one element) whose start is `start`
+        let kind = |start: Option<&str>| -> Result<VariableKind, FmuError> {
+            use Fmi3Type as T;
+            Ok(match value_type {
+                T::Float64 | T::Float32 => VariableKind::Real {
+                    start: values.float("start", start)?,
+                    unit: unit.clone(),
+                    nominal: self.nominal,
+                    min: values.float("min", self.min.as_deref())?,
+                    max: values.float("max", self.max.as_deref())?,
+                    derivative: None, // set by `expand`
+                },
+                T::Int8 | T::UInt8 | T::Int16 | T::UInt16 | T::Int32 => VariableKind::Integer {
+                    start: values.narrow_integer("start", start)?,
+                    min: values.narrow_integer("min", self.min.as_deref())?,
+                    max: values.narrow_integer("max", self.max.as_deref())?,
+                },
+                T::UInt32 | T::Int64 | T::UInt64 => VariableKind::Real {
+                    start: values.wide_integer("start", start)?,
+                    unit: None,
+                    nominal: None,
+                    min: values.wide_integer("min", self.min.as_deref())?,
+                    max: values.wide_integer("max", self.max.as_deref())?,
+                    derivative: None,
+                },
+                T::Boolean => VariableKind::Boolean {
+                    start: values.boolean("start", start)?,
+                },
+                T::String => VariableKind::String {
+                    start: self.start_elements.first().cloned(),
+                },
+                T::Enumeration => VariableKind::Enumeration {
+                    declared_type: self.declared_type.clone().ok_or_else(|| {
+                        invalid(&location, "an <Enumeration> needs a declaredType attribute")
+                    })?,
+                    start: values.enumeration("start", start)?,
+                    min: values.enumeration("min", self.min.as_deref())?,
+                    max: values.enumeration("max", self.max.as_deref())?,
+                },
+            })
+        };
+        let variable = |name: String, kind: VariableKind| Variable {
             name,
-            index,
+            index, // the elements' by `expand`
             value_reference,
-            description: self.description,
+            description: self.description.clone(),
             causality,
             variability,
             initial,
             kind,
+            fmi3_type: Some(value_type),
+            element: None, // the elements' by `expand`
+        };
+        let variables = match &dimensions {
+            None => vec![variable(name.clone(), kind(self.start.as_deref())?)],
+            Some(dimensions) => {
+                let n = element_count(dimensions);
+                let starts: Vec<Option<&str>> = match self.start.as_deref() {
+                    None => vec![None; n],
+                    Some(text) => {
+                        let words: Vec<&str> = text.split_whitespace().collect();
+                        if words.len() != n {
+                            return Err(invalid(
+                                &location,
+                                format!(
+                                    "start has {} values for the {n} elements of the array \
+                                     (dimensions {}): an array's start lists every element, \
+                                     row-major",
+                                    words.len(),
+                                    shape(dimensions)
+                                ),
+                            ));
+                        }
+                        words.into_iter().map(Some).collect()
+                    }
+                };
+                starts
+                    .into_iter()
+                    .enumerate()
+                    .map(|(position, start)| {
+                        let name = element_name(&name, &element_indices(position, dimensions));
+                        Ok(variable(name, kind(start)?))
+                    })
+                    .collect::<Result<Vec<_>, FmuError>>()?
+            }
+        };
+        Ok(Declared {
+            name,
+            location,
+            value_reference,
+            value_type,
+            dimensions,
+            derivative,
+            variables,
         })
+    }
+}
+
+/// The sizes of an array's `<Dimension>`s (`None` for a scalar), each
+/// fixed, and within what is left of [`MAX_ARRAY_ELEMENTS`].
+fn fixed_dimensions(
+    dimensions: &[RawDimension],
+    location: &str,
+    elements_left: &mut usize,
+) -> Result<Option<Vec<usize>>, FmuError> {
+    if dimensions.is_empty() {
+        return Ok(None);
+    }
+    let mut sizes = Vec::with_capacity(dimensions.len());
+    let mut elements: u64 = 1;
+    for d in dimensions {
+        let size = match *d {
+            RawDimension::Fixed(size) => size,
+            RawDimension::Structural(vr) => {
+                return Err(invalid(
+                    location,
+                    format!(
+                        "it is an array whose size is the structural parameter with \
+                         valueReference {vr} (<Dimension valueReference=\"{vr}\"/>); arrays \
+                         sized by structural parameters are not read yet, only fixed sizes \
+                         (<Dimension start=\"…\"/>)"
+                    ),
+                ))
+            }
+        };
+        elements = elements.saturating_mul(size);
+        sizes.push(usize::try_from(size).unwrap_or(usize::MAX));
+    }
+    if elements > *elements_left as u64 {
+        return Err(invalid(
+            location,
+            format!(
+                "the array has {elements} elements (dimensions {}): fricsim reads at most \
+                 {MAX_ARRAY_ELEMENTS} array elements per FMU, each as a variable of its own",
+                shape(&sizes)
+            ),
+        ));
+    }
+    *elements_left -= elements as usize;
+    Ok(Some(sizes))
+}
+
+/// `3` or `2 × 3`, for messages.
+fn shape(dimensions: &[usize]) -> String {
+    dimensions
+        .iter()
+        .map(usize::to_string)
+        .collect::<Vec<_>>()
+        .join(" × ")
+}
+
+/// The 1-based indices of the element at `position` (row-major: the
+/// last index runs fastest).
+fn element_indices(mut position: usize, dimensions: &[usize]) -> Vec<usize> {
+    let mut indices = vec![0; dimensions.len()];
+    for (index, &size) in indices.iter_mut().zip(dimensions).rev() {
+        *index = position % size + 1;
+        position /= size;
+    }
+    indices
+}
+
+/// The name of an element in FMI's structured naming: `k[2]`, `A[1,3]`;
+/// an element of `der(x)` (or `der(x,2)`) is `der(x[2])` (`der(x[2],2)`),
+/// as FMI 2.0 names the derivative of an element.
+fn element_name(array: &str, indices: &[usize]) -> String {
+    let subscript = format!(
+        "[{}]",
+        indices
+            .iter()
+            .map(usize::to_string)
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    if let Some(inner) = array.strip_prefix("der(").and_then(|r| r.strip_suffix(')')) {
+        let (state, order) = inner.split_at(inner.find(',').unwrap_or(inner.len()));
+        return format!("der({state}{subscript}{order})");
+    }
+    format!("{array}{subscript}")
+}
+
+/// A variable's values as written, read as its type's.
+struct ValueText<'a> {
+    location: &'a str,
+    value_type: Fmi3Type,
+}
+
+impl ValueText<'_> {
+    fn float(&self, what: &str, text: Option<&str>) -> Result<Option<f64>, FmuError> {
+        text.map(|t| {
+            t.trim()
+                .parse::<f64>()
+                .map_err(|_| invalid(self.location, format!("{what}=\"{t}\" is not a number")))
+        })
+        .transpose()
+    }
+
+    /// An integer within the range of the variable's integer type.
+    fn integer(&self, what: &str, t: &str) -> Result<i128, FmuError> {
+        let (low, high) = integer_range(self.value_type);
+        t.trim()
+            .parse::<i128>()
+            .ok()
+            .filter(|v| (low..=high).contains(v))
+            .ok_or_else(|| {
+                invalid(
+                    self.location,
+                    format!(
+                        "{what}=\"{t}\" is not a value of type {} (whole numbers from {low} to {high})",
+                        self.value_type
+                    ),
+                )
+            })
+    }
+
+    /// `Int8` … `Int32`, held as an `i32`.
+    fn narrow_integer(&self, what: &str, text: Option<&str>) -> Result<Option<i32>, FmuError> {
+        text.map(|t| Ok(self.integer(what, t)? as i32)).transpose()
+    }
+
+    /// `UInt32`, `Int64`, `UInt64`, held as an `f64`: only if it holds
+    /// the value exactly.
+    fn wide_integer(&self, what: &str, text: Option<&str>) -> Result<Option<f64>, FmuError> {
+        text.map(|t| {
+            let v = self.integer(what, t)?;
+            let x = v as f64;
+            if x as i128 != v {
+                return Err(invalid(
+                    self.location,
+                    format!(
+                        "{what}=\"{t}\": fricsim holds {} values as 64-bit floats, which \
+                         cannot hold this one exactly",
+                        self.value_type
+                    ),
+                ));
+            }
+            Ok(x)
+        })
+        .transpose()
+    }
+
+    /// An `Enumeration`'s value (`Int64` in FMI 3.0), held as FMI 2.0's
+    /// 32-bit one.
+    fn enumeration(&self, what: &str, text: Option<&str>) -> Result<Option<i32>, FmuError> {
+        text.map(|t| {
+            t.trim().parse::<i32>().map_err(|_| {
+                invalid(
+                    self.location,
+                    format!("{what}=\"{t}\" is not a 32-bit integer"),
+                )
+            })
+        })
+        .transpose()
+    }
+
+    fn boolean(&self, what: &str, text: Option<&str>) -> Result<Option<bool>, FmuError> {
+        match text.map(str::trim) {
+            None => Ok(None),
+            Some("true" | "1") => Ok(Some(true)),
+            Some("false" | "0") => Ok(Some(false)),
+            Some(t) => Err(invalid(
+                self.location,
+                format!(
+                    "{what}=\"{t}\" is not a boolean (one of {})",
+                    list(&["true", "false", "1", "0"])
+                ),
+            )),
+        }
+    }
+}
+
+/// The values of an FMI 3.0 integer type (§2.4.7.5).
+fn integer_range(t: Fmi3Type) -> (i128, i128) {
+    use Fmi3Type as T;
+    match t {
+        T::Int8 => (i8::MIN.into(), i8::MAX.into()),
+        T::UInt8 => (0, u8::MAX.into()),
+        T::Int16 => (i16::MIN.into(), i16::MAX.into()),
+        T::UInt16 => (0, u16::MAX.into()),
+        T::UInt32 => (0, u32::MAX.into()),
+        T::Int64 | T::Enumeration => (i64::MIN.into(), i64::MAX.into()),
+        T::UInt64 => (0, u64::MAX.into()),
+        _ => (i32::MIN.into(), i32::MAX.into()),
     }
 }

@@ -6,12 +6,12 @@
 //! read here too, to pick the reader of its `fmiVersion`:
 //!
 //! - [`fmi2`]: FMI 2.0 (FMI 2.0.4 §2.2, §4.3.1);
-//! - [`fmi3`]: FMI 3.0 (FMI 3.0.1 §2.4, §4.3.1), for its scalar variables
-//!   of the types that have an FMI 2.0 counterpart (`Float64`, `Int32`,
-//!   `Boolean`, `String`, `Enumeration`); an array, a structural
-//!   parameter or another type is refused by name. `fricsim info` shows
-//!   such an FMU; running one needs the FMI 3.0 calls, which the host does
-//!   not make yet ([`crate::instance`] refuses it with a message).
+//! - [`fmi3`]: FMI 3.0 (FMI 3.0.1 §2.4, §4.3.1): its variables of every
+//!   type but `Binary` and `Clock`, each as the FMI 2.0 type that holds
+//!   its values ([`Fmi3Type::kind_name`]), and its arrays of fixed size
+//!   expanded into one variable per element, `name[i]` ([`Array`]); a
+//!   structural parameter, an array sized by one, `Binary` and `Clock`
+//!   are refused by name.
 //!
 //! Parsing is one pass of quick-xml's pull reader over the document
 //! (`xml.rs`: well-formedness, positions, attribute values), which the
@@ -59,10 +59,14 @@ pub struct ModelDescription {
     pub unit_definitions: Option<Vec<String>>,
     pub log_categories: Vec<LogCategory>,
     pub default_experiment: Option<DefaultExperiment>,
-    /// In document order: `variables[i]` has `index == i + 1`.
+    /// In document order (an FMI 3.0 array as its elements, in its
+    /// place): `variables[i]` has `index == i + 1`.
     pub variables: Vec<Variable>,
     /// `ModelStructure/Outputs`.
     pub outputs: Vec<Unknown>,
+    /// FMI 3.0's arrays, in document order: each is in `variables` as its
+    /// elements (empty for FMI 2.0, which has none).
+    pub arrays: Vec<Array>,
     by_name: HashMap<String, usize>,
 }
 
@@ -105,7 +109,9 @@ pub struct DefaultExperiment {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Variable {
     pub name: String,
-    /// 1-based position in `ModelVariables`, as used by `ModelStructure`.
+    /// 1-based position in [`ModelDescription::variables`]: in
+    /// `ModelVariables`, as FMI 2.0's `ModelStructure` uses it; for FMI 3.0
+    /// with the arrays expanded into their elements.
     pub index: usize,
     pub value_reference: ValueReference,
     pub description: Option<String>,
@@ -113,12 +119,102 @@ pub struct Variable {
     pub variability: Variability,
     pub initial: Option<Initial>,
     pub kind: VariableKind,
+    /// FMI 3.0: the type the FMU declares (`None` for FMI 2.0, whose type
+    /// is `kind`'s): which `fmi3Get…`/`fmi3Set…` reach the value.
+    pub fmi3_type: Option<Fmi3Type>,
+    /// FMI 3.0: the array this variable is an element of, if it is one
+    /// (its `value_reference` is then fricsim's, not the FMU's).
+    pub element: Option<ArrayElement>,
 }
 
-/// The type of a variable with its attributes, by FMI 2.0's names: FMI
-/// 3.0's `Float64` is `Real` and its `Int32` is `Integer` (the types
-/// issue 45 imports); its other types (`Float32`, the other integer
-/// widths, `Binary`, `Clock`) and arrays will need variants of their own.
+impl Variable {
+    /// The type's name in the FMU's own FMI version: `Real`, `Integer`, …
+    /// for FMI 2.0; `Float64`, `UInt8`, … for FMI 3.0.
+    pub fn type_name(&self) -> &'static str {
+        match self.fmi3_type {
+            Some(t) => t.as_str(),
+            None => self.kind.type_name(),
+        }
+    }
+}
+
+/// An FMI 3.0 array variable of fixed size (a variable with
+/// `<Dimension start="…"/>` children, FMI 3.0.1 §2.4.7.4), which fricsim
+/// reads per element: each element is a [`Variable`] of its own, named
+/// with FMI's structured naming (`x_table[1]`, `A[1,2]`: 1-based indices,
+/// the last running fastest, i.e. row-major as the FMU lays the values
+/// out), with its own start value and a value reference that fricsim
+/// gives it (see [`Array::first_element`]). An instance reads and writes
+/// the elements through the array's own value reference
+/// ([`crate::Fmi3Instance`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Array {
+    /// The name the FMU gives the array (`x_table`).
+    pub name: String,
+    /// The FMU's value reference of the whole array.
+    pub value_reference: ValueReference,
+    pub value_type: Fmi3Type,
+    /// The size of each dimension, outermost first.
+    pub dimensions: Vec<usize>,
+    /// The value reference fricsim gives the first element (in row-major
+    /// order); the others follow it. Element value references are
+    /// numbered from [`ELEMENT_VALUE_REFERENCES`] (2³¹), or from just above
+    /// the FMU's largest value reference if the FMU uses that range too,
+    /// array after array in document order, so that none is one of the
+    /// FMU's own.
+    pub first_element: ValueReference,
+    /// The 1-based index of the first element in `ModelVariables` (as
+    /// fricsim has it, elements expanded); the others follow it.
+    pub first_index: usize,
+}
+
+impl Array {
+    /// The number of elements (the product of the dimensions).
+    pub fn len(&self) -> usize {
+        element_count(&self.dimensions)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Whether `vr` is the value reference of one of its elements; which.
+    pub fn element_position(&self, vr: ValueReference) -> Option<usize> {
+        let position = vr.checked_sub(self.first_element)? as usize;
+        (position < self.len()).then_some(position)
+    }
+}
+
+/// The number of elements of an array of `dimensions`: their product,
+/// which the reader has kept within [`fmi3::MAX_ARRAY_ELEMENTS`] unless a
+/// size is 0 (the sizes before it may then multiply past `usize`, and the
+/// count is 0).
+pub(crate) fn element_count(dimensions: &[usize]) -> usize {
+    dimensions
+        .iter()
+        .try_fold(1usize, |n, &d| n.checked_mul(d))
+        .unwrap_or(0)
+}
+
+/// Where the first element value reference fricsim gives the elements of
+/// FMI 3.0 arrays is ([`Array::first_element`]): 2³¹, above the value
+/// references exporters number from 0.
+pub const ELEMENT_VALUE_REFERENCES: ValueReference = 1 << 31;
+
+/// Which element of an [`Array`] a [`Variable`] is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ArrayElement {
+    /// Index into [`ModelDescription::arrays`].
+    pub array: usize,
+    /// 0-based position in the array's values, row-major.
+    pub position: usize,
+}
+
+/// The type of a variable with its attributes, by FMI 2.0's names: the
+/// core's view of a value. An FMI 3.0 variable is the kind that holds its
+/// type's values ([`Fmi3Type::kind_name`]: `Float64` and `Float32` are
+/// `Real`, `Int8` … `Int32` are `Integer`, …), with its FMI 3.0 type in
+/// [`Variable::fmi3_type`].
 #[derive(Clone, Debug, PartialEq)]
 pub enum VariableKind {
     Real {
@@ -284,6 +380,57 @@ xml_enum!(
     }
 );
 
+xml_enum!(
+    /// The types of FMI 3.0 variables that fricsim reads (FMI 3.0.1
+    /// §2.4.7; not `Binary` and `Clock`). Each is held by the FMI 2.0
+    /// type of the core that holds all its values ([`Fmi3Type::kind_name`]).
+    Fmi3Type {
+        Float32 = "Float32",
+        Float64 = "Float64",
+        Int8 = "Int8",
+        UInt8 = "UInt8",
+        Int16 = "Int16",
+        UInt16 = "UInt16",
+        Int32 = "Int32",
+        UInt32 = "UInt32",
+        Int64 = "Int64",
+        UInt64 = "UInt64",
+        Boolean = "Boolean",
+        String = "String",
+        Enumeration = "Enumeration",
+    }
+);
+
+impl Fmi3Type {
+    /// The [`VariableKind`] that holds the values: `Real` (an `f64`) for
+    /// the floats and for the integers `i32` cannot hold (`UInt32`,
+    /// `Int64`, `UInt64`: every `UInt32` exactly, a 64-bit value only if
+    /// an `f64` holds it exactly, else refused where it is met), `Integer`
+    /// for the narrower integers, and `Boolean`, `String`, `Enumeration`
+    /// as themselves (an FMI 3.0 `Enumeration` is read and written as
+    /// `Int64`, and held as FMI 2.0's 32-bit one).
+    pub fn kind_name(self) -> &'static str {
+        use Fmi3Type as T;
+        match self {
+            T::Float32 | T::Float64 | T::UInt32 | T::Int64 | T::UInt64 => "Real",
+            T::Int8 | T::UInt8 | T::Int16 | T::UInt16 | T::Int32 => "Integer",
+            T::Boolean => "Boolean",
+            T::String => "String",
+            T::Enumeration => "Enumeration",
+        }
+    }
+
+    /// Whether `fmi3Get<Type>` of it is that of the [`VariableKind`] that
+    /// holds it (`Float64` for `Real`, `Int32` for `Integer`, `Boolean`,
+    /// `String`): the value passes as it is, with no conversion.
+    pub fn is_kind_native(self) -> bool {
+        matches!(
+            self,
+            Fmi3Type::Float64 | Fmi3Type::Int32 | Fmi3Type::Boolean | Fmi3Type::String
+        )
+    }
+}
+
 impl ModelDescription {
     /// Whether the FMU is an FMI 3.0 one (`fmiVersion="3.0"`): its binary
     /// exports `fmi3…` functions and lives in `binaries/x86_64-linux`.
@@ -325,6 +472,28 @@ impl ModelDescription {
             "2.0" => fmi2::read(document, root, version),
             "3.0" => fmi3::read(document, root, version),
             _ => Err(FmuError::UnsupportedFmiVersion { found: version }),
+        }
+    }
+
+    /// The variable whose value reference is `vr` (an FMI 3.0 array's
+    /// element by the value reference fricsim gives it), if there is one.
+    pub fn variable_by_value_reference(&self, vr: ValueReference) -> Option<&Variable> {
+        self.variables.iter().find(|v| v.value_reference == vr)
+    }
+
+    /// For a name that is no variable's: if it is an FMI 3.0 array's (`k`),
+    /// what to name instead, to add to a message (``; `k` is an FMI 3.0
+    /// array of 3 elements, which are variables one by one: `k[1]` …
+    /// `k[3]` ``); "" for any other name.
+    pub fn array_hint(&self, name: &str) -> String {
+        match self.arrays.iter().find(|a| a.name == name) {
+            Some(a) if !a.is_empty() => format!(
+                "; `{name}` is an FMI 3.0 array of {} elements, which are variables one by one: `{}` … `{}`",
+                a.len(),
+                self.variables[a.first_index - 1].name,
+                self.variables[a.first_index + a.len() - 2].name
+            ),
+            _ => String::new(),
         }
     }
 

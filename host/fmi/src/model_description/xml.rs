@@ -95,6 +95,10 @@ impl XmlNumber for u32 {
     const KIND: &'static str = "non-negative integer";
 }
 
+impl XmlNumber for u64 {
+    const KIND: &'static str = "non-negative integer";
+}
+
 impl XmlNumber for usize {
     const KIND: &'static str = "non-negative integer";
 }

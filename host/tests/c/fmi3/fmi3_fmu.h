@@ -6,7 +6,8 @@
  * no variables of), each of which logs why and returns fmi3Error.
  *
  * A model file (bouncing_ball.c, stair.c in this folder) defines
- * MODEL_IDENTIFIER and INSTANTIATION_TOKEN before including this header,
+ * MODEL_IDENTIFIER and INSTANTIATION_TOKEN before including this header
+ * (and OFFERS_EVERY_TYPE if it has variables of every type, feedthrough.c),
  * and a struct `Model` whose first member is a `Base`; the functions every
  * model writes alike are the macros at the end (COMMON_FUNCTIONS,
  * STATE_FUNCTIONS). Written for the
@@ -142,6 +143,9 @@ static fmi3Status fail(Base *b, const char *format, ...) {
     NOT_OFFERED(fmi3Set##Type, const fmi3ValueReference vr[], size_t n, const fmi3##Type v[],      \
                 size_t nv)
 
+/* (a model with variables of these types defines OFFERS_EVERY_TYPE
+ * before including this header, and the functions itself) */
+#ifndef OFFERS_EVERY_TYPE
 NOT_OFFERED_GET_SET(Float32)
 NOT_OFFERED_GET_SET(Int8)
 NOT_OFFERED_GET_SET(UInt8)
@@ -150,6 +154,7 @@ NOT_OFFERED_GET_SET(UInt16)
 NOT_OFFERED_GET_SET(UInt32)
 NOT_OFFERED_GET_SET(Int64)
 NOT_OFFERED_GET_SET(UInt64)
+#endif
 NOT_OFFERED(fmi3GetBinary, const fmi3ValueReference vr[], size_t n, size_t sizes[], fmi3Binary v[],
             size_t nv)
 NOT_OFFERED(fmi3SetBinary, const fmi3ValueReference vr[], size_t n, const size_t sizes[],
