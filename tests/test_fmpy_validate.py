@@ -19,7 +19,9 @@ MODEL_EXCHANGE_STATES = {"Dahl": (["F_dahl"], 1), "LuGre": (["z"], 1), "ResetInt
                   "Bristle2D": (["z1", "z2"], 1), "BlimanSorine": (["x1", "x2"], 1),
                   "ElastoPlastic": (["z"], 5),
                   "MaxwellSlip": ([f"F_element[{i}]" for i in range(1, 101)], 101),
-                  "GMS": ([f"F_element[{i}]" for i in range(1, 101)], 101)}
+                  "GMS": ([f"F_element[{i}]" for i in range(1, 101)], 101),
+                  # no continuous states: its switches are its events
+                  "Classical": ([], 4)}
 
 EXPECTED = {
     "Dahl": {"input": {"v"}, "output": {"F", "z", "sliding", "P_diss", "E_stored"}, "parameter": {"sigma", "Fc", "alpha", "F_offset"},
@@ -92,7 +94,8 @@ def test_declared_variables_and_capabilities(name):
     if name == "LuGre":
         assert sum(1 for v in md.modelVariables if v.name.startswith("x_table[")) >= 16
     # Model Exchange beside Co-Simulation, same binary, for the laws that
-    # are ODEs (issue 22); the bristle law and the rigs are Co-Simulation only
+    # are ODEs (issue 22) and the classical law (events only); the bristle
+    # law and the rigs are Co-Simulation only
     me = md.modelExchange
     if name in shipped.MODEL_EXCHANGE:
         states, indicators = MODEL_EXCHANGE_STATES[name]

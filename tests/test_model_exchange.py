@@ -572,3 +572,112 @@ def test_element_laws_events_at_each_switch_and_model_exchange_equals_co_simulat
     error = np.max(np.abs(me[:, 0] - cs[:, 0])) / level
     print(f"{name}: Model Exchange - Co-Simulation, {error:.2e} of the level")
     assert error <= (1e-7 if name == "MaxwellSlip" else 1e-5), error
+
+
+# ---- the classical law: events only ----------------------------------------------
+
+def spring_mass_slide(m, k, c, fc, v_a, t0, x0, v0):
+    """The closed form of a mass on a spring pulled at `v_a`, sliding
+    forward against Coulomb + viscous friction `fc + c·v` (Sun et al. 2016
+    eq. 1):  m·x'' + c·x' + k·x = k·v_a·t − fc, from (t0, x0, v0), an
+    underdamped oscillation about x_p(t) = v_a·t − (fc + c·v_a)/k. Gives
+    the functions x(t) and v(t)."""
+    w0 = math.sqrt(k / m)
+    zeta = c / (2 * math.sqrt(k * m))
+    wd = w0 * math.sqrt(1 - zeta ** 2)
+    a = x0 - (v_a * t0 - (fc + c * v_a) / k)     # displacement from x_p
+    b = (v0 - v_a + zeta * w0 * a) / wd          # so that x'(t0) = v0
+
+    def x(t):
+        s = t - t0
+        return v_a * t - (fc + c * v_a) / k + np.exp(-zeta * w0 * s) * (a * np.cos(wd * s) + b * np.sin(wd * s))
+
+    def v(t):
+        s = t - t0
+        e = np.exp(-zeta * w0 * s)
+        return v_a + e * ((-zeta * w0 * a + wd * b) * np.cos(wd * s) + (-zeta * w0 * b - wd * a) * np.sin(wd * s))
+
+    return x, v
+
+
+@pytest.mark.parametrize("fmi_version", ["2.0", "3.0"])
+def test_classical_stick_slip_events_follow_the_closed_form(tmp_path, fmi_version):
+    """Classical.fmu in Model Exchange (no continuous states, four event
+    indicators) on a 1 kg mass pulled through a 2 N/m spring at 0.1 m/s,
+    the mass's ODE in Python, CVode at rtol 1e-10. With vs = 0 (Coulomb +
+    viscous, Sun et al. 2016 eq. 1) every phase has a closed form, and the
+    events must fall where it puts them:
+    - stuck from rest until the spring force reaches Fs: t = Fs/(k·v_a);
+    - breaking away under F = Fs until v = dv: t − t_b = √(2·m·dv/(k·v_a))
+      to first order (the spring force grows as k·v_a·(t − t_b));
+    - sliding: the damped oscillation of `spring_mass_slide` from the state
+      at that event, sample by sample, until v falls back to dv, where the
+      closed form's own crossing is;
+    - stuck again (F = F_app, the net force zero: the mass creeps at the
+      velocity it entered with) until F_app reaches Fs again."""
+    m, k, v_a = 1.0, 2.0, 0.1
+    fc, fs, sigma2, dv = 1.0, 1.5, 0.4, 1e-5
+    parameters = {"Fc": fc, "Fs": fs, "vs": 0.0, "sigma2": sigma2, "dv": dv}
+
+    def rig(t, xe, y):
+        x, v = xe
+        return [v, (k * (v_a * t - x) - y["F"]) / m]
+
+    path = fmu_path("Classical") if fmi_version == "2.0" else DIST / "fmi3" / "Classical.fmu"
+    run = MeRun("Classical", tmp_path, parameters,
+                inputs=lambda t, xe: {"v": xe[1], "F_app": k * (v_a * t - xe[0])},
+                outputs=["F", "F_app"], x0=[0.0, 0.0], nominals=[1.0, 0.1], rhs=rig, rtol=1e-10,
+                path=path)
+    assert run.md.fmiVersion == fmi_version
+    assert run.nf == 0 and run.nz == 4
+    times = np.round(np.arange(0, 20001) * 1e-3, 10)
+    rows = run.run(times)
+    run.close()
+    x, v, f = rows[:, 0], rows[:, 1], rows[:, 2]
+    # (time, which indicator crossed, state after) in order
+    events = [(t, int(np.flatnonzero(roots)[0]), xe) for t, roots, _, xe in run.events]
+    kinds = [i for _, i, _ in events]
+
+    # 1. stuck from rest: x does not move, F = F_app, until F_app = Fs
+    t_break = fs / (k * v_a)
+    assert kinds[0] == 2, f"first event: indicator {kinds[0]} ({events[:3]})"
+    assert abs(events[0][0] - t_break) < 1e-7, f"break-away at {events[0][0]}, closed form {t_break}"
+    before = times < t_break - 1e-3
+    assert np.max(np.abs(x[before])) == 0.0 and np.max(np.abs(v[before])) == 0.0
+    np.testing.assert_allclose(f[before], k * v_a * times[before], rtol=0, atol=1e-12)
+
+    # 2. breaking away under Fs until v = dv
+    t_slide, kind, (x1, v1) = events[1]
+    assert kind == 0 and abs(v1 - dv) < 1e-12
+    t_leave = t_break + math.sqrt(2 * m * dv / (k * v_a))
+    assert abs(t_slide - t_leave) < 1e-3 * (t_leave - t_break), f"{t_slide} vs {t_leave}"
+
+    # 3. sliding: the closed form from the state at the event
+    x_cf, v_cf = spring_mass_slide(m, k, sigma2, fc, v_a, t_slide, x1, v1)
+    t_stick, kind, (x2, v2) = next(e for e in events[2:] if e[1] == 0)
+    assert kind == 0 and abs(v2 - dv) < 1e-12
+    slide = (times > t_slide) & (times < t_stick)
+    assert slide.sum() > 1000, "the slide is too short to check"
+    assert np.max(np.abs(x[slide] - x_cf(times[slide]))) < 1e-7
+    assert np.max(np.abs(v[slide] - v_cf(times[slide]))) < 1e-7
+    np.testing.assert_allclose(f[slide], fc + sigma2 * v[slide], rtol=0, atol=1e-9)
+    # the closed form's own crossing of dv on the way down
+    grid = np.linspace(t_slide + 0.5, t_stick + 0.5, 200001)
+    falling = np.flatnonzero((v_cf(grid[:-1]) >= dv) & (v_cf(grid[1:]) < dv))
+    lo, hi = grid[falling[0]], grid[falling[0] + 1]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if v_cf(mid) >= dv else (lo, mid)
+    assert abs(t_stick - lo) < 1e-7, f"re-stick at {t_stick}, closed form {lo}"
+
+    # 4. stuck again, creeping at the velocity it entered with, until
+    #    F_app = k·(v_a·t − x) reaches Fs again
+    f_app2 = k * (v_a * t_stick - x2)
+    assert abs(f_app2) < fs, f"the contact re-sticks with F_app = {f_app2}"
+    t_break2 = t_stick + (fs - f_app2) / (k * (v_a - v2))
+    t_next, kind, _ = next(e for e in events if e[0] > t_stick + 1e-9 and e[1] in (2, 3))
+    assert kind == 2 and abs(t_next - t_break2) < 1e-6, f"{t_next} vs {t_break2}"
+    stuck = (times > t_stick + 1e-3) & (times < t_break2 - 1e-3)
+    assert stuck.sum() > 100
+    np.testing.assert_allclose(v[stuck], v2, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(f[stuck], rows[stuck, 3], rtol=0, atol=1e-12)  # F = F_app

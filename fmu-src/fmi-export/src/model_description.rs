@@ -194,7 +194,9 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     }
     let _ = writeln!(w, "    </Outputs>");
     let mut initial_unknowns: Vec<usize> = outputs.iter().map(|(i, _)| *i).collect();
-    if let Some(me) = &info.model_exchange {
+    // (a model without continuous states, only event indicators, has no
+    // `<Derivatives>`: the schema wants at least one `<Unknown>` in it)
+    if let Some(me) = info.model_exchange.filter(|me| !me.states.is_empty()) {
         let _ = writeln!(w, "    <Derivatives>");
         for s in me.states {
             let i = s.derivative as usize;

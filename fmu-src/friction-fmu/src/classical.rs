@@ -1,14 +1,18 @@
 //! `Classical.fmu`: Coulomb + viscous + static friction on the Stribeck
 //! curve with Karnopp's zero-velocity band (Sun et al. 2016 eq. 1 and 12;
 //! Thimmalapura 2004 eq. 2.1–2.3; Karnopp 1985; docs/models.md
-//! "Classical"). Co-Simulation only: the law has no state, and its force
-//! follows from the two inputs, the sliding velocity `v` and the force
-//! `F_app` the rest of the system applies to the contact, which a stuck
-//! contact holds up to `Fs`.
+//! "Classical"). The law has no state: its force follows from the two
+//! inputs, the sliding velocity `v` and the force `F_app` the rest of the
+//! system applies to the contact, which a stuck contact holds up to `Fs`.
+//! In Model Exchange it has no continuous state either; its four event
+//! indicators mark the switches, where the force jumps: the band's edges
+//! `v = ±dv` and the static level `F_app = ±Fs`.
 
 use crate::param_err;
-use fmi_export::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
-use friction_laws::classical::{Classical, ClassicalParams};
+use fmi_export::{
+    Capabilities, DefaultExperiment, Model, ModelExchange, ModelInfo, Ode, Values, Variable,
+};
+use friction_laws::classical::{Branch, Classical, ClassicalParams};
 
 pub mod vr {
     pub const V: u32 = 0;
@@ -132,23 +136,39 @@ pub static INFO: ModelInfo = ModelInfo {
         step_size: 1e-3,
     },
     capabilities: Capabilities::FULL,
-    model_exchange: None,
+    model_exchange: Some(ModelExchange {
+        states: &[],
+        event_indicators: 4,
+        states_jump_at_events: false,
+    }),
 };
 
 #[derive(Clone, Debug)]
 pub struct ClassicalFmu {
     law: Classical,
+    /// In Model Exchange, the branch chosen at the last event, whose
+    /// formula holds until the next ([`Classical::force_on`]); `None`
+    /// before the first event and always in Co-Simulation, where the
+    /// branch follows the inputs.
+    latched: Option<Branch>,
 }
 
 impl Default for ClassicalFmu {
     fn default() -> Self {
         ClassicalFmu {
             law: Classical::new(ClassicalParams::default()).expect("default parameters are valid"),
+            latched: None,
         }
     }
 }
 
 impl ClassicalFmu {
+    /// The branch in force at these inputs: the latched one in Model
+    /// Exchange, the inputs' own otherwise.
+    fn branch(&self, v: f64, f_app: f64) -> Branch {
+        self.latched.unwrap_or_else(|| self.law.branch(v, f_app))
+    }
+
     pub fn params(values: &Values) -> ClassicalParams {
         ClassicalParams {
             fc: values.real(vr::FC),
@@ -168,14 +188,18 @@ impl Model for ClassicalFmu {
 
     fn initialize(&mut self, values: &Values) -> Result<(), String> {
         self.law = Classical::new(Self::params(values)).map_err(param_err)?;
+        self.latched = None;
         Ok(())
     }
 
     fn compute_outputs(&self, values: &mut Values) {
         let (v, f_app) = (values.real(vr::V), values.real(vr::F_APP));
-        values.set(vr::F, self.law.force(v, f_app));
-        values.set_boolean(vr::STUCK, self.law.stuck(v, f_app));
-        values.set(vr::P_DISS, self.law.dissipated_power(v, f_app));
+        let branch = self.branch(v, f_app);
+        let f = self.law.force_on(branch, v, f_app);
+        values.set(vr::F, f);
+        values.set_boolean(vr::STUCK, branch == Branch::Stuck);
+        // (the law stores no energy: all of F·v is dissipated)
+        values.set(vr::P_DISS, f * v);
         values.set(vr::E_STORED, 0.0);
     }
 
@@ -184,17 +208,54 @@ impl Model for ClassicalFmu {
         Ok(())
     }
 
-    fmi_export::delegate_state!(law);
+    /// The state is the latched branch (Model Exchange), one number:
+    /// its code, or −1 for none.
+    fn save_state(&self, out: &mut Vec<f64>) {
+        out.push(self.latched.map_or(-1.0, Branch::code));
+    }
 
-    /// `∂F/∂v`, `∂F/∂F_app` ([`Classical::force_partials`]) and those of
-    /// `P_diss = F·v`.
+    fn state_len(&self) -> Option<usize> {
+        Some(1)
+    }
+
+    fn write_state_into(&self, out: &mut [f64]) {
+        out[0] = self.latched.map_or(-1.0, Branch::code);
+    }
+
+    fn state_is_finite(&self) -> Option<bool> {
+        Some(true)
+    }
+
+    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+        self.latched = match state {
+            [code] if *code == -1.0 => None,
+            [code] => Some(Branch::from_code(*code).ok_or_else(|| {
+                format!("Classical: {code} is not a branch (0 to 3, or -1 for none)")
+            })?),
+            _ => {
+                return Err(format!(
+                    "Classical's state is one value (its branch), got {}",
+                    state.len()
+                ))
+            }
+        };
+        Ok(())
+    }
+
+    fn clone_model(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
+
+    /// `∂F/∂v`, `∂F/∂F_app` ([`Classical::force_partials_on`] the branch in
+    /// force) and those of `P_diss = F·v`.
     fn partial_derivative(&self, values: &Values, output: u32, input: u32) -> Option<f64> {
         let (v, f_app) = (values.real(vr::V), values.real(vr::F_APP));
-        let (by_v, by_app) = self.law.force_partials(v, f_app);
+        let branch = self.branch(v, f_app);
+        let (by_v, by_app) = self.law.force_partials_on(branch, v);
         match (output, input) {
             (vr::F, vr::V) => Some(by_v),
             (vr::F, vr::F_APP) => Some(by_app),
-            (vr::P_DISS, vr::V) => Some(by_v * v + self.law.force(v, f_app)),
+            (vr::P_DISS, vr::V) => Some(by_v * v + self.law.force_on(branch, v, f_app)),
             (vr::P_DISS, vr::F_APP) => Some(by_app * v),
             (vr::E_STORED, vr::V | vr::F_APP) => Some(0.0),
             _ => None,
@@ -208,8 +269,49 @@ impl Model for ClassicalFmu {
     /// `dF/dt = ∂F/∂v·dv/dt + ∂F/∂F_app·dF_app/dt` (between switches).
     fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {
         let (v, f_app) = (values.real(vr::V), values.real(vr::F_APP));
-        let (by_v, by_app) = self.law.force_partials(v, f_app);
+        let (by_v, by_app) = self.law.force_partials_on(self.branch(v, f_app), v);
         (output == vr::F)
             .then(|| by_v * slopes[vr::V as usize] + by_app * slopes[vr::F_APP as usize])
+    }
+
+    fmi_export::ode_is_self!();
+}
+
+/// Model Exchange: no continuous states; the indicators are `v − dv`,
+/// `v + dv`, `Fs − F_app` and `Fs + F_app`, each continuous in the inputs
+/// and crossing zero where [`Classical::branch`] changes (the last two
+/// change it only inside the band; outside it their crossings are
+/// harmless events). The event iteration latches the branch of the
+/// inputs at the event; between events the force is that branch's formula,
+/// continuous, as the standard asks of the right-hand side an importer's
+/// solver integrates.
+impl Ode for ClassicalFmu {
+    fn continuous_states(&self, _x: &mut [f64]) {}
+
+    fn set_continuous_states(&mut self, _x: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn event_indicators(&self, values: &Values, z: &mut [f64]) {
+        let (v, f_app) = (values.real(vr::V), values.real(vr::F_APP));
+        let p = self.law.params();
+        z.copy_from_slice(&[v - p.dv, v + p.dv, p.fs - f_app, p.fs + f_app]);
+    }
+
+    fn nominals(&self, _values: &Values, _nominal: &mut [f64]) {}
+
+    fn event_update(&mut self, values: &Values) -> bool {
+        let (v, f_app) = (values.real(vr::V), values.real(vr::F_APP));
+        self.latched = Some(match self.latched {
+            None => self.law.branch(v, f_app),
+            Some(from) => self.law.branch_after_event(from, v, f_app),
+        });
+        false
+    }
+
+    /// The outputs' partials with respect to the inputs, as in
+    /// Co-Simulation.
+    fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
+        Model::partial_derivative(self, values, unknown, known)
     }
 }

@@ -5,8 +5,9 @@
 //! `Bristle2D.fmu`, `Classical.fmu`, `BlimanSorine.fmu` and
 //! `ElastoPlastic.fmu`;
 //! `fmi2Instantiate` picks the law by GUID. Every law but the bristle one
-//! and the stateless classical one is also an ODE and is offered for Model
-//! Exchange too ([`fmi_export::Ode`]), from the same equations.
+//! is offered for Model Exchange too ([`fmi_export::Ode`]), from the same
+//! equations: as an ODE, or (the stateless classical law) by its event
+//! indicators alone.
 #![forbid(unsafe_code)]
 
 pub mod bliman_sorine;
@@ -54,12 +55,12 @@ pub static REGISTRY: LazyLock<[ModelFactory; 10]> = LazyLock::new(|| {
             create: || Box::new(bristle2d::Bristle2DFmu::default()),
             create_model_exchange: Some(|| Box::new(bristle2d::Bristle2DMe::default())),
         },
-        // Co-Simulation only: the classical law has no state (its force
-        // follows from v and F_app), so there is no ODE to offer
+        // Model Exchange without continuous states: the classical law's
+        // force follows from v and F_app, its switches are events
         ModelFactory {
             info: &classical::INFO,
             create: || Box::new(classical::ClassicalFmu::default()),
-            create_model_exchange: None,
+            create_model_exchange: Some(|| Box::new(classical::ClassicalFmu::default())),
         },
         ModelFactory {
             info: &bliman_sorine::INFO,

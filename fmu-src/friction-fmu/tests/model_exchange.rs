@@ -85,6 +85,18 @@ impl Me {
         x
     }
 
+    fn get_boolean(&self, name: &str) -> bool {
+        let mut x = 0;
+        let vr = self.vr(name);
+        assert_eq!(
+            unsafe { fmi2GetBoolean(self.c, &vr, 1, &mut x) },
+            OK,
+            "{}",
+            last_error()
+        );
+        x != 0
+    }
+
     fn nx(&self) -> usize {
         self.info.model_exchange.unwrap().states.len()
     }
@@ -754,18 +766,92 @@ fn reset_integrator_events() {
     assert_eq!(nominal, [z0]);
 }
 
+/// Classical in Model Exchange has no continuous states and four event
+/// indicators, `v − dv`, `v + dv`, `Fs − F_app` and `Fs + F_app`, which
+/// change sign exactly where its force changes branch: stuck (F = F_app),
+/// breaking away (F = ±Fs) and sliding (the Stribeck curve). At each
+/// point the force equals the law's, the event iteration changes nothing,
+/// and the partials match central differences away from the switches.
+#[test]
+fn classical_indicators_mark_its_switches() {
+    let me = Me::new("Classical", &[]);
+    assert_eq!(me.nx(), 0);
+    assert!(me.derivatives().is_empty() && me.states().is_empty());
+    let (fs, dv) = (me.get("Fs"), me.get("dv"));
+    let law = friction_laws::classical::Classical::new(Default::default()).unwrap();
+    let indicators = |me: &Me| {
+        let mut z = [f64::NAN; 4];
+        assert_eq!(
+            unsafe { fmi2GetEventIndicators(me.c, z.as_mut_ptr(), 4) },
+            OK,
+            "{}",
+            last_error()
+        );
+        z
+    };
+    // (v, F_app, the branch): every sign pattern of the indicators
+    for (v, f_app, stuck) in [
+        (0.0, 1.0, true),
+        (0.5 * dv, -2.0, true),
+        (-0.9 * dv, 3.0, false),
+        (0.2 * dv, -3.0, false),
+        (2.0 * dv, 0.5, false),
+        (-5e-3, -1.0, false),
+    ] {
+        me.set("v", v);
+        me.set("F_app", f_app);
+        me.event();
+        let z = indicators(&me);
+        assert_eq!(z, [v - dv, v + dv, fs - f_app, fs + f_app]);
+        let in_band = z[0] < 0.0 && z[1] > 0.0;
+        let holds = z[2] >= 0.0 && z[3] >= 0.0;
+        assert_eq!(in_band && holds, stuck, "v {v}, F_app {f_app}");
+        assert_eq!(me.get_boolean("stuck"), stuck, "v {v}, F_app {f_app}");
+        assert_eq!(me.get("F"), law.force(v, f_app), "v {v}, F_app {f_app}");
+        let context = format!("Classical at v {v}, F_app {f_app}");
+        check_partials(
+            &me,
+            &[("F", 1.0), ("P_diss", 1e-3)],
+            &[("v", 1e-9), ("F_app", 1e-6)],
+            1e-5,
+            &context,
+        );
+    }
+    // Between events the branch of the last one holds, so the force an
+    // importer's solver sees is continuous: stuck just inside the band,
+    // then moved just outside it, the force is still F_app and only the
+    // indicator says the edge was crossed; the event switches to the curve.
+    me.set("F_app", 1.0);
+    me.set("v", dv * (1.0 - 1e-9));
+    me.event();
+    let inside = (me.get("F"), indicators(&me)[0]);
+    me.set("v", dv * (1.0 + 1e-9));
+    let crossed = (me.get("F"), indicators(&me)[0]);
+    me.event();
+    let outside = me.get("F");
+    assert!(inside.1 < 0.0 && crossed.1 > 0.0);
+    assert_eq!((inside.0, crossed.0), (1.0, 1.0));
+    assert!((outside - law.steady_state(dv)).abs() < 1e-9);
+    // and an event exactly on the edge takes the switch (the solver stops
+    // there): stuck, then v = dv exactly at an event, is sliding
+    me.set("v", 0.0);
+    me.event();
+    me.set("v", dv);
+    me.event();
+    assert!(!me.get_boolean("stuck"));
+    assert_eq!(me.get("F"), law.steady_state(dv));
+}
+
 /// The bristle law with random reconnection has no Model Exchange
 /// interface: instantiating it for Model Exchange is refused, naming it.
 #[test]
 fn the_bristle_law_is_co_simulation_only() {
-    for model in ["Bristle", "Classical"] {
-        let (c, info) = instantiate(model, fmi2ModelExchange);
-        assert!(info.model_exchange.is_none());
-        assert!(c.is_null());
-        let m = last_error();
-        assert!(
-            m.contains(model) && m.contains("Co-Simulation (1) only"),
-            "{m}"
-        );
-    }
+    let (c, info) = instantiate("Bristle", fmi2ModelExchange);
+    assert!(info.model_exchange.is_none());
+    assert!(c.is_null());
+    let m = last_error();
+    assert!(
+        m.contains("Bristle") && m.contains("Co-Simulation (1) only"),
+        "{m}"
+    );
 }

@@ -71,6 +71,43 @@ impl ClassicalParams {
     }
 }
 
+/// The branches of the law, between which its force jumps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Branch {
+    /// Inside the band, `|F_app| ≤ Fs`: `F = F_app`.
+    Stuck,
+    /// Inside the band, `F_app > Fs`: `F = Fs`.
+    BreakingAwayForward,
+    /// Inside the band, `F_app < −Fs`: `F = −Fs`.
+    BreakingAwayBackward,
+    /// Outside the band: the Stribeck curve `Fss(v)`.
+    Sliding,
+}
+
+impl Branch {
+    /// A number for the FMU state: 0, 1, 2, 3 in the order above.
+    pub fn code(self) -> f64 {
+        match self {
+            Branch::Stuck => 0.0,
+            Branch::BreakingAwayForward => 1.0,
+            Branch::BreakingAwayBackward => 2.0,
+            Branch::Sliding => 3.0,
+        }
+    }
+
+    /// The branch of [`Branch::code`]; `None` for any other number.
+    pub fn from_code(code: f64) -> Option<Branch> {
+        [
+            Branch::Stuck,
+            Branch::BreakingAwayForward,
+            Branch::BreakingAwayBackward,
+            Branch::Sliding,
+        ]
+        .into_iter()
+        .find(|b| b.code() == code)
+    }
+}
+
 /// The classical law (stateless: its parameters).
 #[derive(Clone, Debug)]
 pub struct Classical {
@@ -128,26 +165,83 @@ impl Classical {
 
     /// Stuck: inside the band with `|F_app| ≤ Fs`.
     pub fn stuck(&self, v: f64, f_app: f64) -> bool {
-        self.in_band(v) && f_app.abs() <= self.p.fs
+        self.branch(v, f_app) == Branch::Stuck
+    }
+
+    /// Which branch of the law the inputs are on.
+    pub fn branch(&self, v: f64, f_app: f64) -> Branch {
+        if !self.in_band(v) {
+            Branch::Sliding
+        } else if f_app.abs() <= self.p.fs {
+            Branch::Stuck
+        } else if f_app > 0.0 {
+            Branch::BreakingAwayForward
+        } else {
+            Branch::BreakingAwayBackward
+        }
+    }
+
+    /// The branch after an event at these inputs, coming from `from` (the
+    /// branch before it): [`Classical::branch`], except that a boundary
+    /// the inputs sit on exactly (`|v| = dv`, `|F_app| = Fs`) counts as
+    /// crossed, away from `from`. An importer's solver stops at the
+    /// boundary an indicator crossed, often exactly on it, and this is
+    /// how the switch is taken there instead of missed.
+    pub fn branch_after_event(&self, from: Branch, v: f64, f_app: f64) -> Branch {
+        let (dv, fs) = (self.p.dv, self.p.fs);
+        let breaking_away = || {
+            if f_app > 0.0 {
+                Branch::BreakingAwayForward
+            } else {
+                Branch::BreakingAwayBackward
+            }
+        };
+        match from {
+            Branch::Sliding if v.abs() > dv => Branch::Sliding,
+            // entering the band (on its edge too)
+            Branch::Sliding if f_app.abs() <= fs => Branch::Stuck,
+            Branch::Sliding => breaking_away(),
+            // leaving the band (from its edge too)
+            _ if v.abs() >= dv => Branch::Sliding,
+            Branch::Stuck if f_app.abs() < fs => Branch::Stuck,
+            Branch::Stuck => breaking_away(),
+            _ if f_app.abs() < fs => Branch::Stuck,
+            _ => breaking_away(),
+        }
     }
 
     /// The friction force: `F_app` when stuck, `Fs·sgn F_app` inside the
     /// band beyond the static level, `Fss(v)` outside the band.
     pub fn force(&self, v: f64, f_app: f64) -> f64 {
-        if self.in_band(v) {
-            f_app.clamp(-self.p.fs, self.p.fs)
-        } else {
-            self.steady_state(v)
+        self.force_on(self.branch(v, f_app), v, f_app)
+    }
+
+    /// The force of `branch`'s formula, wherever the inputs are: `F_app`
+    /// (stuck), `±Fs` (breaking away), `Fss(v)` (sliding). A Model Exchange
+    /// importer's solver evaluates the branch it was on at the last event
+    /// until an event indicator stops it at the switch, so the force stays
+    /// continuous within its steps (FMI 2.0.4 §3.1).
+    pub fn force_on(&self, branch: Branch, v: f64, f_app: f64) -> f64 {
+        match branch {
+            Branch::Stuck => f_app,
+            Branch::BreakingAwayForward => self.p.fs,
+            Branch::BreakingAwayBackward => -self.p.fs,
+            Branch::Sliding => self.steady_state(v),
         }
     }
 
     /// `(∂F/∂v, ∂F/∂F_app)`: `(0, 1)` stuck, `(0, 0)` breaking away,
     /// `(dFss/dv, 0)` sliding.
     pub fn force_partials(&self, v: f64, f_app: f64) -> (f64, f64) {
-        if self.in_band(v) {
-            (0.0, if f_app.abs() <= self.p.fs { 1.0 } else { 0.0 })
-        } else {
-            (self.steady_state_slope(v), 0.0)
+        self.force_partials_on(self.branch(v, f_app), v)
+    }
+
+    /// [`Classical::force_partials`] of `branch`'s formula.
+    pub fn force_partials_on(&self, branch: Branch, v: f64) -> (f64, f64) {
+        match branch {
+            Branch::Stuck => (0.0, 1.0),
+            Branch::BreakingAwayForward | Branch::BreakingAwayBackward => (0.0, 0.0),
+            Branch::Sliding => (self.steady_state_slope(v), 0.0),
         }
     }
 
@@ -244,6 +338,60 @@ mod tests {
         }
         assert_eq!(law.force(2.0 * p.dv, -9.0), law.steady_state(2.0 * p.dv));
         assert!(!law.stuck(p.dv, 0.0));
+    }
+
+    /// An event stops on the boundary its indicator crossed: there the
+    /// switch is taken, away from the branch before, where `branch` alone
+    /// would keep the old one.
+    #[test]
+    fn a_boundary_at_an_event_counts_as_crossed() {
+        let p = ClassicalParams::default();
+        let law = Classical::new(p).unwrap();
+        let (fs, dv) = (p.fs, p.dv);
+        use Branch::*;
+        // breaking away on F_app = ±Fs exactly
+        assert_eq!(law.branch(0.0, fs), Stuck);
+        assert_eq!(law.branch_after_event(Stuck, 0.0, fs), BreakingAwayForward);
+        assert_eq!(
+            law.branch_after_event(Stuck, 0.0, -fs),
+            BreakingAwayBackward
+        );
+        // leaving the band on |v| = dv exactly
+        assert_eq!(law.branch(dv * (1.0 - 1e-16), 3.0), BreakingAwayForward);
+        assert_eq!(
+            law.branch_after_event(BreakingAwayForward, dv, 3.0),
+            Sliding
+        );
+        assert_eq!(law.branch_after_event(Stuck, -dv, 0.3), Sliding);
+        // entering it on |v| = dv exactly: stuck, or breaking away beyond Fs
+        assert_eq!(law.branch(dv, 0.3), Sliding);
+        assert_eq!(law.branch_after_event(Sliding, dv, 0.3), Stuck);
+        assert_eq!(
+            law.branch_after_event(Sliding, -dv, -3.0),
+            BreakingAwayBackward
+        );
+        // back below Fs while breaking away: stuck again
+        assert_eq!(
+            law.branch_after_event(BreakingAwayForward, 0.0, fs),
+            BreakingAwayForward
+        );
+        assert_eq!(
+            law.branch_after_event(BreakingAwayForward, 0.0, 0.9 * fs),
+            Stuck
+        );
+        // away from every boundary it is the inputs' own branch
+        for from in [Stuck, BreakingAwayForward, BreakingAwayBackward, Sliding] {
+            for (v, f_app) in [
+                (0.0, 1.0),
+                (0.5 * dv, 5.0),
+                (-0.5 * dv, -5.0),
+                (3.0 * dv, 0.0),
+            ] {
+                assert_eq!(law.branch_after_event(from, v, f_app), law.branch(v, f_app));
+            }
+            assert_eq!(Branch::from_code(from.code()), Some(from));
+        }
+        assert_eq!(Branch::from_code(0.5), None);
     }
 
     #[test]

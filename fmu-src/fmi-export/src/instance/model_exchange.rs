@@ -22,13 +22,12 @@ impl Instance {
     /// [`crate::Model::ode`], its description declares the states.
     pub fn make_model_exchange(&mut self) -> Result<(), String> {
         let info = self.info;
-        let me = info.model_exchange.ok_or_else(|| {
-            format!(
-                "{} declares no continuous states: it has no Model Exchange interface",
-                info.model_name
-            )
-        })?;
-        if self.model.ode().is_none() || me.states.is_empty() {
+        let me = info
+            .model_exchange
+            .ok_or_else(|| format!("{} declares no Model Exchange interface", info.model_name))?;
+        // (no continuous states is allowed: a law whose force follows from
+        // its inputs takes part in Model Exchange by its event indicators)
+        if self.model.ode().is_none() || me.states.is_empty() && me.event_indicators == 0 {
             return Err(format!(
                 "{} has no Model Exchange model in this binary",
                 info.model_name
