@@ -580,6 +580,32 @@ impl<S: RowSink> RowSink for Recorder<S> {
 }
 
 /// The variable `component.variable` among the opened FMUs.
+/// Named FMUs, opened, and start values checked against them.
+pub type OpenedWithStartValues = (Vec<(String, Fmu)>, Vec<(String, ParameterValue)>);
+
+/// Open each `(name, fmu path)` and check each start value
+/// `(component.variable, value)` against its FMU ([`check_start_value`]),
+/// before anything is instantiated: what `fricsim cosim` builds its
+/// system from ([`System::from_fmus`]), so that its `--set` is held to the
+/// same rules as `run`'s.
+pub fn open_with_start_values(
+    components: &[(String, &std::path::Path)],
+    start_values: &[(String, StartValue)],
+) -> Result<OpenedWithStartValues, String> {
+    let fmus = components
+        .iter()
+        .map(|(name, path)| Ok((name.clone(), Fmu::open(path).map_err(|e| e.to_string())?)))
+        .collect::<Result<Vec<_>, String>>()?;
+    let checked = start_values
+        .iter()
+        .map(|(port, value)| {
+            let var = variable_of(&fmus, port)?;
+            Ok((port.clone(), check_start_value(port, var, value)?))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok((fmus, checked))
+}
+
 fn variable_of<'a>(fmus: &'a [(String, Fmu)], port: &str) -> Result<&'a ScalarVariable, String> {
     let (c, v) = port
         .split_once('.')
@@ -634,7 +660,12 @@ pub fn check_start_value(
         )));
     }
     let type_name = var.kind.type_name();
-    let not_of_type = || Err(refuse(format!("not a {type_name} value")));
+    let article = if type_name.starts_with(['E', 'I']) {
+        "an"
+    } else {
+        "a"
+    };
+    let not_of_type = || Err(refuse(format!("not {article} {type_name} value")));
     match &var.kind {
         VariableKind::Real { min, max, .. } => {
             let x = match value {

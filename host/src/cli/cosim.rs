@@ -7,6 +7,7 @@ use fricsim::isolate::child::Child;
 use fricsim::master::{simulate_streaming, MasterAlgorithm, NoObserver, Observer, Streamed};
 use fricsim::output_file::OutputFile;
 use fricsim::results::ResultWriter;
+use fricsim::run::StartValue;
 use fricsim::system::{Experiment, RecordedType, System};
 use fricsim::writer_thread::on_writer_thread;
 use std::path::{Path, PathBuf};
@@ -16,7 +17,9 @@ pub struct CosimArgs {
     /// A component: name=path.fmu (repeat).
     #[arg(long = "fmu", required = true)]
     pub fmus: Vec<String>,
-    /// A parameter: component.variable=value (repeat).
+    /// A start value: component.variable=value (repeat), read as the
+    /// variable's type and checked as `run --set` checks it (causality,
+    /// type, min and max) before any FMU is instantiated.
     #[arg(long = "set")]
     pub parameters: Vec<String>,
     /// A connection: component.output->component.input (repeat).
@@ -182,7 +185,7 @@ pub struct CosimPlan {
 /// The options read: components, parameters, connections.
 pub struct Parsed<'a> {
     components: Vec<(String, &'a Path)>,
-    parameters: Vec<(String, f64)>,
+    parameters: Vec<(String, StartValue)>,
     connections: Vec<(String, String)>,
 }
 
@@ -203,6 +206,8 @@ fn parse(a: &CosimArgs) -> Result<Parsed<'_>, String> {
                 .ok_or(format!("--fmu expects name=path.fmu, got `{s}`"))
         })
         .collect::<Result<Vec<_>, _>>()?;
+    // read as each variable's type and checked against it when the FMUs
+    // are open (`open_with_start_values`)
     let parameters = a
         .parameters
         .iter()
@@ -210,12 +215,7 @@ fn parse(a: &CosimArgs) -> Result<Parsed<'_>, String> {
             let (k, v) = s
                 .split_once('=')
                 .ok_or(format!("--set expects component.variable=value, got `{s}`"))?;
-            let v = match v {
-                "true" => 1.0,
-                "false" => 0.0,
-                v => v.parse::<f64>().map_err(|e| format!("--set {s}: {e}"))?,
-            };
-            Ok((k.to_string(), v))
+            Ok((k.to_string(), StartValue::Text(v.to_string())))
         })
         .collect::<Result<Vec<_>, String>>()?;
     let connections = a
@@ -252,9 +252,11 @@ fn build(
     parsed: &Parsed,
 ) -> Result<(System, Box<dyn MasterAlgorithm>, CosimPlan), String> {
     // the FMUs are told the stop time, as `run` and FMPy tell them
-    let mut system = System::build_for(
-        &parsed.components,
-        &parsed.parameters,
+    let (fmus, parameters) =
+        fricsim::run::open_with_start_values(&parsed.components, &parsed.parameters)?;
+    let mut system = System::from_fmus(
+        fmus,
+        &parameters,
         &parsed.connections,
         Experiment::stepped(0.0, a.step, a.stop),
     )

@@ -343,3 +343,52 @@ fn an_fmi3_fmu_is_shown_by_info_and_its_binary_loaded_as_fmi3() {
     );
     assert!(!out.exists());
 }
+
+/// `cosim --set` is checked as `run --set` is, before any FMU is
+/// instantiated: a value below the variable's `min`, one not of its type,
+/// an output, and an unknown variable are each refused, naming the
+/// variable and the value; nothing is written.
+#[test]
+fn cosim_start_values_are_checked_as_run_checks_them() {
+    let s = setup();
+    let friction = format!("friction={}", common::lugre_fmu().display());
+    for (set, parts) in [
+        (
+            "friction.sigma0=-5",
+            &[
+                "cannot set `friction.sigma0` to \"-5\"",
+                "below the declared min = 0",
+            ][..],
+        ),
+        (
+            "friction.sigma0=stiff",
+            &["cannot set `friction.sigma0`", "not a Real value"],
+        ),
+        (
+            "friction.F=2",
+            &["cannot set `friction.F` to \"2\"", "causality \"output\""],
+        ),
+        (
+            "friction.no_such=1",
+            &["`friction` has no variable `no_such`"],
+        ),
+    ] {
+        let out = s.out();
+        let mut args = cosim_alone(&friction, out.to_str().unwrap());
+        args.extend(["--set", set]);
+        assert_refused(&args, parts);
+        assert!(!out.exists(), "{set}");
+    }
+    // a Boolean takes true/false, and a good value runs
+    let out = s.out();
+    let mut args = cosim_alone(&friction, out.to_str().unwrap());
+    args.extend([
+        "--set",
+        "friction.sigma0=1e5",
+        "--set",
+        "friction.parameter_sensitivities=true",
+    ]);
+    let (code, _, stderr) = fricsim(&args);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(out.exists());
+}

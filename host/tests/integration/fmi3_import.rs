@@ -708,7 +708,7 @@ fn misused_arrays_are_refused_with_clear_errors() {
     assert!(e.contains("`g` has no variable `A[3,1]`"), "{e}");
     let e = run(&["--set", "g.offset[1]=2.5"]);
     assert!(
-        e.contains("`g.offset[1]` is an Integer variable; it cannot be set to 2.5"),
+        e.contains("cannot set `g.offset[1]` to \"2.5\": not an Integer value"),
         "{e}"
     );
     let e = run(&["--connect", "g.yd->g.u[1]"]);
@@ -1121,4 +1121,67 @@ fn our_fmi3_lugre_takes_table_elements_by_the_fmi2_names() {
     let f = *runs[1].1[0].last().unwrap();
     let scale = 3.0 + (0.5 - 3.0) * 0.02 / 0.15;
     assert!((f - scale).abs() < 0.01 * scale, "F = {f}, scale {scale}");
+}
+
+/// An SSP connector names the SSP type of an FMI 3.0 variable
+/// (`ssc:Real` for Float32 and Float64, `ssc:Integer` for every integer
+/// width), not the core's kind that holds it: an `Int64` held as a Real
+/// is refused as `ssc:Real` and accepted as `ssc:Integer`, and a
+/// `Float32` is a `ssc:Real`.
+#[test]
+fn ssp_connectors_name_the_fmi3_type_class_not_the_holding_kind() {
+    let (dir, path) = feedthrough();
+    let check = |connectors: &str| {
+        let ssd = dir.path().join("types.ssd");
+        std::fs::write(
+            &ssd,
+            format!(
+                r#"<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription version="1.0" name="types"
+    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
+    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon">
+  <ssd:System name="types">
+    <ssd:Elements>
+      <ssd:Component name="ft" source="{fmu}">
+        <ssd:Connectors>
+{connectors}
+        </ssd:Connectors>
+      </ssd:Component>
+    </ssd:Elements>
+  </ssd:System>
+</ssd:SystemStructureDescription>
+"#,
+                fmu = path.display()
+            ),
+        )
+        .unwrap();
+        fricsim::ssp::SystemFile::open(&ssd)
+            .map_err(|e| e.to_string())
+            .and_then(|f| f.check().map(|_| ()).map_err(|e| e.to_string()))
+    };
+    let connector = |name: &str, kind: &str, ty: &str| {
+        format!(
+            r#"          <ssd:Connector name="{name}" kind="{kind}"><ssc:{ty}/></ssd:Connector>"#
+        )
+    };
+    for (name, kind, right, wrong) in [
+        ("Int64_output", "output", "Integer", "Real"),
+        ("UInt32_input", "input", "Integer", "Real"),
+        ("Int8_output", "output", "Integer", "Real"),
+        ("Float32_input", "input", "Real", "Integer"),
+        ("Float64_output", "output", "Real", "Integer"),
+    ] {
+        assert_eq!(
+            check(&connector(name, kind, right)),
+            Ok(()),
+            "{name} as ssc:{right}"
+        );
+        let message = check(&connector(name, kind, wrong)).unwrap_err();
+        let ty = name.split('_').next().unwrap();
+        assert!(
+            message.contains(&format!("the connector is ssc:{wrong}, but `{name}`"))
+                && message.ends_with(&format!("is {ty}")),
+            "{name} as ssc:{wrong}: {message}"
+        );
+    }
 }

@@ -307,12 +307,12 @@ fn a_start_value_that_cannot_be_set_is_refused_naming_the_variable_and_the_value
         (
             "stair.top",
             "ten",
-            "cannot set `stair.top` to \"ten\": not a Integer value",
+            "cannot set `stair.top` to \"ten\": not an Integer value",
         ),
         (
             "stair.top",
             "2.5",
-            "cannot set `stair.top` to \"2.5\": not a Integer value",
+            "cannot set `stair.top` to \"2.5\": not an Integer value",
         ),
         (
             "stair.top",
@@ -358,7 +358,7 @@ fn a_start_value_that_cannot_be_set_is_refused_naming_the_variable_and_the_value
     assert_eq!(typed("stair.step_height", StartValue::Integer(2)), None);
     assert_eq!(typed("stair.top", StartValue::Real(4.0)), None);
     let error = typed("stair.top", StartValue::Boolean(true)).unwrap();
-    assert!(error.contains("not a Integer value"), "{error}");
+    assert!(error.contains("not an Integer value"), "{error}");
 }
 
 /// The rows of `file` run with `output_interval`.

@@ -289,14 +289,14 @@ fn check_connector(c: &ComponentDef, k: &ConnectorDef, fmu: &Fmu) -> Result<(), 
         ));
     }
     if let Some(t) = k.type_name {
-        if t != var.kind.type_name() {
+        if t != var.ssp_type_name() {
             return Err(error(
                 &k.location,
                 format!(
                     "the connector is ssc:{t}, but `{}` in {} is {}",
                     k.name,
                     c.source_text,
-                    var.kind.type_name()
+                    var.type_name()
                 ),
             ));
         }

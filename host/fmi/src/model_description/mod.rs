@@ -136,6 +136,16 @@ impl Variable {
             None => self.kind.type_name(),
         }
     }
+
+    /// The SSP connector type (`ssc:Real`, `ssc:Integer`, …) that
+    /// describes the variable ([`Fmi3Type::ssp_type_name`] for an FMI 3.0
+    /// one).
+    pub fn ssp_type_name(&self) -> &'static str {
+        match self.fmi3_type {
+            Some(t) => t.ssp_type_name(),
+            None => self.kind.type_name(),
+        }
+    }
 }
 
 /// An FMI 3.0 array variable of fixed size (a variable with
@@ -414,6 +424,22 @@ impl Fmi3Type {
         match self {
             T::Float32 | T::Float64 | T::UInt32 | T::Int64 | T::UInt64 => "Real",
             T::Int8 | T::UInt8 | T::Int16 | T::UInt16 | T::Int32 => "Integer",
+            T::Boolean => "Boolean",
+            T::String => "String",
+            T::Enumeration => "Enumeration",
+        }
+    }
+
+    /// The SSP 1.0 connector type of this type (`ssc:Real`, …): `Real`
+    /// for the floats, `Integer` for every integer width, the others as
+    /// themselves. Not [`Fmi3Type::kind_name`]: an `Int64` is held as a
+    /// `Real` but is an `Integer` connector.
+    pub fn ssp_type_name(self) -> &'static str {
+        use Fmi3Type as T;
+        match self {
+            T::Float32 | T::Float64 => "Real",
+            T::Int8 | T::UInt8 | T::Int16 | T::UInt16 => "Integer",
+            T::Int32 | T::UInt32 | T::Int64 | T::UInt64 => "Integer",
             T::Boolean => "Boolean",
             T::String => "String",
             T::Enumeration => "Enumeration",
