@@ -52,7 +52,8 @@ EXPECTED = {
             "parameter": {"sigma2", "n_elements", "Fc", "Fs", "vs", "stribeck_exponent", "C"}
             | {f"k[{i}]" for i in range(1, 101)} | {f"alpha[{i}]" for i in range(1, 101)}},
     "Rig1D": {"input": {"F", "F_ext", "x_act_in", "x_ref", "v_ref"},
-              "output": {"x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl"},
+              "output": {"x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl",
+                         "F_app"},
               "parameter": {"m", "c", "k", "x_a0", "v_a", "v_surface", "x0", "v0", "actuator", "act_amp",
                             "act_freq", "dither_amp", "dither_freq", "F_step", "t_step", "drive_amp",
                             "drive_freq", "control", "ref_x0", "ref_v0", "ref_v_amp", "ref_freq", "ctrl_kp",

@@ -50,6 +50,7 @@ FRICSIM = ROOT / "target" / "release" / "fricsim"
 # keep the suite short where the run is long
 RUNS = {
     "stick_slip": 9.0,  # the first slip is at 7.54 s
+    "classical_stick_slip": 4.0,  # stuck again at 2.97 s
     "dahl_velocity": None,
     "lugre_step_force": None,
     "hidden_effect_rig": None,
@@ -131,9 +132,9 @@ def run_fricsim(ssp, step, n, tmp_path):
     header = out.read_text().splitlines()[0].split(",")
     data = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
     # fricsim run records the Integer and Boolean outputs too (the laws'
-    # `sliding`, the bristle model's `n_connected`); the libcosim runs here
-    # record the Real ones, which are compared
-    discrete = (".sliding", ".n_connected")
+    # `sliding`, Classical's `stuck`, the bristle model's `n_connected`); the
+    # libcosim runs here record the Real ones, which are compared
+    discrete = (".sliding", ".stuck", ".n_connected")
     return data[:, 0], {c: data[:, k] for k, c in enumerate(header) if k > 0 and not c.endswith(discrete)}
 
 

@@ -253,7 +253,7 @@ fn recorded_inputs_and_parameters_follow_the_outputs_they_are_connected_to() {
     assert!(e.contains("no component `belt`"), "{e}");
     let cols = m.columns();
     let k = cols.iter().position(|c| c == "rig.F").unwrap();
-    assert_eq!(cols[k - 1], "rig.F_ctrl", "after the rig's outputs");
+    assert_eq!(cols[k - 1], "rig.F_app", "after the rig's outputs");
     assert_eq!(
         &cols[cols.len() - 6..],
         [

@@ -898,9 +898,11 @@ fn input_nominal(fmus: &[(String, Fmu)], name: &str, variable: &str) -> f64 {
 /// The stick-slip system as plain Rust: Rig1D (`rig`) and LuGre
 /// (`friction`) with the file's parameter values, `rig.v → friction.v`,
 /// `friction.F → rig.F`.
-/// Columns the monolithic loops record: Rig1D's ten outputs, LuGre's three
-/// (F, z and the Boolean `sliding`, as 0 or 1).
-const RECORDED: usize = 15;
+/// Columns the monolithic loops record: Rig1D's eleven outputs, LuGre's
+/// five (F, z, P_diss, E_stored and the Boolean `sliding`, as 0 or 1).
+const RECORDED: usize = 16;
+/// The column of LuGre's F among them, after Rig1D's eleven.
+const FRICTION_F: usize = 11;
 
 /// What a run of a monolithic loop records, as a host run does
 /// ([`fricsim_core::master::Run`]): the time of each communication point and a
@@ -981,7 +983,7 @@ impl StickSlipModel {
         )
     }
 
-    /// The outputs the FMUs record (Rig1D's ten, LuGre's F, z, P_diss,
+    /// The outputs the FMUs record (Rig1D's eleven, LuGre's F, z, P_diss,
     /// E_stored and sliding) at time
     /// `t`, one row per communication point in the host's format
     /// ([`fricsim_core::master::Run`]: the time, and a [`Rows`] of [`RECORDED`]
@@ -1003,7 +1005,7 @@ impl StickSlipModel {
             friction: force_in,
             ..Default::default()
         };
-        // all ten at once, as the FMU's `compute_outputs` computes them
+        // all eleven at once, as the FMU's `compute_outputs` computes them
         let y = rig.outputs(&u);
         recording.time.push(t);
         recording.rows.push_zeros().copy_from_slice(&[
@@ -1017,6 +1019,7 @@ impl StickSlipModel {
             y.drive_force,
             y.control_command,
             y.control_force,
+            y.applied_force,
             friction_force,
             lugre.z(),
             power,
@@ -1071,7 +1074,7 @@ impl StickSlipModel {
             }
         });
         std::hint::black_box(&recording);
-        (wall, recording.rows[n][10], 0.0)
+        (wall, recording.rows[n][FRICTION_F], 0.0)
     }
 
     /// Strong coupling in one loop, as the host's `newton` master: the
@@ -1178,7 +1181,7 @@ impl StickSlipModel {
         std::hint::black_box(&recording);
         Ok((
             wall,
-            recording.rows[n][10],
+            recording.rows[n][FRICTION_F],
             iterations as f64 / n.max(1) as f64,
         ))
     }

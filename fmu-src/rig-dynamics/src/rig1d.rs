@@ -80,6 +80,24 @@
 //! and slopes of that step (before the first step: with zero inputs), and
 //! the acceleration output is 0.
 //!
+//! **Applied force** ([`Rig1D::applied_force`]): every force on the body
+//! but the friction input F, along the contact, positive with v, the input
+//! `F_app` of a law with a stuck state (Karnopp's band: Classical):
+//!
+//! F_app = k·(x_a − x) − c·ẋ + F_ext + F_d + F_ctrl − m·a_s(t),
+//!
+//! so that m·v̇ = F_app − F: a contact that holds F = F_app keeps the slip
+//! velocity constant. −m·a_s is the inertial force of the surface's
+//! acceleration (its dither; the belt speed is constant). It depends on
+//! the state and on F_ext, x_act_in, x_ref, v_ref, never on F. With m = 0
+//! the body has no velocity of its own to keep: F_app is the force that
+//! holds it on the surface (v = 0), k·(x_a − x_h) + F_ext + F_d − c·v_s(t),
+//! at the held position x_h: the position state when c > 0; when c = 0,
+//! where x follows F at once, the position at the start of the last step
+//! (with that step's inputs) carried with the surface to its end (before
+//! the first step: x0). A contact holding F = F_app at each communication
+//! point then keeps the body where it was.
+//!
 //! Defaults: the 1995 stick-slip benchmark (m = 1 kg, k = 2 N/m, pulled at
 //! 0.1 m/s, everything else off), stepped exactly; the first version of
 //! this file stepped it with Gauss–Legendre, which the results match to
@@ -402,6 +420,8 @@ pub struct Rig1DOutputs {
     pub control_command: f64,
     /// [`Rig1D::control_force`].
     pub control_force: f64,
+    /// [`Rig1D::applied_force`].
+    pub applied_force: f64,
 }
 
 /// `∂/∂F` of the state and outputs after a step with the friction force
@@ -416,6 +436,10 @@ pub struct StepSensitivity {
     pub acceleration: f64,
     /// Of the spring force `k·(x_a − x)`.
     pub spring_force: f64,
+    /// Of the applied force `F_app` ([`Rig1D::applied_force`]), through
+    /// the state only (it has no direct feedthrough from `F`):
+    /// `−k·∂x/∂F − c·∂ẋ/∂F`.
+    pub applied_force: f64,
 }
 
 /// The state at one instant: position, velocity, velocity-error integral.
@@ -431,6 +455,8 @@ pub struct Rig1D {
     p: Rig1DParams,
     /// Time since the start (the prescribed signals depend on it).
     t: f64,
+    /// Position; in the quasi-static mode with c = 0, where the position
+    /// follows the forces, the held position of [`Rig1D::applied_force`].
     x: f64,
     xd: f64,
     /// ξ = ∫(v_ref − ẋ) dt of the controller (0 when it is off).
@@ -620,6 +646,38 @@ impl Rig1D {
         self.p.control.gain * self.control_command(u)
     }
 
+    /// Applied force F_app: every force on the body but friction, along
+    /// the contact, positive with v, such that m·v̇ = F_app − F (see the
+    /// module documentation):
+    /// k·(x_a − x) − c·ẋ + F_ext + F_d + F_ctrl − m·a_s(t) when m > 0;
+    /// k·(x_a − x_h) + F_ext + F_d − c·v_s(t) when m = 0, the force that
+    /// holds the body on the surface at its held position x_h. Never a
+    /// function of F.
+    pub fn applied_force(&self, u: &Rig1DInputs) -> f64 {
+        let held_spring = self.p.k * (self.actuator_position(u) - self.x);
+        self.applied_force_of(
+            held_spring,
+            u.f_ext,
+            self.drive_force(),
+            self.control_force(u),
+        )
+    }
+
+    /// [`Rig1D::applied_force`] from the spring force at the held position
+    /// `k·(x_a − x)` (x the state), F_ext, F_d and F_ctrl, for it and for
+    /// [`Rig1D::outputs`] alike.
+    #[inline]
+    fn applied_force_of(&self, held_spring: f64, f_ext: f64, drive: f64, control: f64) -> f64 {
+        let p = &self.p;
+        if p.m == 0.0 {
+            // no inertia, no controller: the force that makes v = 0
+            held_spring + f_ext + drive - p.c * self.surface_velocity(self.t)
+        } else {
+            held_spring - p.c * self.xd + f_ext + drive + control
+                - p.m * self.surface_acceleration()
+        }
+    }
+
     pub fn acceleration(&self, u: &Rig1DInputs) -> f64 {
         if self.p.m == 0.0 {
             return 0.0;
@@ -661,6 +719,13 @@ impl Rig1D {
             (spring_force - p.c * self.xd + u.f_ext - u.friction + drive_force + control_force)
                 / p.m
         };
+        // at the state's position (the held one when m = c = 0): no F
+        let held_spring = if p.m == 0.0 && p.c == 0.0 {
+            p.k * (actuator_position - self.x)
+        } else {
+            spring_force
+        };
+        let applied_force = self.applied_force_of(held_spring, u.f_ext, drive_force, control_force);
         Rig1DOutputs {
             position,
             slip_velocity: self.xd - self.surface_velocity(t),
@@ -672,6 +737,7 @@ impl Rig1D {
             drive_force,
             control_command,
             control_force,
+            applied_force,
         }
     }
 
@@ -740,8 +806,9 @@ impl Rig1D {
     /// outputs: the slip velocity `v = ẋ − v_s(t)` and `v_body` take
     /// `∂ẋ⁺/∂F`, the position `x` and `x_rel` take `∂x⁺/∂F`, the spring
     /// force `−k·∂x⁺/∂F`, the acceleration `(−k·∂x⁺/∂F − c·∂ẋ⁺/∂F − 1)/m`
-    /// (its direct feedthrough `−F/m` included). `F_ext` enters with the
-    /// opposite sign.
+    /// (its direct feedthrough `−F/m` included), the applied force
+    /// `−k·∂x⁺/∂F − c·∂ẋ⁺/∂F` (no direct feedthrough from `F`). `F_ext`
+    /// enters the state with the opposite sign (and `F_app` directly, +1).
     pub fn held_step_sensitivity(&self, h: f64) -> Option<StepSensitivity> {
         if !self.plain || h.is_nan() || h <= 0.0 {
             return None;
@@ -760,6 +827,7 @@ impl Rig1D {
             xd,
             acceleration: (-p.k * x - p.c * xd - 1.0) / p.m,
             spring_force: -p.k * x,
+            applied_force: -p.k * x - p.c * xd,
         })
     }
 
@@ -793,7 +861,11 @@ impl Rig1D {
     fn step_general(&mut self, u: &Rig1DInputs, du: &Rig1DInputs, h: f64) {
         let p = self.p;
         if p.m == 0.0 && p.c == 0.0 {
-            // pure force balance: nothing to integrate
+            // pure force balance: nothing to integrate. The held position
+            // of `applied_force`: x at the start of the step, carried with
+            // the surface to its end.
+            let moved = self.surface_position(self.t + h) - self.surface_position(self.t);
+            self.x = self.position(u) + moved;
             self.t += h;
             self.xd = self.quasi_static_velocity(&u.at(du, h), du);
             return;

@@ -5,7 +5,8 @@
 //! one a displacement-driven law (Bristle) takes.
 //!
 //! Value references 0–14 are those of the first version (ramp actuator
-//! only); the modes' variables follow.
+//! only); the modes' variables follow, then the applied force `F_app`
+//! (43), the input of a friction law with a stuck state (Classical).
 
 use fmi_export::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
 use rig_dynamics::rig1d::{
@@ -57,6 +58,7 @@ pub mod vr {
     pub const CTRL_FF: u32 = 40;
     pub const CTRL_GAIN: u32 = 41;
     pub const CTRL_U_MAX: u32 = 42;
+    pub const F_APP: u32 = 43;
 }
 
 /// Direct feedthrough, over every mode (a dependency that is zero in the
@@ -69,8 +71,13 @@ const ALL_INPUTS: &[u32] = &[vr::F, vr::F_EXT, vr::X_ACT_IN, vr::X_REF, vr::V_RE
 /// the command takes the reference inputs. The slip velocity v is a state
 /// (quasi-static: its value at the end of the last step): no feedthrough.
 const REFERENCE_INPUTS: &[u32] = &[vr::X_REF, vr::V_REF];
+/// The applied force takes every input but the friction force F: F_ext,
+/// the spring (x_act_in) and the controller's reference. Not F, in any
+/// mode (the quasi-static one takes the held position): a friction law fed
+/// with it (Classical) and feeding F back forms no algebraic loop.
+const APPLIED_FORCE_DEPS: &[u32] = &[vr::F_EXT, vr::X_ACT_IN, vr::X_REF, vr::V_REF];
 
-static VARIABLES: [Variable; 43] = [
+static VARIABLES: [Variable; 44] = [
     Variable::input(
         vr::F,
         "F",
@@ -165,7 +172,7 @@ static VARIABLES: [Variable; 43] = [
         "x0",
         0.0,
         "m",
-        "Initial position (unused when m = c = 0)",
+        "Initial position (m = c = 0: only the held position of F_app before the first step)",
     ),
     Variable::parameter(
         vr::V0,
@@ -374,13 +381,20 @@ static VARIABLES: [Variable; 43] = [
         "Saturation |u_ctrl| <= ctrl_u_max (EMPS: 10 V); 0 = no saturation",
     )
     .with_min(0.0),
+    Variable::output(
+        vr::F_APP,
+        "F_app",
+        "N",
+        "Applied force, every force on the body but F, positive with v (Classical's input F_app): k*(x_act - x) - c*v_body + F_ext + F_drive + F_ctrl - m*a_s, a_s the surface acceleration; holding F = F_app keeps v constant. No feedthrough from F. m = 0: k*(x_act - x_h) + F_ext + F_drive - c*v_s, which holds the body on the surface at x_h (c = 0: x at the start of the last step, moved with the surface)",
+        APPLIED_FORCE_DEPS,
+    ),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
     model_name: "Rig1D",
     model_identifier: "Rig1D",
     guid: "{f9254f7d-c408-47bd-a8a6-d02748805905}",
-    description: "One-degree-of-freedom rig: m*x'' = k*(x_a(t) - x) - c*x' + F_ext - F + F_drive(t) + F_ctrl, slip velocity v = x' - v_s(t). Actuator point prescribed (ramp + sinusoid) or from an input; drive force step + sinusoid; PD/PI controller with saturation on a built-in or input reference; moving surface with dither; quasi-static mode m = 0. 2-stage Gauss-Legendre, sub-stepped, saturation switches located. Defaults: the 1995 stick-slip benchmark (m = 1, k = 2, pulled at 0.1 m/s).",
+    description: "One-degree-of-freedom rig: m*x'' = k*(x_a(t) - x) - c*x' + F_ext - F + F_drive(t) + F_ctrl, slip velocity v = x' - v_s(t). Actuator point prescribed (ramp + sinusoid) or from an input; drive force step + sinusoid; PD/PI controller with saturation on a built-in or input reference; moving surface with dither; quasi-static mode m = 0; output F_app, every force on the body but friction, for a law with a stuck state (Classical). 2-stage Gauss-Legendre, sub-stepped, saturation switches located. Defaults: the 1995 stick-slip benchmark (m = 1, k = 2, pulled at 0.1 m/s).",
     source: "docs/models.md, Rig1D (Canudas de Wit et al. 1995 stick-slip benchmark; Appels and Herder piezo push, quasi-static; Sun et al. 2016 step forces and velocity trials; Thimmalapura 2004 sine drive; EMPS control loop, Janot et al. 2019).",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 20.0, step_size: 1e-4 },
@@ -458,6 +472,7 @@ impl Rig1DFmu {
             vr::F_DRIVE => rig.drive_force(),
             vr::U_CTRL => rig.control_command(&u()),
             vr::F_CTRL => rig.control_force(&u()),
+            vr::F_APP => rig.applied_force(&u()),
             _ => return None,
         })
     }
@@ -494,13 +509,13 @@ impl Model for Rig1DFmu {
         Ok(())
     }
 
-    /// The ten outputs from [`Rig1D::outputs`] (what the monolithic loop of
+    /// The eleven outputs from [`Rig1D::outputs`] (what the monolithic loop of
     /// `speed-table` records too), the values the single-output functions
     /// of `compute_outputs_of` give.
     fn compute_outputs(&self, v: &mut Values) {
         let y = self.rig.outputs(&inputs(v.as_slice()));
-        // the last output's entry checked once covers the other nine
-        const LAST: usize = vr::F_CTRL as usize;
+        // the last output's entry checked once covers the other ten
+        const LAST: usize = vr::F_APP as usize;
         let Some(out) = v.as_mut_slice().get_mut(..=LAST) else {
             unreachable!("a value table holds every variable")
         };
@@ -515,6 +530,7 @@ impl Model for Rig1DFmu {
         set(vr::F_DRIVE, y.drive_force);
         set(vr::U_CTRL, y.control_command);
         set(vr::F_CTRL, y.control_force);
+        set(vr::F_APP, y.applied_force);
     }
 
     /// The outputs asked for only (a directional derivative wants v, say):
@@ -565,8 +581,9 @@ impl Model for Rig1DFmu {
     /// rig's closed form ([`Rig1D::held_step_sensitivity`]; the step is
     /// linear in the forces, smooth for any spread). The outputs that do
     /// not depend on the forces in that mode (the prescribed actuator
-    /// point, no drive force, no controller) have 0. Any other input, and
-    /// every other mode: `None`.
+    /// point, no drive force, no controller) have 0. F_app depends on F
+    /// through the state only, on F_ext also directly (+1). Any other
+    /// input, and every other mode: `None`.
     fn step_partial_derivative(
         &self,
         _values: &Values,
@@ -587,6 +604,8 @@ impl Model for Rig1DFmu {
             vr::V | vr::V_BODY => sign * d.xd,
             vr::A => sign * d.acceleration,
             vr::F_SPRING => sign * d.spring_force,
+            vr::F_APP if input == vr::F => d.applied_force,
+            vr::F_APP => 1.0 - d.applied_force,
             vr::X_ACT | vr::F_DRIVE | vr::U_CTRL | vr::F_CTRL => 0.0,
             _ => return None,
         })

@@ -75,7 +75,7 @@ fn step_sensitivities_to_the_friction_force_agree_with_finite_differences() {
     let friction = [("F", 0.3), ("F_ext", 0.1)];
     for h in [1e-3, 5e-2] {
         // the stick-slip benchmark rig: ∂v/∂F ≈ −h/m, ∂x/∂F ≈ −h²/2m
-        for output in ["v", "x", "x_rel", "a"] {
+        for output in ["v", "x", "x_rel", "a", "F_app"] {
             let r = sensitivity("Rig1D", &[], &friction, output, "F", h);
             assert_close(&format!("Rig1D d{output}/dF, h = {h}"), r, 1e-6);
         }
@@ -90,7 +90,7 @@ fn step_sensitivities_to_the_friction_force_agree_with_finite_differences() {
                 continue;
             }
             let warm = [("F", 20.0), ("F_ext", 0.1), ("x_ref", target)];
-            for output in ["v", "x"] {
+            for output in ["v", "x", "F_app"] {
                 let mut fmu = Fmu::new("Rig1D", EMPS);
                 for _ in 0..200 {
                     for (name, value) in warm {
@@ -122,8 +122,8 @@ fn step_sensitivities_to_the_friction_force_agree_with_finite_differences() {
 type Fallback<'a> = (&'a [(&'a str, f64)], f64, &'a str);
 
 /// Rig1D's outputs.
-const RIG1D_OUTPUTS: [&str; 10] = [
-    "x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl",
+const RIG1D_OUTPUTS: [&str; 11] = [
+    "x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl", "F_app",
 ];
 
 /// A damped Rig1D on a moving, dithered surface: the plain mode.
@@ -138,7 +138,9 @@ const PLAIN: &[(&str, f64)] = &[
 /// forces, at any step length: ω·h from 1.4e-4 to 0.07), Rig1D's
 /// directional derivatives with respect to F and F_ext are the rig's
 /// closed form (`Rig1D::held_step_sensitivity`) bit for bit, every output,
-/// and agree with differences outside the FMU.
+/// and agree with differences outside the FMU. F_app has no direct
+/// feedthrough from F (its derivative is the state's change alone) and
+/// one of +1 from F_ext.
 #[test]
 fn rig1d_held_step_derivatives_are_the_rigs_closed_form() {
     let p = Rig1DParams {
@@ -166,20 +168,43 @@ fn rig1d_held_step_derivatives_are_the_rigs_closed_form() {
             0.0,
             0.0,
             0.0,
+            d.applied_force,
         ];
         for (input, sign) in [("F", 1.0), ("F_ext", -1.0)] {
             for (output, want) in RIG1D_OUTPUTS.iter().zip(by_f) {
                 let got = fmu.directional_derivative(output, input);
+                let want = match (*output, input) {
+                    ("F_app", "F") => want,
+                    ("F_app", _) => 1.0 - want,
+                    _ => 0.0 + sign * want,
+                };
                 assert_eq!(
                     got.to_bits(),
-                    (0.0 + sign * want).to_bits(),
+                    want.to_bits(),
                     "h {h}: d{output}/d{input} {got:e} vs {want:e}"
                 );
             }
         }
-        for output in ["v", "x", "a"] {
-            let r = with_scale(&mut fmu, output, "F", h);
-            assert_close(&format!("Rig1D d{output}/dF, h = {h}"), r, 1e-6);
+        // −k·∂x/∂F − c·∂ẋ/∂F: c·h/m + k·h²/2m for a short step (what
+        // the held F changed of the damper and spring forces)
+        if h <= 1e-4 {
+            let short = p.c * h / p.m + p.k * h * h / (2.0 * p.m);
+            assert!(
+                (d.applied_force - short).abs() <= 1e-3 * short,
+                "{:e} vs {short:e}",
+                d.applied_force
+            );
+        }
+        let pairs = [
+            ("v", "F"),
+            ("x", "F"),
+            ("a", "F"),
+            ("F_app", "F"),
+            ("F_app", "F_ext"),
+        ];
+        for (output, input) in pairs {
+            let r = with_scale(&mut fmu, output, input, h);
+            assert_close(&format!("Rig1D d{output}/d{input}, h = {h}"), r, 1e-6);
         }
     }
 }
@@ -206,7 +231,7 @@ fn rig1d_directional_derivatives_fall_back_to_the_differences() {
             fmu.set(input, 0.3 * (k as f64).sin());
             fmu.step(h);
         }
-        for output in ["v", "x", "a"] {
+        for output in ["v", "x", "a", "F_app"] {
             let (j, fd) = fmu.step_derivative_and_differences(output, input, h);
             assert_eq!(j.to_bits(), fd.to_bits(), "{params:?}: d{output}/d{input}");
         }
@@ -275,7 +300,7 @@ fn run(fmu: &mut Fmu, steps: usize, h: f64, record: &mut Vec<u64>) {
             &["F", "F_ext", "x_act_in", "x_ref"],
             &[
                 "x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl",
-                "F_ctrl",
+                "F_ctrl", "F_app",
             ],
         )
     } else {

@@ -22,6 +22,7 @@ mod stair;
 
 mod appels_herder;
 mod archive;
+mod classical;
 mod cli_errors;
 mod connection_units;
 mod crash_safe_output;

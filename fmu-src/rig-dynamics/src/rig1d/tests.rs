@@ -1061,16 +1061,26 @@ fn held_step_sensitivity_to_the_friction_force_matches_differences() {
                     r.relative_displacement(&u),
                     r.acceleration(&u),
                     r.spring_force(&u),
+                    r.applied_force(&u),
                 ]
             };
             let d = 1e-3;
             let (a, b) = (outputs(1.0, d), outputs(-1.0, d));
-            let got = [s.x, s.xd, s.xd, s.x, s.acceleration, s.spring_force];
-            // the size each output is rounded at: the spring force and the
-            // acceleration are differences of terms of k·x
+            let got = [
+                s.x,
+                s.xd,
+                s.xd,
+                s.x,
+                s.acceleration,
+                s.spring_force,
+                s.applied_force,
+            ];
+            // the size each output is rounded at: the spring force, the
+            // acceleration and the applied force are differences of terms
+            // of k·x
             let spring = p.k * a[0].abs().max(a[5].abs() / p.k);
-            let rounded_at = [a[0], a[1], a[2], a[3], spring / p.m, spring];
-            for k in 0..6 {
+            let rounded_at = [a[0], a[1], a[2], a[3], spring / p.m, spring, spring];
+            for k in 0..7 {
                 let fd = (a[k] - b[k]) / (2.0 * d);
                 let size = a[k].abs().max(b[k].abs()).max(rounded_at[k].abs());
                 let noise = 10.0 * f64::EPSILON * size / d;
@@ -1088,7 +1098,7 @@ fn held_step_sensitivity_to_the_friction_force_matches_differences() {
             }
         }
     }
-    assert_eq!(compared, 2 * 5 * 6);
+    assert_eq!(compared, 2 * 5 * 7);
     // the modes that do not take the plain path
     for p in [
         Rig1DParams {
@@ -1225,6 +1235,7 @@ fn all_outputs_at_once_are_the_single_outputs_bit_for_bit() {
             y.drive_force,
             y.control_command,
             y.control_force,
+            y.applied_force,
         ]
         .map(f64::to_bits)
     };
@@ -1240,6 +1251,7 @@ fn all_outputs_at_once_are_the_single_outputs_bit_for_bit() {
             drive_force: rig.drive_force(),
             control_command: rig.control_command(u),
             control_force: rig.control_force(u),
+            applied_force: rig.applied_force(u),
         };
         assert_eq!(bits(&rig.outputs(u)), bits(&single), "{what}: {u:?}");
     };
@@ -1301,4 +1313,356 @@ fn state_is_finite_answers_as_a_scan_of_the_state() {
             assert!(!r.state_is_finite(), "state value {k} = {bad}");
         }
     }
+}
+
+/// F_app of a rig after stepping, against its closed form written out here
+/// from the parameters and the state (`closed(rig, u)`), in a run whose
+/// friction input changes at every step; at each point, F_app is the same
+/// bit for bit whatever the friction input, and a contact holding
+/// F = F_app leaves the body without acceleration relative to the
+/// surface: m·(ẍ − a_s) = F_app − F = 0 (to the rounding of the forces,
+/// `scale`). Returns how many points were compared.
+fn check_applied_force(
+    p: Rig1DParams,
+    u_at: impl Fn(f64) -> Rig1DInputs,
+    closed: impl Fn(&Rig1D, &Rig1DInputs) -> f64,
+    scale: f64,
+) -> usize {
+    let mut rig = Rig1D::new(p).unwrap();
+    let h = 1e-3;
+    let mut n = 0;
+    for i in 0..400 {
+        let t = rig.time();
+        let u = Rig1DInputs {
+            friction: 0.7 * (13.0 * t).sin() - 0.2,
+            ..u_at(t)
+        };
+        rig.step(&u, &no_inputs(), h);
+        let u = u_at(rig.time());
+        let f_app = rig.applied_force(&u);
+        let want = closed(&rig, &u);
+        assert!(
+            (f_app - want).abs() <= 1e-12 * scale,
+            "step {i}: F_app {f_app:e}, closed form {want:e}"
+        );
+        for friction in [0.0, -0.0, 1.5, -3.0, 1e6] {
+            let other = rig.applied_force(&Rig1DInputs { friction, ..u });
+            assert_eq!(other.to_bits(), f_app.to_bits(), "F = {friction}");
+        }
+        let held = Rig1DInputs {
+            friction: f_app,
+            ..u
+        };
+        let relative = rig.acceleration(&held) - rig.surface_acceleration();
+        assert!(
+            (p.m * relative).abs() <= 1e-12 * scale,
+            "step {i}: m·(a − a_s) = {:e} with F = F_app",
+            p.m * relative
+        );
+        n += 1;
+    }
+    n
+}
+
+/// F_app = k·(x_a − x) − c·ẋ + F_ext + F_d + F_ctrl − m·a_s, each term
+/// written out from the parameters, in every mode with a mass: the spring
+/// to a moving (ramped and sinusoidal) actuator with a damper and F_ext on
+/// a belt whose dither accelerates it (the inertial term −m·a_s), the
+/// actuator from its input with the drive step and sinusoid, and the
+/// controller (built-in reference; input reference, saturating).
+#[test]
+fn applied_force_is_every_force_but_friction_with_a_mass() {
+    let tau = 2.0 * PI;
+    let f_ext = |t: f64| 0.3 + 0.1 * (5.0 * t).cos();
+    // a_s = −A·ω²·sin ωt of the dither, written out
+    let surface_acc = |p: &Rig1DParams, t: f64| {
+        let w = tau * p.dither.freq;
+        -p.dither.amp * w * w * (w * t).sin()
+    };
+    let mut compared = 0;
+
+    // spring to a moving actuator, damper, F_ext, dithered belt
+    let p = Rig1DParams {
+        act_sine: Sinusoid::new(2e-3, 3.0),
+        dither: Sinusoid::new(2e-4, 25.0),
+        ..damped_on_a_moving_surface()
+    };
+    assert!(surface_acc(&p, 0.01).abs() > 1.0, "the belt accelerates");
+    compared += check_applied_force(
+        p,
+        |t| Rig1DInputs {
+            f_ext: f_ext(t),
+            ..Default::default()
+        },
+        |rig, u| {
+            let t = rig.time();
+            let x_a = p.x_a0 + p.v_a * t + p.act_sine.amp * (tau * p.act_sine.freq * t).sin();
+            p.k * (x_a - rig.position(u)) - p.c * rig.velocity() + u.f_ext
+                - p.m * surface_acc(&p, t)
+        },
+        1.0,
+    );
+
+    // the actuator point from its input, with the drive force step and sine
+    let p = Rig1DParams {
+        actuator: Actuator::Input,
+        drive: DriveForce {
+            f_step: 0.6,
+            t_step: 0.1234,
+            sine: Sinusoid::new(0.25, 2.0),
+        },
+        ..damped_on_a_moving_surface()
+    };
+    compared += check_applied_force(
+        p,
+        |t| Rig1DInputs {
+            f_ext: f_ext(t),
+            x_act: 0.01 * t + 1e-3 * (7.0 * t).sin(),
+            ..Default::default()
+        },
+        |rig, u| {
+            let t = rig.time();
+            let step = if t >= 0.1234 { 0.6 } else { 0.0 };
+            let drive = step + 0.25 * (tau * 2.0 * t).sin();
+            p.k * (u.x_act - rig.position(u)) - p.c * rig.velocity() + u.f_ext + drive
+                - p.m * surface_acc(&p, t)
+        },
+        1.0,
+    );
+
+    // the controller: built-in reference (unsaturated), and the input
+    // reference with saturation (the EMPS loop, stiff: its forces are
+    // G·Kp·|x| ~ 1e3 N)
+    let builtin = Rig1DParams {
+        control: Controller {
+            mode: Control::BuiltIn,
+            kp: 40.0,
+            kd: 3.0,
+            ki: 5.0,
+            ff: 0.7,
+            gain: 2.0,
+            u_max: 0.0,
+            reference: Reference {
+                x0: 0.01,
+                v0: 2e-3,
+                sine: Sinusoid::new(1e-3, 0.8),
+            },
+        },
+        ..damped_on_a_moving_surface()
+    };
+    for (p, scale) in [(builtin, 1.0), (emps(10.0), 1e3)] {
+        let input_reference = p.control.mode == Control::Input;
+        let reference = move |t: f64| {
+            if input_reference {
+                (0.02 * (tau * t).sin(), 0.02 * tau * (tau * t).cos())
+            } else {
+                (0.0, 0.0)
+            }
+        };
+        compared += check_applied_force(
+            p,
+            |t| {
+                let (x_ref, v_ref) = reference(t);
+                Rig1DInputs {
+                    f_ext: f_ext(t),
+                    x_ref,
+                    v_ref,
+                    ..Default::default()
+                }
+            },
+            |rig, u| {
+                let t = rig.time();
+                let g = &p.control;
+                let (x_ref, v_ref) = if input_reference {
+                    (u.x_ref, u.v_ref)
+                } else {
+                    let r = &g.reference;
+                    let w = tau * r.sine.freq;
+                    (
+                        r.x0 + r.v0 * t + r.sine.amp / w * (1.0 - (w * t).cos()),
+                        r.v0 + r.sine.amp * (w * t).sin(),
+                    )
+                };
+                let (x, xd) = (rig.position(u), rig.velocity());
+                let command = g.kp * (x_ref - x) + g.kd * (g.ff * v_ref - xd) + g.ki * rig.xi;
+                let command = if g.u_max > 0.0 {
+                    command.clamp(-g.u_max, g.u_max)
+                } else {
+                    command
+                };
+                let x_a = p.x_a0 + p.v_a * t;
+                p.k * (x_a - x) - p.c * xd + u.f_ext + g.gain * command - p.m * surface_acc(&p, t)
+            },
+            scale,
+        );
+    }
+    assert_eq!(compared, 4 * 400);
+}
+
+/// The quasi-static rig (m = 0, c = 0), where the position follows F at
+/// once: F_app = k·(x_a − x_h) + F_ext + F_d, x_h the held position (the
+/// position at the start of the last step, carried with the surface), not
+/// a function of F. A contact that holds F = F_app at every communication
+/// point (what a stuck Classical contact does under the Jacobi master)
+/// keeps the body where it was on the surface, x − x_s(t) = x0 (the held
+/// position before the first step), while F_app
+/// grows with the actuator: the spring force at the held position. Ramped
+/// actuator and F_ext, a drive step, a dithered belt; and the piezo
+/// staircase through `x_act_in`.
+#[test]
+fn applied_force_quasi_static_holds_the_body_where_it_was() {
+    let k = 116.04e3;
+    for actuator in [Actuator::Prescribed, Actuator::Input] {
+        let p = Rig1DParams {
+            m: 0.0,
+            c: 0.0,
+            k,
+            actuator,
+            x_a0: 2e-6,
+            x0: 2e-6,
+            v_a: 8.25e-8,
+            v_surface: 1e-7,
+            dither: Sinusoid::new(1e-8, 3.0),
+            drive: DriveForce {
+                f_step: 0.05,
+                t_step: 0.5,
+                sine: Sinusoid::OFF,
+            },
+            ..Default::default()
+        };
+        let x_act = |t: f64| match actuator {
+            Actuator::Prescribed => p.x_a0 + p.v_a * t,
+            // 0.825e-9 m every 10 ms from x_a0
+            Actuator::Input => p.x_a0 + 0.825e-9 * (t / 1e-2 + 1e-9).floor(),
+        };
+        let f_ext = |t: f64| 0.01 + 0.02 * t;
+        let drive = |t: f64| if t >= 0.5 { 0.05 } else { 0.0 };
+        let mut rig = Rig1D::new(p).unwrap();
+        // before the first step: held at x0 (here the relaxed spring)
+        let x_held0 = p.x0;
+        let u0 = Rig1DInputs {
+            f_ext: f_ext(0.0),
+            x_act: x_act(0.0),
+            ..Default::default()
+        };
+        assert_eq!(rig.applied_force(&u0), k * (p.x_a0 - x_held0) + f_ext(0.0));
+        let h = 1e-2;
+        let mut force = rig.applied_force(&u0);
+        for i in 0..100 {
+            let t = rig.time();
+            let u = Rig1DInputs {
+                friction: force,
+                f_ext: f_ext(t),
+                x_act: x_act(t),
+                ..Default::default()
+            };
+            // the body where the contact holds it, relative to the surface
+            let relative = rig.relative_displacement(&u);
+            assert!(
+                (relative - x_held0).abs() <= 1e-15,
+                "t = {t}: x − x_s = {relative:e}, held at {x_held0:e}"
+            );
+            rig.step(&u, &no_inputs(), h);
+            let t = rig.time();
+            let u = Rig1DInputs {
+                f_ext: f_ext(t),
+                x_act: x_act(t),
+                ..Default::default()
+            };
+            force = rig.applied_force(&u);
+            let x_held = x_held0 + rig.surface_position(t);
+            let want = k * (x_act(t) - x_held) + f_ext(t) + drive(t);
+            assert!(
+                (force - want).abs() <= 1e-9 * want.abs(),
+                "step {i}: F_app {force:e}, closed form {want:e}"
+            );
+            for friction in [0.0, 0.3, -2.0] {
+                let other = rig.applied_force(&Rig1DInputs { friction, ..u });
+                assert_eq!(other.to_bits(), force.to_bits());
+            }
+        }
+        // the spring took the actuator's travel: F_app grew by k·Δx_a
+        let travel = x_act(1.0) - x_act(0.0) - rig.surface_position(1.0);
+        assert!(travel.abs() > 1e-9);
+        let grown = force - (f_ext(1.0) + 0.05);
+        assert!(
+            (grown - k * travel).abs() <= 1e-9 * (k * travel).abs(),
+            "{actuator:?}: {grown:e} vs k·travel {:e}",
+            k * travel
+        );
+    }
+}
+
+/// The damped quasi-static rig (m = 0, c > 0):
+/// F_app = k·(x_a − x) + F_ext + F_d − c·v_s(t), the force for which
+/// c·ẋ = k·(x_a − x) + F_ext − F + F_d gives ẋ = v_s (no slip); not a
+/// function of F.
+#[test]
+fn applied_force_quasi_static_damped_gives_no_slip() {
+    let p = Rig1DParams {
+        m: 0.0,
+        c: 2.0,
+        k: 50.0,
+        v_a: 0.01,
+        x0: 0.002,
+        v_surface: 0.003,
+        dither: Sinusoid::new(1e-4, 4.0),
+        drive: DriveForce {
+            f_step: 0.1,
+            t_step: 0.2,
+            sine: Sinusoid::new(0.05, 1.5),
+        },
+        ..Default::default()
+    };
+    let tau = 2.0 * PI;
+    let compared = check_applied_force_without_mass(p, |rig, u| {
+        let t = rig.time();
+        let v_s = p.v_surface + 1e-4 * tau * 4.0 * (tau * 4.0 * t).cos();
+        let drive = if t >= 0.2 { 0.1 } else { 0.0 } + 0.05 * (tau * 1.5 * t).sin();
+        p.k * (p.v_a * t - rig.position(u)) + u.f_ext + drive - p.c * v_s
+    });
+    assert_eq!(compared, 300);
+}
+
+/// [`check_applied_force`] for the damped quasi-static rig, where the
+/// property is of the velocity: with F = F_app the balance gives ẋ = v_s.
+fn check_applied_force_without_mass(
+    p: Rig1DParams,
+    closed: impl Fn(&Rig1D, &Rig1DInputs) -> f64,
+) -> usize {
+    let mut rig = Rig1D::new(p).unwrap();
+    let mut n = 0;
+    for i in 0..300 {
+        let t = rig.time();
+        let u = Rig1DInputs {
+            friction: 0.4 * (9.0 * t).cos(),
+            f_ext: 0.05 * t,
+            ..Default::default()
+        };
+        rig.step(&u, &no_inputs(), 1e-3);
+        let u = Rig1DInputs {
+            f_ext: 0.05 * rig.time(),
+            ..Default::default()
+        };
+        let f_app = rig.applied_force(&u);
+        let want = closed(&rig, &u);
+        assert!(
+            (f_app - want).abs() <= 1e-13,
+            "step {i}: {f_app:e} vs {want:e}"
+        );
+        let other = rig.applied_force(&Rig1DInputs { friction: 7.0, ..u });
+        assert_eq!(other.to_bits(), f_app.to_bits());
+        let held = Rig1DInputs {
+            friction: f_app,
+            ..u
+        };
+        let slip =
+            rig.quasi_static_velocity(&held, &no_inputs()) - rig.surface_velocity(rig.time());
+        assert!(
+            slip.abs() <= 1e-14,
+            "step {i}: slip {slip:e} with F = F_app"
+        );
+        n += 1;
+    }
+    n
 }
