@@ -7,7 +7,8 @@
 
 use super::{event_indicator_vr, time_vr};
 use crate::exports::{
-    call_named, create, free_instance_of, in_slice, out_slice, LiveSet, Request, FMI3_LIVE,
+    both_usable, call_named, create, free_instance_of, in_slice, out_slice, recent_instance,
+    LiveSet, Request, FMI3_LIVE,
 };
 use crate::ffi::fmi2Status;
 use crate::instance::Instance;
@@ -345,6 +346,18 @@ pub unsafe fn unsupported(
     unsafe { call!(c, function, row "fmi3Unsupported", |_| Err(why.to_string())) }
 }
 
+/// Whether `vr` is a scalar of FMI 3.0, not an array whose one value
+/// reference stands for several values (a value reference past the table
+/// is left to the general path, which the fast paths' own checks send it
+/// to).
+#[inline(always)]
+fn is_scalar(inst: &Instance, vr: u32) -> bool {
+    match inst.fmi3_layout {
+        Some(layout) if layout.has_arrays => layout.variable_of(vr).is_none_or(|v| v.len == 1),
+        _ => true,
+    }
+}
+
 /// The table's value references of the FMI 3.0 value references `vrs`
 /// of a get or set of `n_values` values: `vrs` itself when the model has
 /// no arrays, else each array as its elements, in `buffer`
@@ -460,6 +473,28 @@ unsafe fn get_converted<T>(
     (value, n_values): (*mut T, usize),
     convert: fn(f64) -> T,
 ) -> fmi3Status {
+    // The step loop's case, one scalar whose reading runs none of the
+    // model's code (`Instance::get_plain`: a master recording a flag after
+    // its fmi3GetFloat64 has brought the outputs up to date), as
+    // `fmi2GetBoolean` takes it; anything else takes the general path.
+    if n == 1 && n_values == 1 && both_usable(vr, value) {
+        // SAFETY: non-null and aligned, one element (FMI contract)
+        let vr = unsafe { *vr };
+        // SAFETY: as `call`
+        if let Some((admitted, inst)) = unsafe { recent_instance(&FMI3_LIVE, c, mask) } {
+            let x = if is_scalar(inst, vr) {
+                inst.get_plain(t, vr)
+            } else {
+                None
+            };
+            drop(admitted);
+            if let Some(x) = x {
+                // SAFETY: non-null and aligned, one element (FMI contract)
+                unsafe { *value = convert(x) };
+                return fmi3OK;
+            }
+        }
+    }
     unsafe {
         call_mask(c, function, mask, |inst| {
             let vrs = in_slice(vr, n, "valueReferences[]")?;
@@ -592,6 +627,24 @@ pub unsafe fn set_float64(
     value: *const f64,
     n_values: usize,
 ) -> fmi3Status {
+    // The step loop's case, one scalar set without a check of the model's
+    // (`Instance::set_real_plain`), before the general path, as
+    // `fmi2SetReal` takes it: it calls nothing and cannot fail or panic,
+    // so it needs no `catch_unwind`. Anything else, or any doubt, takes
+    // the general path, nothing changed.
+    const ALLOWED: u32 = allowed_mask("fmi3SetFloat64");
+    if n == 1 && n_values == 1 && both_usable(vr, value) {
+        // SAFETY: non-null and aligned, one element each (FMI contract)
+        let (vr, value) = unsafe { (*vr, *value) };
+        // SAFETY: as `call`
+        if let Some((admitted, inst)) = unsafe { recent_instance(&FMI3_LIVE, c, ALLOWED) } {
+            let done = is_scalar(inst, vr) && inst.set_real_plain(vr, value);
+            drop(admitted);
+            if done {
+                return fmi3OK;
+            }
+        }
+    }
     unsafe {
         set_converted(
             c,
