@@ -143,6 +143,12 @@ def test_info_is_the_model_description():
     force = lugre.variable("F")
     assert (force.causality, force.type, force.unit) == ("output", "Real", "N")
     assert lugre.variable("sigma0").causality == "parameter"
+    # an FMI 3.0 FMU's variables by their FMI 3.0 type names
+    lugre3 = fricsim.info(ROOT / "dist" / "fmi3" / "LuGre.fmu")
+    assert lugre3.fmi_version == "3.0"
+    assert (lugre3.variable("F").type, lugre3.variable("F").unit) == ("Float64", "N")
+    assert lugre3.variable("sliding").type == "Boolean"
+    assert lugre3.variable("x_table[1]").type == "Float64"
     with pytest.raises(KeyError, match="no variable `nosuch`"):
         lugre.variable("nosuch")
     with pytest.raises(fricsim.FricsimError, match="nosuch.fmu"):

@@ -94,7 +94,8 @@ fn description_json(d: &ModelDescription, platforms: &[String]) -> serde_json::V
                 "value_reference": v.value_reference,
                 "causality": v.causality.to_string(),
                 "variability": v.variability.to_string(),
-                "type": v.kind.type_name(),
+                // the FMU's own type name: `Float64`, `Int16`, … in FMI 3.0
+                "type": v.type_name(),
                 "start": v.kind.start_text(),
                 "unit": v.kind.unit(),
                 "description": v.description,

@@ -1132,17 +1132,9 @@ fn held_step_sensitivity_to_the_friction_force_matches_differences() {
     }
 }
 
-/// `outputs` gives each output bit for bit as its single-output function
-/// does, in every mode of the rig: the default (plain) mode, a damped rig
-/// on a dithered belt, the actuator sinusoid and the actuator input, the
-/// drive step (before, at and after t_step) and sinusoid, the built-in and
-/// the input reference of the controller with and without saturation, the
-/// quasi-static modes (c = 0: position fed through; c > 0), over states
-/// reached by stepping and states set directly (signed zeros included),
-/// and inputs of both signs, zeros of both signs among them.
-#[test]
-fn all_outputs_at_once_are_the_single_outputs_bit_for_bit() {
-    let pd = Controller {
+/// A PID controller on its built-in sinusoidal reference, unsaturated.
+fn built_in_pid() -> Controller {
+    Controller {
         mode: Control::BuiltIn,
         kp: 40.0,
         kd: 3.0,
@@ -1155,7 +1147,20 @@ fn all_outputs_at_once_are_the_single_outputs_bit_for_bit() {
             v0: 2e-3,
             sine: Sinusoid::new(1e-3, 0.8),
         },
-    };
+    }
+}
+
+/// `outputs` gives each output bit for bit as its single-output function
+/// does, in every mode of the rig: the default (plain) mode, a damped rig
+/// on a dithered belt, the actuator sinusoid and the actuator input, the
+/// drive step (before, at and after t_step) and sinusoid, the built-in and
+/// the input reference of the controller with and without saturation, the
+/// quasi-static modes (c = 0: position fed through; c > 0), over states
+/// reached by stepping and states set directly (signed zeros included),
+/// and inputs of both signs, zeros of both signs among them.
+#[test]
+fn all_outputs_at_once_are_the_single_outputs_bit_for_bit() {
+    let pd = built_in_pid();
     let sets = [
         Rig1DParams::default(),
         damped_on_a_moving_surface(),
@@ -1434,20 +1439,7 @@ fn applied_force_is_every_force_but_friction_with_a_mass() {
     // reference with saturation (the EMPS loop, stiff: its forces are
     // G·Kp·|x| ~ 1e3 N)
     let builtin = Rig1DParams {
-        control: Controller {
-            mode: Control::BuiltIn,
-            kp: 40.0,
-            kd: 3.0,
-            ki: 5.0,
-            ff: 0.7,
-            gain: 2.0,
-            u_max: 0.0,
-            reference: Reference {
-                x0: 0.01,
-                v0: 2e-3,
-                sine: Sinusoid::new(1e-3, 0.8),
-            },
-        },
+        control: built_in_pid(),
         ..damped_on_a_moving_surface()
     };
     for (p, scale) in [(builtin, 1.0), (emps(10.0), 1e3)] {
