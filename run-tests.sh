@@ -38,20 +38,34 @@ finish() {
         exit "$status"
     fi
 }
+# mark STEP: the elapsed time when STEP ended, so that a CI log shows
+# where its minutes go
+mark() {
+    echo "run-tests.sh: $1 done, $((SECONDS / 60)) min $((SECONDS % 60)) s since the start" >&2
+}
 # a failure in the foreground stops the background set-ups too
 trap 'for pid in "${pids[@]}"; do kill "$pid" 2> /dev/null || true; done' EXIT
 
 start venv scripts/setup-venv.sh
 scripts/setup-windows.sh
+mark "MinGW-w64 and Wine set-up"
 start browser-and-fmi-crate bash -c 'scripts/setup-browser.sh && scripts/setup-fmi-crate.sh'
 ./build-fmu.sh
+mark "build-fmu.sh (FMUs, fricsim, examples)"
+cargo test --workspace --profile release-test --no-run
+mark "Rust test build"
 cargo test --workspace --profile release-test
+mark "Rust tests"
 # the host's library crates document their public API without a broken link
 RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p fricsim-fmi -p fricsim-core \
     -p fricsim-diagnose -p fricsim-hidden-effects -p fricsim
+mark "API documentation"
 finish venv
+mark "pinned venv (waited for)"
 finish browser-and-fmi-crate
+mark "Chromium and the fmi crate (waited for)"
 scripts/setup-python-package.sh
+mark "Python package fricsim"
 # on two workers, each test file whole on one of them (a file's module
 # fixtures, such as its Dask cluster or the Wine prefix of
 # test_windows_dll.py, stay in one process) but the long files whose tests
@@ -61,3 +75,4 @@ scripts/setup-python-package.sh
 # after its last test, prints the Python stack of each of its threads
 # (not once the interpreter has shut the handler down, at its very end)
 PYTHONFAULTHANDLER=1 .venv/bin/python -m pytest tests -q -n 2 --dist loadfile --no-loadscope-reorder --durations=15
+mark "Python tests"

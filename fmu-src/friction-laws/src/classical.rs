@@ -163,11 +163,6 @@ impl Classical {
         v.abs() < self.p.dv
     }
 
-    /// Stuck: inside the band with `|F_app| ≤ Fs`.
-    pub fn stuck(&self, v: f64, f_app: f64) -> bool {
-        self.branch(v, f_app) == Branch::Stuck
-    }
-
     /// Which branch of the law the inputs are on.
     pub fn branch(&self, v: f64, f_app: f64) -> Branch {
         if !self.in_band(v) {
@@ -243,14 +238,6 @@ impl Classical {
             Branch::BreakingAwayForward | Branch::BreakingAwayBackward => (0.0, 0.0),
             Branch::Sliding => (self.steady_state_slope(v), 0.0),
         }
-    }
-
-    /// The power the contact dissipates, `F·v` (W): the law stores no
-    /// energy. Inside the band a stuck contact holds `F_app` at a small
-    /// `v` of either sign, so there it can be slightly negative
-    /// (`|P| < Fs·dv`).
-    pub fn dissipated_power(&self, v: f64, f_app: f64) -> f64 {
-        self.force(v, f_app) * v
     }
 
     /// The number of values of the state (0: the law has none).
@@ -330,14 +317,14 @@ mod tests {
         let law = Classical::new(p).unwrap();
         for v in [0.0, 0.5 * p.dv, -0.9 * p.dv] {
             assert_eq!(law.force(v, 1.7), 1.7);
-            assert!(law.stuck(v, 1.7));
+            assert_eq!(law.branch(v, 1.7), Branch::Stuck);
             assert_eq!(law.force(v, -2.35), -2.35);
             assert_eq!(law.force(v, 3.0), p.fs);
-            assert!(!law.stuck(v, 3.0));
+            assert_eq!(law.branch(v, 3.0), Branch::BreakingAwayForward);
             assert_eq!(law.force(v, -9.0), -p.fs);
         }
         assert_eq!(law.force(2.0 * p.dv, -9.0), law.steady_state(2.0 * p.dv));
-        assert!(!law.stuck(p.dv, 0.0));
+        assert_eq!(law.branch(p.dv, 0.0), Branch::Sliding);
     }
 
     /// An event stops on the boundary its indicator crossed: there the

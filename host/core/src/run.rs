@@ -180,14 +180,7 @@ impl PreparedRun {
                 .unwrap_or_else(|| file.settings.master_or_default()),
         )?;
         let checked = file.check().map_err(|e| e.to_string())?;
-        let start_values = options
-            .start_values
-            .iter()
-            .map(|(port, value)| {
-                let var = variable_of(&checked.fmus, port)?;
-                Ok((port.clone(), check_start_value(port, var, value)?))
-            })
-            .collect::<Result<Vec<_>, String>>()?;
+        let start_values = check_start_values(&checked.fmus, &options.start_values)?;
         // the FMUs are told the stop time, as FMPy tells them
         let mut system = file
             .instantiate(
@@ -579,7 +572,6 @@ impl<S: RowSink> RowSink for Recorder<S> {
     }
 }
 
-/// The variable `component.variable` among the opened FMUs.
 /// Named FMUs, opened, and start values checked against them.
 pub type OpenedWithStartValues = (Vec<(String, Fmu)>, Vec<(String, ParameterValue)>);
 
@@ -596,16 +588,26 @@ pub fn open_with_start_values(
         .iter()
         .map(|(name, path)| Ok((name.clone(), Fmu::open(path).map_err(|e| e.to_string())?)))
         .collect::<Result<Vec<_>, String>>()?;
-    let checked = start_values
-        .iter()
-        .map(|(port, value)| {
-            let var = variable_of(&fmus, port)?;
-            Ok((port.clone(), check_start_value(port, var, value)?))
-        })
-        .collect::<Result<Vec<_>, String>>()?;
+    let checked = check_start_values(&fmus, start_values)?;
     Ok((fmus, checked))
 }
 
+/// Each start value `(component.variable, value)` checked against the
+/// variable it names among the FMUs ([`check_start_value`]).
+fn check_start_values(
+    fmus: &[(String, Fmu)],
+    start_values: &[(String, StartValue)],
+) -> Result<Vec<(String, ParameterValue)>, String> {
+    start_values
+        .iter()
+        .map(|(port, value)| {
+            let var = variable_of(fmus, port)?;
+            Ok((port.clone(), check_start_value(port, var, value)?))
+        })
+        .collect()
+}
+
+/// The variable `component.variable` among the opened FMUs.
 fn variable_of<'a>(fmus: &'a [(String, Fmu)], port: &str) -> Result<&'a ScalarVariable, String> {
     let (c, v) = port
         .split_once('.')
