@@ -57,20 +57,48 @@ pub struct Fitted {
 /// shorter batch stops the fit).
 /// A batch is the columns of one forward-difference Jacobian, which an
 /// evaluator may run in parallel.
-pub type Residuals<'a> = dyn FnMut(&[FrictionModel]) -> Vec<Option<DVector<f64>>> + 'a;
+pub type Residuals<'a> = ResidualsOf<'a, FrictionModel>;
 
-/// The Jacobian of the residuals in θ at `base.at(free, θ)` from one
+/// [`Residuals`] of models of any kind (the fit of another law than
+/// LuGre, [`crate::memory`]).
+pub type ResidualsOf<'a, M> = dyn FnMut(&[M]) -> Vec<Option<DVector<f64>>> + 'a;
+
+/// The Jacobian of the residuals in θ at `coordinates.at(θ)` from one
 /// evaluation, when the evaluator can give it (`None`: differences).
-pub type ExactJacobian<'a> =
-    dyn FnMut(&FrictionModel, &[Free], &[f64]) -> Option<DMatrix<f64>> + 'a;
+pub type ExactJacobian<'a, C = Freed> = dyn FnMut(&C, &[f64]) -> Option<DMatrix<f64>> + 'a;
 
-struct Problem<'a, 'r> {
-    base: FrictionModel,
-    free: Vec<Free>,
+/// What a fit moves: the coordinates θ of a model (transformed so that
+/// every θ is a physical model) and the model at θ.
+pub trait Coordinates {
+    type Model: Clone;
+    /// θ of the start.
+    fn theta(&self) -> Vec<f64>;
+    /// The model at `theta`.
+    fn at(&self, theta: &[f64]) -> Self::Model;
+}
+
+/// A LuGre model and the parameters a fit frees ([`FrictionModel::free`]).
+pub struct Freed {
+    pub model: FrictionModel,
+    pub free: Vec<Free>,
+}
+
+impl Coordinates for Freed {
+    type Model = FrictionModel;
+    fn theta(&self) -> Vec<f64> {
+        self.model.theta(&self.free)
+    }
+    fn at(&self, theta: &[f64]) -> FrictionModel {
+        self.model.at(&self.free, theta)
+    }
+}
+
+struct Problem<'a, 'r, C: Coordinates> {
+    coordinates: C,
     theta: DVector<f64>,
-    residual: &'r mut Residuals<'a>,
+    residual: &'r mut ResidualsOf<'a, C::Model>,
     /// Where the Jacobian comes from when not from differences.
-    exact: Option<&'r mut ExactJacobian<'a>>,
+    exact: Option<&'r mut ExactJacobian<'a, C>>,
     /// Length of the residual vector (for the refusal vector).
     len: usize,
     diff_step: f64,
@@ -82,7 +110,7 @@ struct Problem<'a, 'r> {
     best: Option<(f64, Vec<f64>)>,
 }
 
-impl Problem<'_, '_> {
+impl<C: Coordinates> Problem<'_, '_, C> {
     /// The residuals at each θ of `thetas` (one batch), or `None` when the
     /// budget is spent.
     fn residuals_at(&mut self, thetas: &[Vec<f64>]) -> Option<Vec<DVector<f64>>> {
@@ -90,8 +118,7 @@ impl Problem<'_, '_> {
             return None;
         }
         self.evaluations += thetas.len();
-        let models: Vec<FrictionModel> =
-            thetas.iter().map(|t| self.base.at(&self.free, t)).collect();
+        let models: Vec<C::Model> = thetas.iter().map(|t| self.coordinates.at(t)).collect();
         let results = (self.residual)(&models);
         // an evaluator that gives fewer has stopped (the diagnosis's time
         // limit): so does the fit, with the best seen
@@ -117,9 +144,9 @@ impl Problem<'_, '_> {
 
 /// A wrapper whose `residuals` and `jacobian` run the simulations (the
 /// crate's trait takes `&self`, the simulations need `&mut`).
-struct Fit<'a, 'r>(std::cell::RefCell<Problem<'a, 'r>>);
+struct Fit<'a, 'r, C: Coordinates>(std::cell::RefCell<Problem<'a, 'r, C>>);
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_, '_> {
+impl<C: Coordinates> LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_, '_, C> {
     type ResidualStorage = Owned<f64, Dyn>;
     type JacobianStorage = Owned<f64, Dyn, Dyn>;
     type ParameterStorage = Owned<f64, Dyn>;
@@ -149,9 +176,9 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_, '_> {
         let theta: Vec<f64> = p.theta.iter().copied().collect();
         if p.evaluations < p.budget {
             let Problem {
-                exact, base, free, ..
+                exact, coordinates, ..
             } = &mut *p;
-            if let Some(jacobian) = exact.as_mut().and_then(|j| j(base, free, &theta)) {
+            if let Some(jacobian) = exact.as_mut().and_then(|j| j(coordinates, &theta)) {
                 p.evaluations += 1;
                 return Some(jacobian);
             }
@@ -176,21 +203,20 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_, '_> {
     }
 }
 
-/// Minimise `residual` over the free parameters of `start` with at most
-/// `budget` evaluations; the best model seen, its cost and the count.
-fn minimise<'a>(
-    start: &FrictionModel,
-    residual: &mut Residuals<'a>,
-    exact: Option<&mut ExactJacobian<'a>>,
+/// Minimise `residual` over the coordinates θ of `coordinates`, from
+/// theirs, with at most `budget` evaluations; the best model seen, its
+/// cost and the count.
+fn minimise<'a, C: Coordinates>(
+    coordinates: C,
+    residual: &mut ResidualsOf<'a, C::Model>,
+    exact: Option<&mut ExactJacobian<'a, C>>,
     diff_step: f64,
     budget: usize,
-) -> (FrictionModel, f64, usize) {
-    let free = start.free();
-    let theta0 = start.theta(&free);
+) -> (C::Model, f64, usize) {
+    let theta0 = coordinates.theta();
     let mut problem = Problem {
         theta: DVector::from_vec(theta0.clone()),
-        base: start.clone(),
-        free: free.clone(),
+        coordinates,
         residual,
         exact,
         len: 1,
@@ -206,7 +232,10 @@ fn minimise<'a>(
             problem.len = r[0].len();
             problem.residuals = r.pop();
         }
-        None => return (start.clone(), f64::INFINITY, problem.evaluations),
+        None => {
+            let start = problem.coordinates.at(&theta0);
+            return (start, f64::INFINITY, problem.evaluations);
+        }
     }
     let (result, _report) = LevenbergMarquardt::new()
         .with_patience(12)
@@ -215,7 +244,7 @@ fn minimise<'a>(
         .minimize(Fit(std::cell::RefCell::new(problem)));
     let p = result.0.into_inner();
     let (cost, theta) = p.best.unwrap_or((f64::INFINITY, theta0));
-    (start.at(&free, &theta), cost, p.evaluations)
+    (p.coordinates.at(&theta), cost, p.evaluations)
 }
 
 /// The force-fit residuals of `model`: (law − data) / (√n · scale) on the
@@ -330,8 +359,8 @@ pub fn fit(
             .map(|m| force_residuals(&mut sim.borrow_mut(), data, train, scale, m))
             .collect()
     };
-    let mut exact = |base: &FrictionModel, free: &[Free], theta: &[f64]| {
-        if free.len() < SENSITIVITIES_FROM {
+    let mut exact = |c: &Freed, theta: &[f64]| {
+        if c.free.len() < SENSITIVITIES_FROM {
             return None;
         }
         force_jacobian(
@@ -339,11 +368,12 @@ pub fn fit(
             data,
             train,
             scale,
-            (base, free, theta),
+            (&c.model, &c.free, theta),
         )
     };
+    let free = start.free();
     let (model, cost, n) = minimise(
-        &start,
+        Freed { model: start, free },
         &mut residual,
         Some(&mut exact),
         DIFF_STEP,
@@ -361,12 +391,27 @@ pub fn fit(
 /// co-simulation per model, already normalised), with at most `budget`
 /// co-simulations. Returns `start` itself when nothing better was found.
 pub fn polish(start: &FrictionModel, residual: &mut Residuals<'_>, budget: usize) -> Fitted {
-    let (model, cost, evaluations) = minimise(start, residual, None, POLISH_DIFF_STEP, budget);
+    let coordinates = Freed {
+        model: start.clone(),
+        free: start.free(),
+    };
+    let (model, cost, evaluations) = polish_any(coordinates, residual, budget);
     Fitted {
         model,
         rms: cost.sqrt(),
         evaluations,
     }
+}
+
+/// [`polish`] of a model of any kind: `residual` minimised over the
+/// coordinates θ from theirs, with at most `budget` co-simulations; the
+/// best model seen, its cost and the count.
+pub fn polish_any<C: Coordinates>(
+    coordinates: C,
+    residual: &mut ResidualsOf<'_, C::Model>,
+    budget: usize,
+) -> (C::Model, f64, usize) {
+    minimise(coordinates, residual, None, POLISH_DIFF_STEP, budget)
 }
 
 impl FrictionModel {

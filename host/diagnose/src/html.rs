@@ -322,10 +322,30 @@ fn verdict(s: &mut String, d: &Diagnosis) {
     );
     let _ = writeln!(
         s,
-        "<tr><td><strong>final</strong></td><td class=\"num\"><strong>{}</strong></td><td>{}</td></tr>\n</table>",
+        "<tr><td><strong>final</strong></td><td class=\"num\"><strong>{}</strong></td><td>{}</td></tr>",
         number(d.final_rms),
         percent(d.nominal_rms, d.final_rms)
     );
+    if d.memory.outcome == crate::memory::MemoryOutcome::Moved {
+        let _ = writeln!(
+            s,
+            "<tr><td><strong>final, moved to GMS</strong></td><td class=\"num\"><strong>{}</strong></td><td>{}</td></tr>",
+            number(d.memory.gms_heldout_rms),
+            percent(d.nominal_rms, d.memory.gms_heldout_rms)
+        );
+    }
+    let _ = writeln!(s, "</table>");
+    // the report's words, its emphasis as HTML
+    let words = escape(&super::report::memory_words(&d.memory));
+    let mut html = String::new();
+    for (i, part) in words.split("**").enumerate() {
+        if i % 2 == 1 {
+            let _ = write!(html, "<strong>{part}</strong>");
+        } else {
+            html.push_str(part);
+        }
+    }
+    let _ = writeln!(s, "<p>{}</p>", html.replace('`', ""));
     let _ = writeln!(
         s,
         "<p>Floor: measurement noise and quantisation {}, the co-simulation's step error {}, together {}. {}</p>",

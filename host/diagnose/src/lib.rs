@@ -46,6 +46,7 @@ pub mod fit;
 pub mod html;
 pub mod intervals;
 pub mod localise;
+pub mod memory;
 pub mod model;
 pub mod problem;
 #[cfg(feature = "progress-line")]
@@ -78,6 +79,7 @@ use ssp::SystemFile;
 use stages::baseline::baseline;
 use stages::force::estimate_force;
 use stages::load::{load, step_of, Loaded};
+use stages::memory::check_memory;
 use stages::problem::{channel_scales, Problem};
 use stages::refine::Polishing;
 use stages::rounds::search;
@@ -501,6 +503,10 @@ pub struct Diagnosis {
     /// Every LuGre FMU parameter the final model sets differently from the
     /// nominal as given.
     pub changes: Vec<FmuValue>,
+    /// Whether the held-out data prefer GMS's pre-sliding memory to the
+    /// final LuGre model's ([`memory`]): the GMS it was moved to, or why
+    /// it was not.
+    pub memory: memory::MemoryCheck,
     pub samples: usize,
     pub heldout_samples: usize,
     /// Family-wise significance level.
@@ -727,9 +733,18 @@ pub fn diagnose_records(
     // 5. and 6. the candidate rounds, each accepted model refined
     let mut polishing = Polishing::default();
     let search = search(&problem, &mut system, &mut sim, &baseline, &mut polishing)?;
-    // 7. the report's figures
+    // 7. LuGre's pre-sliding memory against GMS's
+    let memory = check_memory(&problem, &search);
+    // 8. the report's figures
     budget.progress().stage("the summary");
-    summarise(&problem, &mut sim, baseline, search, polishing, started)
+    summarise(
+        &problem,
+        &mut sim,
+        baseline,
+        (search, memory),
+        polishing,
+        started,
+    )
 }
 
 /// The co-simulation step is divided by this for the step-error estimate

@@ -6,7 +6,7 @@
 //! and renamed into place at the end, so a failure leaves nothing half
 //! written.
 
-use super::model::FrictionModel;
+use super::memory::{GmsModel, MemoryCheck, MemoryOutcome, PRESLIDING_MEMORY};
 use super::Diagnosis;
 use crate::ssp::SystemFile;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
@@ -47,7 +47,23 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
     for (inputs, name, _) in input_files(d) {
         write_inputs(inputs, &dir.join(name))?;
     }
-    write_ssp(file, friction, &d.final_model, &dir.join("refitted.ssp"))?;
+    write_ssp(
+        file,
+        friction,
+        &d.final_model.parameters(),
+        &dir.join("refitted.ssp"),
+    )?;
+    if let (MemoryOutcome::Moved, Some(gms), Some(path)) =
+        (&d.memory.outcome, &d.memory.gms, &d.memory.gms_fmu)
+    {
+        let moved = super::memory::moved_to_gms(file, friction, path)?;
+        write_ssp(
+            &moved,
+            friction,
+            &gms.parameters(),
+            &dir.join("refitted-gms.ssp"),
+        )?;
+    }
     std::fs::write(
         dir.join("report.html"),
         super::html::page(d, &figures, &d.rerun, d.min_gain),
@@ -59,6 +75,50 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
     let kept: PathBuf = tmp.keep();
     std::fs::rename(&kept, out).map_err(|e| format!("{}: {e}", out.display()))?;
     Ok(())
+}
+
+/// What the check of the pre-sliding memory found, in a paragraph.
+pub fn memory_words(m: &MemoryCheck) -> String {
+    let compared = || {
+        format!(
+            "held-out RMS {:.5} with LuGre, {:.5} with GMS ({} of the mean square, p = {:.2e}, threshold {:.2e})",
+            m.lugre_heldout_rms,
+            m.gms_heldout_rms,
+            pct(m.lugre_heldout_rms.powi(2), m.gms_heldout_rms.powi(2)),
+            m.p_value,
+            m.threshold
+        )
+    };
+    let gms = |g: &GmsModel| {
+        format!(
+            "Fc = {:.4e} N, Fs = {:.4e} N, vs = {:.4e} m/s, σ2 = {:.4e} N·s/m, {} elements of total stiffness {:.4e} N/m (pre-sliding distance {:.3e} m), C = {:.4e} N/s (lag {:.3e} s at Fc)",
+            g.fc,
+            g.fs,
+            g.vs,
+            g.sigma2,
+            g.elements,
+            g.sigma0,
+            g.presliding_distance(),
+            g.attraction,
+            g.fc / g.attraction
+        )
+    };
+    match m.outcome {
+        MemoryOutcome::Moved => format!(
+            "**Pre-sliding memory** (`{PRESLIDING_MEMORY}`): the held-out data prefer GMS's nonlocal memory (Al-Bender, Lampaert and Swevers 2005) to LuGre's: {}. The nominal moves to GMS, {}.",
+            compared(),
+            m.gms.as_ref().map_or(String::new(), gms)
+        ),
+        MemoryOutcome::Kept => format!(
+            "Pre-sliding memory: LuGre's is kept; GMS, with the final model's levels as its start, does not predict the held-out data better by the acceptance rule: {}.{}",
+            compared(),
+            m.reason.as_ref().map_or(String::new(), |r| format!(" {r}."))
+        ),
+        MemoryOutcome::NotTried => format!(
+            "Pre-sliding memory: GMS was not tried: {}.",
+            m.reason.as_deref().unwrap_or("no reason recorded").trim_end_matches('.')
+        ),
+    }
 }
 
 /// The relative change from `before` to `after`, signed, in per cent
@@ -149,6 +209,15 @@ pub fn markdown(d: &Diagnosis) -> String {
         d.final_rms,
         pct(d.nominal_rms, d.final_rms),
     );
+    if d.memory.outcome == MemoryOutcome::Moved {
+        let _ = writeln!(
+            s,
+            "| final, moved to GMS | {:.5} | {} |",
+            d.memory.gms_heldout_rms,
+            pct(d.nominal_rms, d.memory.gms_heldout_rms)
+        );
+    }
+    let _ = writeln!(s, "\n{}", memory_words(&d.memory));
     let _ = writeln!(
         s,
         "\nFloor: measurement noise and quantisation {:.5}, the co-simulation's step error {:.5}, together {:.5}.",
@@ -565,10 +634,16 @@ fn write_inputs(inputs: &super::InputColumns, path: &Path) -> Result<(), Fail> {
 /// the friction component's parameter bindings replaced by one inline set
 /// (its nominal values with the refitted ones over them), packed into a
 /// self-contained `.ssp` by [`crate::ssp::pack::pack`].
+///
+/// `file` may have the friction component on another FMU than the ssd's
+/// (the nominal moved to GMS, [`SystemFile::with_component_source`]): its
+/// source is then the file's, and the connectors the file dropped are
+/// left out with their connections. `refitted`: the friction FMU's
+/// parameters by name.
 fn write_ssp(
     file: &SystemFile,
     friction: &str,
-    model: &FrictionModel,
+    refitted: &[(String, f64)],
     out: &Path,
 ) -> Result<(), Fail> {
     let ssd = file.ssd_path();
@@ -588,16 +663,38 @@ fn write_ssp(
         };
         put(&p.variable, ty, v);
     }
-    for (name, x) in model.parameters() {
+    for (name, x) in refitted {
+        let x = *x;
         // the effects' switches are Booleans ([`crate::effects::EffectSpec::switch`])
         if crate::effects::Effect::switches().any(|s| s == name) {
-            put(&name, "Boolean", (x != 0.0).to_string());
-        } else if name == "n_table" {
-            put(&name, "Integer", (x as i64).to_string());
+            put(name, "Boolean", (x != 0.0).to_string());
+        } else if name == "n_table" || name == "n_elements" {
+            put(name, "Integer", (x as i64).to_string());
         } else {
-            put(&name, "Real", format!("{x:e}"));
+            put(name, "Real", format!("{x:e}"));
         }
     }
+    // the friction component's connectors in the file (all of the ssd's
+    // unless it moved to another FMU)
+    let kept: Vec<&str> = file
+        .components
+        .iter()
+        .find(|c| c.name == friction)
+        .map(|c| c.connectors.iter().map(|c| c.name.as_str()).collect())
+        .unwrap_or_default();
+    let dropped_connector =
+        |e: &BytesStart| attr(e, "name").is_some_and(|n| !kept.contains(&n.as_str()));
+    let dropped_connection = |e: &BytesStart| {
+        [
+            ("startElement", "startConnector"),
+            ("endElement", "endConnector"),
+        ]
+        .iter()
+        .any(|(element, connector)| {
+            attr(e, element).as_deref() == Some(friction)
+                && attr(e, connector).is_some_and(|n| !kept.contains(&n.as_str()))
+        })
+    };
 
     let mut reader = quick_xml::Reader::from_str(&text);
     let mut writer = quick_xml::Writer::new(Vec::new());
@@ -624,6 +721,20 @@ fn write_ssp(
                 skip_depth = 1;
             }
             Event::Empty(e) if in_friction && local(e.name().as_ref()) == "ParameterBindings" => {}
+            // connectors and connections of an FMU the friction no longer is
+            Event::Start(e)
+                if (in_friction
+                    && local(e.name().as_ref()) == "Connector"
+                    && dropped_connector(&e))
+                    || (local(e.name().as_ref()) == "Connection" && dropped_connection(&e)) =>
+            {
+                skip_depth = 1;
+            }
+            Event::Empty(e)
+                if (in_friction
+                    && local(e.name().as_ref()) == "Connector"
+                    && dropped_connector(&e))
+                    || (local(e.name().as_ref()) == "Connection" && dropped_connection(&e)) => {}
             Event::Start(e) => {
                 let e = absolute_source(file, &e).map_err(|m| fail(&m))?;
                 if local(e.name().as_ref()) == "Component" {

@@ -246,6 +246,16 @@ pub fn system_parameters(
     setup: &Setup,
     model: &FrictionModel,
 ) -> Vec<(String, ParameterValue)> {
+    system_parameters_with(file, &setup.friction_name, model.parameters())
+}
+
+/// The parameters of the system `file` with the component `friction`'s
+/// set to `friction_parameters` (its FMU's names).
+pub fn system_parameters_with(
+    file: &SystemFile,
+    friction: &str,
+    friction_parameters: Vec<(String, f64)>,
+) -> Vec<(String, ParameterValue)> {
     use crate::ssp::Value;
     let mut p: Vec<(String, ParameterValue)> = file
         .parameters
@@ -260,11 +270,8 @@ pub fn system_parameters(
             (format!("{}.{}", d.component, d.variable), v)
         })
         .collect();
-    for (name, value) in model.parameters() {
-        p.push((
-            format!("{}.{}", setup.friction_name, name),
-            ParameterValue::Number(value),
-        ));
+    for (name, value) in friction_parameters {
+        p.push((format!("{friction}.{name}"), ParameterValue::Number(value)));
     }
     p
 }

@@ -208,7 +208,7 @@ impl Settings {
 
 /// A parsed system file. For an `.ssp`, the unpacked archive lives as long
 /// as this value.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct SystemFile {
     /// The file given to [`SystemFile::open`].
     pub path: PathBuf,
@@ -229,7 +229,9 @@ pub struct SystemFile {
     base: PathBuf,
     /// The `.ssv` files of the parameter bindings (outside an archive).
     parameter_files: Vec<PathBuf>,
-    _unpacked: Option<TempDir>,
+    /// The archive's unpacked directory, shared by the copies of the
+    /// file (removed when the last is dropped).
+    _unpacked: Option<std::sync::Arc<TempDir>>,
 }
 
 /// A connection checked against the FMUs: from an output to an input.
@@ -362,7 +364,7 @@ impl SystemFile {
             let name = format!("{shown}!/SystemStructure.ssd");
             let base = dir.path().to_path_buf();
             let mut file = SystemFile::parse_file(path, &ssd, name, base, true)?;
-            file._unpacked = Some(dir);
+            file._unpacked = Some(std::sync::Arc::new(dir));
             Ok(file)
         } else {
             let base = path
@@ -445,6 +447,39 @@ impl SystemFile {
             );
         }
         Ok(self.base.join(relative))
+    }
+
+    /// The component `name` given another FMU, `source`: its connectors
+    /// that `keep` refuses (those the new FMU does not have) are dropped
+    /// with every connection to them, and so are its parameter bindings
+    /// (they were the old FMU's). What the diagnosis co-simulates when it
+    /// tries another friction law in place of the nominal one.
+    pub fn with_component_source(
+        &self,
+        name: &str,
+        source: &Path,
+        keep: impl Fn(&str) -> bool,
+    ) -> Result<SystemFile, String> {
+        let mut file = self.clone();
+        let component = file
+            .components
+            .iter_mut()
+            .find(|c| c.name == name)
+            .ok_or_else(|| format!("{}: no component `{name}`", self.ssd))?;
+        component.source = source.to_path_buf();
+        component.source_text = source.display().to_string();
+        component.connectors.retain(|c| keep(&c.name));
+        let kept: Vec<String> = component
+            .connectors
+            .iter()
+            .map(|c| c.name.clone())
+            .collect();
+        let gone =
+            |(c, v): &(Option<String>, String)| c.as_deref() == Some(name) && !kept.contains(v);
+        file.connections
+            .retain(|c| !gone(&c.start) && !gone(&c.end));
+        file.parameters.retain(|p| p.component != name);
+        Ok(file)
     }
 
     /// The SystemStructure.ssd itself: the file given, or the one unpacked

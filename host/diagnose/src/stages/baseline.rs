@@ -187,7 +187,7 @@ const GIVEN: &str = "the nominal as given";
 /// at least [`crate::Options::groups`] of them (each block an independent
 /// trial, `--blocks`), else that many runs of consecutive held-out
 /// samples; one label per sample `scored` picked.
-fn acceptance_groups(p: &Problem, scored: &Scored) -> Vec<usize> {
+pub(crate) fn acceptance_groups(p: &Problem, scored: &Scored) -> Vec<usize> {
     let picked = &scored.picked;
     let n = picked.len();
     let time = &p.scored_data().time;

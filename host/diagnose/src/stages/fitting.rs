@@ -11,6 +11,8 @@ use super::split::Picker;
 use crate::fit;
 use crate::model::{Effect, FrictionModel};
 use crate::sim::{co_simulate_robust, co_simulate_with, system_parameters, FrictionSim};
+use crate::ssp::SystemFile;
+use crate::system::ParameterValue;
 use crate::CANDIDATE_OUTPUT_ERROR_ITERATIONS;
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -50,24 +52,37 @@ impl Problem<'_> {
         pick: &Picker,
         step: Option<f64>,
     ) -> Option<DVector<f64>> {
+        let params = system_parameters(self.file, &self.setup, m);
+        self.fit_residuals_of(self.file, &params, pick, step)
+    }
+
+    /// [`Problem::fit_residuals`] of the system `file` with `params` (a
+    /// system whose friction is another law than LuGre,
+    /// [`crate::memory`]).
+    pub(crate) fn fit_residuals_of(
+        &self,
+        file: &SystemFile,
+        params: &[(String, ParameterValue)],
+        pick: &Picker,
+        step: Option<f64>,
+    ) -> Option<DVector<f64>> {
         // past the time limit: none (the fit stops, crate::budget)
         if self.budget.stop_here() {
             return None;
         }
         self.budget.cosimulation();
         // a system of its own (an FMU instance stays on its thread)
-        let mut system = self.file.build(0.0).ok()?;
-        let params = system_parameters(self.file, &self.setup, m);
+        let mut system = file.build(0.0).ok()?;
         let records = pick.records.as_deref();
         let r = match step {
             None => {
-                co_simulate_robust(&mut system, &params, &self.setup, &self.data, records)
+                co_simulate_robust(&mut system, params, &self.setup, &self.data, records)
                     .ok()?
                     .0
             }
             Some(h) => co_simulate_with(
                 &mut system,
-                &params,
+                params,
                 &self.data,
                 records,
                 &self.setup.master,

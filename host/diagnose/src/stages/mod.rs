@@ -21,7 +21,10 @@
 //!    change in `rounds/resolution.rs`;
 //! 6. [`refine`]: each accepted model refined on the output error (called
 //!    by the rounds for every accepted model);
-//! 7. [`summary`]: the intervals, the floor, the localisation, the
+//! 7. [`memory`]: whether the held-out data prefer GMS's pre-sliding
+//!    memory to LuGre's ([`crate::memory`]); the nominal moved to GMS
+//!    when they do;
+//! 8. [`summary`]: the intervals, the floor, the localisation, the
 //!    report's figures: the [`crate::Diagnosis`].
 //!
 //! The tests that decide are in [`crate::acceptance`]. The time limit
@@ -34,6 +37,7 @@ pub(crate) mod baseline;
 pub(crate) mod fitting;
 pub(crate) mod force;
 pub(crate) mod load;
+pub(crate) mod memory;
 pub(crate) mod problem;
 pub(crate) mod refine;
 pub(crate) mod rounds;

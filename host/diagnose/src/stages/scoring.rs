@@ -9,7 +9,7 @@ use super::problem::Problem;
 use crate::acceptance::Scored;
 use crate::model::FrictionModel;
 use crate::sim::{co_simulate_robust, co_simulate_with, system_parameters, ChannelResiduals};
-use crate::system::System;
+use crate::system::{ParameterValue, System};
 use crate::FINE_STEP_DIVISOR;
 
 impl Problem<'_> {
@@ -25,25 +25,41 @@ impl Problem<'_> {
         models: &[FrictionModel],
         step: Option<f64>,
     ) -> Result<Scored, String> {
+        let parameters: Vec<_> = models
+            .iter()
+            .map(|m| system_parameters(self.file, &self.setup, m))
+            .collect();
+        self.score_parameters_at(system, &parameters, step)
+    }
+
+    /// [`Problem::score_at`] of the system's parameters, one set per fold
+    /// (a system whose friction is another law than LuGre,
+    /// [`crate::memory`]).
+    pub(crate) fn score_parameters_at(
+        &self,
+        system: &mut System,
+        fold_parameters: &[Vec<(String, ParameterValue)>],
+        step: Option<f64>,
+    ) -> Result<Scored, String> {
         let scored_data = self.scored_data();
         let mut merged: Option<ChannelResiduals> = None;
         let mut picked = Vec::new();
         let mut notes = Vec::new();
-        for (fold, model) in self.split.folds.iter().zip(models) {
-            let params = system_parameters(self.file, &self.setup, model);
+        for (fold, params) in self.split.folds.iter().zip(fold_parameters) {
+            let params = params.as_slice();
             let records = fold.scores.records.as_deref();
             self.budget.cosimulation();
             let r = match step {
                 None => {
                     let (r, note) =
-                        co_simulate_robust(system, &params, &self.setup, scored_data, records)?;
+                        co_simulate_robust(system, params, &self.setup, scored_data, records)?;
                     notes.extend(note);
                     r
                 }
                 Some(h) => {
                     let r = co_simulate_with(
                         system,
-                        &params,
+                        params,
                         scored_data,
                         records,
                         &self.setup.master,

@@ -1,4 +1,4 @@
-//! Stage 7, the report's figures: the 95 % intervals of the final
+//! Stage 8, the report's figures: the 95 % intervals of the final
 //! model's fitted parameters and of each effect's change
 //! ([`crate::intervals`]), the remaining error against the floor no model
 //! can go below (measurement noise and the co-simulation's step error),
@@ -16,6 +16,7 @@ use super::rounds::Search;
 use super::run_force;
 use crate::acceptance::Scored;
 use crate::intervals::{self, ThetaCovariance};
+use crate::memory::MemoryCheck;
 use crate::model::FrictionModel;
 use crate::problem::{FrictionData, Measured};
 use crate::sim::FrictionSim;
@@ -32,7 +33,7 @@ pub(crate) fn summarise(
     p: &Problem,
     sim: &mut FrictionSim,
     baseline: Baseline,
-    search: Search,
+    (search, memory): (Search, MemoryCheck),
     polishing: Polishing,
     started: Instant,
 ) -> Result<Diagnosis, String> {
@@ -139,6 +140,7 @@ pub(crate) fn summarise(
         rounds,
         round_thresholds,
         changes: changes(p, &current, covariance.as_ref()),
+        memory,
         nominal_model: p.setup.nominal.clone(),
         baseline_model: baseline.model,
         final_model: current,
