@@ -31,6 +31,20 @@ two_mass_fmu.py) and a mode of the simulator:
 - `servo`: ServoAxis, the same drive train under a PD position controller
   on the motor, driven by a position reference (`drive.r`; measured: both
   positions and the controller's force `drive.u`).
+
+Memory cases (MEMORY_KINDS, not in the suite's default grid): the truth is
+another friction law than the nominal's. `presliding_memory`: a Rig1D
+whose true friction is the Generalized Maxwell-Slip law (Al-Bender,
+Lampaert and Swevers 2005; lugre_rig.c's law=gms), presliding hysteresis
+with nonlocal memory (Masing's rule, wiping-out), while the nominal is
+LuGre. Both have the same levels Fc, Fs, vs, σ2, the same presliding
+stiffness σ0 (the GMS elements built from it: lugre_rig.c's header) and
+damping σ1 (GMS: shared among the elements by stiffness); GMS has 10
+elements and a frictional lag Fc/C of 1-10 ms. The presliding distance
+Fc/σ0 is 0.3-1 mm, and the actuator dithers (its spring force swinging by
+±0.3-0.6·Fc) on top of the drive, so that the record has many reversals
+inside presliding besides its gross slides. The case's "size" is that
+change of structure: its magnitude is only a label and sizes nothing.
 """
 
 from __future__ import annotations
@@ -74,6 +88,11 @@ GRID_PLANT_KINDS = ("two_mass_none", "two_mass_viscous")
 #: the nominal to LuGre to add what Dahl cannot express.
 DAHL_KINDS = ("dahl_none", "dahl_viscous")
 
+#: Cases whose truth is another law than the nominal's (the docstring):
+#: GMS's presliding memory against a LuGre nominal. Not in KINDS, so in
+#: no plant's kinds and not in the suite's default grid.
+MEMORY_KINDS = ("presliding_memory",)
+
 #: The effect a kind should be diagnosed as (None: nothing to find).
 EXPECTED: dict[str, str | None] = {
     "none": None,
@@ -85,6 +104,7 @@ EXPECTED: dict[str, str | None] = {
     "presliding_soft_nominal": "presliding",
     "dahl_none": None,
     "dahl_viscous": "viscous",
+    "presliding_memory": "presliding_memory",
 }
 EXPECTED.update({f"{plant}_{kind}": EXPECTED[kind] for plant in PLANTS for kind in KINDS})
 
@@ -203,6 +223,17 @@ def _draw(kind: str, magnitude: float, seed: int, duration: float) -> Case:
     if effect == "presliding_stiff_nominal":
         nominal["sigma0"] = 1e6
         nominal["sigma1"] = 2 * zeta * math.sqrt(1e6 * m)
+    if kind in MEMORY_KINDS:
+        # a presliding distance Fc/σ0 of 0.3-1 mm, as the presliding cases
+        nominal["sigma0"] = fc / rng.uniform(3e-4, 1e-3)
+        nominal["sigma1"] = 2 * zeta * math.sqrt(nominal["sigma0"] * m)
+        # reversals inside presliding: the actuator dithers, its spring
+        # force swinging by ±(0.3-0.6)·Fc, at 0.2-0.6 s a cycle and no
+        # faster than a quarter of the contact's own frequency
+        # √((σ0 + k)/m) (so the mass follows it quasi-statically)
+        own_period = 2 * math.pi * math.sqrt(m / (nominal["sigma0"] + k))
+        drive["dither_amp"] = rng.uniform(0.3, 0.6) * fc / k
+        drive["dither_period"] = max(rng.uniform(0.2, 0.6), 4 * own_period)
     if kind in DAHL_KINDS:
         nominal.update(Fs=fc, sigma1=0.0, sigma2=0.0)
     if plant == "two_mass":
@@ -240,7 +271,7 @@ def _draw(kind: str, magnitude: float, seed: int, duration: float) -> Case:
 
 def run_simulator(case: Case, params: dict, out: Path, truth: bool = False, table=()) -> None:
     args = [str(simulator())]
-    args += [f"{k}={v!r}" for k, v in {**case.rig, **params}.items()]
+    args += [f"{k}={v}" if isinstance(v, str) else f"{k}={v!r}" for k, v in {**case.rig, **params}.items()]
     args += [f"{k}={v}" for k, v in case.drive.items()]
     args += [f"duration={case.duration}", f"sample={case.sample}", f"resolution={case.resolution}"]
     args += [f"seed={case.seed}", f"truth={int(truth)}"]
@@ -288,6 +319,11 @@ def size_hidden_effect(case: Case, work: Path) -> None:
         t["sigma1"] = 2 * case._zeta * math.sqrt(t["sigma0"] * case.rig["m"])  # type: ignore[attr-defined]
         return
     if effect == "none":
+        return
+    if case.kind in MEMORY_KINDS:
+        # the truth is GMS with the nominal's levels, σ0 and σ1: 10
+        # elements, the frictional lag Fc/C 1-10 ms; nothing is sized
+        t.update(law="gms", n_elements=10, C=fc / 10 ** rng.uniform(-3.0, -2.0))
         return
     free = work / f"{case.name}.effect-free.csv"
     run_simulator(case, p, free, truth=True)
