@@ -95,6 +95,37 @@ def test_coarse_data_two_explanations_not_separated_name_neither(tmp_path):
     assert any("do not separate them" in n and "neither is named" in n for n in notes), notes
 
 
+def test_a_gms_contact_moves_the_nominal_to_gms(tmp_path):
+    """A contact whose truth is GMS (the independent simulator's `law=gms`:
+    nonlocal pre-sliding memory, a dithered actuator making reversals
+    inside pre-sliding) and a LuGre nominal with its levels: the diagnosis
+    names the pre-sliding memory, moves the nominal to GMS by the
+    acceptance rule, and the GMS system it writes (refitted-gms.ssp) runs
+    in `fricsim run` and follows the measured position closer than the
+    refitted LuGre system does. (On the LuGre cases above, the same check
+    keeps LuGre: `check` would see the extra name.)"""
+    case = cases.draw("presliding_memory", 0.1, 1)
+    row = suite.run_case(case, tmp_path)
+    check(row)
+    out = tmp_path / f"out-{case.name}"
+    report = json.loads((out / "report.json").read_text())
+    memory = report["memory"]
+    assert memory["outcome"] == "moved", memory
+    assert memory["p_value"] < memory["threshold"] and memory["gain"] >= report["min_gain"], memory
+    assert memory["gms_heldout_rms"] < 0.5 * memory["lugre_heldout_rms"], memory
+    assert "Pre-sliding memory" in (out / "report.md").read_text()
+    measured = cases.read_columns(tmp_path / f"{case.name}.csv")["rig.x"]
+    errors = {}
+    for command in report["rerun"]:
+        subprocess.run(command.split(), check=True, capture_output=True,
+                       executable=str(suite.FRICSIM))
+        result = Path(command.split()[-1])
+        x = cases.read_columns(result)["rig.x"]
+        errors[result.name] = cases.rms(a - b for a, b in zip(x, measured))
+    assert set(errors) == {"rerun.csv", "rerun-gms.csv"}, errors
+    assert errors["rerun-gms.csv"] < 0.5 * errors["rerun.csv"], errors
+
+
 def test_the_simulator_converges():
     """Halving the simulator's step moves the noise-free position by far less
     than the 1 µm encoder step."""

@@ -474,7 +474,8 @@ pub struct Diagnosis {
     /// hypotheses of the round (one per candidate, one per family of
     /// explanations of one signature).
     pub round_thresholds: Vec<f64>,
-    /// The final error is above [`UNEXPLAINED_FACTOR`] × `floor_rms`.
+    /// The final error (GMS's when the nominal moved to it, `memory`) is
+    /// above [`UNEXPLAINED_FACTOR`] × `floor_rms`.
     pub unexplained: bool,
     /// Held-out RMS of the measurement noise estimated from the data, its
     /// quantisation included (normalised like the others).

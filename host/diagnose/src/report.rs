@@ -592,20 +592,31 @@ pub fn input_files(d: &Diagnosis) -> Vec<(&super::InputColumns, String, String)>
 /// the diagnosis's master, step and the record's time span, so that the
 /// run is the co-simulation the report scored (the inputs interpolated
 /// over each step, as the diagnosis gives them).
+///
+/// With the nominal moved to GMS, the same for `refitted-gms.ssp` after
+/// them (results `rerun-gms….csv`).
 pub fn rerun_commands(d: &Diagnosis, out: &Path) -> Vec<String> {
-    let ssp = out.join("refitted.ssp");
-    input_files(d)
+    let mut systems = vec![("refitted.ssp", "")];
+    if d.memory.outcome == MemoryOutcome::Moved {
+        systems.push(("refitted-gms.ssp", "-gms"));
+    }
+    systems
         .into_iter()
-        .map(|((time, _), inputs, result)| {
-            let (start, stop) = (time[0], *time.last().unwrap_or(&time[0]));
-            format!(
-                "fricsim run {} --input {} --master {} --step {:?} --start {start:?} --stop {stop:?} --out {}",
-                ssp.display(),
-                out.join(inputs).display(),
-                d.master,
-                d.step,
-                out.join(result).display()
-            )
+        .flat_map(|(ssp, tag)| {
+            input_files(d)
+                .into_iter()
+                .map(move |((time, _), inputs, result)| {
+                    let (start, stop) = (time[0], *time.last().unwrap_or(&time[0]));
+                    let result = result.replacen("rerun", &format!("rerun{tag}"), 1);
+                    format!(
+                        "fricsim run {} --input {} --master {} --step {:?} --start {start:?} --stop {stop:?} --out {}",
+                        out.join(ssp).display(),
+                        out.join(inputs).display(),
+                        d.master,
+                        d.step,
+                        out.join(result).display()
+                    )
+                })
         })
         .collect()
 }

@@ -16,7 +16,7 @@ use super::rounds::Search;
 use super::run_force;
 use crate::acceptance::Scored;
 use crate::intervals::{self, ThetaCovariance};
-use crate::memory::MemoryCheck;
+use crate::memory::{MemoryCheck, MemoryOutcome};
 use crate::model::FrictionModel;
 use crate::problem::{FrictionData, Measured};
 use crate::sim::FrictionSim;
@@ -123,7 +123,12 @@ pub(crate) fn summarise(
         baseline_rms: baseline.scored.rms(),
         refit: baseline.refit,
         final_rms,
-        unexplained: final_rms > UNEXPLAINED_FACTOR * floor,
+        // the nominal moved to GMS: what GMS leaves
+        unexplained: if memory.outcome == MemoryOutcome::Moved {
+            memory.gms_heldout_rms
+        } else {
+            final_rms
+        } > UNEXPLAINED_FACTOR * floor,
         noise_floor_rms: noise,
         step_error_rms: numerical,
         floor_rms: floor,
