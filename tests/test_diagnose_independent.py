@@ -109,10 +109,12 @@ def test_a_gms_contact_moves_the_nominal_to_gms(tmp_path):
     check(row)
     out = tmp_path / f"out-{case.name}"
     report = json.loads((out / "report.json").read_text())
-    memory = report["memory"]
-    assert memory["outcome"] == "moved", memory
-    assert memory["p_value"] < memory["threshold"] and memory["gain"] >= report["min_gain"], memory
-    assert memory["gms_heldout_rms"] < 0.5 * memory["lugre_heldout_rms"], memory
+    memory = {m["law"]: m for m in report["memory"]}
+    gms = memory["gms"]
+    assert gms["outcome"] == "moved", memory
+    assert gms["p_value"] < gms["threshold"] and gms["gain"] >= report["min_gain"], gms
+    assert gms["heldout_rms"] < 0.5 * gms["lugre_heldout_rms"], gms
+    assert memory["elasto_plastic"]["outcome"] != "moved", memory
     assert "Pre-sliding memory" in (out / "report.md").read_text()
     measured = cases.read_columns(tmp_path / f"{case.name}.csv")["rig.x"]
     errors = {}

@@ -229,12 +229,12 @@ def diagnose_case(
     report = json.loads((out / "report.json").read_text())
     found = [e["name"] for e in report["effects"]]
     final_rms = report["final_rms"]
-    # the nominal moved from LuGre to GMS names the pre-sliding memory,
-    # and the moved model is the final one
-    memory = report.get("memory", {})
-    if memory.get("outcome") == "moved":
-        found.append("presliding_memory")
-        final_rms = memory["gms_heldout_rms"]
+    # the nominal moved from LuGre to another law (GMS, elasto-plastic)
+    # names that law's effect, and the moved model is the final one
+    moved = [m for m in report.get("memory", []) if m["outcome"] == "moved"]
+    if moved:
+        found.append(moved[0]["effect"])
+        final_rms = moved[0]["heldout_rms"]
     expected = cases.EXPECTED[case.kind]
     row.update(
         found=found,
@@ -245,7 +245,7 @@ def diagnose_case(
         floor_rms=report["floor_rms"],
         unexplained=report["unexplained"],
         refit_kept=report["refit"]["kept"],
-        memory=memory.get("outcome"),
+        moved_to=moved[0]["law"] if moved else None,
         never_worse=final_rms <= 1.05 * report["nominal_rms"],
         diagnose_seconds=report["wall_seconds"],
     )

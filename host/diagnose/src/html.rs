@@ -326,12 +326,13 @@ fn verdict(s: &mut String, d: &Diagnosis) {
         number(d.final_rms),
         percent(d.nominal_rms, d.final_rms)
     );
-    if d.memory.outcome == crate::memory::MemoryOutcome::Moved {
+    if let Some(m) = crate::memory::moved(&d.memory) {
         let _ = writeln!(
             s,
-            "<tr><td><strong>final, moved to GMS</strong></td><td class=\"num\"><strong>{}</strong></td><td>{}</td></tr>",
-            number(d.memory.gms_heldout_rms),
-            percent(d.nominal_rms, d.memory.gms_heldout_rms)
+            "<tr><td><strong>final, moved to {}</strong></td><td class=\"num\"><strong>{}</strong></td><td>{}</td></tr>",
+            m.law.model_name(),
+            number(m.heldout_rms),
+            percent(d.nominal_rms, m.heldout_rms)
         );
     }
     let _ = writeln!(s, "</table>");

@@ -474,7 +474,8 @@ pub struct Diagnosis {
     /// hypotheses of the round (one per candidate, one per family of
     /// explanations of one signature).
     pub round_thresholds: Vec<f64>,
-    /// The final error (GMS's when the nominal moved to it, `memory`) is
+    /// The final error (the other law's when the nominal moved to it,
+    /// `memory`) is
     /// above [`UNEXPLAINED_FACTOR`] × `floor_rms`.
     pub unexplained: bool,
     /// Held-out RMS of the measurement noise estimated from the data, its
@@ -504,10 +505,10 @@ pub struct Diagnosis {
     /// Every LuGre FMU parameter the final model sets differently from the
     /// nominal as given.
     pub changes: Vec<FmuValue>,
-    /// Whether the held-out data prefer GMS's pre-sliding memory to the
-    /// final LuGre model's ([`memory`]): the GMS it was moved to, or why
-    /// it was not.
-    pub memory: memory::MemoryCheck,
+    /// Whether the held-out data prefer another law's pre-sliding to the
+    /// final LuGre model's ([`memory`]): one check per law (GMS, the
+    /// elasto-plastic law), the law the nominal moved to, or why not.
+    pub memory: Vec<memory::LawCheck>,
     pub samples: usize,
     pub heldout_samples: usize,
     /// Family-wise significance level.

@@ -1,27 +1,36 @@
-//! Pre-sliding memory: LuGre's, or nonlocal (GMS).
+//! The laws a LuGre nominal may move to when its pre-sliding is not
+//! LuGre's: nonlocal memory (GMS) or an elastic stick (elasto-plastic).
 //!
-//! LuGre's force in pre-sliding is a function of one bristle state
-//! (Canudas de Wit et al. 1995): after a reversal the force leaves its
-//! turning point at twice the virgin stiffness and forgets every earlier
-//! turning point. A contact of many asperities behaves otherwise: its
-//! pre-sliding curve after a reversal is the virgin curve scaled by two
-//! (Masing's rule), every element stiffness acts at once (the reversal
-//! stiffness equals the virgin one), and a minor loop is wiped out when
-//! the path passes its start again. The Generalized Maxwell-Slip model
-//! (Al-Bender, Lampaert and Swevers 2005) has that memory, LuGre's Stribeck
-//! curve in gross sliding and a frictional lag of its own (the attraction
-//! `C`).
+//! **Nonlocal memory.** LuGre's force in pre-sliding is a function of one
+//! bristle state (Canudas de Wit et al. 1995): after a reversal the force
+//! leaves its turning point at twice the virgin stiffness and forgets
+//! every earlier turning point. A contact of many asperities behaves
+//! otherwise: its pre-sliding curve after a reversal is the virgin curve
+//! scaled by two (Masing's rule), every element stiffness acts at once
+//! (the reversal stiffness equals the virgin one), and a minor loop is
+//! wiped out when the path passes its start again. The Generalized
+//! Maxwell-Slip model (Al-Bender, Lampaert and Swevers 2005) has that
+//! memory, LuGre's Stribeck curve in gross sliding and a frictional lag
+//! of its own (the attraction `C`). The GMS start has LuGre's Stribeck
+//! curve (`Fc`, `Fs`, `vs`, δ, σ2) and [`GMS_ELEMENTS`] elements of equal
+//! stiffness `σ0/N` whose slip distances are the quantiles of an
+//! exponential, `Δ_i = −(Fs/σ0)·ln(1 − (i − ½)/N)`, with weights
+//! `α_i ∝ k_i·Δ_i` (`Σα_i = 1`): its virgin curve `Σ min(k_i·x, α_i·Fs)`
+//! then has LuGre's virgin stiffness `σ0·exp(−σ0·x/Fs)` in the mean and
+//! its level `Fs`, so that the two laws differ in their memory, not in
+//! their curve; LuGre's σ1 is the elements' total micro-damping. The fit
+//! frees the levels, σ0 (σ1 following √σ0) and `C`.
 //!
-//! The diagnosis moves a LuGre nominal to GMS the way it moves a Dahl
-//! nominal to LuGre: with the fitted LuGre's levels as the start. The GMS
-//! start has LuGre's Stribeck curve (`Fc`, `Fs`, `vs`, δ, σ2) and
-//! [`GMS_ELEMENTS`] elements of equal stiffness `σ0/N` whose slip
-//! distances are the quantiles of an exponential,
-//! `Δ_i = −(Fs/σ0)·ln(1 − (i − ½)/N)`, with weights `α_i ∝ k_i·Δ_i`
-//! (`Σα_i = 1`): its virgin curve `Σ min(k_i·x, α_i·Fs)` then has LuGre's
-//! virgin stiffness `σ0·exp(−σ0·x/Fs)` in the mean and its level `Fs`, so
-//! that the two laws differ in their memory, not in their curve. The fit
-//! frees the levels, σ0 and `C` ([`GmsCoordinates`]).
+//! **An elastic stick.** Under a force that oscillates below break-away,
+//! LuGre creeps a little every cycle; the elasto-plastic model of Dupont,
+//! Hayward, Armstrong and Altpeter 2002 is a spring below its break-away
+//! deflection `z_ba` and does not. Its start is LuGre's parameters with
+//! `z_ba` a fraction of `Fc/σ0` ([`ELASTIC_FRACTION_STARTS`]); the fit
+//! frees the levels, σ0 (σ1 following √σ0) and that fraction.
+//!
+//! The diagnosis moves a LuGre nominal to one of them the way it moves a
+//! Dahl nominal to LuGre: with the fitted LuGre's levels as the start
+//! (`stages/memory.rs` decides).
 
 use crate::fit::Coordinates;
 use crate::model::FrictionModel;
@@ -37,6 +46,117 @@ pub const GMS_ELEMENTS: usize = 10;
 /// attraction `C = Fc/τ`.
 pub const LAG_STARTS: [f64; 3] = [1e-3, 1e-2, 1e-1];
 
+/// Break-away deflections the elasto-plastic fit starts from, as
+/// fractions of `Fc/σ0`.
+pub const ELASTIC_FRACTION_STARTS: [f64; 3] = [0.5, 0.8, 0.95];
+
+/// A law other than LuGre that the diagnosis tries.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum OtherLaw {
+    Gms,
+    ElastoPlastic,
+}
+
+impl OtherLaw {
+    pub const ALL: [OtherLaw; 2] = [OtherLaw::Gms, OtherLaw::ElastoPlastic];
+
+    /// The FMU's model name (and file stem).
+    pub fn model_name(self) -> &'static str {
+        match self {
+            OtherLaw::Gms => "GMS",
+            OtherLaw::ElastoPlastic => "ElastoPlastic",
+        }
+    }
+
+    /// The effect the report names when the nominal moves to it.
+    pub fn effect(self) -> &'static str {
+        match self {
+            OtherLaw::Gms => "presliding_memory",
+            OtherLaw::ElastoPlastic => "elastic_presliding",
+        }
+    }
+
+    /// What the law has that LuGre has not, and its source.
+    pub fn words(self) -> &'static str {
+        match self {
+            OtherLaw::Gms => "nonlocal pre-sliding memory (GMS, Al-Bender, Lampaert and Swevers 2005)",
+            OtherLaw::ElastoPlastic => "an elastic stick without drift below break-away (elasto-plastic, Dupont, Hayward, Armstrong and Altpeter 2002)",
+        }
+    }
+
+    /// The suffix of its files in the report directory
+    /// (`refitted-gms.ssp`).
+    pub fn file_tag(self) -> &'static str {
+        match self {
+            OtherLaw::Gms => "gms",
+            OtherLaw::ElastoPlastic => "elastoplastic",
+        }
+    }
+
+    /// The starts of its fit from the LuGre model `lugre`.
+    pub fn starts(self, lugre: &FrictionModel) -> Vec<LawModel> {
+        match self {
+            OtherLaw::Gms => LAG_STARTS
+                .iter()
+                .map(|&lag| LawModel::Gms(GmsModel::from_lugre(lugre, lag)))
+                .collect(),
+            OtherLaw::ElastoPlastic => ELASTIC_FRACTION_STARTS
+                .iter()
+                .map(|&r| LawModel::ElastoPlastic(ElastoPlasticModel::from_lugre(lugre, r)))
+                .collect(),
+        }
+    }
+}
+
+/// A fitted model of one of the [`OtherLaw`]s.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LawModel {
+    Gms(GmsModel),
+    ElastoPlastic(ElastoPlasticModel),
+}
+
+impl LawModel {
+    /// Its FMU's parameters by name.
+    pub fn parameters(&self) -> Vec<(String, f64)> {
+        match self {
+            LawModel::Gms(m) => m.parameters(),
+            LawModel::ElastoPlastic(m) => m.parameters(),
+        }
+    }
+
+    /// Its parameters in words, for the report.
+    pub fn describe(&self) -> String {
+        match self {
+            LawModel::Gms(g) => format!(
+                "Fc = {:.4e} N, Fs = {:.4e} N, vs = {:.4e} m/s, σ1 = {:.4e} N·s/m, σ2 = {:.4e} N·s/m, {} elements of total stiffness {:.4e} N/m (pre-sliding distance {:.3e} m), C = {:.4e} N/s (lag {:.3e} s at Fc)",
+                g.fc,
+                g.fs,
+                g.vs,
+                g.sigma1,
+                g.sigma2,
+                g.elements,
+                g.sigma0,
+                g.presliding_distance(),
+                g.attraction,
+                g.fc / g.attraction
+            ),
+            LawModel::ElastoPlastic(e) => format!(
+                "Fc = {:.4e} N, Fs = {:.4e} N, vs = {:.4e} m/s, σ0 = {:.4e} N/m, σ1 = {:.4e} N·s/m, σ2 = {:.4e} N·s/m, z_ba = {:.4e} m ({:.0} % of Fc/σ0)",
+                e.fc,
+                e.fs,
+                e.vs,
+                e.sigma0,
+                e.sigma1,
+                e.sigma2,
+                e.z_ba,
+                100.0 * e.z_ba * e.sigma0 / e.fc
+            ),
+        }
+    }
+}
+
 /// A GMS friction law as the diagnosis fits it (SI units).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GmsModel {
@@ -45,6 +165,9 @@ pub struct GmsModel {
     pub vs: f64,
     pub stribeck_exponent: f64,
     pub sigma2: f64,
+    /// The elements' total micro-damping (N·s/m), shared in proportion
+    /// to their stiffness.
+    pub sigma1: f64,
     /// The elements' total stiffness `Σ k_i` (N/m): the stiffness of the
     /// virgin curve and of every reversal.
     pub sigma0: f64,
@@ -63,6 +186,7 @@ impl GmsModel {
             vs: lugre.vs,
             stribeck_exponent: lugre.stribeck_exponent,
             sigma2: lugre.sigma2,
+            sigma1: lugre.sigma1,
             sigma0: lugre.sigma0,
             attraction: lugre.fc / lag,
             elements: GMS_ELEMENTS,
@@ -90,6 +214,7 @@ impl GmsModel {
             ("vs".to_string(), self.vs),
             ("stribeck_exponent".to_string(), self.stribeck_exponent),
             ("sigma2".to_string(), self.sigma2),
+            ("sigma1".to_string(), self.sigma1),
             ("C".to_string(), self.attraction),
             ("n_elements".to_string(), self.elements as f64),
         ];
@@ -112,114 +237,211 @@ impl GmsModel {
     }
 }
 
-/// What the GMS fit moves: `ln Fc`, `ln(Fs/Fc − 1)` when the start has a
-/// Stribeck peak (else `Fs = Fc` stays), `ln σ0` and `ln C`: every θ is a
-/// valid GMS (`0 < Fc ≤ Fs`, σ0 and `C` positive).
-pub struct GmsCoordinates {
-    pub start: GmsModel,
+/// An elasto-plastic friction law as the diagnosis fits it (SI units;
+/// the FMU's parameters).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ElastoPlasticModel {
+    pub fc: f64,
+    pub fs: f64,
+    pub vs: f64,
+    pub stribeck_exponent: f64,
+    pub sigma0: f64,
+    pub sigma1: f64,
+    pub sigma2: f64,
+    /// The break-away deflection (m), below `Fc/σ0`.
+    pub z_ba: f64,
 }
 
-impl GmsCoordinates {
-    fn stribeck(&self) -> bool {
-        self.start.fs > self.start.fc * (1.0 + 1e-9)
+impl ElastoPlasticModel {
+    /// LuGre's parameters with `z_ba = fraction·Fc/σ0`.
+    pub fn from_lugre(lugre: &FrictionModel, fraction: f64) -> ElastoPlasticModel {
+        ElastoPlasticModel {
+            fc: lugre.fc,
+            fs: lugre.fs.max(lugre.fc),
+            vs: lugre.vs,
+            stribeck_exponent: lugre.stribeck_exponent,
+            sigma0: lugre.sigma0,
+            sigma1: lugre.sigma1,
+            sigma2: lugre.sigma2,
+            z_ba: fraction * lugre.fc / lugre.sigma0,
+        }
+    }
+
+    /// The FMU's parameters.
+    pub fn parameters(&self) -> Vec<(String, f64)> {
+        vec![
+            ("Fc".to_string(), self.fc),
+            ("Fs".to_string(), self.fs),
+            ("vs".to_string(), self.vs),
+            ("stribeck_exponent".to_string(), self.stribeck_exponent),
+            ("sigma0".to_string(), self.sigma0),
+            ("sigma1".to_string(), self.sigma1),
+            ("sigma2".to_string(), self.sigma2),
+            ("z_ba".to_string(), self.z_ba),
+        ]
     }
 }
 
-impl Coordinates for GmsCoordinates {
-    type Model = GmsModel;
+/// What a fit of an [`OtherLaw`] moves, from `start`: `ln Fc`,
+/// `ln(Fs/Fc − 1)` when the start has a Stribeck peak (else `Fs = Fc`
+/// stays), `ln σ0` with σ1 following `√σ0`, and the law's own: GMS's
+/// `ln C`, the elasto-plastic `z_ba` as `logit(z_ba·σ0/Fc)`. Every θ is a
+/// valid model (`0 < Fc ≤ Fs`, σ0 and `C` positive, `0 < z_ba < Fc/σ0`).
+pub struct LawCoordinates {
+    pub start: LawModel,
+}
+
+impl LawCoordinates {
+    /// `(Fc, Fs, σ0, σ1)` of the start.
+    fn levels(&self) -> (f64, f64, f64, f64) {
+        match &self.start {
+            LawModel::Gms(g) => (g.fc, g.fs, g.sigma0, g.sigma1),
+            LawModel::ElastoPlastic(e) => (e.fc, e.fs, e.sigma0, e.sigma1),
+        }
+    }
+
+    fn stribeck(&self) -> bool {
+        let (fc, fs, _, _) = self.levels();
+        fs > fc * (1.0 + 1e-9)
+    }
+}
+
+impl Coordinates for LawCoordinates {
+    type Model = LawModel;
 
     fn theta(&self) -> Vec<f64> {
-        let s = &self.start;
-        let mut t = vec![s.fc.ln(), s.sigma0.ln(), s.attraction.ln()];
+        let (fc, fs, sigma0, _) = self.levels();
+        let own = match &self.start {
+            LawModel::Gms(g) => g.attraction.ln(),
+            LawModel::ElastoPlastic(e) => {
+                let r = e.z_ba * e.sigma0 / e.fc;
+                (r / (1.0 - r)).ln()
+            }
+        };
+        let mut t = vec![fc.ln(), sigma0.ln(), own];
         if self.stribeck() {
-            t.push((s.fs / s.fc - 1.0).ln());
+            t.push((fs / fc - 1.0).ln());
         }
         t
     }
 
-    fn at(&self, theta: &[f64]) -> GmsModel {
-        let mut m = self.start.clone();
-        m.fc = theta[0].exp();
-        m.sigma0 = theta[1].exp();
-        m.attraction = theta[2].exp();
-        m.fs = if self.stribeck() {
-            m.fc * (1.0 + theta[3].exp())
+    fn at(&self, theta: &[f64]) -> LawModel {
+        let (_, _, sigma0_start, sigma1_start) = self.levels();
+        let fc = theta[0].exp();
+        let sigma0 = theta[1].exp();
+        let sigma1 = sigma1_start * (sigma0 / sigma0_start).sqrt();
+        let fs = if self.stribeck() {
+            fc * (1.0 + theta[3].exp())
         } else {
-            m.fc
+            fc
         };
-        m
+        match &self.start {
+            LawModel::Gms(g) => LawModel::Gms(GmsModel {
+                fc,
+                fs,
+                sigma0,
+                sigma1,
+                attraction: theta[2].exp(),
+                ..g.clone()
+            }),
+            LawModel::ElastoPlastic(e) => {
+                let r = 1.0 / (1.0 + (-theta[2]).exp());
+                LawModel::ElastoPlastic(ElastoPlasticModel {
+                    fc,
+                    fs,
+                    sigma0,
+                    sigma1,
+                    z_ba: r * fc / sigma0,
+                    ..e.clone()
+                })
+            }
+        }
     }
 }
 
-/// The effect's name in the report.
-pub const PRESLIDING_MEMORY: &str = "presliding_memory";
-
-/// What the check decided.
+/// What the check of one law decided.
 #[derive(Clone, Debug, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum MemoryOutcome {
-    /// GMS predicts the held-out data better: the nominal moves to it.
+    /// It predicts the held-out data better than LuGre (and better than
+    /// the other laws that do): the nominal moves to it.
     Moved,
-    /// Tried; LuGre's memory stays (GMS not better by the rule).
+    /// Tried; LuGre stays (or another law that predicts better).
     Kept,
-    /// Not tried (`MemoryCheck::reason` says why).
+    /// Not tried (`LawCheck::reason` says why).
     NotTried,
 }
 
-/// The check's result, for the report.
+/// The check of one law, for the report.
 #[derive(Clone, Debug, Serialize)]
-pub struct MemoryCheck {
+pub struct LawCheck {
+    pub law: OtherLaw,
+    /// The effect named when the nominal moves to it.
+    pub effect: &'static str,
     pub outcome: MemoryOutcome,
-    /// Why it was not tried, or what failed.
+    /// Why it was not tried or not moved to, or what failed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
     /// Held-out RMS of the final LuGre model (normalised).
     pub lugre_heldout_rms: f64,
-    /// Held-out RMS of the fitted GMS (normalised; NaN when not tried).
-    pub gms_heldout_rms: f64,
-    /// Relative drop of the held-out mean square from LuGre to GMS.
+    /// Held-out RMS of the law fitted (normalised; NaN when not tried).
+    pub heldout_rms: f64,
+    /// Relative drop of the held-out mean square from LuGre to the law.
     pub gain: f64,
-    /// One-sided p-value that GMS explains the held-out data better.
+    /// One-sided p-value that the law explains the held-out data better.
     pub p_value: f64,
-    /// The p-value had to be below this (the family-wise α).
+    /// The p-value had to be below this (α over the laws tried).
     pub threshold: f64,
-    /// The GMS fitted on every sample (when tried).
+    /// The law fitted on every sample (when tried).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub gms: Option<GmsModel>,
-    /// Where the GMS FMU was found.
+    pub fitted: Option<LawModel>,
+    /// Where its FMU was found.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub gms_fmu: Option<PathBuf>,
+    pub fmu: Option<PathBuf>,
     pub cosimulations: usize,
     pub seconds: f64,
 }
 
-impl MemoryCheck {
-    pub(crate) fn not_tried(lugre_rms: f64, threshold: f64, reason: String) -> MemoryCheck {
-        MemoryCheck {
+impl LawCheck {
+    pub(crate) fn not_tried(
+        law: OtherLaw,
+        lugre_rms: f64,
+        threshold: f64,
+        reason: String,
+    ) -> LawCheck {
+        LawCheck {
+            law,
+            effect: law.effect(),
             outcome: MemoryOutcome::NotTried,
             reason: Some(reason),
             lugre_heldout_rms: lugre_rms,
-            gms_heldout_rms: f64::NAN,
+            heldout_rms: f64::NAN,
             gain: f64::NAN,
             p_value: f64::NAN,
             threshold,
-            gms: None,
-            gms_fmu: None,
+            fitted: None,
+            fmu: None,
             cosimulations: 0,
             seconds: 0.0,
         }
     }
 }
 
-/// The system `file` with its friction component `friction` on the GMS
-/// FMU at `gms` (connected by the variables GMS has: `v` and `F`).
-pub fn moved_to_gms(
+/// The check the nominal moved on, if any.
+pub fn moved(checks: &[LawCheck]) -> Option<&LawCheck> {
+    checks.iter().find(|c| c.outcome == MemoryOutcome::Moved)
+}
+
+/// The system `file` with its friction component `friction` on the FMU at
+/// `path` (connected by the variables that FMU has: `v` and `F` for GMS
+/// and the elasto-plastic law).
+pub fn moved_to(
     file: &crate::ssp::SystemFile,
     friction: &str,
-    gms: &std::path::Path,
+    path: &std::path::Path,
 ) -> Result<crate::ssp::SystemFile, String> {
-    let fmu = crate::fmu::Fmu::open(gms).map_err(|e| format!("{}: {e}", gms.display()))?;
-    file.with_component_source(friction, gms, |c| fmu.variable(c).is_ok())
+    let fmu = crate::fmu::Fmu::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    file.with_component_source(friction, path, |c| fmu.variable(c).is_ok())
 }
 
 #[cfg(test)]
@@ -227,7 +449,7 @@ mod tests {
     use super::*;
 
     fn lugre() -> FrictionModel {
-        let mut m = FrictionModel::coulomb_for_tests(2.0, 1e4, 0.0);
+        let mut m = FrictionModel::coulomb_for_tests(2.0, 1e4, 40.0);
         m.fs = 2.6;
         m.vs = 0.01;
         m
@@ -265,31 +487,60 @@ mod tests {
     }
 
     #[test]
-    fn coordinates_round_trip_and_keep_fs_at_least_fc() {
-        let c = GmsCoordinates {
-            start: GmsModel::from_lugre(&lugre(), 1e-2),
-        };
-        let t = c.theta();
-        assert_eq!(t.len(), 4);
-        let back = c.at(&t);
-        for (a, b) in [
-            (back.fc, c.start.fc),
-            (back.fs, c.start.fs),
-            (back.sigma0, c.start.sigma0),
-            (back.attraction, c.start.attraction),
-        ] {
-            assert!((a - b).abs() < 1e-12 * b);
+    fn coordinates_round_trip_and_keep_every_model_valid() {
+        for law in OtherLaw::ALL {
+            for start in law.starts(&lugre()) {
+                let c = LawCoordinates {
+                    start: start.clone(),
+                };
+                let t = c.theta();
+                assert_eq!(t.len(), 4);
+                let back = c.at(&t);
+                for ((name, a), (_, b)) in back.parameters().iter().zip(start.parameters()) {
+                    assert!((a - b).abs() <= 1e-12 * b.abs(), "{name}: {a} vs {b}");
+                }
+                for far in [[0.1, 3.0, -30.0, -40.0], [3.0, 12.0, 30.0, 5.0]] {
+                    let m = c.at(&far);
+                    let p: std::collections::BTreeMap<_, _> = m.parameters().into_iter().collect();
+                    assert!(p["Fs"] >= p["Fc"] && p["Fc"] > 0.0);
+                    // σ1 follows √σ0
+                    let sigma0 = match &m {
+                        LawModel::Gms(g) => g.elements().0.iter().sum(),
+                        LawModel::ElastoPlastic(e) => e.sigma0,
+                    };
+                    let ratio = p["sigma1"] / f64::sqrt(sigma0);
+                    let (s0, s1) = (lugre().sigma0, lugre().sigma1);
+                    assert!((ratio - s1 / s0.sqrt()).abs() <= 1e-9 * ratio.abs().max(1e-300));
+                    if let LawModel::ElastoPlastic(e) = &m {
+                        assert!(e.z_ba >= 0.0 && e.z_ba < e.fc / e.sigma0, "{e:?}");
+                    }
+                }
+            }
         }
-        let far = c.at(&[0.1, 3.0, -2.0, -40.0]);
-        assert!(far.fs >= far.fc);
         // without a Stribeck peak Fs follows Fc
         let mut flat = lugre();
         flat.fs = flat.fc;
-        let c = GmsCoordinates {
-            start: GmsModel::from_lugre(&flat, 1e-2),
+        let c = LawCoordinates {
+            start: OtherLaw::Gms.starts(&flat)[0].clone(),
         };
         assert_eq!(c.theta().len(), 3);
-        let m = c.at(&[1.0, 9.0, 4.0]);
-        assert_eq!(m.fs, m.fc);
+        let p: std::collections::BTreeMap<_, _> =
+            c.at(&[1.0, 9.0, 4.0]).parameters().into_iter().collect();
+        assert_eq!(p["Fs"], p["Fc"]);
+    }
+
+    /// The elasto-plastic start is LuGre's parameters with z_ba the given
+    /// fraction of Fc/σ0.
+    #[test]
+    fn the_elastoplastic_start_is_lugre_with_a_break_away() {
+        let l = lugre();
+        let LawModel::ElastoPlastic(e) = &OtherLaw::ElastoPlastic.starts(&l)[1] else {
+            panic!("not elasto-plastic")
+        };
+        assert_eq!(
+            (e.fc, e.fs, e.sigma0, e.sigma1),
+            (l.fc, l.fs, l.sigma0, l.sigma1)
+        );
+        assert!((e.z_ba - ELASTIC_FRACTION_STARTS[1] * l.fc / l.sigma0).abs() < 1e-18);
     }
 }

@@ -6,7 +6,7 @@
 //! and renamed into place at the end, so a failure leaves nothing half
 //! written.
 
-use super::memory::{GmsModel, MemoryCheck, MemoryOutcome, PRESLIDING_MEMORY};
+use super::memory::{moved, LawCheck, LawModel, MemoryOutcome, OtherLaw};
 use super::Diagnosis;
 use crate::ssp::SystemFile;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
@@ -53,16 +53,12 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
         &d.final_model.parameters(),
         &dir.join("refitted.ssp"),
     )?;
-    if let (MemoryOutcome::Moved, Some(gms), Some(path)) =
-        (&d.memory.outcome, &d.memory.gms, &d.memory.gms_fmu)
+    if let Some((m, fitted, path)) =
+        moved(&d.memory).and_then(|m| Some((m, m.fitted.as_ref()?, m.fmu.as_ref()?)))
     {
-        let moved = super::memory::moved_to_gms(file, friction, path)?;
-        write_ssp(
-            &moved,
-            friction,
-            &gms.parameters(),
-            &dir.join("refitted-gms.ssp"),
-        )?;
+        let moved = super::memory::moved_to(file, friction, path)?;
+        let name = format!("refitted-{}.ssp", m.law.file_tag());
+        write_ssp(&moved, friction, &fitted.parameters(), &dir.join(name))?;
     }
     std::fs::write(
         dir.join("report.html"),
@@ -77,48 +73,45 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
     Ok(())
 }
 
-/// What the check of the pre-sliding memory found, in a paragraph.
-pub fn memory_words(m: &MemoryCheck) -> String {
-    let compared = || {
-        format!(
-            "held-out RMS {:.5} with LuGre, {:.5} with GMS ({} of the mean square, p = {:.2e}, threshold {:.2e})",
-            m.lugre_heldout_rms,
-            m.gms_heldout_rms,
-            pct(m.lugre_heldout_rms.powi(2), m.gms_heldout_rms.powi(2)),
-            m.p_value,
-            m.threshold
-        )
-    };
-    let gms = |g: &GmsModel| {
-        format!(
-            "Fc = {:.4e} N, Fs = {:.4e} N, vs = {:.4e} m/s, σ2 = {:.4e} N·s/m, {} elements of total stiffness {:.4e} N/m (pre-sliding distance {:.3e} m), C = {:.4e} N/s (lag {:.3e} s at Fc)",
-            g.fc,
-            g.fs,
-            g.vs,
-            g.sigma2,
-            g.elements,
-            g.sigma0,
-            g.presliding_distance(),
-            g.attraction,
-            g.fc / g.attraction
-        )
-    };
-    match m.outcome {
-        MemoryOutcome::Moved => format!(
-            "**Pre-sliding memory** (`{PRESLIDING_MEMORY}`): the held-out data prefer GMS's nonlocal memory (Al-Bender, Lampaert and Swevers 2005) to LuGre's: {}. The nominal moves to GMS, {}.",
-            compared(),
-            m.gms.as_ref().map_or(String::new(), gms)
-        ),
-        MemoryOutcome::Kept => format!(
-            "Pre-sliding memory: LuGre's is kept; GMS, with the final model's levels as its start, does not predict the held-out data better by the acceptance rule: {}.{}",
-            compared(),
-            m.reason.as_ref().map_or(String::new(), |r| format!(" {r}."))
-        ),
-        MemoryOutcome::NotTried => format!(
-            "Pre-sliding memory: GMS was not tried: {}.",
-            m.reason.as_deref().unwrap_or("no reason recorded").trim_end_matches('.')
-        ),
+/// What the checks of the other laws found, one sentence each.
+pub fn memory_words(checks: &[LawCheck]) -> String {
+    let mut words = Vec::new();
+    for m in checks {
+        let name = m.law.model_name();
+        let compared = || {
+            format!(
+                "held-out RMS {:.5} with LuGre, {:.5} with {name} ({} of the mean square, p = {:.2e}, threshold {:.2e})",
+                m.lugre_heldout_rms,
+                m.heldout_rms,
+                pct(m.lugre_heldout_rms.powi(2), m.heldout_rms.powi(2)),
+                m.p_value,
+                m.threshold
+            )
+        };
+        words.push(match m.outcome {
+            MemoryOutcome::Moved => format!(
+                "**{}** (`{}`): the held-out data prefer {} to LuGre's pre-sliding: {}. The nominal moves to {name}: {}.",
+                match m.law {
+                    OtherLaw::Gms => "Pre-sliding memory",
+                    OtherLaw::ElastoPlastic => "Elastic pre-sliding",
+                },
+                m.effect,
+                m.law.words(),
+                compared(),
+                m.fitted.as_ref().map_or(String::new(), LawModel::describe)
+            ),
+            MemoryOutcome::Kept => format!(
+                "{name} (with the final model's levels as its start) does not replace LuGre: {}.{}",
+                compared(),
+                m.reason.as_ref().map_or(String::new(), |r| format!(" {}.", r.trim_end_matches('.')))
+            ),
+            MemoryOutcome::NotTried => format!(
+                "{name} was not tried: {}.",
+                m.reason.as_deref().unwrap_or("no reason recorded").trim_end_matches('.')
+            ),
+        });
     }
+    words.join(" ")
 }
 
 /// The relative change from `before` to `after`, signed, in per cent
@@ -209,12 +202,13 @@ pub fn markdown(d: &Diagnosis) -> String {
         d.final_rms,
         pct(d.nominal_rms, d.final_rms),
     );
-    if d.memory.outcome == MemoryOutcome::Moved {
+    if let Some(m) = moved(&d.memory) {
         let _ = writeln!(
             s,
-            "| final, moved to GMS | {:.5} | {} |",
-            d.memory.gms_heldout_rms,
-            pct(d.nominal_rms, d.memory.gms_heldout_rms)
+            "| final, moved to {} | {:.5} | {} |",
+            m.law.model_name(),
+            m.heldout_rms,
+            pct(d.nominal_rms, m.heldout_rms)
         );
     }
     let _ = writeln!(s, "\n{}", memory_words(&d.memory));
@@ -593,12 +587,13 @@ pub fn input_files(d: &Diagnosis) -> Vec<(&super::InputColumns, String, String)>
 /// run is the co-simulation the report scored (the inputs interpolated
 /// over each step, as the diagnosis gives them).
 ///
-/// With the nominal moved to GMS, the same for `refitted-gms.ssp` after
-/// them (results `rerun-gms….csv`).
+/// With the nominal moved to another law, the same for its
+/// `refitted-<law>.ssp` after them (results `rerun-<law>….csv`).
 pub fn rerun_commands(d: &Diagnosis, out: &Path) -> Vec<String> {
-    let mut systems = vec![("refitted.ssp", "")];
-    if d.memory.outcome == MemoryOutcome::Moved {
-        systems.push(("refitted-gms.ssp", "-gms"));
+    let mut systems = vec![("refitted.ssp".to_string(), String::new())];
+    if let Some(m) = moved(&d.memory) {
+        let tag = m.law.file_tag();
+        systems.push((format!("refitted-{tag}.ssp"), format!("-{tag}")));
     }
     systems
         .into_iter()
@@ -610,7 +605,7 @@ pub fn rerun_commands(d: &Diagnosis, out: &Path) -> Vec<String> {
                     let result = result.replacen("rerun", &format!("rerun{tag}"), 1);
                     format!(
                         "fricsim run {} --input {} --master {} --step {:?} --start {start:?} --stop {stop:?} --out {}",
-                        out.join(ssp).display(),
+                        out.join(&ssp).display(),
                         out.join(inputs).display(),
                         d.master,
                         d.step,

@@ -1,23 +1,27 @@
 //! Stage 7 (after the candidate rounds, before the summary): whether the
-//! held-out data prefer GMS's pre-sliding memory to LuGre's
-//! ([`crate::memory`]). The final LuGre model's fold models are moved to
-//! GMS with their levels and stiffness as the start, each fitted on its
-//! fold's fit samples by output error (the memory lives in the stick,
-//! which the force the data imply leaves out), scored on the held-out
-//! samples as every candidate is, and compared with LuGre's score by the
-//! paired test of two explanations that are not nested
-//! ([`separation_test`]) under the one acceptance rule
-//! ([`Acceptance`]). When it passes, the diagnosis names the effect
-//! `presliding_memory` and reports the GMS that replaces LuGre.
+//! held-out data prefer another law's pre-sliding to LuGre's
+//! ([`crate::memory`]): GMS's nonlocal memory, or the elasto-plastic
+//! law's elastic stick. For each law, the final LuGre model's fold models
+//! are moved to it with their levels and stiffness as the start, each
+//! fitted on its fold's fit samples by output error (pre-sliding lives in
+//! the stick, which the force the data imply leaves out), scored on the
+//! held-out samples as every candidate is, and compared with LuGre's
+//! score by the paired test of two explanations that are not nested
+//! ([`separation_test`]) under the one acceptance rule ([`Acceptance`]),
+//! its threshold α shared among the laws tried (as a round shares it
+//! among its candidates). The nominal moves to the law that passes with
+//! the lowest held-out error, and the diagnosis names its effect
+//! (`presliding_memory`, `elastic_presliding`).
 //!
-//! Tried only where the comparison means something: a LuGre model GMS can
-//! hold (one level in both directions, no position table, no normal-force
-//! form, no offset), pre-sliding the data resolve (the final model's
-//! pre-sliding distance `Fs/σ0` at least [`RESOLVED_STEPS`] times the
-//! position resolution), `GMS.fmu` beside the friction FMU, and time left.
-//! Otherwise the report says which of these it lacked.
+//! Tried only where the comparison means something: a LuGre model the
+//! other laws can hold (one level in both directions, no position table,
+//! no normal-force form, no offset), pre-sliding the data resolve (the
+//! final model's pre-sliding distance `Fs/σ0` at least [`RESOLVED_STEPS`]
+//! times the position resolution), the law's FMU beside the friction FMU
+//! (`GMS.fmu`, `ElastoPlastic.fmu`), and time left. Otherwise the report
+//! says which of these it lacked.
 //!
-//! Takes the [`Problem`] and the [`Search`]; gives a [`MemoryCheck`].
+//! Takes the [`Problem`] and the [`Search`]; gives a [`LawCheck`] per law.
 
 use super::baseline::acceptance_groups;
 use super::problem::Problem;
@@ -25,23 +29,22 @@ use super::rounds::Search;
 use super::split::Picker;
 use crate::acceptance::{drop_beyond_step_error, mean, separation_test, Acceptance, Scored};
 use crate::fit::{polish_any, Coordinates, ResidualsOf};
-use crate::memory::{
-    moved_to_gms, GmsCoordinates, GmsModel, MemoryCheck, MemoryOutcome, LAG_STARTS,
-};
+use crate::memory::{moved_to, LawCheck, LawCoordinates, LawModel, MemoryOutcome, OtherLaw};
 use crate::model::FrictionModel;
 use crate::sim::system_parameters_with;
 use crate::POLISH_ITERATIONS;
 use nalgebra::DVector;
 use rayon::prelude::*;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Pre-sliding shorter than this many position resolutions is not
 /// resolved well enough to tell one memory from another.
 pub const RESOLVED_STEPS: f64 = 5.0;
 
-/// Why `m` cannot be moved to GMS, if it cannot: the LuGre features GMS
-/// does not have.
-fn gms_cannot_hold(m: &FrictionModel) -> Option<String> {
+/// Why `m` cannot be moved to another law, if it cannot: the LuGre
+/// features GMS and the elasto-plastic FMU do not have.
+fn others_cannot_hold(m: &FrictionModel) -> Option<String> {
     let features = [
         (m.direction_dependent, "direction-dependent levels"),
         (
@@ -59,24 +62,30 @@ fn gms_cannot_hold(m: &FrictionModel) -> Option<String> {
         .collect();
     (!held.is_empty()).then(|| {
         format!(
-            "the final LuGre model has {}, which GMS does not",
+            "the final LuGre model has {}, which neither GMS nor the elasto-plastic law has",
             held.join(" and ")
         )
     })
 }
 
-/// Run the check ([the module](self)).
-pub(crate) fn check_memory(p: &Problem, search: &Search) -> MemoryCheck {
+/// Run the checks ([the module](self)): one [`LawCheck`] per law of
+/// [`OtherLaw::ALL`], at most one of them `Moved`.
+pub(crate) fn check_memory(p: &Problem, search: &Search) -> Vec<LawCheck> {
     let lugre_rms = search.scored.rms();
-    let threshold = p.options.alpha;
-    let not_tried = |reason: String| MemoryCheck::not_tried(lugre_rms, threshold, reason);
-    if let Some(why) = gms_cannot_hold(&search.current) {
-        return not_tried(why);
+    let threshold = p.options.alpha / OtherLaw::ALL.len() as f64;
+    let every_law = |reason: String| -> Vec<LawCheck> {
+        OtherLaw::ALL
+            .iter()
+            .map(|&law| LawCheck::not_tried(law, lugre_rms, threshold, reason.clone()))
+            .collect()
+    };
+    if let Some(why) = others_cannot_hold(&search.current) {
+        return every_law(why);
     }
     let distance = search.current.fs.max(search.current.fc) / search.current.sigma0;
     let resolution = p.context.position_resolution;
     if distance.is_nan() || distance < RESOLVED_STEPS * resolution {
-        return not_tried(format!(
+        return every_law(format!(
             "the data do not resolve pre-sliding: the final model's pre-sliding distance Fs/σ0 = {distance:.3e} m is under {RESOLVED_STEPS} times the position resolution {resolution:.3e} m"
         ));
     }
@@ -86,82 +95,123 @@ pub(crate) fn check_memory(p: &Problem, search: &Search) -> MemoryCheck {
         .iter()
         .find(|c| c.name == p.setup.friction_name)
     else {
-        return not_tried(format!(
+        return every_law(format!(
             "no component `{}` in the system file",
             p.setup.friction_name
         ));
     };
-    let gms_path = component.source.with_file_name("GMS.fmu");
-    if !gms_path.is_file() {
+    let mut checks: Vec<LawCheck> = OtherLaw::ALL
+        .iter()
+        .map(|&law| {
+            let path = component
+                .source
+                .with_file_name(format!("{}.fmu", law.model_name()));
+            check_law(p, search, law, path, threshold)
+        })
+        .collect();
+    // the nominal moves to the law that passed with the lowest error
+    let passed: Vec<usize> = (0..checks.len())
+        .filter(|&i| checks[i].outcome == MemoryOutcome::Moved)
+        .collect();
+    if let Some(&best) = passed
+        .iter()
+        .min_by(|&&a, &&b| checks[a].heldout_rms.total_cmp(&checks[b].heldout_rms))
+    {
+        let (name, rms) = (checks[best].law.model_name(), checks[best].heldout_rms);
+        for &i in passed.iter().filter(|&&i| i != best) {
+            checks[i].outcome = MemoryOutcome::Kept;
+            checks[i].reason = Some(format!(
+                "it passed too, but {name} predicts the held-out data better (held-out RMS {rms:.5} against {:.5})",
+                checks[i].heldout_rms
+            ));
+        }
+    }
+    checks
+}
+
+/// The check of one law whose FMU is at `path`.
+fn check_law(
+    p: &Problem,
+    search: &Search,
+    law: OtherLaw,
+    path: PathBuf,
+    threshold: f64,
+) -> LawCheck {
+    let not_tried =
+        |reason: String| LawCheck::not_tried(law, search.scored.rms(), threshold, reason);
+    let name = law.model_name();
+    if !path.is_file() {
         return not_tried(format!(
-            "no GMS.fmu beside the friction FMU ({} does not exist)",
-            gms_path.display()
+            "no {name}.fmu beside the friction FMU ({} does not exist)",
+            path.display()
         ));
     }
-    const WHAT: &str = "the check of the pre-sliding memory (GMS against LuGre)";
-    if p.budget.skip_if_expired(|| WHAT.into()) {
+    let what = format!("the check of {name} against LuGre");
+    if p.budget.skip_if_expired(|| what.clone()) {
         return not_tried("the time limit was reached before it".into());
     }
     p.budget
         .progress()
-        .stage("pre-sliding memory: GMS against LuGre");
+        .stage(format!("pre-sliding: {name} against LuGre"));
     let started = Instant::now();
-    let (outcome, cut) = p
-        .budget
-        .cut_short(|| WHAT.into(), || try_gms(p, search, &gms_path));
+    let (outcome, cut) = p.budget.cut_short(
+        || what.clone(),
+        || try_law(p, search, law, &path, threshold),
+    );
     let mut check = match outcome {
         Ok(check) => check,
-        Err(e) => not_tried(format!("GMS could not be scored: {e}")),
+        Err(e) => not_tried(format!("{name} could not be scored: {e}")),
     };
     if cut && check.outcome == MemoryOutcome::Moved {
         // a fit the limit stopped is not taken as a finding
         check.outcome = MemoryOutcome::Kept;
-        check.reason = Some("the time limit stopped the GMS fit; LuGre is kept".into());
+        check.reason = Some(format!(
+            "the time limit stopped the {name} fit; LuGre is kept"
+        ));
     }
-    check.gms_fmu = Some(gms_path);
+    check.fmu = Some(path);
     check.seconds = started.elapsed().as_secs_f64();
     check
 }
 
-/// Fit GMS on each fold, score it, decide.
-fn try_gms(
+/// Fit `law` on each fold, score it, decide.
+fn try_law(
     p: &Problem,
     search: &Search,
-    gms_path: &std::path::Path,
-) -> Result<MemoryCheck, String> {
-    let file = moved_to_gms(p.file, &p.setup.friction_name, gms_path)?;
+    law: OtherLaw,
+    path: &Path,
+    threshold: f64,
+) -> Result<LawCheck, String> {
+    let file = moved_to(p.file, &p.setup.friction_name, path)?;
     let params =
-        |m: &GmsModel| system_parameters_with(&file, &p.setup.friction_name, m.parameters());
+        |m: &LawModel| system_parameters_with(&file, &p.setup.friction_name, m.parameters());
     let cosimulations = std::sync::atomic::AtomicUsize::new(0);
-    // one GMS per fold, from the fold's LuGre
-    let fit = |lugre: &FrictionModel, pick: &Picker| -> GmsModel {
-        let residuals = |m: &GmsModel| {
+    // one model per fold, from the fold's LuGre: the best start refined
+    let fit = |lugre: &FrictionModel, pick: &Picker| -> LawModel {
+        let residuals = |m: &LawModel| {
             cosimulations.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             p.fit_residuals_of(&file, &params(m), pick, None)
         };
-        let cost = |m: &GmsModel| residuals(m).map_or(f64::INFINITY, |r| r.norm_squared());
-        let starts: Vec<GmsModel> = LAG_STARTS
-            .iter()
-            .map(|&lag| GmsModel::from_lugre(lugre, lag))
-            .collect();
+        let cost = |m: &LawModel| residuals(m).map_or(f64::INFINITY, |r| r.norm_squared());
+        let starts = law.starts(lugre);
         let costs: Vec<f64> = starts.par_iter().map(cost).collect();
         let best = (0..starts.len())
             .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
             .unwrap_or(0);
-        let mut residual = |models: &[GmsModel]| -> Vec<Option<DVector<f64>>> {
+        let mut residual = |models: &[LawModel]| -> Vec<Option<DVector<f64>>> {
             if p.budget.stop_here() {
                 return Vec::new();
             }
             models.par_iter().map(residuals).collect()
         };
-        let residual: &mut ResidualsOf<'_, GmsModel> = &mut residual;
-        let coordinates = GmsCoordinates {
+        let residual: &mut ResidualsOf<'_, LawModel> = &mut residual;
+        let coordinates = LawCoordinates {
             start: starts[best].clone(),
         };
         let budget = POLISH_ITERATIONS * (coordinates.theta().len() + 1) + 1;
         polish_any(coordinates, residual, budget).0
     };
-    let folds: Vec<GmsModel> = p
+    let folds: Vec<LawModel> = p
         .split
         .folds
         .par_iter()
@@ -179,15 +229,17 @@ fn try_gms(
     let lugre = &search.scored;
     let group = acceptance_groups(p, lugre);
     let p_value = separation_test(&scored, lugre, &group).map_err(|e| e.to_string())?;
-    let (ml, mg) = (mean(&lugre.q), mean(&scored.q));
-    let gain = if ml > 0.0 { (ml - mg) / ml } else { 0.0 };
+    let (ml, mo) = (mean(&lugre.q), mean(&scored.q));
+    let gain = if ml > 0.0 { (ml - mo) / ml } else { 0.0 };
     let rule = Acceptance {
-        threshold: p.options.alpha,
+        threshold,
         min_gain: p.options.min_gain,
     };
     let moved = rule.passes(gain, p_value)
         && drop_beyond_step_error(lugre, scored.rms(), search.step_error);
-    Ok(MemoryCheck {
+    Ok(LawCheck {
+        law,
+        effect: law.effect(),
         outcome: if moved {
             MemoryOutcome::Moved
         } else {
@@ -195,12 +247,12 @@ fn try_gms(
         },
         reason: None,
         lugre_heldout_rms: lugre.rms(),
-        gms_heldout_rms: scored.rms(),
+        heldout_rms: scored.rms(),
         gain,
         p_value,
-        threshold: rule.threshold,
-        gms: Some(whole),
-        gms_fmu: None,
+        threshold,
+        fitted: Some(whole),
+        fmu: None,
         cosimulations: cosimulations.into_inner() + p.split.folds.len(),
         seconds: 0.0,
     })

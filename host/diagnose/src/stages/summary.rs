@@ -16,7 +16,7 @@ use super::rounds::Search;
 use super::run_force;
 use crate::acceptance::Scored;
 use crate::intervals::{self, ThetaCovariance};
-use crate::memory::{MemoryCheck, MemoryOutcome};
+use crate::memory::{moved, LawCheck};
 use crate::model::FrictionModel;
 use crate::problem::{FrictionData, Measured};
 use crate::sim::FrictionSim;
@@ -33,7 +33,7 @@ pub(crate) fn summarise(
     p: &Problem,
     sim: &mut FrictionSim,
     baseline: Baseline,
-    (search, memory): (Search, MemoryCheck),
+    (search, memory): (Search, Vec<LawCheck>),
     polishing: Polishing,
     started: Instant,
 ) -> Result<Diagnosis, String> {
@@ -123,12 +123,9 @@ pub(crate) fn summarise(
         baseline_rms: baseline.scored.rms(),
         refit: baseline.refit,
         final_rms,
-        // the nominal moved to GMS: what GMS leaves
-        unexplained: if memory.outcome == MemoryOutcome::Moved {
-            memory.gms_heldout_rms
-        } else {
-            final_rms
-        } > UNEXPLAINED_FACTOR * floor,
+        // the nominal moved to another law: what that law leaves
+        unexplained: moved(&memory).map_or(final_rms, |m| m.heldout_rms)
+            > UNEXPLAINED_FACTOR * floor,
         noise_floor_rms: noise,
         step_error_rms: numerical,
         floor_rms: floor,
