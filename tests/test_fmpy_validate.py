@@ -49,7 +49,7 @@ EXPECTED = {
                     "parameter": {"sigma2", "n_elements"} | {f"k[{i}]" for i in range(1, 101)}
                     | {f"W[{i}]" for i in range(1, 101)}},
     "GMS": {"input": {"v"}, "output": {"F", "P_diss", "E_stored", "n_slipping"},
-            "parameter": {"sigma2", "n_elements", "Fc", "Fs", "vs", "stribeck_exponent", "C"}
+            "parameter": {"sigma1", "sigma2", "n_elements", "Fc", "Fs", "vs", "stribeck_exponent", "C"}
             | {f"k[{i}]" for i in range(1, 101)} | {f"alpha[{i}]" for i in range(1, 101)}},
     "Rig1D": {"input": {"F", "F_ext", "x_act_in", "x_ref", "v_ref"},
               "output": {"x", "v", "a", "F_spring", "x_act", "x_rel", "v_body", "F_drive", "u_ctrl", "F_ctrl",

@@ -12,7 +12,9 @@
 //! reversal is `v`'s.
 //!
 //! The element arrays are `k[i]` and `W[i]` (or `alpha[i]`), `i` =
-//! 1..=100; `n_elements` says how many are used. Both FMUs are one
+//! 1..=100; `n_elements` says how many are used. GMS's micro-damping
+//! `sigma1` (each element's `σ_i·ż_i`, the total shared in proportion to
+//! stiffness) came later and follows the arrays. Both FMUs are one
 //! generic model, [`ElementsFmu`], over the two laws ([`ElementLaw`]).
 
 use crate::{input_ramp, param_err, sliding_velocity_input};
@@ -26,7 +28,10 @@ use std::sync::LazyLock;
 
 /// Value references: 0..=6 shared by both FMUs, 7..=11 GMS's curve, then
 /// the arrays (at [`Layout`]'s bases: value references are the positions
-/// in the variable table, so each FMU's arrays follow its last scalar).
+/// in the variable table, so each FMU's arrays follow its last scalar),
+/// then GMS's `sigma1` (412), appended after its arrays so that no value
+/// reference of the first GMS moved (FMI 3.0's `time` and event
+/// indicators, which follow the table, moved up by one).
 pub mod vr {
     pub const V: u32 = 0;
     pub const F: u32 = 1;
@@ -41,6 +46,8 @@ pub mod vr {
     pub const VS: u32 = 9;
     pub const STRIBECK_EXPONENT: u32 = 10;
     pub const C: u32 = 11;
+    /// GMS only: the total micro-damping, after GMS's four arrays.
+    pub const SIGMA1: u32 = C + 1 + 4 * super::MAX_ELEMENTS as u32;
 }
 
 /// Where an FMU's arrays start (each of `MAX_ELEMENTS` values, element
@@ -98,7 +105,11 @@ fn common(law: &str, sigma2: f64) -> Vec<Variable> {
             vr::F,
             "F",
             "N",
-            "Friction force F = sum of the element forces F_i + sigma2*v, resisting positive motion (the rig applies -F)",
+            if law == "GMS" {
+                "Friction force F = sum of the element forces F_i + sum of the element dampings sigma_i*dz_i/dt (sigma_i = sigma1*k[i]/sum k, dz_i/dt = v sticking, dF_i/dt/k[i] slipping) + sigma2*v, resisting positive motion (the rig applies -F)"
+            } else {
+                "Friction force F = sum of the element forces F_i + sigma2*v, resisting positive motion (the rig applies -F)"
+            },
             &[vr::V],
         ),
         Variable::output(
@@ -108,7 +119,7 @@ fn common(law: &str, sigma2: f64) -> Vec<Variable> {
             leak(format!(
                 "Power the contact dissipates, F*v - dE_stored/dt: the slipping elements' share plus sigma2*v^2{}",
                 if law == "GMS" {
-                    " (a slipping element attracted faster than the motion loads it returns energy: P_diss can be negative for a while)"
+                    ", plus the element dampings' sum of sigma_i*dz_i/dt*v (a slipping element attracted faster than the motion loads it returns energy: P_diss can be negative for a while)"
                 } else {
                     " = sum over sliding elements of W[i]*|v| + sigma2*v^2, never negative"
                 }
@@ -320,11 +331,21 @@ pub static GMS_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
         (d.k, d.alpha),
     ));
     with_states(&mut variables, GMS_LAYOUT);
+    variables.push(
+        Variable::parameter(
+            vr::SIGMA1,
+            "sigma1",
+            d.sigma1,
+            "N.s/m",
+            "Micro-damping, the elements' total: element i has sigma_i = sigma1*k[i]/sum k and adds sigma_i*dz_i/dt to F (dz_i/dt = v sticking, dF_i/dt/k[i] slipping); while every element sticks it adds sigma1*v",
+        )
+        .with_min(0.0),
+    );
     ModelInfo {
         model_name: "GMS",
         model_identifier: "GMS",
         guid: "{d4e8b2a7-19c6-4f03-9a5d-7e2c61b0f8d9}",
-        description: "Generalized Maxwell-Slip friction: n elasto-slide elements in parallel, F = sum F_i + sigma2*v; element i sticks (dF_i/dt = k[i]*v) until sgn(v)*F_i = alpha[i]*s(v), then slips with dF_i/dt = C*(sgn(v)*alpha[i] - F_i/s(v)) until the motion reverses. Pre-sliding hysteresis with nonlocal memory, Stribeck, frictional lag.",
+        description: "Generalized Maxwell-Slip friction: n elasto-slide elements in parallel, F = sum (F_i + sigma_i*dz_i/dt) + sigma2*v; element i sticks (dF_i/dt = k[i]*v) until sgn(v)*F_i = alpha[i]*s(v), then slips with dF_i/dt = C*(sgn(v)*alpha[i] - F_i/s(v)) until the motion reverses. Pre-sliding hysteresis with nonlocal memory, Stribeck, frictional lag.",
         source: "Al-Bender, Lampaert, Swevers 2005; Lampaert, Swevers, Al-Bender 2002. Default elements and C ours, on LuGre's 1995 levels. See docs/models.md.",
         variables: Box::leak(variables.into_boxed_slice()),
         default_experiment: EXPERIMENT,
@@ -346,6 +367,9 @@ pub trait ElementLaw: Clone + std::fmt::Debug + Send + 'static {
     fn nominal(values: &Values, i: usize) -> f64;
     fn k(&self) -> &[f64];
     fn sigma2(&self) -> f64;
+    /// The micro-damping per unit of element stiffness, `σ_i/k_i` (GMS:
+    /// `σ1/Σ k_j`; Maxwell-slip: 0): `F` has `damping·Σ Ḟ_i`.
+    fn damping(&self) -> f64;
     fn forces(&self) -> &[f64];
     fn set_forces(&mut self, f: &[f64]);
     fn step(&mut self, v: Ramp, h: f64);
@@ -443,6 +467,9 @@ impl ElementLaw for MaxwellSlip {
     fn slips(&self, i: usize, v: f64) -> bool {
         self.slipping(i, v)
     }
+    fn damping(&self) -> f64 {
+        0.0
+    }
     element_law_methods!();
 }
 
@@ -467,6 +494,7 @@ impl ElementLaw for Gms {
             vs: values.real(vr::VS),
             delta: values.real(vr::STRIBECK_EXPONENT),
             c: values.real(vr::C),
+            sigma1: values.real(vr::SIGMA1),
             sigma2: values.real(vr::SIGMA2),
         };
         Gms::new(p).map_err(param_err)
@@ -476,6 +504,9 @@ impl ElementLaw for Gms {
     }
     fn slips(&self, i: usize, _v: f64) -> bool {
         self.slipping(i)
+    }
+    fn damping(&self) -> f64 {
+        self.damping_per_stiffness()
     }
     element_law_methods!();
 }
@@ -582,12 +613,25 @@ impl<L: ElementLaw> Model for ElementsFmu<L> {
         false
     }
 
-    /// `dF/dt = Σ Ḟ_i + σ2·dv/dt`.
+    /// `dF/dt = Σ Ḟ_i + d·Σ dḞ_i/dt + σ2·dv/dt` in the current modes,
+    /// `d` = [`ElementLaw::damping`] and `dḞ_i/dt = ∂Ḟ_i/∂F_i·Ḟ_i +
+    /// ∂Ḟ_i/∂v·dv/dt`.
     fn output_derivative(&self, values: &Values, slopes: &[f64], output: u32) -> Option<f64> {
         let v = values.real(vr::V);
+        let slope = slopes[vr::V as usize];
         let n = self.law.forces().len();
         let elements: f64 = (0..n).map(|i| self.law.rate(i, v)).sum();
-        (output == vr::F).then(|| elements + self.law.sigma2() * slopes[vr::V as usize])
+        let d = self.law.damping();
+        if d == 0.0 {
+            return (output == vr::F).then(|| elements + self.law.sigma2() * slope);
+        }
+        let damping: f64 = (0..n)
+            .map(|i| {
+                let (by_f, by_v) = self.law.rate_partials(i, v);
+                by_f * self.law.rate(i, v) + by_v * slope
+            })
+            .sum();
+        (output == vr::F).then(|| elements + d * damping + self.law.sigma2() * slope)
     }
 
     /// `Ḟ_i` in the current modes; 0 past `n_elements`.
@@ -645,9 +689,10 @@ impl<L: ElementLaw> Ode for ElementsFmu<L> {
     }
 
     /// In closed form: `der(F_element[i])` has `∂/∂F_i` and `∂/∂v` from
-    /// the law; `F = Σ F_i + σ2·v`; `E_stored = Σ F_i²/(2·k_i)`;
-    /// `P_diss = Σ_slipping F_i·(v − Ḟ_i/k_i) + σ2·v²`. Past
-    /// `n_elements` every partial is 0.
+    /// the law; `F = Σ F_i + d·Σ Ḟ_i + σ2·v` (`d` =
+    /// [`ElementLaw::damping`], GMS's `Σ σ_i·ż_i`); `E_stored = Σ
+    /// F_i²/(2·k_i)`; `P_diss = Σ_slipping F_i·(v − Ḟ_i/k_i) + d·Σ Ḟ_i·v
+    /// + σ2·v²`. Past `n_elements` every partial is 0.
     fn partial_derivative(&self, values: &Values, unknown: u32, known: u32) -> Option<f64> {
         let v = values.real(vr::V);
         let at = L::layout();
@@ -669,22 +714,39 @@ impl<L: ElementLaw> Ode for ElementsFmu<L> {
             });
         }
         let slipping = |i: usize| i < n && self.law.slips(i, v);
+        // the damping d·Σ Ḟ_i (0 without): its partials by F_i (i < n) and v
+        let d = self.law.damping();
+        let damped = d != 0.0;
+        let damping_by_f = |i: usize| d * self.law.rate_partials(i, v).0;
+        let damping_by_v = || d * (0..n).map(|i| self.law.rate_partials(i, v).1).sum::<f64>();
         Some(match (unknown, by_state) {
+            (vr::F, Some(i)) if damped && i < n => 1.0 + damping_by_f(i),
             (vr::F, Some(i)) => (i < n) as u8 as f64,
+            (vr::F, None) if damped => self.law.sigma2() + damping_by_v(),
             (vr::F, None) => self.law.sigma2(),
             (vr::E_STORED, Some(i)) if i < n => f[i] / k[i],
             (vr::E_STORED, _) => 0.0,
             (vr::P_DISS, Some(i)) if slipping(i) => {
                 let (by_f, _) = self.law.rate_partials(i, v);
-                v - self.law.rate(i, v) / k[i] - f[i] * by_f / k[i]
+                let element = v - self.law.rate(i, v) / k[i] - f[i] * by_f / k[i];
+                if damped {
+                    element + damping_by_f(i) * v
+                } else {
+                    element
+                }
             }
+            // a sticking element's Ḟ_i = k_i·v does not depend on F_i
             (vr::P_DISS, Some(_)) => 0.0,
             (vr::P_DISS, None) => {
                 let elements: f64 = (0..n)
                     .filter(|&i| slipping(i))
                     .map(|i| f[i] * (1.0 - self.law.rate_partials(i, v).1 / k[i]))
                     .sum();
-                elements + 2.0 * self.law.sigma2() * v
+                if !damped {
+                    return Some(elements + 2.0 * self.law.sigma2() * v);
+                }
+                let rates: f64 = (0..n).map(|i| self.law.rate(i, v)).sum();
+                elements + d * rates + damping_by_v() * v + 2.0 * self.law.sigma2() * v
             }
             _ => return None,
         })

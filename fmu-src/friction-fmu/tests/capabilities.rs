@@ -15,6 +15,8 @@ use std::f64::consts::PI;
 type Signal = (&'static str, fn(f64) -> f64);
 /// An invalid-parameter case: model, assignments, text the message must contain.
 type BadCase<'a> = (&'a str, &'a [(&'a str, f64)], &'a str);
+/// Parameters set by name.
+type Params = &'static [(&'static str, f64)];
 
 /// A driving input for each model.
 fn drive(model: &str) -> Vec<Signal> {
@@ -149,6 +151,10 @@ fn directional_derivatives_agree_with_finite_differences() {
     check_step_sensitivity("MaxwellSlip", &[], "F", "v", &[("v", 1e-6)], h);
     check_step_sensitivity("GMS", &[], "F", "v", &[("v", 1e-6)], h);
     check_step_sensitivity("GMS", &[], "F", "v", &[("v", -5e-2)], h);
+    // with the micro-damping: sticking, on the Stribeck curve, gross sliding
+    for v in [1e-6, 2e-3, -5e-2] {
+        check_step_sensitivity("GMS", &[("sigma1", 30.0)], "F", "v", &[("v", v)], h);
+    }
     check_step_sensitivity(
         "Classical",
         &[],
@@ -372,18 +378,24 @@ fn step_size_independence_with_interpolated_inputs() {
 }
 
 /// dF/dt from fmi2GetRealOutputDerivatives against a short forward step
-/// with the input moving at the slope that was declared.
+/// with the input moving at the slope that was declared. GMS with its
+/// micro-damping, whose `Σ σ_i·ż_i` moves with the forces and with `v`:
+/// some elements slipping, some sticking.
 #[test]
 fn output_derivatives_agree_with_a_short_step() {
-    let cases: [(&str, &str, f64, f64); 5] = [
-        ("LuGre", "v", 1e-4, 3e-3),
-        ("Dahl", "v", 1e-4, 2e-3),
-        ("ResetIntegrator", "v", 1e-6, 1e-4),
-        ("Bristle", "x", 1e-9, 1e-8),
-        ("LuGre", "v", 2e-2, -0.5),
+    let damped: Params = &[("sigma1", 40.0)];
+    let cases: [(&str, Params, &str, f64, f64); 8] = [
+        ("LuGre", &[], "v", 1e-4, 3e-3),
+        ("Dahl", &[], "v", 1e-4, 2e-3),
+        ("ResetIntegrator", &[], "v", 1e-6, 1e-4),
+        ("Bristle", &[], "x", 1e-9, 1e-8),
+        ("LuGre", &[], "v", 2e-2, -0.5),
+        ("GMS", damped, "v", 2e-2, -0.5),
+        ("GMS", damped, "v", -1.5e-3, 0.3),
+        ("GMS", &[], "v", 1.5e-3, 0.3),
     ];
-    for (model, input, u, slope) in cases {
-        let mut fmu = Fmu::new(model, &[]);
+    for (model, params, input, u, slope) in cases {
+        let mut fmu = Fmu::new(model, params);
         for _ in 0..5 {
             fmu.set(input, u);
             fmu.step(1e-4);
@@ -395,9 +407,13 @@ fn output_derivatives_agree_with_a_short_step() {
         let dt = 1e-8;
         fmu.step(dt);
         let fd = (fmu.get("F") - f0) / dt;
+        println!(
+            "{model} {params:?} at {u}: dF/dt {rate:e}, short step {fd:e}, {:.1e} apart",
+            (rate - fd).abs() / fd.abs()
+        );
         assert!(
             (rate - fd).abs() <= 1e-3 * fd.abs().max(1e-9),
-            "{model}: dF/dt {rate:e}, short step {fd:e}"
+            "{model} {params:?}: dF/dt {rate:e}, short step {fd:e}"
         );
     }
 }
@@ -490,6 +506,82 @@ fn dahl_offset_shifts_the_force_and_not_its_derivatives() {
     }
 }
 
+/// GMS's micro-damping in Co-Simulation (value reference 412, after the
+/// arrays). Sticking throughout (2e-7 m, below every element's slip
+/// deflection): `F = Σ k_i·x + σ1·v + σ2·v` to 1e-12, and the step
+/// sensitivity `∂F(t + h)/∂v = Σ k_i·h + σ1 + σ2`. In gross sliding, the
+/// velocity raised from 5e-4 to 5e-3 m/s (the level falls from 1.39 to 1
+/// N and every slipping element relaxes to it), `F − Σ F_element[i] −
+/// σ2·v` is `Σ σ_i·C·(α_i − F_i/s)/k_i` from the element forces the FMU
+/// outputs, and it vanishes as the forces reach their levels.
+#[test]
+fn gms_micro_damping_adds_sigma_i_times_the_deflection_rates() {
+    assert_eq!(
+        friction_fmu::maxwell_slip::vr::SIGMA1,
+        412,
+        "sigma1 is appended after the arrays"
+    );
+    let (sigma1, sigma2) = (30.0, 0.4);
+    let h = 1e-3;
+    let total_k = 1e5;
+    for v in [1e-6, -1e-6] {
+        let mut fmu = Fmu::new("GMS", &[("sigma1", sigma1)]);
+        for _ in 0..200 {
+            fmu.set("v", v);
+            fmu.step(h);
+        }
+        assert_eq!(fmu.get_any("n_slipping"), 0.0);
+        let x = v * h * 200.0;
+        let want = total_k * x + sigma1 * v + sigma2 * v;
+        let f = fmu.get("F");
+        let error = (f - want).abs() / want.abs();
+        println!("GMS sticking at {v}: F {f:e}, relative error {error:e}");
+        assert!(error <= 1e-12, "F {f}, want {want}");
+        let (j, fd) = fmu.step_sensitivity("F", "v", h);
+        let want = total_k * h + sigma1 + sigma2;
+        println!("GMS sticking at {v}: dF/dv {j}, closed form {want}, differences {fd}");
+        assert!((j - want).abs() <= 1e-6 * want, "{j} {want}");
+        assert!((fd - want).abs() <= 1e-6 * want, "{fd} {want}");
+    }
+    let mut fmu = Fmu::new("GMS", &[("sigma1", sigma1)]);
+    for _ in 0..100 {
+        fmu.set("v", 5e-4);
+        fmu.step(h);
+    }
+    assert_eq!(fmu.get_any("n_slipping"), 10.0);
+    let v = 5e-3;
+    let s = 1.0 + 0.5 * (-25.0f64).exp();
+    let damping = |fmu: &Fmu| {
+        let (mut sum, mut want) = (0.0, 0.0);
+        for i in 1..=10 {
+            let (k, alpha) = (fmu.get(&format!("k[{i}]")), fmu.get(&format!("alpha[{i}]")));
+            let f = fmu.get(&format!("F_element[{i}]"));
+            sum += f;
+            want += sigma1 * k / total_k * fmu.get("C") * (alpha - f / s) / k;
+        }
+        (fmu.get("F") - sum - sigma2 * v, want)
+    };
+    let mut worst: f64 = 0.0;
+    let mut first = 0.0;
+    for j in 0..50 {
+        fmu.set("v", v);
+        fmu.step(h);
+        let (got, want) = damping(&fmu);
+        if j == 0 {
+            first = want;
+        }
+        worst = worst.max((got - want).abs() / want.abs());
+    }
+    println!("GMS gross sliding: damping from {first:e} N, worst relative error {worst:e}");
+    assert!(first < -1e-2, "{first}");
+    assert!(worst <= 1e-9, "{worst:e}");
+    for _ in 0..1000 {
+        fmu.step(h);
+    }
+    let (got, _) = damping(&fmu);
+    assert!(got.abs() <= 1e-12, "{got:e}");
+}
+
 #[test]
 fn invalid_parameters_are_refused_with_name_and_value() {
     // Outside the bounds the model description declares: refused when set.
@@ -506,9 +598,30 @@ fn invalid_parameters_are_refused_with_name_and_value() {
             &[("sigma11", -1.0)],
             "sigma11 (value reference",
         ),
+        (
+            "GMS",
+            &[("sigma1", -2.0)],
+            "sigma1 (value reference 412) = -2",
+        ),
     ];
     for (model, bad, needle) in when_set {
         common::refused_when_set(model, bad, needle);
+    }
+    // not finite: refused when set, named with its value
+    for bad in [f64::NAN, f64::INFINITY] {
+        let fmu = Fmu::instantiated("GMS", &[]);
+        assert_eq!(
+            fmu.set_any("sigma1", bad),
+            fmi_export::ffi::fmi2Status::fmi2Error
+        );
+        let m = common::last_error();
+        assert!(
+            m.contains(&format!(
+                "sigma1 (value reference 412) must be finite but was {bad}"
+            )),
+            "{m}"
+        );
+        assert_eq!(fmu.get("sigma1"), 0.0);
     }
     // Within them, but not a valid model (Fc > 0, Fs >= Fc, a table of at
     // least two increasing points, ...): refused at initialization.

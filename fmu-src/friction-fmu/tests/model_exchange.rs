@@ -209,7 +209,8 @@ fn check_partials(
     knowns: &[(&str, f64)],
     rtol: f64,
     context: &str,
-) {
+) -> f64 {
+    let mut worst: f64 = 0.0;
     for &(known, step) in knowns {
         let at = me.get(known);
         for &(unknown, floor) in unknowns {
@@ -217,12 +218,14 @@ fn check_partials(
             let up = me.value_with(unknown, known, at + step);
             let down = me.value_with(unknown, known, at - step);
             let differences = (up - down) / (2.0 * step);
+            worst = worst.max((closed - differences).abs() / closed.abs().max(floor));
             assert!(
                 (closed - differences).abs() <= rtol * closed.abs().max(floor),
                 "{context}: d{unknown}/d{known} = {closed}, differences {differences}"
             );
         }
     }
+    worst
 }
 
 /// The state is the force of the law `F_dahl`, the output
@@ -459,13 +462,20 @@ fn elasto_plastic_partials_match_differences() {
     }
 }
 
-/// Maxwell-slip and GMS with element 1 slipping (put at its level and
-/// switched by an event) and the others sticking, in both directions.
+/// Maxwell-slip and GMS (also with its micro-damping, whose `Σ σ_i·ż_i`
+/// puts `∂Ḟ_i/∂F_i` and `∂Ḟ_i/∂v` into `F` and `P_diss`) with element 1
+/// slipping (put at its level and switched by an event) and the others
+/// sticking, in both directions.
 #[test]
 fn element_laws_partials_match_differences() {
-    for model in ["MaxwellSlip", "GMS"] {
+    let models: [(&str, Params); 3] = [
+        ("MaxwellSlip", &[]),
+        ("GMS", &[]),
+        ("GMS", &[("sigma1", 40.0)]),
+    ];
+    for (model, params) in models {
         for v in [2e-4, -1.5e-3] {
-            let me = Me::new(model, &[]);
+            let me = Me::new(model, params);
             me.set("v", v);
             let level = if model == "GMS" {
                 // alpha[1]*s(v), s(v) = Fc + (Fs - Fc)*exp(-(v/vs)^2)
@@ -483,8 +493,8 @@ fn element_laws_partials_match_differences() {
             // off the level, so that the attraction acts (GMS)
             x[0] *= 0.97;
             me.set_states(&x);
-            let context = format!("{model} at v {v}");
-            check_partials(
+            let context = format!("{model} {params:?} at v {v}");
+            let worst = check_partials(
                 &me,
                 &[
                     ("der(F_element[1])", 1.0),
@@ -497,6 +507,7 @@ fn element_laws_partials_match_differences() {
                 1e-6,
                 &context,
             );
+            println!("{context}: worst relative difference {worst:.1e}");
         }
     }
 }
@@ -551,6 +562,9 @@ fn bristle2d_partials_match_differences_inside_and_sliding() {
         }
     }
 }
+
+/// Parameters set by name.
+type Params = &'static [(&'static str, f64)];
 
 /// A model, its inputs, its states and the outputs compared.
 type Case = (
@@ -640,8 +654,13 @@ fn the_right_hand_side_is_the_one_the_step_integrates() {
 /// reversal: an event at `v < 0` sticks every element.
 #[test]
 fn element_laws_right_hand_side_is_the_one_the_step_integrates() {
-    for (model, v) in [("MaxwellSlip", 2e-4), ("GMS", -3e-4)] {
-        let mut cs = Fmu::new(model, &[]);
+    let cases: [(&str, Params, f64); 3] = [
+        ("MaxwellSlip", &[], 2e-4),
+        ("GMS", &[], -3e-4),
+        ("GMS", &[("sigma1", 40.0)], -3e-4),
+    ];
+    for (model, params, v) in cases {
+        let mut cs = Fmu::new(model, params);
         cs.set("v", v);
         cs.step(6e-2);
         let slipping = cs.get_any("n_slipping");
@@ -649,7 +668,7 @@ fn element_laws_right_hand_side_is_the_one_the_step_integrates() {
             slipping > 0.0 && slipping < 10.0,
             "{model}: {slipping} slip"
         );
-        let me = Me::new(model, &[]);
+        let me = Me::new(model, params);
         me.set("v", v);
         let names: Vec<String> = (1..=100).map(|i| format!("F_element[{i}]")).collect();
         let x: Vec<f64> = names.iter().map(|s| cs.get(s)).collect();

@@ -21,7 +21,12 @@
 //!   with `F_i/s(v)` read in the direction of motion; written with the
 //!   sign outside, as here, the law is odd in `v`.) `C` (N/s) sets the
 //!   frictional lag: in gross sliding every element slips and
-//!   `Σ F_i` relaxes to `s(v)` with the time constant `s(v)/C`.
+//!   `Σ F_i` relaxes to `s(v)` with the time constant `s(v)/C`. Each
+//!   element has the paper's micro-viscous damping `σ_i·ż_i` on its
+//!   deflection rate `ż_i = Ḟ_i/k_i` (`v` while it sticks), one total
+//!   `σ1` shared in proportion to stiffness, `σ_i = σ1·k_i/Σ k_j`:
+//!   `F = Σ F_i + Σ σ_i·ż_i + σ2·v`. The damping acts on the force only;
+//!   the element forces move as without it.
 //!
 //! [`MaxwellSlip::step`] is exact: on each piece of the step where `v`
 //! keeps one sign, `F_i ← clamp(F_i + k_i·Δx)`. [`Gms::step`] is exact for
@@ -363,8 +368,9 @@ impl MaxwellSlip {
 
 /// GMS parameters: element stiffnesses `k` (N/m) and weights `alpha`
 /// (`Σ α_i = 1`), the Stribeck curve (`fc`, `fs` N, `vs` m/s, `delta`),
-/// the attraction `c` (N/s) and the viscous coefficient `sigma2`
-/// (N·s/m).
+/// the attraction `c` (N/s), the total micro-damping `sigma1` (N·s/m,
+/// element `i`'s share `σ1·k_i/Σ k_j`) and the viscous coefficient
+/// `sigma2` (N·s/m).
 #[derive(Clone, Debug, PartialEq)]
 pub struct GmsParams {
     pub k: Vec<f64>,
@@ -374,6 +380,7 @@ pub struct GmsParams {
     pub vs: f64,
     pub delta: f64,
     pub c: f64,
+    pub sigma1: f64,
     pub sigma2: f64,
 }
 
@@ -382,7 +389,8 @@ impl Default for GmsParams {
     /// with LuGre's 1995 set (σ0 = 1e5 N/m, Fc = 1 N, Fs = 1.5 N,
     /// vs = 1e-3 m/s, δ = 2, σ2 = 0.4 N·s/m) and `C = 100 N/s`: a
     /// frictional-lag time constant `s(v)/C` of 10 ms at the Coulomb
-    /// level. `C` and the element spread are ours.
+    /// level. `C` and the element spread are ours. No micro-damping
+    /// (σ1 = 0: the law as it was before σ1).
     fn default() -> Self {
         let (fc, fs) = (1.0, 1.5);
         let (k, w) = even_elements(10, 1e5, fs);
@@ -394,6 +402,7 @@ impl Default for GmsParams {
             vs: 1e-3,
             delta: 2.0,
             c: 100.0,
+            sigma1: 0.0,
             sigma2: 0.4,
         }
     }
@@ -404,7 +413,7 @@ const WEIGHT_SUM_TOLERANCE: f64 = 1e-9;
 
 impl GmsParams {
     /// Elements as for Maxwell-slip with `Σ α_i = 1` (to 1e-9);
-    /// `0 < Fc ≤ Fs`, `vs, δ, C > 0`, `σ2 ≥ 0`.
+    /// `0 < Fc ≤ Fs`, `vs, δ, C > 0`, `σ1, σ2 ≥ 0`.
     pub fn validate(&self) -> Result<(), ParamError> {
         validate_elements(&self.k, &self.alpha, "alpha")?;
         let sum: f64 = self.alpha.iter().sum();
@@ -430,6 +439,7 @@ impl GmsParams {
         require_positive("vs", self.vs)?;
         require_positive("stribeck_exponent", self.delta)?;
         require_positive("C", self.c)?;
+        require_non_negative("sigma1", self.sigma1)?;
         require_non_negative("sigma2", self.sigma2)
     }
 }
@@ -439,6 +449,8 @@ impl GmsParams {
 #[derive(Clone, Debug)]
 pub struct Gms {
     p: GmsParams,
+    /// `σ1/Σ k_j`: element `i`'s damping is `σ_i = damping·k_i`.
+    damping: f64,
     f: Vec<f64>,
     mode: Vec<f64>,
 }
@@ -449,6 +461,7 @@ impl Gms {
         p.validate()?;
         let n = p.k.len();
         Ok(Gms {
+            damping: p.sigma1 / p.k.iter().sum::<f64>(),
             p,
             f: vec![0.0; n],
             mode: vec![0.0; n],
@@ -535,9 +548,34 @@ impl Gms {
         }
     }
 
-    /// `F = Σ F_i + σ2·v`.
+    /// `F = Σ F_i + Σ σ_i·ż_i + σ2·v` ([`Gms::damping_force`]; with
+    /// σ1 = 0, `Σ F_i + σ2·v` as without the term).
     pub fn force(&self, v: f64) -> f64 {
-        self.f.iter().sum::<f64>() + self.p.sigma2 * v
+        let elements = self.f.iter().sum::<f64>();
+        if self.p.sigma1 == 0.0 {
+            return elements + self.p.sigma2 * v;
+        }
+        elements + self.damping_force(v) + self.p.sigma2 * v
+    }
+
+    /// `σ1/Σ k_j`, the damping of an element per unit of its stiffness:
+    /// `σ_i = σ1·k_i/Σ k_j` (a uniform damping ratio, as LuGre's σ1
+    /// relative to σ0).
+    pub fn damping_per_stiffness(&self) -> f64 {
+        self.damping
+    }
+
+    /// The micro-damping force `Σ σ_i·ż_i` (N) in the current modes, with
+    /// `ż_i = Ḟ_i/k_i` element `i`'s deflection rate ([`Gms::element_rate`]:
+    /// `v` sticking, `C·(sgn(v)·α_i − F_i/s(v))/k_i` slipping). As
+    /// `σ_i/k_i = σ1/Σ k_j` for every element, it is `σ1/Σ k_j·Σ Ḟ_i`.
+    pub fn damping_force(&self, v: f64) -> f64 {
+        // the rates of `element_rate`, the level evaluated once
+        let level = self.level(v);
+        let rates: f64 = (0..self.f.len())
+            .map(|i| self.rate_at_level(i, v, level))
+            .sum();
+        self.damping * rates
     }
 
     /// `Ḟ_i` in the current modes: `k_i·v` sticking,
@@ -550,7 +588,18 @@ impl Gms {
                 0.0
             };
         }
-        self.p.c * (v.signum() * self.p.alpha[i] - self.f[i] / self.level(v))
+        self.rate_at_level(i, v, self.level(v))
+    }
+
+    /// [`Gms::element_rate`] with `s(v)` given as `level`.
+    fn rate_at_level(&self, i: usize, v: f64, level: f64) -> f64 {
+        if self.mode[i] == 0.0 {
+            return self.p.k[i] * v;
+        }
+        if v == 0.0 {
+            return 0.0;
+        }
+        self.p.c * (v.signum() * self.p.alpha[i] - self.f[i] / level)
     }
 
     /// `(∂Ḟ_i/∂F_i, ∂Ḟ_i/∂v)` in the current modes.
@@ -597,16 +646,21 @@ impl Gms {
         spring_energy(&self.p.k, &self.f)
     }
 
-    /// `P_diss = F·v − dE/dt = Σ_slipping F_i·(v − Ḟ_i/k_i) + σ2·v²` (W).
-    /// A slipping element whose force is attracted faster than the
-    /// motion loads it returns energy: the law dissipates over a cycle,
-    /// not at every instant.
+    /// `P_diss = F·v − dE/dt = Σ_slipping F_i·(v − ż_i) + Σ σ_i·ż_i·v +
+    /// σ2·v²` (W), `ż_i = Ḟ_i/k_i`: a sticking element's spring takes
+    /// what the motion does on it (`ż_i = v`), its damper dissipates
+    /// `σ_i·v²`. A slipping element whose force is attracted faster than
+    /// the motion loads it returns energy: the law dissipates over a
+    /// cycle, not at every instant.
     pub fn dissipated_power(&self, v: f64) -> f64 {
         let elements: f64 = (0..self.f.len())
             .filter(|&i| self.mode[i] != 0.0)
             .map(|i| self.f[i] * (v - self.element_rate(i, v) / self.p.k[i]))
             .sum();
-        elements + self.p.sigma2 * v * v
+        if self.p.sigma1 == 0.0 {
+            return elements + self.p.sigma2 * v * v;
+        }
+        elements + self.damping_force(v) * v + self.p.sigma2 * v * v
     }
 
     /// The state: `n` element forces, then `n` modes.
@@ -790,12 +844,162 @@ mod tests {
         assert!((a - b).abs() <= 1e-9, "{a} {b}");
     }
 
+    fn gms_damped(sigma1: f64) -> Gms {
+        Gms::new(GmsParams {
+            sigma1,
+            ..GmsParams::default()
+        })
+        .unwrap()
+    }
+
+    /// Sticking throughout (the motion below every element's slip
+    /// deflection), each element's deflection rate is `v`: the damping
+    /// adds `Σ σ_i·v = σ1·v`, `F = Σ k_i·x + σ1·v + σ2·v`.
+    #[test]
+    fn sticking_contact_adds_sigma1_v() {
+        let sigma1 = 37.5;
+        for v in [3e-5, -2e-5, 4e-3] {
+            let mut l = gms_damped(sigma1);
+            let p = l.params().clone();
+            let (h, n) = (1e-5, 30);
+            // 30·1e-5·4e-3 = 1.2e-6 m, below the first element's
+            // Δ_1 = α_1·Fs/k_1 = 2.7e-6 m
+            for _ in 0..n {
+                l.step(Ramp::constant(v), h);
+            }
+            assert_eq!(l.slipping_count(), 0, "{v}");
+            let x = v * h * n as f64;
+            let stiffness: f64 = p.k.iter().sum();
+            let want = stiffness * x + sigma1 * v + p.sigma2 * v;
+            let got = l.force(v);
+            println!(
+                "v {v}: F {got}, relative error {:e}",
+                (got - want).abs() / want.abs()
+            );
+            assert!(
+                (got - want).abs() <= 1e-12 * want.abs(),
+                "{v}: {got} {want}, {:e} relative",
+                (got - want).abs() / want.abs()
+            );
+            // the damping alone
+            let d = l.damping_force(v);
+            assert!((d - sigma1 * v).abs() <= 1e-12 * (sigma1 * v).abs(), "{d}");
+        }
+    }
+
+    /// In gross sliding every element slips: the damping is
+    /// `Σ σ_i·C·(α_i − F_i/s)/k_i` (`v > 0`), and as every element
+    /// relaxes with the same time constant `s/C`, it decays as
+    /// `e^(−C·t/s)` and vanishes once the forces are at their levels.
+    /// (Slid into from rest at one velocity, every element reaches its
+    /// level sticking and the term is 0 at once: the run slides at
+    /// 5e-4 m/s, where `s` = 1.39 N, then at 5e-3 m/s, `s` = 1 N.)
+    #[test]
+    fn gross_sliding_damping_decays_with_the_forces() {
+        let sigma1 = 50.0;
+        let v = 5e-3;
+        let mut l = gms_damped(sigma1);
+        l.step(Ramp::constant(5e-4), 0.1); // every element slipping
+        assert_eq!(l.slipping_count(), 10);
+        let p = l.params().clone();
+        let total_k: f64 = p.k.iter().sum();
+        let s = l.level(v);
+        let by_elements = |l: &Gms| -> f64 {
+            let f = l.element_forces();
+            (0..f.len())
+                .map(|i| sigma1 * p.k[i] / total_k * p.c * (p.alpha[i] - f[i] / s) / p.k[i])
+                .sum()
+        };
+        let d0 = by_elements(&l);
+        assert!(d0 < -1e-2, "{d0}: the forces are still moving");
+        let mut worst: f64 = 0.0;
+        for j in 0..=20 {
+            if j > 0 {
+                l.step(Ramp::constant(v), 1e-3);
+            }
+            let want = by_elements(&l);
+            let f_sum: f64 = l.element_forces().iter().sum();
+            let from_force = l.force(v) - f_sum - p.sigma2 * v;
+            let decayed = d0 * (-p.c * j as f64 * 1e-3 / s).exp();
+            worst = worst
+                .max((l.damping_force(v) - want).abs() / want.abs())
+                .max((from_force - want).abs() / want.abs())
+                .max((decayed - want).abs() / want.abs());
+        }
+        println!("damping from {d0:e} N: worst relative error {worst:e}");
+        assert!(worst <= 1e-9, "{worst:e}");
+        l.step(Ramp::constant(v), 1.0); // 100 time constants
+        let d = l.damping_force(v);
+        assert!(d.abs() <= 1e-12, "{d:e}");
+        assert!((l.force(v) - s - p.sigma2 * v).abs() <= 1e-12);
+    }
+
+    /// `∫F·v dt = ∫P_diss dt + ΔE_stored` through gross sliding and
+    /// reversals, without and with the micro-damping (whose `Σ σ_i·ż_i·v`
+    /// is in `P_diss`).
+    #[test]
+    fn gms_energy_balances() {
+        for sigma1 in [0.0, 50.0] {
+            let mut l = gms_damped(sigma1);
+            let (h, n) = (1e-5, 200_000);
+            let (mut work, mut dissipated, mut damping) = (0.0, 0.0, 0.0);
+            let e0 = l.stored_energy();
+            for j in 0..n {
+                let t = j as f64 * h;
+                let v = Ramp::new(
+                    2e-3 * (6.0 * t).cos(),
+                    -2e-3 * 6.0 * (6.0 * (t + 0.5 * h)).sin(),
+                );
+                let vm = v.at(0.5 * h);
+                // midpoint rule for F·v and P_diss on the state at mid-step
+                let mut mid = l.clone();
+                mid.step(v, 0.5 * h);
+                work += mid.force(vm) * vm * h;
+                dissipated += mid.dissipated_power(vm) * h;
+                damping += mid.damping_force(vm) * vm * h;
+                l.step(v, h);
+            }
+            let balance = work - dissipated - (l.stored_energy() - e0);
+            println!(
+                "sigma1 {sigma1}: balance {:e} of the work {work:e}, damping's share {:e}",
+                balance.abs() / work.abs(),
+                damping / work
+            );
+            assert!(balance.abs() <= 1e-5 * work.abs(), "{balance} of {work}");
+            if sigma1 > 0.0 {
+                // ten times the tolerance: a P_diss without the term fails
+                assert!(damping > 1e-4 * work, "{damping} of {work}");
+            }
+        }
+    }
+
+    /// With σ1 = 0 the force and the power are the sums without the term
+    /// (the law as before σ1), bit for bit.
+    #[test]
+    fn zero_sigma1_leaves_the_force_as_it_was() {
+        let mut l = gms();
+        for (v, h) in [(4e-3, 0.03), (-1e-3, 0.01), (0.0, 0.01), (2e-4, 0.002)] {
+            l.step(Ramp::constant(v), h);
+            let sum: f64 = l.element_forces().iter().sum();
+            assert_eq!(l.force(v).to_bits(), (sum + 0.4 * v).to_bits());
+            assert_eq!(l.damping_per_stiffness(), 0.0);
+        }
+    }
+
     #[test]
     fn validation_names_the_parameter_and_element() {
         let mut p = GmsParams::default();
         p.alpha[3] = 0.5;
         let e = p.validate().unwrap_err().to_string();
         assert!(e.contains("alpha") && e.contains("sum to"), "{e}");
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            let p = GmsParams {
+                sigma1: bad,
+                ..GmsParams::default()
+            };
+            let e = p.validate().unwrap_err().to_string();
+            assert!(e.contains(&format!("sigma1 = {bad}")), "{e}");
+        }
         let mut p = MaxwellSlipParams::default();
         p.k[2] = -1.0;
         let e = p.validate().unwrap_err().to_string();
