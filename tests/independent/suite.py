@@ -233,7 +233,8 @@ def diagnose_case(
     # names that law's effect, and the moved model is the final one
     moved = [m for m in report.get("memory", []) if m["outcome"] == "moved"]
     if moved:
-        found.append(moved[0]["effect"])
+        # the effects found under LuGre that the move explains are not named
+        found = [f for f in found if f not in moved[0].get("explains", [])] + [moved[0]["effect"]]
         final_rms = moved[0]["heldout_rms"]
     expected = cases.EXPECTED[case.kind]
     row.update(

@@ -12,7 +12,7 @@ use crate::sim::ChannelResiduals;
 use std::fmt;
 
 /// A co-simulation scored on the held-out samples.
-#[derive(Clone)]
+#[derive(Clone, Debug)]
 pub struct Scored {
     pub(crate) residuals: ChannelResiduals,
     /// Held-out positions into `residuals.samples`.

@@ -735,8 +735,8 @@ pub fn diagnose_records(
     // 5. and 6. the candidate rounds, each accepted model refined
     let mut polishing = Polishing::default();
     let search = search(&problem, &mut system, &mut sim, &baseline, &mut polishing)?;
-    // 7. LuGre's pre-sliding memory against GMS's
-    let memory = check_memory(&problem, &search);
+    // 7. LuGre's pre-sliding against GMS's and the elasto-plastic law's
+    let memory = check_memory(&problem, &baseline, &search);
     // 8. the report's figures
     budget.progress().stage("the summary");
     summarise(

@@ -46,6 +46,9 @@ pub const GMS_ELEMENTS: usize = 10;
 /// attraction `C = Fc/τ`.
 pub const LAG_STARTS: [f64; 3] = [1e-3, 1e-2, 1e-1];
 
+/// The frictional-lag time constants `Fc/C` a GMS fit may reach (s).
+pub const LAG_RANGE: (f64, f64) = (1e-5, 10.0);
+
 /// Break-away deflections the elasto-plastic fit starts from, as
 /// fractions of `Fc/σ0`.
 pub const ELASTIC_FRACTION_STARTS: [f64; 3] = [0.5, 0.8, 0.95];
@@ -285,7 +288,7 @@ impl ElastoPlasticModel {
 /// What a fit of an [`OtherLaw`] moves, from `start`: `ln Fc`,
 /// `ln(Fs/Fc − 1)` when the start has a Stribeck peak (else `Fs = Fc`
 /// stays), `ln σ0` with σ1 following `√σ0`, and the law's own: GMS's
-/// `ln C`, the elasto-plastic `z_ba` as `logit(z_ba·σ0/Fc)`. Every θ is a
+/// `ln C` as a logit within [`LAG_RANGE`], the elasto-plastic `z_ba` as `logit(z_ba·σ0/Fc)`. Every θ is a
 /// valid model (`0 < Fc ≤ Fs`, σ0 and `C` positive, `0 < z_ba < Fc/σ0`).
 pub struct LawCoordinates {
     pub start: LawModel,
@@ -304,6 +307,15 @@ impl LawCoordinates {
         let (fc, fs, _, _) = self.levels();
         fs > fc * (1.0 + 1e-9)
     }
+
+    /// `ln C` is kept strictly inside `(low, high)`: lags `Fc/C` between
+    /// [`LAG_RANGE`]'s ends at the start's `Fc`. Unbounded, a fit on data
+    /// that do not resolve the lag wandered to `C` = 1e11 N/s, where the
+    /// cost is flat, and stopped there.
+    fn attraction_range(&self) -> (f64, f64) {
+        let (fc, _, _, _) = self.levels();
+        ((fc / LAG_RANGE.1).ln(), (fc / LAG_RANGE.0).ln())
+    }
 }
 
 impl Coordinates for LawCoordinates {
@@ -312,7 +324,11 @@ impl Coordinates for LawCoordinates {
     fn theta(&self) -> Vec<f64> {
         let (fc, fs, sigma0, _) = self.levels();
         let own = match &self.start {
-            LawModel::Gms(g) => g.attraction.ln(),
+            LawModel::Gms(g) => {
+                let (low, high) = self.attraction_range();
+                let r = (g.attraction.ln() - low) / (high - low);
+                (r / (1.0 - r)).ln()
+            }
             LawModel::ElastoPlastic(e) => {
                 let r = e.z_ba * e.sigma0 / e.fc;
                 (r / (1.0 - r)).ln()
@@ -341,7 +357,10 @@ impl Coordinates for LawCoordinates {
                 fs,
                 sigma0,
                 sigma1,
-                attraction: theta[2].exp(),
+                attraction: {
+                    let (low, high) = self.attraction_range();
+                    (low + (high - low) / (1.0 + (-theta[2]).exp())).exp()
+                },
                 ..g.clone()
             }),
             LawModel::ElastoPlastic(e) => {
@@ -398,8 +417,20 @@ pub struct LawCheck {
     /// Where its FMU was found.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fmu: Option<PathBuf>,
+    /// The effects the rounds found under LuGre that the move explains:
+    /// the law fitted from the baseline (before them) predicts the
+    /// held-out data as well as from the final model (the p-value that
+    /// the final model's start does better, not below α), so that it is
+    /// the one moved to and they are not named.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub explains: Vec<crate::model::Effect>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub explains_p_value: Option<f64>,
     pub cosimulations: usize,
     pub seconds: f64,
+    /// Its held-out co-simulation (for the comparisons).
+    #[serde(skip)]
+    pub(crate) scored: Option<crate::acceptance::Scored>,
 }
 
 impl LawCheck {
@@ -421,8 +452,11 @@ impl LawCheck {
             threshold,
             fitted: None,
             fmu: None,
+            explains: Vec::new(),
+            explains_p_value: None,
             cosimulations: 0,
             seconds: 0.0,
+            scored: None,
         }
     }
 }

@@ -73,6 +73,20 @@ pub fn write(d: &Diagnosis, file: &SystemFile, friction: &str, out: &Path) -> Re
     Ok(())
 }
 
+/// The sentence on the effects a move explains (empty when none).
+fn explained(m: &LawCheck) -> String {
+    if m.explains.is_empty() {
+        return String::new();
+    }
+    let names: Vec<&str> = m.explains.iter().map(|e| e.name()).collect();
+    format!(
+        " The effects found under LuGre ({}) stood in for it: {} fitted from the baseline, before them, predicts the held-out data as well as from the final model (p = {:.2e} that the final model's start does better), so it starts from the baseline and they are not named.",
+        names.join(", "),
+        m.law.model_name(),
+        m.explains_p_value.unwrap_or(f64::NAN)
+    )
+}
+
 /// What the checks of the other laws found, one sentence each.
 pub fn memory_words(checks: &[LawCheck]) -> String {
     let mut words = Vec::new();
@@ -99,7 +113,7 @@ pub fn memory_words(checks: &[LawCheck]) -> String {
                 m.law.words(),
                 compared(),
                 m.fitted.as_ref().map_or(String::new(), LawModel::describe)
-            ),
+            ) + &explained(m),
             MemoryOutcome::Kept => format!(
                 "{name} (with the final model's levels as its start) does not replace LuGre: {}.{}",
                 compared(),

@@ -198,7 +198,7 @@ impl FrictionSim {
 
 /// Residuals of one co-simulation on the measured channels, at the
 /// measured times (repeated times compare the first row only).
-#[derive(Clone)]
+#[derive(Clone, Debug)]
 pub struct ChannelResiduals {
     /// Channel names.
     pub channels: Vec<String>,

@@ -23,7 +23,7 @@
 //!
 //! Takes the [`Problem`] and the [`Search`]; gives a [`LawCheck`] per law.
 
-use super::baseline::acceptance_groups;
+use super::baseline::{acceptance_groups, Baseline};
 use super::problem::Problem;
 use super::rounds::Search;
 use super::split::Picker;
@@ -70,7 +70,7 @@ fn others_cannot_hold(m: &FrictionModel) -> Option<String> {
 
 /// Run the checks ([the module](self)): one [`LawCheck`] per law of
 /// [`OtherLaw::ALL`], at most one of them `Moved`.
-pub(crate) fn check_memory(p: &Problem, search: &Search) -> Vec<LawCheck> {
+pub(crate) fn check_memory(p: &Problem, baseline: &Baseline, search: &Search) -> Vec<LawCheck> {
     let lugre_rms = search.scored.rms();
     let threshold = p.options.alpha / OtherLaw::ALL.len() as f64;
     let every_law = |reason: String| -> Vec<LawCheck> {
@@ -125,8 +125,63 @@ pub(crate) fn check_memory(p: &Problem, search: &Search) -> Vec<LawCheck> {
                 checks[i].heldout_rms
             ));
         }
+        if !search.effects.is_empty() {
+            stood_in_for(p, baseline, search, &mut checks[best]);
+        }
     }
     checks
+}
+
+/// Whether the effects the rounds found under LuGre were only standing in
+/// for `moved`'s law: its fit from the baseline (the nominal's levels
+/// refitted, before any effect) is scored like the fit from the final
+/// model, and unless the final model's start predicts the held-out data
+/// better by the acceptance rule, the law from the baseline is the one
+/// moved to and the effects are reported as explained by the move
+/// (`LawCheck::explains`), as the rounds withdraw an effect that later
+/// ones explain.
+fn stood_in_for(p: &Problem, baseline: &Baseline, search: &Search, moved: &mut LawCheck) {
+    let (Some(path), Some(from_final)) = (moved.fmu.clone(), moved.scored.clone()) else {
+        return;
+    };
+    let what = format!(
+        "the check that the effects found stood in for {}",
+        moved.law.model_name()
+    );
+    if p.budget.skip_if_expired(|| what.clone()) {
+        return;
+    }
+    let started = Instant::now();
+    let (fitted, cut) = p.budget.cut_short(
+        || what.clone(),
+        || fit_and_score(p, moved.law, &path, (&baseline.folds, &baseline.model)),
+    );
+    moved.seconds += started.elapsed().as_secs_f64();
+    let Ok(from_baseline) = fitted else {
+        return;
+    };
+    moved.cosimulations += from_baseline.cosimulations;
+    if cut {
+        return;
+    }
+    let group = acceptance_groups(p, &search.scored);
+    let Ok(p_value) = separation_test(&from_final, &from_baseline.scored, &group) else {
+        return;
+    };
+    let (mb, mf) = (mean(&from_baseline.scored.q), mean(&from_final.q));
+    let gain = if mb > 0.0 { (mb - mf) / mb } else { 0.0 };
+    let rule = Acceptance {
+        threshold: p.options.alpha,
+        min_gain: p.options.min_gain,
+    };
+    if rule.passes(gain, p_value) {
+        return;
+    }
+    moved.explains = search.effects.iter().map(|e| e.name).collect();
+    moved.explains_p_value = Some(p_value);
+    moved.heldout_rms = from_baseline.scored.rms();
+    moved.fitted = Some(from_baseline.whole);
+    moved.scored = Some(from_baseline.scored);
 }
 
 /// The check of one law whose FMU is at `path`.
@@ -174,19 +229,26 @@ fn check_law(
     check
 }
 
-/// Fit `law` on each fold, score it, decide.
-fn try_law(
+/// A law fitted on each fold and on every sample, and scored.
+struct LawFit {
+    whole: LawModel,
+    scored: Scored,
+    cosimulations: usize,
+}
+
+/// Fit `law` (its FMU at `path`) on each fold from the fold's LuGre model
+/// of `from` (folds, whole), the best of its starts refined by output
+/// error, and score the fold models on the held-out samples.
+fn fit_and_score(
     p: &Problem,
-    search: &Search,
     law: OtherLaw,
     path: &Path,
-    threshold: f64,
-) -> Result<LawCheck, String> {
+    (from_folds, from_whole): (&[FrictionModel], &FrictionModel),
+) -> Result<LawFit, String> {
     let file = moved_to(p.file, &p.setup.friction_name, path)?;
     let params =
         |m: &LawModel| system_parameters_with(&file, &p.setup.friction_name, m.parameters());
     let cosimulations = std::sync::atomic::AtomicUsize::new(0);
-    // one model per fold, from the fold's LuGre: the best start refined
     let fit = |lugre: &FrictionModel, pick: &Picker| -> LawModel {
         let residuals = |m: &LawModel| {
             cosimulations.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -215,17 +277,37 @@ fn try_law(
         .split
         .folds
         .par_iter()
-        .zip(&search.folds)
+        .zip(from_folds)
         .map(|(fold, lugre)| fit(lugre, &fold.fits))
         .collect();
     let whole = if folds.len() == 1 {
         folds[0].clone()
     } else {
-        fit(&search.current, &p.every_sample)
+        fit(from_whole, &p.every_sample)
     };
     let mut system = file.build(0.0).map_err(|e| e.to_string())?;
     let fold_params: Vec<_> = folds.iter().map(&params).collect();
-    let scored: Scored = p.score_parameters_at(&mut system, &fold_params, None)?;
+    let scored = p.score_parameters_at(&mut system, &fold_params, None)?;
+    Ok(LawFit {
+        whole,
+        scored,
+        cosimulations: cosimulations.into_inner() + p.split.folds.len(),
+    })
+}
+
+/// Fit `law` from the final LuGre model, score it, decide.
+fn try_law(
+    p: &Problem,
+    search: &Search,
+    law: OtherLaw,
+    path: &Path,
+    threshold: f64,
+) -> Result<LawCheck, String> {
+    let LawFit {
+        whole,
+        scored,
+        cosimulations,
+    } = fit_and_score(p, law, path, (&search.folds, &search.current))?;
     let lugre = &search.scored;
     let group = acceptance_groups(p, lugre);
     let p_value = separation_test(&scored, lugre, &group).map_err(|e| e.to_string())?;
@@ -237,23 +319,18 @@ fn try_law(
     };
     let moved = rule.passes(gain, p_value)
         && drop_beyond_step_error(lugre, scored.rms(), search.step_error);
-    Ok(LawCheck {
-        law,
-        effect: law.effect(),
-        outcome: if moved {
-            MemoryOutcome::Moved
-        } else {
-            MemoryOutcome::Kept
-        },
-        reason: None,
-        lugre_heldout_rms: lugre.rms(),
-        heldout_rms: scored.rms(),
-        gain,
-        p_value,
-        threshold,
-        fitted: Some(whole),
-        fmu: None,
-        cosimulations: cosimulations.into_inner() + p.split.folds.len(),
-        seconds: 0.0,
-    })
+    let mut check = LawCheck::not_tried(law, lugre.rms(), threshold, String::new());
+    check.outcome = if moved {
+        MemoryOutcome::Moved
+    } else {
+        MemoryOutcome::Kept
+    };
+    check.reason = None;
+    check.heldout_rms = scored.rms();
+    check.gain = gain;
+    check.p_value = p_value;
+    check.fitted = Some(whole);
+    check.scored = Some(scored);
+    check.cosimulations = cosimulations;
+    Ok(check)
 }
