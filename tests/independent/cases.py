@@ -45,6 +45,24 @@ Fc/σ0 is 0.3-1 mm, and the actuator dithers (its spring force swinging by
 ±0.3-0.6·Fc) on top of the drive, so that the record has many reversals
 inside presliding besides its gross slides. The case's "size" is that
 change of structure: its magnitude is only a label and sizes nothing.
+
+`presliding_drift`: a Rig1D whose true friction is the elasto-plastic
+law (Dupont, Hayward, Armstrong and Altpeter 2002; lugre_rig.c's
+law=elastoplastic), LuGre with a purely elastic range below the break-away
+deflection z_ba, drawn as 0.5-0.9 of Fc/σ0, while the nominal is LuGre
+with the same Fc, Fs, vs, σ0, σ1, σ2 (Fc/σ0 0.3-1 mm, as above). Under
+a force below break-away LuGre creeps, the elasto-plastic contact does
+not, so the record holds the spring force: the actuator (lugre_rig.c's
+drive=hold) ramps to a position, holds there with a dither for 3-6 s
+(at least 6 dither periods), slides the mass by 1-3 cm, rests, and again,
+the levels and slides of either sign. The hold positions are set from the
+truth itself, so that the spring force holds a chosen mean level,
+±(0.5-0.65)·σ0·z_ba (0.25-0.59·Fc), and the dither swings it by
+±(0.1-0.2)·σ0·z_ba, below the elastic limit σ0·z_ba throughout: the
+truth is run up to the end of each rest, its friction force read there,
+and the next hold position is the rest's plus (level − that force) over
+the stiffness σ0·k/(σ0 + k) that holds the mass then (exact for the
+elastic range, the mass at rest).
 """
 
 from __future__ import annotations
@@ -89,9 +107,10 @@ GRID_PLANT_KINDS = ("two_mass_none", "two_mass_viscous")
 DAHL_KINDS = ("dahl_none", "dahl_viscous")
 
 #: Cases whose truth is another law than the nominal's (the docstring):
-#: GMS's presliding memory against a LuGre nominal. Not in KINDS, so in
-#: no plant's kinds and not in the suite's default grid.
-MEMORY_KINDS = ("presliding_memory",)
+#: GMS's presliding memory, the elasto-plastic law's drift-free
+#: presliding, each against a LuGre nominal. Not in KINDS, so in no
+#: plant's kinds and not in the suite's default grid.
+MEMORY_KINDS = ("presliding_memory", "presliding_drift")
 
 #: The effect a kind should be diagnosed as (None: nothing to find).
 EXPECTED: dict[str, str | None] = {
@@ -105,6 +124,7 @@ EXPECTED: dict[str, str | None] = {
     "dahl_none": None,
     "dahl_viscous": "viscous",
     "presliding_memory": "presliding_memory",
+    "presliding_drift": "elastic_presliding",
 }
 EXPECTED.update({f"{plant}_{kind}": EXPECTED[kind] for plant in PLANTS for kind in KINDS})
 
@@ -227,6 +247,7 @@ def _draw(kind: str, magnitude: float, seed: int, duration: float) -> Case:
         # a presliding distance Fc/σ0 of 0.3-1 mm, as the presliding cases
         nominal["sigma0"] = fc / rng.uniform(3e-4, 1e-3)
         nominal["sigma1"] = 2 * zeta * math.sqrt(nominal["sigma0"] * m)
+    if kind == "presliding_memory":
         # reversals inside presliding: the actuator dithers, its spring
         # force swinging by ±(0.3-0.6)·Fc, at 0.2-0.6 s a cycle and no
         # faster than a quarter of the contact's own frequency
@@ -264,6 +285,7 @@ def _draw(kind: str, magnitude: float, seed: int, duration: float) -> Case:
     else:
         case = Case(kind, magnitude, seed, duration, {"m": m, "k": k, "c": c}, drive, nominal)
     case.truth = dict(nominal)
+    case._peak_speed = peak_speed  # type: ignore[attr-defined]
     case._zeta = zeta  # type: ignore[attr-defined]
     case._rng = rng  # type: ignore[attr-defined]
     return case
@@ -320,10 +342,17 @@ def size_hidden_effect(case: Case, work: Path) -> None:
         return
     if effect == "none":
         return
-    if case.kind in MEMORY_KINDS:
+    if case.kind == "presliding_memory":
         # the truth is GMS with the nominal's levels, σ0 and σ1: 10
         # elements, the frictional lag Fc/C 1-10 ms; nothing is sized
         t.update(law="gms", n_elements=10, C=fc / 10 ** rng.uniform(-3.0, -2.0))
+        return
+    if case.kind == "presliding_drift":
+        # the truth is elasto-plastic with the nominal's parameters, its
+        # break-away deflection 0.5-0.9 of Fc/σ0; the drive holds the
+        # spring force below it (the docstring); nothing is sized
+        t.update(law="elastoplastic", z_ba=rng.uniform(0.5, 0.9) * fc / p["sigma0"])
+        hold_drive(case, work)
         return
     free = work / f"{case.name}.effect-free.csv"
     run_simulator(case, p, free, truth=True)
@@ -375,6 +404,85 @@ def size_hidden_effect(case: Case, work: Path) -> None:
         case.table = (xs, [1 + a * q for q in pattern])
     else:
         raise ValueError(case.kind)
+
+
+def hold_drive(case: Case, work: Path) -> None:
+    """The drive of a presliding_drift case (the docstring), its hold
+    positions set from the truth: case.drive becomes lugre_rig.c's
+    drive=hold, and case._holds lists each hold as (start, end, level): the
+    dithered interval (s) and the mean friction force it was set for."""
+    rng: random.Random = case._rng  # type: ignore[attr-defined]
+    m, k = case.rig["m"], case.rig["k"]
+    fs, sigma0 = case.nominal["Fs"], case.nominal["sigma0"]
+    limit = sigma0 * case.truth["z_ba"]  # the elastic limit of the force
+    # the spring force per metre of actuator while the mass is held by
+    # the contact's stiffness σ0 (elastic, at rest)
+    k_held = k * sigma0 / (k + sigma0)
+    own = 2 * math.pi * math.sqrt(m / (sigma0 + k))  # the contact's period
+
+    def ms(seconds: float) -> int:  # every time on the 1 ms grid
+        return max(1, round(1000 * seconds))
+
+    # the dither as in presliding_memory: 0.2-0.6 s a cycle, no faster than
+    # a quarter of the contact's own frequency; ramps and rests long enough
+    # for the mass to follow and settle
+    period, ramp, rest = ms(max(rng.uniform(0.2, 0.6), 4 * own)), ms(max(0.3, 2 * own)), ms(max(0.5, 6 * own))
+    swing = rng.uniform(0.1, 0.2) * limit
+    case.drive = {"drive": "hold", "dither_amp": swing / k_held, "dither_period": period / 1000}
+    total = ms(case.duration)
+    blocks = []  # (cycles, level, slide or None, slide time)
+    now, direction = 0, rng.choice([-1, 1])
+    while True:
+        cycles = max(6, round(rng.uniform(3.0, 6.0) / (period / 1000)))
+        level = rng.choice([-1, 1]) * rng.uniform(0.5, 0.65) * limit
+        # 1-3 cm of the mass's travel, plus the spring's stretch from one
+        # side's break-away to the other's
+        slide = direction * (rng.uniform(0.01, 0.03) + 2 * fs / k)
+        slide_ms = ms(2 * abs(slide) / (case._peak_speed * rng.uniform(0.7, 1.5)))  # type: ignore[attr-defined]
+        if now + ramp + cycles * period + slide_ms + rest > total:
+            # a last hold in what is left, when 6 periods fit
+            cycles = (total - now - ramp) // period
+            if cycles >= 6:
+                blocks.append((cycles, level, None, 0))
+            break
+        blocks.append((cycles, level, slide, slide_ms))
+        now += ramp + cycles * period + slide_ms + rest
+        direction = -direction
+
+    times, positions, dithered, holds = [0], [0.0], [], []
+
+    def drive_to(end: int) -> dict:
+        return {**case.drive, "hold_t": ",".join(repr(t / 1000) for t in times[:end]),
+                "hold_x": ",".join(repr(x) for x in positions[:end]),
+                "hold_dither": ",".join(str(d) for d in dithered[:end - 1])}
+
+    def add(duration: int, position: float, dither: int) -> None:
+        times.append(times[-1] + duration)
+        positions.append(position)
+        dithered.append(dither)
+
+    # at the start the spring is relaxed and the contact unloaded
+    force = 0.0
+    for cycles, level, slide, slide_ms in blocks:
+        hold = positions[-1] + (level - force) / k_held
+        add(ramp, hold, 0)
+        add(cycles * period, hold, 1)
+        holds.append((times[-2] / 1000, times[-1] / 1000, level))
+        if slide is None:
+            break
+        add(slide_ms, hold + slide, 0)
+        add(rest, hold + slide, 0)
+        # the truth up to the end of this rest: its friction force there
+        part = Case(case.kind, case.magnitude, case.seed, times[-1] / 1000, case.rig, drive_to(len(times)),
+                    case.nominal, case.truth, sample=case.sample, resolution=case.resolution)
+        out = work / f"{case.name}.hold.csv"
+        run_simulator(part, case.truth, out, truth=True)
+        force = read_columns(out)["true_F"][-1]
+        out.unlink()
+    if times[-1] < total:
+        add(total - times[-1], positions[-1], 0)
+    case.drive = drive_to(len(times))
+    case._holds = holds  # type: ignore[attr-defined]
 
 
 def make(case: Case, work: Path) -> tuple[Path, Path]:

@@ -19,7 +19,8 @@
  * min(√(m/σ0), m/σ1, g/(σ0·|v|)), at most h_max (1e-5 s), landing on every
  * sample time. Halving the fraction moves the samples by far less than the 1 µm
  * encoder step (checked by tests/test_diagnose_independent.py and, for
- * law=gms, tests/test_independent_gms.py). Sampling: every `sample`
+ * law=gms, tests/test_independent_gms.py; law=elastoplastic,
+ * tests/test_independent_elastoplastic.py). Sampling: every `sample`
  * seconds; the mass and the actuator are read through an encoder (Gaussian
  * noise of `noise` m, then rounded to `resolution` m).
  *
@@ -71,6 +72,30 @@
  * of its slip distance in a step at the default fraction). C: `C`
  * (default 1000 N/s).
  *
+ * law=elastoplastic: instead of LuGre, the single-state elasto-plastic
+ * law (Dupont, Hayward, Armstrong and Altpeter, "Single state
+ * elastoplastic friction models", IEEE TAC 47(5), 2002): LuGre whose
+ * bristle deflection is purely elastic below the break-away deflection
+ * z_ba, so that a force below break-away makes no drift:
+ *
+ *   z' = v − α(z, v)·σ0·|v|·z / g(v),   F = σ0·z + σ1·z' + σ2·v,
+ *
+ * g(v) = Fc + (Fs − Fc)·exp(−(v/vs)²) the Stribeck curve above, and with
+ * w = sgn(v)·z and w_ss = g(v)/σ0 (the steady deflection):
+ *
+ *   α = 0                                            if w ≤ z_ba,
+ *   α = ½·sin(π·(w − (w_ss + z_ba)/2)/(w_ss − z_ba)) + ½   if z_ba < w < w_ss,
+ *   α = 1                                            if w ≥ w_ss,
+ *
+ * 0 ≤ z_ba < min(Fc, Fs)/σ0 (key `z_ba`, m). So unloading (sgn v ≠ sgn z)
+ * is elastic, z' = v, and so is loading up to z_ba; past w_ss the law is
+ * LuGre's. α is continuous with its slope in w (the sine meets 0 and 1
+ * with zero slope), so Runge–Kutta needs no event location at z_ba and
+ * w_ss; its step is besides at most step_fraction·(2/π)·(w_ss − z_ba)/|v|,
+ * the time scale of the sine's steepest part (the bound of ∂z'/∂z there),
+ * so that the transition is resolved. The levels are one pair for both
+ * directions and no position table (refused with the law).
+ *
  * plant=prescribed: no dynamics, the body's position prescribed, for
  * checking a law alone: x(t) = amp·sin(2π·t/period), or with
  * `path=x0,x1,...` the turning points x0 → x1 → ... traversed at constant
@@ -105,14 +130,31 @@
  * time,drive.r,drive.x_m,drive.x_l,drive.u[,true_x,true_F] (true_x: the
  * carriage's noise-free position, as for every plant).
  *
+ * drive=hold: the actuator through given positions hold_x = p_0..p_n at
+ * times hold_t = t_0..t_n (s, increasing; the lists from the caller, e.g.
+ * cases.py's presliding_drift, which sets them so that the spring force
+ * holds chosen levels): from t_i to t_(i+1) it moves from p_i to
+ * p_(i+1) as p_i + (p_(i+1) − p_i)·(u − sin(2πu)/(2π)), u the fraction of
+ * the interval (speed and acceleration zero at both ends), at rest at p_0
+ * before t_0 and at p_n after t_n. The dither (dither_amp,
+ * dither_period) is on only in the intervals whose flag in hold_dither (one
+ * 0 or 1 per interval) is 1, from the interval's start,
+ * dither_amp·e(τ)·sin(2π·τ/dither_period) with τ the time since it, faded
+ * in over the first dither period and out over the last by e =
+ * ½·(1 − cos(π·τ/dither_period)) (on an interval of a whole number of
+ * dither periods, two or more, the actuator is then twice continuously
+ * differentiable throughout).
+ *
  * Usage: lugre_rig key=value ... > data.csv
  *   keys: m c k Fc Fs Fc_neg Fs_neg vs sigma0 sigma1 sigma2 duration
- *         sample resolution noise seed drive (sines|triangle|steps)
+ *         sample resolution noise seed drive (sines|triangle|steps|hold)
  *         amp period  n_table x_table scale (comma lists)
  *         plant (rig|two_mass|servo|prescribed)  m_m c_m (two_mass,
  *         servo)  Kp Kd  force_resolution (servo)  path speed (comma
  *         lists; prescribed)  dither_amp dither_period
- *         law (lugre|gms)  n_elements C (gms)  step_fraction h_max
+ *         hold_t hold_x hold_dither (comma lists; hold)
+ *         law (lugre|gms|elastoplastic)  n_elements C (gms)
+ *         z_ba (elastoplastic)  step_fraction h_max
  *         truth=1 (also write the noise-free x and the friction force)
  * Output: time,rig.x_act_in,rig.x[,true_x,true_F]
  */
@@ -146,6 +188,16 @@ static int gms = 0, n_elements = 10;
 static double C_attraction = 1000;
 static double k_el[MAX_ELEMENTS], alpha_el[MAX_ELEMENTS];
 static int mode_el[MAX_ELEMENTS]; /* 0: sticking; +1, −1: slipping that way */
+
+/* law=elastoplastic: the break-away deflection (the header comment) */
+static int elastoplastic = 0;
+static double z_ba = 0;
+
+/* drive=hold: the actuator's positions, their times, the dithered
+   intervals */
+#define MAX_HOLD 256
+static int hold = 0, n_hold_t = 0, n_hold_x = 0, n_hold_dither = 0, hold_i = 0;
+static double hold_t[MAX_HOLD], hold_x[MAX_HOLD], hold_dither[MAX_HOLD];
 
 /* plant=prescribed: a sine, or a path of turning points */
 #define MAX_PATH 256
@@ -203,8 +255,32 @@ static double drive_position(double t) {
            amp * ((1 - a2) * sin(ph1) + a2 * sin(ph2));
 }
 
-/* the actuator's position: the drive, plus the dither when there is one */
+/* drive=hold at t (the header comment): the interval [t_i, t_(i+1)) that
+   holds t is searched from the last one found (the calls come in nearly
+   increasing t) */
+static double hold_position(double t) {
+    int n = n_hold_t;
+    if (t <= hold_t[0]) return hold_x[0];
+    if (t >= hold_t[n - 1]) return hold_x[n - 1];
+    while (hold_i > 0 && t < hold_t[hold_i]) hold_i--;
+    while (hold_i < n - 2 && t >= hold_t[hold_i + 1]) hold_i++;
+    double t0 = hold_t[hold_i], t1 = hold_t[hold_i + 1];
+    double u = (t - t0) / (t1 - t0);
+    double xa = hold_x[hold_i] + (hold_x[hold_i + 1] - hold_x[hold_i]) * (u - sin(2 * M_PI * u) / (2 * M_PI));
+    if (dither_amp != 0 && hold_i < n_hold_dither && hold_dither[hold_i] != 0) {
+        /* faded in over the first dither period, out over the last */
+        double tau = t - t0, rest = t1 - t, e = 1;
+        if (tau < dither_period) e *= 0.5 * (1 - cos(M_PI * tau / dither_period));
+        if (rest < dither_period) e *= 0.5 * (1 - cos(M_PI * rest / dither_period));
+        xa += dither_amp * e * sin(2 * M_PI * tau / dither_period);
+    }
+    return xa;
+}
+
+/* the actuator's position: the drive, plus the dither when there is one
+   (drive=hold: its own, in its dithered intervals) */
 static double actuator(double t) {
+    if (hold) return hold_position(t);
     double xa = drive_position(t);
     if (dither_amp != 0) xa += dither_amp * sin(2 * M_PI * t / dither_period);
     return xa;
@@ -226,6 +302,17 @@ static double level(double v, double x) {
     double fc = v >= 0 ? Fc : Fc_neg, fs = v >= 0 ? Fs : Fs_neg;
     double r = v / vs;
     return position_scale(x) * (fc + (fs - fc) * exp(-r * r));
+}
+
+/* law=elastoplastic: α(z, v) with w = sgn(v)·z, w_ss = g/σ0 (Dupont,
+   Hayward, Armstrong and Altpeter 2002, the header comment): 0 up to the
+   break-away deflection z_ba (elastic), a half sine up to w_ss, 1 past it
+   (LuGre) */
+static double ep_alpha(double z, double v, double g) {
+    double w = v > 0 ? z : v < 0 ? -z : 0, w_ss = g / sigma0;
+    if (w <= z_ba) return 0;
+    if (w >= w_ss) return 1;
+    return 0.5 * sin(M_PI * (w - 0.5 * (w_ss + z_ba)) / (w_ss - z_ba)) + 0.5;
 }
 
 /* the motor force of the two-mass plant */
@@ -312,6 +399,13 @@ static void advance_segment(double t) {
 /* the friction force at (x, v); its states' rates into dy (z: dy[2];
    GMS: dy[5 + i], the modes held) */
 static double friction(double x, double v, const double *y, double *dy) {
+    if (elastoplastic) {
+        /* z' = v − α(z, v)·σ0·|v|·z/g(v), F = σ0·z + σ1·z' + σ2·v */
+        double z = y[2], g = level(v, x);
+        double zd = v - ep_alpha(z, v, g) * sigma0 * fabs(v) * z / g;
+        dy[2] = zd;
+        return sigma0 * z + sigma1 * zd + sigma2 * v;
+    }
     if (!gms) {
         double z = y[2];
         double zd = v - sigma0 * fabs(v) * z / level(v, x);
@@ -392,7 +486,7 @@ int main(int argc, char **argv) {
         KEY("m_m", m_m) KEY("c_m", c_m) KEY("Kp", Kp) KEY("Kd", Kd)
         KEY("force_resolution", force_resolution)
         KEY("dither_amp", dither_amp) KEY("dither_period", dither_period)
-        KEY("C", C_attraction)
+        KEY("C", C_attraction) KEY("z_ba", z_ba)
         else if (strcmp(key, "plant") == 0) {
             two_mass = strcmp(val, "two_mass") == 0;
             servo = strcmp(val, "servo") == 0;
@@ -410,9 +504,13 @@ int main(int argc, char **argv) {
         else if (strcmp(key, "path") == 0) n_path = parse_list(val, path, MAX_PATH);
         else if (strcmp(key, "speed") == 0) n_speed = parse_list(val, speed_list, MAX_PATH);
         else if (strcmp(key, "n_elements") == 0) n_elements = atoi(val);
+        else if (strcmp(key, "hold_t") == 0) n_hold_t = parse_list(val, hold_t, MAX_HOLD);
+        else if (strcmp(key, "hold_x") == 0) n_hold_x = parse_list(val, hold_x, MAX_HOLD);
+        else if (strcmp(key, "hold_dither") == 0) n_hold_dither = parse_list(val, hold_dither, MAX_HOLD);
         else if (strcmp(key, "law") == 0) {
             gms = strcmp(val, "gms") == 0;
-            if (!gms && strcmp(val, "lugre") != 0) {
+            elastoplastic = strcmp(val, "elastoplastic") == 0;
+            if (!gms && !elastoplastic && strcmp(val, "lugre") != 0) {
                 fprintf(stderr, "lugre_rig: unknown law `%s`\n", val);
                 return 2;
             }
@@ -431,6 +529,28 @@ int main(int argc, char **argv) {
     if (gms && (n_elements < 1 || n_elements > MAX_ELEMENTS || C_attraction <= 0)) {
         fprintf(stderr, "lugre_rig: law=gms needs 1 <= n_elements <= %d and C > 0\n", MAX_ELEMENTS);
         return 2;
+    }
+    if (elastoplastic) {
+        if ((Fc_neg != Fc || Fs_neg != Fs) || n_table > 0) {
+            fprintf(stderr, "lugre_rig: law=elastoplastic takes one pair of levels (no Fc_neg, Fs_neg) and no "
+                            "position table\n");
+            return 2;
+        }
+        if (!(z_ba >= 0 && z_ba < fmin(Fc, Fs) / sigma0)) {
+            fprintf(stderr, "lugre_rig: law=elastoplastic needs 0 <= z_ba < min(Fc, Fs)/sigma0 = %g m\n",
+                    fmin(Fc, Fs) / sigma0);
+            return 2;
+        }
+    }
+    hold = strcmp(drive, "hold") == 0;
+    if (hold) {
+        int ok = n_hold_t >= 2 && n_hold_x == n_hold_t && (n_hold_dither == 0 || n_hold_dither == n_hold_t - 1);
+        for (int i = 0; ok && i + 1 < n_hold_t; i++) ok = hold_t[i + 1] > hold_t[i];
+        if (!ok) {
+            fprintf(stderr, "lugre_rig: drive=hold needs hold_t (two or more, increasing), hold_x as many and "
+                            "hold_dither one per interval (or none)\n");
+            return 2;
+        }
     }
     if (dither_amp != 0 && dither_period <= 0) {
         fprintf(stderr, "lugre_rig: dither_period must be positive\n");
@@ -516,6 +636,11 @@ int main(int argc, char **argv) {
             if (!gms) {
                 double relax = step_fraction * level(v0, x0) / (sigma0 * fabs(v0) + 1e-300);
                 if (relax < h) h = relax;
+                if (elastoplastic) {
+                    /* the sine of α: ∂z'/∂z is at most (π/2)·|v|/(w_ss − z_ba) there */
+                    double sine = step_fraction * (2 / M_PI) * (level(v0, x0) / sigma0 - z_ba) / (fabs(v0) + 1e-300);
+                    if (sine < h) h = sine;
+                }
             } else {
                 /* the slipping elements' relaxation time s/C, and a small
                    part of each sticking element's slip distance α_i·s/k_i */

@@ -23,7 +23,10 @@ or bad-data rows).
 --only presliding_memory (cases.MEMORY_KINDS, in no default grid) runs
 those kinds too, seeds 1..N at the label 10 %: a GMS truth against a
 LuGre nominal, a change of structure no effect of the library is, so
-they count as named right only if the diagnosis names it.
+they count as named right only if the diagnosis names it. Likewise
+--only presliding_drift: an elasto-plastic truth (no drift below
+break-away) against a LuGre nominal, named right as
+`elastic_presliding`.
 --versus OLD_FRICSIM diagnoses each case with an older build as well, in
 turn with this one on the same data (the old first), and writes a
 before/after table: the effects found, the size error, the final/given
@@ -257,7 +260,7 @@ def diagnose_case(
     if named:
         explained = named[-1]["where"]["explained_by"]
         row["localised_as"] = explained[0]["state"] if explained else "none"
-        row["localised_right"] = row["localised_as"] == EXPLAINING_STATE[expected]
+        row["localised_right"] = row["localised_as"] == EXPLAINING_STATE.get(expected)
     if size:
         q, truth, fitted = size
         row["size"] = {"quantity": q, "truth": truth, "fitted": fitted,
