@@ -78,13 +78,18 @@ fn explained(m: &LawCheck) -> String {
     if m.explains.is_empty() {
         return String::new();
     }
+    let law = m.law.model_name();
     let names: Vec<&str> = m.explains.iter().map(|e| e.name()).collect();
-    format!(
-        " The effects found under LuGre ({}) stood in for it: {} fitted from the baseline, before them, predicts the held-out data as well as from the final model (p = {:.2e} that the final model's start does better), so it starts from the baseline and they are not named.",
-        names.join(", "),
-        m.law.model_name(),
-        m.explains_p_value.unwrap_or(f64::NAN)
-    )
+    match m.explains_p_value {
+        Some(p) => format!(
+            " The effects found under LuGre ({}) stood in for it: {law} fitted from the baseline, before them, predicts the held-out data as well as from the final model (p = {p:.2e} that the final model's start does better), so it starts from the baseline and they are not named.",
+            names.join(", ")
+        ),
+        None => format!(
+            " The pre-sliding stiffness found under LuGre ({}) is {law}'s own σ0, fitted again by the move: not named apart.",
+            names.join(", ")
+        ),
+    }
 }
 
 /// What the checks of the other laws found, one sentence each.

@@ -30,7 +30,7 @@ use super::split::Picker;
 use crate::acceptance::{drop_beyond_step_error, mean, separation_test, Acceptance, Scored};
 use crate::fit::{polish_any, Coordinates, ResidualsOf};
 use crate::memory::{moved_to, LawCheck, LawCoordinates, LawModel, MemoryOutcome, OtherLaw};
-use crate::model::FrictionModel;
+use crate::model::{Effect, FrictionModel};
 use crate::sim::system_parameters_with;
 use crate::POLISH_ITERATIONS;
 use nalgebra::DVector;
@@ -125,21 +125,30 @@ pub(crate) fn check_memory(p: &Problem, baseline: &Baseline, search: &Search) ->
                 checks[i].heldout_rms
             ));
         }
-        if !search.effects.is_empty() {
-            stood_in_for(p, baseline, search, &mut checks[best]);
+        // presliding's parameters (σ0, σ1 with it) are the moved law's
+        // own, fitted again by the move: not a finding of its own
+        let moved = &mut checks[best];
+        moved.explains = search
+            .effects
+            .iter()
+            .map(|e| e.name)
+            .filter(|&e| e == Effect::Presliding)
+            .collect();
+        if search.effects.iter().any(|e| e.name != Effect::Presliding) {
+            stood_in_for(p, baseline, search, moved);
         }
     }
     checks
 }
 
-/// Whether the effects the rounds found under LuGre were only standing in
-/// for `moved`'s law: its fit from the baseline (the nominal's levels
-/// refitted, before any effect) is scored like the fit from the final
-/// model, and unless the final model's start predicts the held-out data
-/// better by the acceptance rule, the law from the baseline is the one
-/// moved to and the effects are reported as explained by the move
-/// (`LawCheck::explains`), as the rounds withdraw an effect that later
-/// ones explain.
+/// Whether the other effects the rounds found under LuGre were only
+/// standing in for `moved`'s law: its fit from the baseline (the
+/// nominal's levels refitted, before any effect) is scored like the fit
+/// from the final model, and unless the final model's start predicts the
+/// held-out data better by the acceptance rule, the law from the baseline
+/// is the one moved to and every effect is reported as explained by the
+/// move (`LawCheck::explains`), as the rounds withdraw an effect that
+/// later ones explain.
 fn stood_in_for(p: &Problem, baseline: &Baseline, search: &Search, moved: &mut LawCheck) {
     let (Some(path), Some(from_final)) = (moved.fmu.clone(), moved.scored.clone()) else {
         return;
