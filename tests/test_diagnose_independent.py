@@ -4,7 +4,8 @@ integrator, no code shared with the FMUs), run as a user would (the
 defaults, the CLI), one case of each kind that once failed: nominal =
 truth, a stiff nominal against millimetre presliding, a soft nominal
 against a stiff truth, an effect at 5 %, spikes and a dropout in the data,
-a plant that is not Rig1D, a Dahl nominal. The full grid (more seeds, every
+a plant that is not Rig1D, a Dahl nominal, a GMS and an elasto-plastic
+truth against a LuGre nominal. The full grid (more seeds, every
 effect at 10 % and 5 %) is `python3 tests/independent/suite.py`, whose
 table is in BENCHMARKS.md."""
 
@@ -46,6 +47,9 @@ def check(row: dict) -> None:
         ("direction_dependent", 0.05, 7),
         ("viscous", 0.05, 9),
         ("dahl_viscous", 0.1, 7),
+        # an elasto-plastic truth: LuGre creeps under the held force,
+        # the truth does not; the nominal moves to the elasto-plastic law
+        ("presliding_drift", 0.1, 1),
     ],
 )
 def test_case_from_the_independent_simulator(kind, magnitude, seed, tmp_path):

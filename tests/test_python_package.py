@@ -288,6 +288,30 @@ def test_several_records_to_diagnose_as_paths_or_dataframes(tmp_path):
         fricsim.diagnose(EMPS, [], out=tmp_path / "c")
 
 
+def test_a_nominal_moved_to_another_law_is_what_the_diagnosis_gives(tmp_path):
+    """When the nominal moved from LuGre to another law (report.json's
+    `memory`), `effect_names` ends with that law's effect without the
+    effects the move explains, `refitted_system` is that law's system and
+    the held-out RMS shown is its own; otherwise they are LuGre's."""
+    report = {
+        "system": "s.ssd", "nominal_rms": 0.02, "final_rms": 0.01,
+        "effects": [{"name": "stribeck"}, {"name": "presliding"}],
+        "memory": [
+            {"law": "gms", "effect": "presliding_memory", "outcome": "kept", "heldout_rms": 0.009},
+            {"law": "elasto_plastic", "effect": "elastic_presliding", "outcome": "moved",
+             "heldout_rms": 0.001, "explains": ["presliding"]},
+        ],
+    }
+    d = fricsim.Diagnosis(report, tmp_path)
+    assert d.effect_names == ["stribeck", "elastic_presliding"]
+    assert d.refitted_system == tmp_path / "refitted-elastoplastic.ssp"
+    assert d.final_heldout_rms == 0.001 and "-> 0.00100" in repr(d)
+    report["memory"][1]["outcome"] = "kept"
+    d = fricsim.Diagnosis(report, tmp_path)
+    assert d.effect_names == ["stribeck", "presliding"] and d.moved_to is None
+    assert d.refitted_system == tmp_path / "refitted.ssp" and d.final_heldout_rms == 0.01
+
+
 def test_diagnose_stops_at_its_time_limit_and_says_so(tmp_path):
     """time_limit: the slider table's diagnosis (several seconds in full)
     stopped after half a second still writes its report, whose

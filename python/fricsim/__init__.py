@@ -224,7 +224,11 @@ class Diagnosis:
         self.report_html = out / "report.html"
         self.report_json = out / "report.json"
         self.report_md = out / "report.md"
-        self.refitted_system = out / "refitted.ssp"
+        moved = self.moved_to
+        # the system of the law the nominal moved to, when it moved
+        self.refitted_system = (
+            out / f"refitted-{moved['law'].replace('_', '')}.ssp" if moved else out / "refitted.ssp"
+        )
 
     def __getattr__(self, name: str) -> Any:
         report = self.__dict__.get("report", {})
@@ -233,15 +237,36 @@ class Diagnosis:
         raise AttributeError(f"the diagnosis has no field `{name}`")
 
     @property
+    def moved_to(self) -> Optional[dict]:
+        """The check of the other law the nominal moved to (GMS or the
+        elasto-plastic law: an entry of ``report["memory"]``), or None
+        when LuGre stayed."""
+        return next((m for m in self.report.get("memory", []) if m["outcome"] == "moved"), None)
+
+    @property
     def effect_names(self) -> list:
-        """The effects found, in the order they were added."""
-        return [e["name"] for e in self.report["effects"]]
+        """The effects found, in the order they were added; when the
+        nominal moved to another law, that law's effect
+        (``presliding_memory``, ``elastic_presliding``) last, without the
+        effects the move explains."""
+        names = [e["name"] for e in self.report["effects"]]
+        moved = self.moved_to
+        if moved:
+            names = [n for n in names if n not in moved.get("explains", [])] + [moved["effect"]]
+        return names
+
+    @property
+    def final_heldout_rms(self) -> float:
+        """The held-out RMS of the model the diagnosis ends with: the
+        other law's when the nominal moved to it, else ``final_rms``."""
+        moved = self.moved_to
+        return moved["heldout_rms"] if moved else self.report["final_rms"]
 
     def __repr__(self) -> str:
         found = ", then ".join(self.effect_names) or "no missing effect"
         return (
             f"<Diagnosis of {self.report['system']}: {found}; held-out RMS "
-            f"{self.report['nominal_rms']:.5f} -> {self.report['final_rms']:.5f}; "
+            f"{self.report['nominal_rms']:.5f} -> {self.final_heldout_rms:.5f}; "
             f"{self.report_html}>"
         )
 
