@@ -33,7 +33,7 @@
 //! (`stages/memory.rs` decides).
 
 use crate::fit::Coordinates;
-use crate::model::FrictionModel;
+use crate::model::{stribeck_curve_parameters, FrictionModel};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -211,16 +211,13 @@ impl GmsModel {
 
     /// The GMS FMU's parameters (its names) for this model.
     pub fn parameters(&self) -> Vec<(String, f64)> {
-        let mut p = vec![
-            ("Fc".to_string(), self.fc),
-            ("Fs".to_string(), self.fs),
-            ("vs".to_string(), self.vs),
-            ("stribeck_exponent".to_string(), self.stribeck_exponent),
+        let mut p = stribeck_curve_parameters(self.fc, self.fs, self.vs, self.stribeck_exponent);
+        p.extend([
             ("sigma2".to_string(), self.sigma2),
             ("sigma1".to_string(), self.sigma1),
             ("C".to_string(), self.attraction),
             ("n_elements".to_string(), self.elements as f64),
-        ];
+        ]);
         let (k, alpha) = self.elements();
         for (i, (k, a)) in k.iter().zip(&alpha).enumerate() {
             p.push((format!("k[{}]", i + 1), *k));
@@ -272,16 +269,14 @@ impl ElastoPlasticModel {
 
     /// The FMU's parameters.
     pub fn parameters(&self) -> Vec<(String, f64)> {
-        vec![
-            ("Fc".to_string(), self.fc),
-            ("Fs".to_string(), self.fs),
-            ("vs".to_string(), self.vs),
-            ("stribeck_exponent".to_string(), self.stribeck_exponent),
+        let mut p = stribeck_curve_parameters(self.fc, self.fs, self.vs, self.stribeck_exponent);
+        p.extend([
             ("sigma0".to_string(), self.sigma0),
             ("sigma1".to_string(), self.sigma1),
             ("sigma2".to_string(), self.sigma2),
             ("z_ba".to_string(), self.z_ba),
-        ]
+        ]);
+        p
     }
 }
 

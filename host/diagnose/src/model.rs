@@ -102,6 +102,17 @@ pub struct FrictionModel {
 /// step of each co-simulation of it (minutes for a 16 s record).
 pub const MAX_SCALE: f64 = 100.0;
 
+/// The Stribeck curve's parameters as every friction FMU of the project
+/// names them (LuGre, GMS, the elasto-plastic law).
+pub fn stribeck_curve_parameters(fc: f64, fs: f64, vs: f64, exponent: f64) -> Vec<(String, f64)> {
+    vec![
+        ("Fc".to_string(), fc),
+        ("Fs".to_string(), fs),
+        ("vs".to_string(), vs),
+        ("stribeck_exponent".to_string(), exponent),
+    ]
+}
+
 /// The LuGre parameter names diagnose reads from the nominal FMU.
 pub const READ_PARAMETERS: [&str; 9] = [
     "Fc",
@@ -413,11 +424,8 @@ impl FrictionModel {
 
     /// `(variable, value)` of the LuGre FMU for this model.
     pub fn parameters(&self) -> Vec<(String, f64)> {
-        let mut p = vec![
-            ("Fc".to_string(), self.fc),
-            ("Fs".to_string(), self.fs),
-            ("vs".to_string(), self.vs),
-            ("stribeck_exponent".to_string(), self.stribeck_exponent),
+        let mut p = stribeck_curve_parameters(self.fc, self.fs, self.vs, self.stribeck_exponent);
+        p.extend([
             ("sigma0".to_string(), self.sigma0),
             ("sigma1".to_string(), self.sigma1),
             ("sigma2".to_string(), self.sigma2),
@@ -435,7 +443,7 @@ impl FrictionModel {
                 "position_dependent".to_string(),
                 f64::from(u8::from(self.position_dependent)),
             ),
-        ];
+        ]);
         p.push(("F_offset".to_string(), self.f_offset));
         p.push((
             "direction_dependent_viscous".to_string(),
