@@ -19,7 +19,7 @@
 //!   its level, `Ḟ_i = C·(sgn(v)·α_i − F_i/s(v))`, and sticks again when
 //!   the motion reverses. (The paper writes `sgn(v)·C·(α_i − F_i/s(v))`
 //!   with `F_i/s(v)` read in the direction of motion; written with the
-//!   sign outside, as here, the law is odd in `v`.) `C` (N/s) sets the
+//!   sign inside, as here, the law is odd in `v`.) `C` (N/s) sets the
 //!   frictional lag: in gross sliding every element slips and
 //!   `Σ F_i` relaxes to `s(v)` with the time constant `s(v)/C`. Each
 //!   element has the paper's micro-viscous damping `σ_i·ż_i` on its
