@@ -313,7 +313,9 @@ pub fn variables_markdown() -> String {
         let mut seen_arrays: Vec<&str> = Vec::new();
         for v in info.variables {
             let (name, start) = match v.name.split_once('[') {
-                Some((base, _)) => {
+                Some((base, rest)) => {
+                    // what follows the index: `)` of `der(F_element[1])`
+                    let after = rest.split_once(']').map_or("", |(_, after)| after);
                     if seen_arrays.contains(&base) {
                         continue;
                     }
@@ -323,7 +325,10 @@ pub fn variables_markdown() -> String {
                         .iter()
                         .filter(|w| w.name.starts_with(&format!("{base}[")))
                         .count();
-                    (format!("{base}[i], i = 1..{n}"), "see XML".to_string())
+                    (
+                        format!("{base}[i]{after}, i = 1..{n}"),
+                        "see XML".to_string(),
+                    )
                 }
                 None => (
                     v.name.to_string(),
