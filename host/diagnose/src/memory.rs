@@ -129,6 +129,31 @@ impl LawModel {
         }
     }
 
+    /// `(Fc, Fs, σ0, σ1)`: its Stribeck levels, its stiffness at a
+    /// reversal (GMS: the elements' total) and micro-damping, as LuGre
+    /// names them.
+    pub fn levels(&self) -> (f64, f64, f64, f64) {
+        match self {
+            LawModel::Gms(g) => (g.fc, g.fs, g.sigma0, g.sigma1),
+            LawModel::ElastoPlastic(e) => (e.fc, e.fs, e.sigma0, e.sigma1),
+        }
+    }
+
+    /// `lugre` with this law's levels, stiffness and micro-damping: the
+    /// LuGre model closest to it, whose pre-sliding differs only by the
+    /// law's memory.
+    pub fn as_lugre(&self, lugre: &FrictionModel) -> FrictionModel {
+        let (fc, fs, sigma0, sigma1) = self.levels();
+        let mut m = lugre.clone();
+        m.fc = fc;
+        m.fc_neg = fc;
+        m.fs = fs;
+        m.fs_neg = fs;
+        m.sigma0 = sigma0;
+        m.sigma1 = sigma1;
+        m
+    }
+
     /// Its parameters in words, for the report.
     pub fn describe(&self) -> String {
         match self {
@@ -292,10 +317,7 @@ pub struct LawCoordinates {
 impl LawCoordinates {
     /// `(Fc, Fs, σ0, σ1)` of the start.
     fn levels(&self) -> (f64, f64, f64, f64) {
-        match &self.start {
-            LawModel::Gms(g) => (g.fc, g.fs, g.sigma0, g.sigma1),
-            LawModel::ElastoPlastic(e) => (e.fc, e.fs, e.sigma0, e.sigma1),
-        }
+        self.start.levels()
     }
 
     fn stribeck(&self) -> bool {
@@ -421,11 +443,36 @@ pub struct LawCheck {
     pub explains: Vec<crate::model::Effect>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub explains_p_value: Option<f64>,
+    /// Fitted from the baseline (the nominal's levels refitted, before
+    /// the effects the rounds found): its fit from the final LuGre model
+    /// did not pass, this one did, and it explains every effect found.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub from_baseline: bool,
+    /// For a law that beat the final LuGre model: LuGre refitted from the
+    /// law's levels and stiffness ([`LawModel::as_lugre`]), its held-out
+    /// RMS and the p-value that the law predicts better. The nominal
+    /// moves only when the law beats it too: else its gain was LuGre's
+    /// own pre-sliding re-sized, not the law's memory.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lugre_at_law_stiffness: Option<LugreAtLawStiffness>,
     pub cosimulations: usize,
     pub seconds: f64,
     /// Its held-out co-simulation (for the comparisons).
     #[serde(skip)]
     pub(crate) scored: Option<crate::acceptance::Scored>,
+}
+
+/// LuGre refitted from a law's levels and stiffness
+/// ([`LawCheck::lugre_at_law_stiffness`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct LugreAtLawStiffness {
+    /// The law's stiffness it started from (N/m), on the first fold.
+    pub sigma0: f64,
+    pub heldout_rms: f64,
+    /// Relative drop of the held-out mean square from it to the law.
+    pub gain: f64,
+    /// One-sided p-value that the law predicts the held-out data better.
+    pub p_value: f64,
 }
 
 impl LawCheck {
@@ -449,6 +496,8 @@ impl LawCheck {
             fmu: None,
             explains: Vec::new(),
             explains_p_value: None,
+            from_baseline: false,
+            lugre_at_law_stiffness: None,
             cosimulations: 0,
             seconds: 0.0,
             scored: None,

@@ -80,6 +80,12 @@ fn explained(m: &LawCheck) -> String {
     }
     let law = m.law.model_name();
     let names: Vec<&str> = m.explains.iter().map(|e| e.name()).collect();
+    if m.from_baseline {
+        return format!(
+            " It was fitted from the baseline, before the effects found under LuGre ({}): fitted from the final LuGre model it did not pass, so they are taken as its signature and not named.",
+            names.join(", ")
+        );
+    }
     match m.explains_p_value {
         Some(p) => format!(
             " The effects found under LuGre ({}) stood in for it: {law} fitted from the baseline, before them, predicts the held-out data as well as from the final model (p = {p:.2e} that the final model's start does better), so it starts from the baseline and they are not named.",
@@ -527,9 +533,17 @@ fn overlap_line(e: &super::FoundEffect) -> String {
     let Some(o) = &e.overlap else {
         return String::new();
     };
+    let preferred = if o.encompasses {
+        format!(
+            "alone the data do not separate them (p = {:.1e}), but this one encompasses {other}",
+            o.p_separated,
+            other = o.other
+        )
+    } else {
+        format!("the data prefer this one (p = {:.1e})", o.p_separated)
+    };
     format!(
-        " {other} passed too, and the two overlap: the data prefer this one (p = {:.1e}); fitted together, it adds {:.1} % to {other} (p = {:.1e}) and {other} adds {:.1} % to it (p = {:.1e}).",
-        o.p_separated,
+        " {other} passed too, and the two overlap: {preferred}; fitted together, it adds {:.1} % to {other} (p = {:.1e}) and {other} adds {:.1} % to it (p = {:.1e}).",
         100.0 * o.gain_after_other,
         o.p_after_other,
         100.0 * o.other_gain_after,

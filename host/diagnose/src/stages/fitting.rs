@@ -135,7 +135,7 @@ impl Problem<'_> {
     /// cannot show (presliding: its hysteresis lives in the stick, which
     /// the force fits leave out): the starts scored by co-simulating the
     /// fit samples `pick`, then the best refined ([`Problem::polish`]).
-    fn fit_output_error(&self, starts: &[FrictionModel], pick: &Picker) -> fit::Fitted {
+    pub(crate) fn fit_output_error(&self, starts: &[FrictionModel], pick: &Picker) -> fit::Fitted {
         let costs: Vec<f64> = starts
             .par_iter()
             .map(|m| {

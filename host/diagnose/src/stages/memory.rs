@@ -13,7 +13,16 @@
 //! the lowest held-out error, and the diagnosis names its effect
 //! (`presliding_memory`, `elastic_presliding`).
 //!
-//! Tried only where the comparison means something: a LuGre model the
+//! A law that beats the final LuGre model is moved to only if it also
+//! beats LuGre refitted from the law's own levels and stiffness
+//! ([`lugre_at_law_stiffness`]): a law fitted freely may simply have
+//! found a stiffer or softer pre-sliding that LuGre's own candidate
+//! missed, and that is no evidence of the law's memory.
+//!
+//! Tried only where the comparison means something: a final LuGre model
+//! that leaves something unexplained (its held-out RMS above
+//! [`UNEXPLAINED_FACTOR`] times the floor of noise and step error, as the
+//! report judges it), a LuGre model the
 //! other laws can hold (one level in both directions, no position table,
 //! no normal-force form, no offset), pre-sliding the data resolve (the
 //! final model's pre-sliding distance `Fs/σ0` at least [`RESOLVED_STEPS`]
@@ -29,10 +38,13 @@ use super::rounds::Search;
 use super::split::Picker;
 use crate::acceptance::{drop_beyond_step_error, mean, separation_test, Acceptance, Scored};
 use crate::fit::{polish_any, Coordinates, ResidualsOf};
-use crate::memory::{moved_to, LawCheck, LawCoordinates, LawModel, MemoryOutcome, OtherLaw};
+use crate::memory::{
+    moved_to, LawCheck, LawCoordinates, LawModel, LugreAtLawStiffness, MemoryOutcome, OtherLaw,
+};
 use crate::model::{Effect, FrictionModel};
 use crate::sim::system_parameters_with;
-use crate::POLISH_ITERATIONS;
+use crate::stages::summary::noise_floor;
+use crate::{NO_EVIDENCE_LEVEL, POLISH_ITERATIONS, UNEXPLAINED_FACTOR};
 use nalgebra::DVector;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -82,6 +94,18 @@ pub(crate) fn check_memory(p: &Problem, baseline: &Baseline, search: &Search) ->
     if let Some(why) = others_cannot_hold(&search.current) {
         return every_law(why);
     }
+    // a LuGre model the report calls explaining the data leaves no
+    // memory to find: on the 24 cases of the pre-sliding suite
+    // (BENCHMARKS.md) the final LuGre model scored 22-2280 times the
+    // floor, on the 11 LuGre cases of the independent suite where the
+    // laws were tried 0.48-1.25 times (no law passed there)
+    let noise = noise_floor(p.scored_data(), &search.scored, &p.scales);
+    let floor = (noise * noise + search.step_error * search.step_error).sqrt();
+    if lugre_rms <= UNEXPLAINED_FACTOR * floor {
+        return every_law(format!(
+            "the final LuGre model leaves nothing unexplained: its held-out RMS {lugre_rms:.3e} is within {UNEXPLAINED_FACTOR} times the floor of noise and step error ({floor:.3e})"
+        ));
+    }
     let distance = search.current.fs.max(search.current.fc) / search.current.sigma0;
     let resolution = p.context.position_resolution;
     if distance.is_nan() || distance < RESOLVED_STEPS * resolution {
@@ -106,7 +130,7 @@ pub(crate) fn check_memory(p: &Problem, baseline: &Baseline, search: &Search) ->
             let path = component
                 .source
                 .with_file_name(format!("{}.fmu", law.model_name()));
-            check_law(p, search, law, path, threshold)
+            check_law(p, baseline, search, law, path, threshold)
         })
         .collect();
     // the nominal moves to the law that passed with the lowest error
@@ -125,17 +149,22 @@ pub(crate) fn check_memory(p: &Problem, baseline: &Baseline, search: &Search) ->
                 checks[i].heldout_rms
             ));
         }
-        // presliding's parameters (σ0, σ1 with it) are the moved law's
-        // own, fitted again by the move: not a finding of its own
         let moved = &mut checks[best];
-        moved.explains = search
-            .effects
-            .iter()
-            .map(|e| e.name)
-            .filter(|&e| e == Effect::Presliding)
-            .collect();
-        if search.effects.iter().any(|e| e.name != Effect::Presliding) {
-            stood_in_for(p, baseline, search, moved);
+        if moved.from_baseline {
+            // fitted from the baseline, before every effect the rounds found
+            moved.explains = search.effects.iter().map(|e| e.name).collect();
+        } else {
+            // presliding's parameters (σ0, σ1 with it) are the moved law's
+            // own, fitted again by the move: not a finding of its own
+            moved.explains = search
+                .effects
+                .iter()
+                .map(|e| e.name)
+                .filter(|&e| e == Effect::Presliding)
+                .collect();
+            if search.effects.iter().any(|e| e.name != Effect::Presliding) {
+                stood_in_for(p, baseline, search, moved);
+            }
         }
     }
     checks
@@ -193,9 +222,18 @@ fn stood_in_for(p: &Problem, baseline: &Baseline, search: &Search, moved: &mut L
     moved.scored = Some(from_baseline.scored);
 }
 
-/// The check of one law whose FMU is at `path`.
+/// The check of one law whose FMU is at `path`: fitted from the final
+/// LuGre model and, when that does not move the nominal and the rounds
+/// named effects, from the baseline (the nominal's levels refitted,
+/// before them). An effect named under LuGre may be another law's
+/// signature that sends the law's fit from the final model astray: on an
+/// elasto-plastic truth (`presliding_drift`, seed 12) a Stribeck curve
+/// was named, and the elasto-plastic law fitted from it, at 68 % of
+/// LuGre's held-out mean square below it, missed the round's threshold
+/// (p = 0.0096).
 fn check_law(
     p: &Problem,
+    baseline: &Baseline,
     search: &Search,
     law: OtherLaw,
     path: PathBuf,
@@ -220,7 +258,40 @@ fn check_law(
     let started = Instant::now();
     let (outcome, cut) = p.budget.cut_short(
         || what.clone(),
-        || try_law(p, search, law, &path, threshold),
+        || {
+            let from_final = try_law(
+                p,
+                search,
+                law,
+                &path,
+                threshold,
+                (&search.folds, &search.current),
+            )?;
+            if from_final.outcome == MemoryOutcome::Moved
+                || search.effects.is_empty()
+                || p.budget.expired()
+            {
+                return Ok::<LawCheck, String>(from_final);
+            }
+            let mut from_baseline = try_law(
+                p,
+                search,
+                law,
+                &path,
+                threshold,
+                (&baseline.folds, &baseline.model),
+            )?;
+            from_baseline.cosimulations += from_final.cosimulations;
+            if from_baseline.outcome == MemoryOutcome::Moved {
+                from_baseline.from_baseline = true;
+                Ok(from_baseline)
+            } else {
+                Ok(LawCheck {
+                    cosimulations: from_baseline.cosimulations,
+                    ..from_final
+                })
+            }
+        },
     );
     let mut check = match outcome {
         Ok(check) => check,
@@ -240,6 +311,7 @@ fn check_law(
 
 /// A law fitted on each fold and on every sample, and scored.
 struct LawFit {
+    folds: Vec<LawModel>,
     whole: LawModel,
     scored: Scored,
     cosimulations: usize,
@@ -298,25 +370,29 @@ fn fit_and_score(
     let fold_params: Vec<_> = folds.iter().map(&params).collect();
     let scored = p.score_parameters_at(&mut system, &fold_params, None)?;
     Ok(LawFit {
+        folds,
         whole,
         scored,
         cosimulations: cosimulations.into_inner() + p.split.folds.len(),
     })
 }
 
-/// Fit `law` from the final LuGre model, score it, decide.
+/// Fit `law` from the LuGre model `start` (fold models, whole), score
+/// it, and decide against the final LuGre model of `search`.
 fn try_law(
     p: &Problem,
     search: &Search,
     law: OtherLaw,
     path: &Path,
     threshold: f64,
+    start: (&[FrictionModel], &FrictionModel),
 ) -> Result<LawCheck, String> {
     let LawFit {
+        folds,
         whole,
         scored,
-        cosimulations,
-    } = fit_and_score(p, law, path, (&search.folds, &search.current))?;
+        mut cosimulations,
+    } = fit_and_score(p, law, path, start)?;
     let lugre = &search.scored;
     let group = acceptance_groups(p, lugre);
     let p_value = separation_test(&scored, lugre, &group).map_err(|e| e.to_string())?;
@@ -326,15 +402,60 @@ fn try_law(
         threshold,
         min_gain: p.options.min_gain,
     };
-    let moved = rule.passes(gain, p_value)
-        && drop_beyond_step_error(lugre, scored.rms(), search.step_error);
+    let beats = |other: &Scored, p_value: f64, rule: Acceptance| {
+        let (mo, ml) = (mean(&scored.q), mean(&other.q));
+        let gain = if mo < ml { (ml - mo) / ml } else { 0.0 };
+        rule.passes(gain, p_value) && drop_beyond_step_error(other, scored.rms(), search.step_error)
+    };
+    let mut moved = beats(lugre, p_value, rule);
     let mut check = LawCheck::not_tried(law, lugre.rms(), threshold, String::new());
+    check.reason = None;
+    if moved {
+        // the law must beat LuGre at its own stiffness too, with some
+        // evidence ([`NO_EVIDENCE_LEVEL`]): it has passed the round's
+        // threshold against the final model already; on a GMS truth
+        // (`presliding_memory`, seed 2) it gained 42 % over LuGre at its
+        // stiffness at p = 0.024, above α/2
+        let name = law.model_name();
+        let some_evidence = Acceptance {
+            threshold: NO_EVIDENCE_LEVEL.max(threshold),
+            ..rule
+        };
+        match lugre_at_law_stiffness(p, start.0, &folds) {
+            Ok((resized, evaluations)) => {
+                cosimulations += evaluations;
+                let p_resized =
+                    separation_test(&scored, &resized, &group).map_err(|e| e.to_string())?;
+                let (mr, mo) = (mean(&resized.q), mean(&scored.q));
+                let sigma0 = folds.first().map_or(f64::NAN, |m| m.levels().2);
+                moved = beats(&resized, p_resized, some_evidence);
+                if !moved {
+                    check.reason = Some(format!(
+                        "LuGre refitted from {name}'s levels and stiffness (σ0 = {sigma0:.3e} N/m on the first fold, the final model's {:.3e}) predicts the held-out data as well (held-out RMS {:.5}, p = {p_resized:.2e} that {name} does better): the gain is LuGre's own pre-sliding re-sized, not {name}'s memory",
+                        start.0[0].sigma0,
+                        resized.rms()
+                    ));
+                }
+                check.lugre_at_law_stiffness = Some(LugreAtLawStiffness {
+                    sigma0,
+                    heldout_rms: resized.rms(),
+                    gain: if mr > 0.0 { (mr - mo) / mr } else { 0.0 },
+                    p_value: p_resized,
+                });
+            }
+            Err(e) => {
+                moved = false;
+                check.reason = Some(format!(
+                    "LuGre refitted from {name}'s levels and stiffness could not be scored ({e}), so the gain cannot be told from LuGre's own pre-sliding re-sized"
+                ));
+            }
+        }
+    }
     check.outcome = if moved {
         MemoryOutcome::Moved
     } else {
         MemoryOutcome::Kept
     };
-    check.reason = None;
     check.heldout_rms = scored.rms();
     check.gain = gain;
     check.p_value = p_value;
@@ -342,4 +463,42 @@ fn try_law(
     check.scored = Some(scored);
     check.cosimulations = cosimulations;
     Ok(check)
+}
+
+/// LuGre refitted on each fold from `law_folds`' levels, stiffness and
+/// micro-damping ([`LawModel::as_lugre`]), and from the fold's final
+/// model stiffened to the law's σ0, by output error with σ0 free besides
+/// the final model's own free parameters; scored on the held-out
+/// samples. Gives the score and the co-simulations spent.
+///
+/// Why: on the open-loop two-mass drive with a soft nominal and a
+/// stiffer LuGre contact hidden (`two_mass_presliding_soft_nominal`,
+/// seed 1) the rounds left presliding undecided against Stribeck, and the
+/// elasto-plastic law, its σ0 fitted freely, cut LuGre's held-out mean
+/// square by 97 % and was moved to: a re-sized LuGre pre-sliding,
+/// named as another law's memory.
+fn lugre_at_law_stiffness(
+    p: &Problem,
+    lugre_folds: &[FrictionModel],
+    law_folds: &[LawModel],
+) -> Result<(Scored, usize), String> {
+    let fitted: Vec<_> = p
+        .split
+        .folds
+        .par_iter()
+        .zip(lugre_folds)
+        .zip(law_folds)
+        .map(|((fold, lugre), law)| {
+            let mut starts = [law.as_lugre(lugre), lugre.with_sigma0(law.levels().2)];
+            for s in &mut starts {
+                s.freed.insert(Effect::Presliding);
+            }
+            p.fit_output_error(&starts, &fold.fits)
+        })
+        .collect();
+    let evaluations: usize = fitted.iter().map(|f| f.evaluations).sum();
+    let models: Vec<FrictionModel> = fitted.into_iter().map(|f| f.model).collect();
+    let mut system = p.file.build(0.0).map_err(|e| e.to_string())?;
+    let scored = p.score(&mut system, &models)?;
+    Ok((scored, evaluations + models.len()))
 }

@@ -17,9 +17,9 @@
 //!
 //! Each contender is then checked against itself with its effect taken
 //! out (its levels kept as refitted with it): when that model keeps the
-//! gain (the contender does not pass the round's rule against it), the
-//! gain came from the levels refitted further, not from the effect, which
-//! is then not named. An output-error fit of the levels moves them a
+//! gain (it passes the round's rule against the current model, and the
+//! contender does not pass against it), the gain came from the levels
+//! refitted further, not from the effect, which is then not named. An output-error fit of the levels moves them a
 //! little further at each refit: after a 10 % direction dependence on a
 //! servo axis was found, a direction-dependent viscous term whose
 //! σ2_neg − σ2 was 6e-5 of σ2 (its interval holding zero) gained 2.7 % of
@@ -142,9 +142,13 @@ pub(super) fn refine_contenders(
                     Err(_) => None,
                     Ok(a) => {
                         let (gain, p_value) = nested_test(&a, &r.scored, &p.scales, group)?;
-                        (!rule.passes(gain, p_value)).then(|| {
+                        let (levels_gain, levels_p) = nested_test(&s.scored, &a, &p.scales, group)?;
+                        (!rule.passes(gain, p_value) && rule.passes(levels_gain, levels_p)).then(|| {
                             format!(
-                                "its levels refitted without it score as well (it adds {:.1} % to them, p = {:.1e}): the gain comes from the levels",
+                                "its levels refitted without it keep the gain (they gain {:.1} % over the current model, p = {:.1e}, held-out RMS {:.3e}; it adds {:.1} % to them, p = {:.1e}): the gain comes from the levels",
+                                100.0 * levels_gain,
+                                levels_p,
+                                a.rms(),
                                 100.0 * gain,
                                 p_value
                             )

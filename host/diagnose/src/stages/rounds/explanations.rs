@@ -159,5 +159,67 @@ pub(super) fn overlap_check(
         other_gain_after,
         other_p_after,
         p_separated,
+        encompasses: false,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::acceptance::Acceptance;
+    use crate::OverlapCheck;
+
+    /// An overlap check with the figures of a report's note.
+    fn check(p_separated: f64, adds: (f64, f64), other_adds: (f64, f64)) -> OverlapCheck {
+        OverlapCheck {
+            other: "stribeck".into(),
+            gain_after_other: adds.0,
+            p_after_other: adds.1,
+            other_gain_after: other_adds.0,
+            other_p_after: other_adds.1,
+            p_separated,
+            encompasses: false,
+        }
+    }
+
+    const RULE: Acceptance = Acceptance {
+        threshold: 2e-3,
+        min_gain: 0.02,
+    };
+
+    #[test]
+    fn separated_alone_is_preferred_without_encompassing() {
+        let mut c = check(1e-4, (0.3, 1e-5), (0.2, 1e-5));
+        assert!(c.prefers_this(RULE));
+        assert!(!c.encompasses);
+    }
+
+    /// The open-loop two-mass drive with a stiffer contact hidden under a
+    /// soft nominal (seed 1): presliding and Stribeck not separated alone
+    /// (p = 3.6e-3), presliding adding 78.1 % to Stribeck (p = 4.1e-5),
+    /// Stribeck 19.5 % to presliding (p = 0.14): presliding encompasses it.
+    #[test]
+    fn one_that_adds_to_the_other_and_takes_nothing_encompasses_it() {
+        let mut c = check(3.6e-3, (0.781, 4.1e-5), (0.195, 0.14));
+        assert!(c.prefers_this(RULE));
+        assert!(c.encompasses);
+    }
+
+    /// Each adding to the other (a GMS truth, seed 3 of the pre-sliding
+    /// suite: 49.3 % at p = 2.4e-5 and 67.9 % at p = 9.5e-7; a coarse
+    /// record with a Stribeck curve hidden, seed 7: 26.8 % at p = 4e-4
+    /// and 6.1 % at p = 0.015, above the round's threshold but below
+    /// NO_EVIDENCE_LEVEL), or neither (a clean coarse record): undecided.
+    #[test]
+    fn both_or_neither_adding_is_undecided() {
+        for mut c in [
+            check(0.1, (0.493, 2.4e-5), (0.679, 9.5e-7)),
+            check(0.062, (0.268, 4.3e-4), (0.061, 0.015)),
+            check(0.68, (0.0, 0.23), (0.0, 0.84)),
+            // significant but below the minimum gain does not count as adding
+            check(0.1, (0.01, 1e-6), (0.0, 0.5)),
+        ] {
+            assert!(!c.prefers_this(RULE), "{c:?}");
+            assert!(!c.encompasses);
+        }
+    }
 }

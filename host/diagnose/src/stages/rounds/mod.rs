@@ -386,14 +386,14 @@ fn round(
         if cut {
             return deadline::stop(p, s, &tried, group);
         }
-        let check = check?;
-        if check.p_separated < rule.threshold {
+        let mut check = check?;
+        if check.prefers_this(rule) {
             overlap = Some(check);
             chosen = Some(k);
             break;
         }
         s.notes.push(format!(
-            "{} and {} both lower the held-out error in round {} (held-out RMS {:.4} and {:.4}), and the data do not separate them (p = {:.1e}, not below {:.1e}): neither is named. Fitted together, {} adds {:.1} % to {} (p = {:.1e}) and {} adds {:.1} % to {} (p = {:.1e}).",
+            "{} and {} both lower the held-out error in round {} (held-out RMS {:.4} and {:.4}), and the data do not separate them (p = {:.1e}, not below {:.1e}), nor does either encompass the other: neither is named. Fitted together, {} adds {:.1} % to {} (p = {:.1e}) and {} adds {:.1} % to {} (p = {:.1e}).",
             label(&tried[k].added),
             label(&tried[j].added),
             s.rounds.len() + 1,
