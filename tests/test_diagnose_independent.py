@@ -168,6 +168,49 @@ def test_an_effect_is_not_set_aside_for_levels_that_gain_nothing(tmp_path):
     assert row["size"]["relative_error"] <= 0.10, row["size"]
 
 
+def test_a_stribeck_peak_stood_in_for_by_the_levels_is_named(tmp_path):
+    """The two-mass drive with a 10 % Stribeck peak hidden (seed 3): the
+    levels refitted alone rise 22 % to stand in for it, and from that
+    model re-sized the curve stopped at 0.18 held-out RMS after the
+    screen's three iterations while a position table reached 0.055 and
+    was named. From its five best starts (one of them the given levels)
+    the curve is named and sized."""
+    row = suite.run_case(cases.draw("two_mass_stribeck", 0.1, 3), tmp_path)
+    check(row)
+    assert row["found"] == ["stribeck"], row["found"]
+
+
+def test_direction_dependent_levels_are_not_taken_for_an_offset(tmp_path):
+    """The two-mass drive with a 10 % direction dependence hidden (seed
+    3): an offset is the same force wherever the contact slides, and,
+    fitted in ln Fc and ln Fc_neg, the levels by direction overshot and
+    lost to it (held-out RMS 0.0135 against 0.0013). Fitted as the mean
+    level and the asymmetry they reach the truth, the data do not
+    separate the two, and the levels are named as the family's first.
+    Where the change is put (`localised_as`) is not asserted: on this
+    record its bins by speed explain 48 % of it, by direction 43 %."""
+    row = suite.run_case(cases.draw("two_mass_direction_dependent", 0.1, 3), tmp_path)
+    assert row["report"], row["stderr"]
+    assert row["found"] == ["direction_dependent"], row["found"]
+    assert row["never_worse"]
+    assert row["size"]["relative_error"] <= 0.05, row["size"]
+
+
+def test_an_effect_whose_size_holds_zero_is_not_named(tmp_path):
+    """The servo axis with a 10 % position dependence hidden (seed 4):
+    the six-knot table cannot follow the truth's five knots, and a
+    viscous term then gains 8.5 % of the held-out mean square at
+    p = 5e-6; its σ2 has the interval [-1.7, 2.2] N·s/m, which holds 0,
+    so it is set aside and the table alone is named."""
+    case = cases.draw("servo_position_dependent", 0.1, 4)
+    row = suite.run_case(case, tmp_path)
+    check(row)
+    assert row["found"] == ["position_dependent"], row["found"]
+    report = json.loads((tmp_path / f"out-{case.name}" / "report.json").read_text())
+    reasons = [c.get("unresolved") or "" for r in report["rounds"] for c in r if c["name"] == "viscous"]
+    assert any("holds 0" in why for why in reasons), reasons
+
+
 def test_a_gms_contact_moves_the_nominal_to_gms(tmp_path):
     """A contact whose truth is GMS (the independent simulator's `law=gms`:
     nonlocal pre-sliding memory, a dithered actuator making reversals

@@ -365,10 +365,14 @@ impl FrictionModel {
 
     /// θ of the free parameters.
     pub fn theta(&self, free: &[Free]) -> Vec<f64> {
+        let by_direction = free.contains(&Free::FcNeg);
         free.iter()
             .map(|p| match p {
+                // with levels by direction: the mean level and the
+                // asymmetry (see [`Free::FcNeg`])
+                Free::Fc if by_direction => (0.5 * (self.fc + self.fc_neg)).ln(),
                 Free::Fc => self.fc.ln(),
-                Free::FcNeg => self.fc_neg.ln(),
+                Free::FcNeg => asymmetry(self.fc, self.fc_neg),
                 Free::Sigma2 => self.sigma2.max(1e-300).ln(),
                 Free::Sigma2Neg => self.sigma2_neg.max(1e-300).ln(),
                 // linear (either sign), in units of this model's Fc
@@ -387,13 +391,15 @@ impl FrictionModel {
         let mut m = self.clone();
         let excess = (self.fs / self.fc - 1.0).max(0.0);
         let mut new_excess = excess;
+        // levels by direction: the mean level and the asymmetry
+        let mut asymmetric = None;
         for (p, &t) in free.iter().zip(theta) {
             let x = t.clamp(-700.0, 700.0).exp();
             match p {
                 Free::Offset => m.f_offset = t * self.offset_unit(),
                 Free::Sigma2Neg => m.sigma2_neg = x,
                 Free::Fc => m.fc = x,
-                Free::FcNeg => m.fc_neg = x,
+                Free::FcNeg => asymmetric = Some(t.clamp(-MAX_ASYMMETRY, MAX_ASYMMETRY)),
                 Free::Sigma2 => m.sigma2 = x,
                 Free::StribeckExcess => new_excess = x,
                 Free::Vs => m.vs = x,
@@ -404,6 +410,11 @@ impl FrictionModel {
                 Free::ScalePos(i) => m.scale_pos[*i] = x.clamp(1.0 / MAX_SCALE, MAX_SCALE),
                 Free::ScaleNeg(i) => m.scale_neg[*i] = x.clamp(1.0 / MAX_SCALE, MAX_SCALE),
             }
+        }
+        if let Some(a) = asymmetric {
+            let mean = m.fc;
+            m.fc = mean * (1.0 - a);
+            m.fc_neg = mean * (1.0 + a);
         }
         if !m.direction_dependent {
             m.fc_neg = m.fc;
@@ -544,10 +555,31 @@ impl FrictionModel {
     }
 }
 
+/// The asymmetry `(Fc_neg − Fc)/(Fc_neg + Fc)` of levels by direction,
+/// the coordinate θ of [`Free::FcNeg`].
+fn asymmetry(fc: f64, fc_neg: f64) -> f64 {
+    ((fc_neg - fc) / (fc_neg + fc).max(1e-300)).clamp(-MAX_ASYMMETRY, MAX_ASYMMETRY)
+}
+
+/// The largest asymmetry a fit may reach: one direction's level 1/199 of
+/// the other's (both stay positive).
+const MAX_ASYMMETRY: f64 = 0.99;
+
 /// A free parameter, fitted as θ = ln(value) (or ln(Fs/Fc − 1)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Free {
+    /// The Coulomb level: θ = ln Fc; with [`Free::FcNeg`] free too, the
+    /// mean of the two directions' levels, θ = ln((Fc + Fc_neg)/2).
     Fc,
+    /// The Coulomb level for v < 0, as the asymmetry
+    /// θ = (Fc_neg − Fc)/(Fc_neg + Fc), linear like an offset: the two
+    /// coordinates move what the data show apart (the mean level, and
+    /// the difference that drives a drift), where ln Fc and ln Fc_neg
+    /// each move both. On a two-mass drive with a hidden 10 % direction
+    /// dependence, three Levenberg–Marquardt iterations in ln Fc, ln Fc_neg
+    /// from the given levels overshot to 8 % below both true levels
+    /// (held-out RMS 0.031 against 0.0018 for an offset from the same
+    /// start), and the offset was named.
     FcNeg,
     Sigma2,
     StribeckExcess,
@@ -631,6 +663,48 @@ mod tests {
         assert_eq!(
             interacting,
             [(Effect::PositionDependent, Effect::DirectionDependent)]
+        );
+    }
+
+    /// Levels by direction as coordinates: the mean level and the
+    /// asymmetry, back to the same levels (the Stribeck peak of each
+    /// direction keeps its ratio to the level), each coordinate moving
+    /// what it names and nothing else.
+    #[test]
+    fn levels_by_direction_are_a_mean_level_and_an_asymmetry() {
+        let mut m = FrictionModel::coulomb_for_tests(4.0, 1e7, 0.0);
+        m.fs = 4.4;
+        m.direction_dependent = true;
+        m.fc_neg = 5.0;
+        m.fs_neg = 5.5;
+        let free = m.free();
+        assert_eq!(free, [Free::Fc, Free::FcNeg]);
+        let theta = m.theta(&free);
+        assert!((theta[0] - 4.5f64.ln()).abs() < 1e-15, "{theta:?}");
+        assert!((theta[1] - 1.0 / 9.0).abs() < 1e-15, "{theta:?}");
+        let back = m.at(&free, &theta);
+        for (a, b) in [
+            (back.fc, 4.0),
+            (back.fc_neg, 5.0),
+            (back.fs, 4.4),
+            (back.fs_neg, 5.5),
+        ] {
+            assert!((a - b).abs() < 1e-12, "{a} against {b}");
+        }
+        // the asymmetry moves the levels apart about their mean
+        let apart = m.at(&free, &[theta[0], 0.2]);
+        assert!((apart.fc + apart.fc_neg - 9.0).abs() < 1e-12);
+        assert!((apart.fc_neg - apart.fc - 0.2 * 9.0).abs() < 1e-12);
+        // the mean level scales both, the asymmetry kept
+        let up = m.at(&free, &[(9.0f64).ln(), theta[1]]);
+        assert!((up.fc - 8.0).abs() < 1e-12 && (up.fc_neg - 10.0).abs() < 1e-12);
+        // both levels stay positive at any asymmetry
+        let far = m.at(&free, &[theta[0], -5.0]);
+        assert!(
+            far.fc > 0.0 && far.fc_neg > 0.0,
+            "{} {}",
+            far.fc,
+            far.fc_neg
         );
     }
 }

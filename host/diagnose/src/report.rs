@@ -318,7 +318,7 @@ pub fn markdown(d: &Diagnosis) -> String {
         if !e.alternatives.is_empty() {
             let _ = writeln!(
                 s,
-                "Other explanations of the same signature, fitted in the same round (p: one-sided, that `{}` explains the held-out data better, by the signed-rank test of their squared errors per group):\n\n| explanation | held-out RMS | p | separated | passed itself |\n| --- | --- | --- | --- | --- |",
+                "Other explanations of the same signature, fitted in the same round (p: one-sided, that `{}` explains the held-out data better, by the signed-rank test of their squared errors per group; separated: p below the round's threshold and mean squares further apart than the co-simulation's step error squared):\n\n| explanation | held-out RMS | p | separated | passed itself |\n| --- | --- | --- | --- | --- |",
                 e.name.name()
             );
             for a in &e.alternatives {

@@ -13,7 +13,7 @@ use crate::model::{Effect, FrictionModel};
 use crate::sim::{co_simulate_robust, co_simulate_with, system_parameters, FrictionSim};
 use crate::ssp::SystemFile;
 use crate::system::ParameterValue;
-use crate::CANDIDATE_OUTPUT_ERROR_ITERATIONS;
+use crate::{CANDIDATE_OUTPUT_ERROR_ITERATIONS, OUTPUT_ERROR_STARTS_REFINED};
 use nalgebra::DVector;
 use rayon::prelude::*;
 
@@ -135,6 +135,12 @@ impl Problem<'_> {
     /// cannot show (presliding: its hysteresis lives in the stick, which
     /// the force fits leave out): the starts scored by co-simulating the
     /// fit samples `pick`, then the best refined ([`Problem::polish`]).
+    ///
+    /// Where the data give no force (another plant than Rig1D) the
+    /// [`OUTPUT_ERROR_STARTS_REFINED`] best starts are refined, each for
+    /// the same few iterations, and the best refined kept; on Rig1D the
+    /// best start only (one of them is the force fit's result, near the
+    /// optimum already).
     pub(crate) fn fit_output_error(&self, starts: &[FrictionModel], pick: &Picker) -> fit::Fitted {
         let costs: Vec<f64> = starts
             .par_iter()
@@ -143,11 +149,23 @@ impl Problem<'_> {
                     .map_or(f64::INFINITY, |r| r.norm_squared())
             })
             .collect();
-        let best = (0..starts.len())
-            .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
-            .unwrap_or(0);
-        let mut fitted = self.polish(&starts[best], pick, CANDIDATE_OUTPUT_ERROR_ITERATIONS);
-        fitted.evaluations += starts.len();
+        let mut order: Vec<usize> = (0..starts.len()).collect();
+        order.sort_by(|&a, &b| costs[a].total_cmp(&costs[b]));
+        order.truncate(if self.force.output_error_only.is_some() {
+            OUTPUT_ERROR_STARTS_REFINED
+        } else {
+            1
+        });
+        let fits: Vec<fit::Fitted> = order
+            .par_iter()
+            .map(|&k| self.polish(&starts[k], pick, CANDIDATE_OUTPUT_ERROR_ITERATIONS))
+            .collect();
+        let evaluations: usize = fits.iter().map(|f| f.evaluations).sum();
+        let mut fitted = fits
+            .into_iter()
+            .min_by(|a, b| a.rms.total_cmp(&b.rms))
+            .expect("a fit has a start");
+        fitted.evaluations = evaluations + starts.len();
         fitted
     }
 

@@ -27,11 +27,13 @@
 
 use super::Tried;
 use crate::acceptance::{nested_test, Acceptance, Scored};
-use crate::model::FrictionModel;
+use crate::intervals;
+use crate::model::{Effect, FrictionModel};
 use crate::stages::problem::Problem;
 use crate::stages::refine::refine_folds;
 use crate::stages::rounds::Search;
 use crate::system::System;
+use nalgebra::DVector;
 use rayon::prelude::*;
 
 /// How far a screened contender's held-out RMS may be above the best
@@ -156,20 +158,70 @@ pub(super) fn refine_contenders(
                     }
                 },
             };
-            Ok((r, levels_only))
+            let set_aside = match levels_only {
+                Some(why) => Some(why),
+                None => change_holds_zero(p, &t.added, &r.models),
+            };
+            Ok((r, set_aside))
         })
         .collect();
     for (&k, r) in contenders.iter().zip(refined) {
-        let (r, levels_only) = r?;
+        let (r, set_aside) = r?;
         let t = &mut tried[k];
         t.evaluations += r.evaluations;
         t.models = r.models;
         t.scored = Ok(r.scored);
-        t.levels_only = levels_only;
+        t.set_aside = set_aside;
         // refined past the time limit: its refinement may have been cut
         t.unfinished |= p.budget.expired();
     }
     Ok(())
+}
+
+/// Why a refined contender of one effect is not named when the 95 %
+/// interval of its change from the nominal ([`Effect::change`]: σ2 over
+/// the nominal's, Fc_neg − Fc, F_offset, Fs − Fc, ...) holds 0 in a
+/// fold: the interval the report would give it ([`intervals`], from the
+/// output error of the fold's fit samples, with the co-simulation's step
+/// error as a bias), so that the diagnosis does not name an effect whose
+/// size the data cannot tell from none. `None` when every fold resolves
+/// it, or when the interval cannot be had (a co-simulation fails, a
+/// parameter the data do not move): the check is then not made.
+///
+/// On the servo axis with a 10 % position dependence hidden (seed 4), a
+/// six-knot table that could not follow the truth's five knots left a
+/// residual along the travel, and a viscous term then gained 8.5 % of
+/// the held-out mean square at p = 5e-6 and was named beside the table:
+/// its σ2 = 0.25 N·s/m had the interval [−1.7, 2.2].
+fn change_holds_zero(p: &Problem, added: &[Effect], models: &[FrictionModel]) -> Option<String> {
+    let [effect] = added else { return None };
+    let nominal = &p.setup.nominal;
+    for (fold, model) in p.split.folds.iter().zip(models) {
+        let value = effect.change(nominal, model)?;
+        let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
+            models
+                .par_iter()
+                .map(|m| p.fit_residuals(m, &fold.fits, None))
+                .collect()
+        };
+        let fine = p.fit_residuals(model, &fold.fits, Some(p.fine_step()));
+        let covariance = intervals::theta_covariance(
+            model,
+            &mut residual,
+            fine.as_ref(),
+            p.scales.len(),
+            p.options.groups,
+        )?;
+        let [low, high] =
+            covariance.interval(model, &|m: &FrictionModel| effect.change(nominal, m))?;
+        if low <= 0.0 && 0.0 <= high {
+            return Some(format!(
+                "its change {} = {value:.4} has the 95 % interval [{low:.4}, {high:.4}], which holds 0: the data do not tell it from none",
+                effect.change_name().unwrap_or("from the nominal"),
+            ));
+        }
+    }
+    None
 }
 
 /// The fold models `models` of a contender with its effects `added` taken

@@ -19,7 +19,7 @@ impl Tried {
             force_rms: f64::NAN,
             evaluations: 0,
             scored: Err("not started: the time limit was reached".into()),
-            levels_only: None,
+            set_aside: None,
             unfinished: true,
         }
     }

@@ -78,9 +78,10 @@ struct Tried {
     evaluations: usize,
     /// The held-out co-simulation, or why it failed.
     scored: Result<Scored, String>,
-    /// Set when its levels refitted without it score as well
-    /// ([`contenders::refine_contenders`]): why it is not named.
-    levels_only: Option<String>,
+    /// Why a refined contender is not named, when it is set aside
+    /// ([`contenders::refine_contenders`]): its levels refitted without it
+    /// score as well, or the interval of its change holds 0.
+    set_aside: Option<String>,
     /// Not started, or not finished, within the time limit (`deadline.rs`).
     unfinished: bool,
 }
@@ -300,7 +301,7 @@ fn try_additions(
                 force_rms,
                 evaluations,
                 scored,
-                levels_only: None,
+                set_aside: None,
                 // ended past the time limit: its fit may have been cut
                 unfinished: p.budget.expired(),
             })
@@ -423,7 +424,7 @@ fn round(
     s.round_thresholds.push(rule.threshold);
     if let Some(k) = chosen {
         return Ok(Outcome::Accepted(Choice {
-            alternatives: family_alternatives(k, &tried, &round, group, rule)?,
+            alternatives: family_alternatives(k, &tried, &round, group, rule, s.step_error)?,
             p_value: round[k].p_value,
             threshold: rule.threshold,
             tried,
@@ -502,7 +503,7 @@ fn candidate_score(
         unresolved_change(&t.added, c, m, &p.context)
             .or_else(|| unmoved_resize(&t.added, c, m, &p.context))
     });
-    let unresolved = unresolved.or_else(|| t.levels_only.clone());
+    let unresolved = unresolved.or_else(|| t.set_aside.clone());
     Ok(CandidateScore {
         name: label(&t.added),
         heldout_rms,
@@ -560,7 +561,7 @@ fn rank_passing(
     }
     // one signature, several explanations: the one the data prefer goes
     // first
-    prefer_in_family(&mut passing, tried, group, rule.threshold)?;
+    prefer_in_family(&mut passing, tried, group, rule.threshold, step_error)?;
     Ok(passing)
 }
 
