@@ -9,6 +9,7 @@
 use super::problem::Problem;
 use super::split::Picker;
 use crate::fit;
+use crate::intervals;
 use crate::model::{Effect, FrictionModel};
 use crate::sim::{co_simulate_robust, co_simulate_with, system_parameters, FrictionSim};
 use crate::ssp::SystemFile;
@@ -105,6 +106,32 @@ impl Problem<'_> {
                 (0..channels).map(move |c| r.residuals[c][s] / scales[c] / norm)
             }),
         ))
+    }
+
+    /// The covariance of `model`'s fitted parameters from the output error
+    /// of the samples `pick` ([`intervals::theta_covariance`]), with the
+    /// same residuals co-simulated at the finer step for the step error's
+    /// bias. `None` when a co-simulation fails or a free parameter does
+    /// not move the residuals.
+    pub(crate) fn covariance_on(
+        &self,
+        model: &FrictionModel,
+        pick: &Picker,
+    ) -> Option<intervals::ThetaCovariance> {
+        let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
+            models
+                .par_iter()
+                .map(|m| self.fit_residuals(m, pick, None))
+                .collect()
+        };
+        let fine = self.fit_residuals(model, pick, Some(self.fine_step()));
+        intervals::theta_covariance(
+            model,
+            &mut residual,
+            fine.as_ref(),
+            self.scales.len(),
+            self.options.groups,
+        )
     }
 
     /// Refine `model` on the output error of the fit samples `pick`, for

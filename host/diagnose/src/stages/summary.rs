@@ -15,7 +15,7 @@ use super::refine::Polishing;
 use super::rounds::Search;
 use super::run_force;
 use crate::acceptance::Scored;
-use crate::intervals::{self, ThetaCovariance};
+use crate::intervals::ThetaCovariance;
 use crate::memory::{moved, LawCheck};
 use crate::model::FrictionModel;
 use crate::problem::{FrictionData, Measured};
@@ -24,8 +24,6 @@ use crate::{
     fmu_values, localise, quality, ChannelSummary, DataQuality, Diagnosis, EffectChange, FmuValue,
     FoundEffect, InputColumns, PlotData, UNEXPLAINED_FACTOR,
 };
-use nalgebra::DVector;
-use rayon::prelude::*;
 use std::time::Instant;
 
 /// Assemble the diagnosis; `started`: when it began (for its wall time).
@@ -171,30 +169,15 @@ pub(crate) fn summarise(
 }
 
 /// The covariance of the final model's fitted parameters, from the output
-/// error of the fit samples it was refined on ([`intervals`]): the one
-/// fold's, or every sample's.
+/// error of the fit samples it was refined on
+/// ([`Problem::covariance_on`]): the one fold's, or every sample's.
 fn covariance(p: &Problem, current: &FrictionModel) -> Option<ThetaCovariance> {
     let samples = if p.split.folds.len() == 1 {
         &p.split.folds[0].fits
     } else {
         &p.every_sample
     };
-    let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
-        models
-            .par_iter()
-            .map(|m| p.fit_residuals(m, samples, None))
-            .collect()
-    };
-    // the same residuals with the co-simulation 4× finer: what its step
-    // error moves the estimate by
-    let fine = p.fit_residuals(current, samples, Some(p.fine_step()));
-    intervals::theta_covariance(
-        current,
-        &mut residual,
-        fine.as_ref(),
-        p.scales.len(),
-        p.options.groups,
-    )
+    p.covariance_on(current, samples)
 }
 
 /// Each effect's change from `nominal` in `current` ([`EffectChange`]),

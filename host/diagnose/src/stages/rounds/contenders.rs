@@ -15,6 +15,10 @@
 //! the travel, reached 0.0029 and was named; refined, the viscous
 //! candidate reaches 0.0008 and its σ2 comes within 2 % of the truth.
 //!
+//! A refined contender of one effect whose change from the nominal has a
+//! 95 % interval that holds 0 ([`change_holds_zero`]) is not named: the
+//! data cannot tell its size from none.
+//!
 //! Each contender is then checked against itself with its effect taken
 //! out (its levels kept as refitted with it): when that model keeps the
 //! gain (it passes the round's rule against the current model, and the
@@ -27,13 +31,11 @@
 
 use super::Tried;
 use crate::acceptance::{nested_test, Acceptance, Scored};
-use crate::intervals;
 use crate::model::{Effect, FrictionModel};
 use crate::stages::problem::Problem;
 use crate::stages::refine::refine_folds;
 use crate::stages::rounds::Search;
 use crate::system::System;
-use nalgebra::DVector;
 use rayon::prelude::*;
 
 /// How far a screened contender's held-out RMS may be above the best
@@ -181,7 +183,7 @@ pub(super) fn refine_contenders(
 /// Why a refined contender of one effect is not named when the 95 %
 /// interval of its change from the nominal ([`Effect::change`]: σ2 over
 /// the nominal's, Fc_neg − Fc, F_offset, Fs − Fc, ...) holds 0 in a
-/// fold: the interval the report would give it ([`intervals`], from the
+/// fold: the interval the report would give it ([`Problem::covariance_on`], from the
 /// output error of the fold's fit samples, with the co-simulation's step
 /// error as a bias), so that the diagnosis does not name an effect whose
 /// size the data cannot tell from none. `None` when every fold resolves
@@ -198,20 +200,7 @@ fn change_holds_zero(p: &Problem, added: &[Effect], models: &[FrictionModel]) ->
     let nominal = &p.setup.nominal;
     for (fold, model) in p.split.folds.iter().zip(models) {
         let value = effect.change(nominal, model)?;
-        let mut residual = |models: &[FrictionModel]| -> Vec<Option<DVector<f64>>> {
-            models
-                .par_iter()
-                .map(|m| p.fit_residuals(m, &fold.fits, None))
-                .collect()
-        };
-        let fine = p.fit_residuals(model, &fold.fits, Some(p.fine_step()));
-        let covariance = intervals::theta_covariance(
-            model,
-            &mut residual,
-            fine.as_ref(),
-            p.scales.len(),
-            p.options.groups,
-        )?;
+        let covariance = p.covariance_on(model, &fold.fits)?;
         let [low, high] =
             covariance.interval(model, &|m: &FrictionModel| effect.change(nominal, m))?;
         if low <= 0.0 && 0.0 <= high {
