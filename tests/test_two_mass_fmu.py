@@ -87,6 +87,43 @@ def test_directional_derivatives_are_the_feedthrough_once_an_input_is_set(drive)
     assert combined == pytest.approx(2 * single[("x_l", "u")] + 3 * single[("x_l", "F")], rel=1e-12)
 
 
+def test_states_and_their_partial_derivatives(drive):
+    """The continuous states are listed (ModelStructure/Derivatives) and
+    readable, and with a state among the knowns or a derivative among the
+    unknowns the directional derivatives are the continuous-time partial
+    derivatives (FMI 2.0 §2.1.9), what fricsim's output sensitivities are
+    built from: here the equations of the file's header by hand."""
+    slave, vr, messages, md = drive
+    derivatives = [v for v in md.modelVariables if v.derivative is not None]
+    assert sorted(v.name for v in derivatives) == ["der(v)", "der(v_m)", "der(x_l)", "der(x_m)"]
+    assert sorted(v.derivative.name for v in derivatives) == ["v", "v_m", "x_l", "x_m"]
+    slave.setReal([vr["u"], vr["F"]], [3.0, 0.5])
+    for k in range(20):
+        slave.doStep(k * 1e-3, 1e-3)
+    x_m, v_m, x_l, v, a, dx_m, dv_m, dx_l, dv = slave.getReal(
+        [vr[n] for n in ["x_m", "v_m", "x_l", "v", "a", "der(x_m)", "der(v_m)", "der(x_l)", "der(v)"]])
+    assert v_m != 0.0 and dx_m == v_m and dx_l == v and dv == a
+    m_m, m_l, k_b, c_b, c_m = 0.5, 2.0, 2e4, 20.0, 1.0
+    assert dv_m == pytest.approx((3.0 - k_b * (x_m - x_l) - c_b * (v_m - v) - c_m * v_m) / m_m, rel=1e-12)
+
+    def partial(unknown, known):
+        return slave.getDirectionalDerivative([vr[unknown]], [vr[known]], [1.0])[0]
+
+    assert partial("der(v)", "x_m") == pytest.approx(k_b / m_l, rel=1e-15)
+    assert partial("der(v)", "v") == pytest.approx(-c_b / m_l, rel=1e-15)
+    assert partial("der(v_m)", "v_m") == pytest.approx(-(c_b + c_m) / m_m, rel=1e-15)
+    assert partial("der(x_m)", "v_m") == 1.0
+    assert partial("der(v)", "F") == pytest.approx(-1.0 / m_l, rel=1e-15)
+    assert partial("der(v_m)", "u") == pytest.approx(1.0 / m_m, rel=1e-15)
+    # an output by a state: continuous too (a = der(v))
+    assert partial("a", "x_l") == pytest.approx(-k_b / m_l, rel=1e-15)
+    # a state or derivative is read, never set
+    for name in ["v_m", "der(v)"]:
+        with pytest.raises(Exception):
+            slave.setReal([vr[name]], [1.0])
+    assert any("state or state derivative v_m" in m for s, m in messages if s >= 3), messages
+
+
 @pytest.mark.parametrize(
     "unknown,known,seed,message",
     [

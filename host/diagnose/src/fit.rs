@@ -13,9 +13,9 @@
 //!   on the training data (output error), each residual vector one
 //!   co-simulation; a few iterations from the force fit, for the effects
 //!   whose signature the force estimate cannot see (what happens while the
-//!   contact sticks). The Jacobian by forward differences in θ: the plant
-//!   FMU's state, through which a parameter acts on the outputs, is not
-//!   open to an FMI 2.0 Co-Simulation master.
+//!   contact sticks). The Jacobian from the output sensitivities carried
+//!   along one co-simulation ([`crate::tangent`]) where the plant lists its
+//!   states and is linear; by forward differences in θ otherwise.
 
 use super::model::{Free, FrictionModel};
 use super::problem::FrictionData;
@@ -31,7 +31,7 @@ const DIFF_STEP: f64 = 1e-5;
 
 /// Step of the forward differences of [`polish`]: larger, because a
 /// co-simulation's outputs carry the master's iteration tolerance.
-const POLISH_DIFF_STEP: f64 = 1e-3;
+pub(crate) const POLISH_DIFF_STEP: f64 = 1e-3;
 
 /// The fewest free parameters for which the force fit takes its Jacobian
 /// from the FMU's parameter sensitivities rather than differences. A run
@@ -103,7 +103,11 @@ struct Problem<'a, 'r, C: Coordinates> {
     len: usize,
     diff_step: f64,
     evaluations: usize,
-    /// Stop evaluating (and make LM stop) after this many.
+    /// What the evaluations cost against `budget`: one each, and an exact
+    /// Jacobian as many as the differences it stands in for (so that a
+    /// budget is a number of iterations, whichever way the Jacobian came).
+    charged: usize,
+    /// Stop evaluating (and make LM stop) once this much is charged.
     budget: usize,
     residuals: Option<DVector<f64>>,
     /// The lowest cost seen and its θ: the result, whatever LM reports.
@@ -114,10 +118,11 @@ impl<C: Coordinates> Problem<'_, '_, C> {
     /// The residuals at each θ of `thetas` (one batch), or `None` when the
     /// budget is spent.
     fn residuals_at(&mut self, thetas: &[Vec<f64>]) -> Option<Vec<DVector<f64>>> {
-        if self.evaluations + thetas.len() > self.budget {
+        if self.charged + thetas.len() > self.budget {
             return None;
         }
         self.evaluations += thetas.len();
+        self.charged += thetas.len();
         let models: Vec<C::Model> = thetas.iter().map(|t| self.coordinates.at(t)).collect();
         let results = (self.residual)(&models);
         // an evaluator that gives fewer has stopped (the diagnosis's time
@@ -174,12 +179,13 @@ impl<C: Coordinates> LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_, '_, C> {
         let r0 = self.residuals()?;
         let mut p = self.0.borrow_mut();
         let theta: Vec<f64> = p.theta.iter().copied().collect();
-        if p.evaluations < p.budget {
+        if p.charged + theta.len() <= p.budget {
             let Problem {
                 exact, coordinates, ..
             } = &mut *p;
             if let Some(jacobian) = exact.as_mut().and_then(|j| j(coordinates, &theta)) {
                 p.evaluations += 1;
+                p.charged += theta.len();
                 return Some(jacobian);
             }
         }
@@ -222,6 +228,7 @@ fn minimise<'a, C: Coordinates>(
         len: 1,
         diff_step,
         evaluations: 0,
+        charged: 0,
         budget,
         residuals: None,
         best: None,
@@ -269,7 +276,11 @@ pub fn force_residuals(
 /// their names and rows. By central differences of the map, which is
 /// arithmetic (exponentials of θ, σ1 following √σ0), not a simulation:
 /// with a step of 1e-6 they are exact to about 1e-10.
-fn parameter_map(base: &FrictionModel, free: &[Free], theta: &[f64]) -> Vec<(String, Vec<f64>)> {
+pub(crate) fn parameter_map(
+    base: &FrictionModel,
+    free: &[Free],
+    theta: &[f64],
+) -> Vec<(String, Vec<f64>)> {
     let at = |t: &[f64]| base.at(free, t).parameters();
     let names = at(theta);
     let mut rows = vec![vec![0.0; theta.len()]; names.len()];
@@ -389,13 +400,23 @@ pub fn fit(
 
 /// Refine `start` on an output-error objective (`residual`: one
 /// co-simulation per model, already normalised), with at most `budget`
-/// co-simulations. Returns `start` itself when nothing better was found.
-pub fn polish(start: &FrictionModel, residual: &mut Residuals<'_>, budget: usize) -> Fitted {
+/// co-simulations, or as many iterations as those would make: an exact
+/// Jacobian (`exact`: the output sensitivities carried along one
+/// co-simulation, [`crate::tangent`]; differences where it gives none)
+/// counts as the differences it replaces. Returns `start` itself when
+/// nothing better was found.
+pub fn polish<'a>(
+    start: &FrictionModel,
+    residual: &mut Residuals<'a>,
+    exact: Option<&mut ExactJacobian<'a>>,
+    budget: usize,
+) -> Fitted {
     let coordinates = Freed {
         model: start.clone(),
         free: start.free(),
     };
-    let (model, cost, evaluations) = polish_any(coordinates, residual, budget);
+    let (model, cost, evaluations) =
+        minimise(coordinates, residual, exact, POLISH_DIFF_STEP, budget);
     Fitted {
         model,
         rms: cost.sqrt(),

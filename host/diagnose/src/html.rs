@@ -158,7 +158,7 @@ pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) 
     );
     let _ = write!(
         s,
-        "<header>\n<h1>Diagnosis of <code>{}</code></h1>\n<p class=\"meta\">Measurements: <code>{}</code> ({} samples). Held out: {} ({} samples compared). Friction force: {}. Co-simulation: {} at {} s. {:.1} s wall time, {} co-simulations. Time limit: {}.</p>\n</header>\n",
+        "<header>\n<h1>Diagnosis of <code>{}</code></h1>\n<p class=\"meta\">Measurements: <code>{}</code> ({} samples). Held out: {} ({} samples compared). Friction force: {}. Co-simulation: {} at {} s. {:.1} s wall time, {} co-simulations. Output-error Jacobian: {}. Time limit: {}.</p>\n</header>\n",
         escape(&d.system),
         escape(&d.data),
         d.samples,
@@ -169,6 +169,7 @@ pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) 
         number(d.step),
         d.wall_seconds,
         d.cosimulations,
+        escape(&d.output_jacobian),
         escape(&super::report::time_limit_words(&d.time_limit))
     );
     verdict(&mut s, d);

@@ -165,6 +165,7 @@ pub fn markdown(d: &Diagnosis) -> String {
         "- co-simulation: {} at {} s; {:.2} s wall time, {} co-simulations",
         d.master, d.step, d.wall_seconds, d.cosimulations
     );
+    let _ = writeln!(s, "- output-error Jacobian: {}", d.output_jacobian);
     let _ = writeln!(s, "- time limit: {}\n", time_limit_words(&d.time_limit));
     let _ = writeln!(s, "## Result\n");
     if let Some(sentence) = d.time_limit.sentence() {

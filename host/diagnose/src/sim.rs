@@ -17,6 +17,8 @@ use crate::inputs::ExternalInputs;
 use crate::master::{by_name, by_name_reusing_jacobians, simulate_with};
 use crate::ssp::SystemFile;
 use crate::system::{ParameterValue, System};
+use crate::tangent::Coupling;
+use nalgebra::DMatrix;
 
 /// A parameter's value reference and type in the friction FMU.
 #[derive(Clone, Copy)]
@@ -446,6 +448,16 @@ fn co_simulate_record(
     reuse_jacobian: bool,
 ) -> Result<ChannelResiduals, String> {
     let run = run_on(system, parameters, data, master, step, reuse_jacobian)?;
+    compare(&run, data, step)
+}
+
+/// The residuals of the measured channels of `data` against `run` (a
+/// co-simulation of its time span at macro step `step`).
+fn compare(
+    run: &crate::master::Run,
+    data: &Measured,
+    step: f64,
+) -> Result<ChannelResiduals, String> {
     let mut samples = Vec::new();
     for (k, &t) in data.time.iter().enumerate() {
         let repeated = (k > 0 && data.time[k - 1] == t) || data.quality.excluded[k];
@@ -485,8 +497,91 @@ fn co_simulate_record(
         samples,
         simulated,
         residuals,
-        incomplete: run.error,
+        incomplete: run.error.clone(),
     })
+}
+
+/// The system's parameters and the friction law's values (its FMU's
+/// names) of one co-simulation.
+pub type SystemAndFriction<'a> = (&'a [(String, ParameterValue)], &'a [(String, f64)]);
+
+/// [`co_simulate_with`] at the diagnosis's master and step (no fallback),
+/// with the sensitivities of the simulated channels to the friction
+/// parameters `parameters` (the law FMU's names) carried along each
+/// record's co-simulation ([`Coupling::sensitivities`]): per channel, a
+/// row per compared sample (as the residuals' `samples`), a column per
+/// parameter. `friction`: the law's values (`FrictionModel::parameters`).
+pub fn co_simulate_with_sensitivities(
+    system: &mut System,
+    (system_parameters, friction): SystemAndFriction<'_>,
+    setup: &Setup,
+    data: &Measured,
+    records: Option<&[usize]>,
+    coupling: &Coupling,
+    parameters: &[String],
+) -> Result<(ChannelResiduals, Vec<DMatrix<f64>>), String> {
+    let all: Vec<usize> = (0..data.records.len().max(1)).collect();
+    let mut joined: Option<(ChannelResiduals, Vec<Vec<f64>>)> = None;
+    let channels: Vec<String> = data.outputs.iter().map(|(n, _)| n.clone()).collect();
+    for &i in records.unwrap_or(&all) {
+        let owned;
+        let (record, first) = if data.records.len() <= 1 {
+            (data, 0)
+        } else {
+            owned = data.record(i);
+            (&owned, data.records[i].rows.start)
+        };
+        let run = run_on(
+            system,
+            system_parameters,
+            record,
+            &setup.master,
+            setup.step,
+            setup.reuse_jacobian,
+        )?;
+        if let Some(e) = &run.error {
+            return Err(format!("stopped early: {e}"));
+        }
+        let r = compare(&run, record, setup.step)?;
+        let by_row =
+            coupling.sensitivities((&run, &setup.master), friction, parameters, &channels)?;
+        let (residuals, rows) = joined.get_or_insert_with(|| {
+            (
+                ChannelResiduals::empty(&r.channels),
+                vec![Vec::new(); channels.len()],
+            )
+        });
+        // each compared sample's row of the run (the same time)
+        let mut cursor = 0;
+        for &k in &r.samples {
+            let t = record.time[k];
+            while cursor + 1 < run.time.len() && run.time[cursor] < t - 1e-9 * setup.step {
+                cursor += 1;
+            }
+            if (run.time[cursor] - t).abs() > 1e-9 * setup.step {
+                return Err(format!(
+                    "no communication point at the sample time {t} s: the sensitivities are not interpolated"
+                ));
+            }
+            for (c, m) in by_row.iter().enumerate() {
+                rows[c].extend(m.row(cursor).iter());
+            }
+        }
+        residuals
+            .samples
+            .extend(r.samples.iter().map(|k| k + first));
+        for c in 0..r.channels.len() {
+            residuals.simulated[c].extend_from_slice(&r.simulated[c]);
+            residuals.residuals[c].extend_from_slice(&r.residuals[c]);
+        }
+    }
+    let (residuals, rows) = joined.ok_or_else(|| "no record to co-simulate".to_string())?;
+    let n = residuals.samples.len();
+    let by_sample = rows
+        .into_iter()
+        .map(|values| DMatrix::from_row_slice(n, parameters.len(), &values))
+        .collect();
+    Ok((residuals, by_sample))
 }
 
 /// The friction law's inputs and force along a co-simulation of the

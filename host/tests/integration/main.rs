@@ -49,6 +49,7 @@ mod mid_run_failures;
 mod misuse;
 mod model_description;
 mod model_exchange;
+mod output_sensitivities;
 mod parallel_instances;
 mod parameter_sensitivities;
 mod reference;

@@ -320,6 +320,22 @@ impl LuGre {
         Some(self.sens.as_ref()?.dz[parameter.index()])
     }
 
+    /// Add `dz` to the carried `∂z/∂p` of `parameter`: what a master that
+    /// couples the law to a plant adds after each step when the inputs
+    /// themselves depend on `p` (`∂z⁺/∂v·∂v/∂p + ∂z⁺/∂x·∂x/∂p`, from
+    /// [`LuGre::held_step_sensitivity`]); the law's own update carries
+    /// `∂z/∂p` along inputs that do not. `false` when the sensitivities
+    /// are not carried.
+    pub fn add_to_z_sensitivity(&mut self, parameter: Parameter, dz: f64) -> bool {
+        match self.sens.as_deref_mut() {
+            Some(s) => {
+                s.dz[parameter.index()] += dz;
+                true
+            }
+            None => false,
+        }
+    }
+
     /// `∂F/∂p` at the current state and the inputs `(v, x, Fn)`: the
     /// derivative of [`LuGre::force`] along the trajectory so far (see the
     /// module's equations); `None` when the sensitivities are not carried.

@@ -8,14 +8,21 @@
 
 use super::problem::Problem;
 use super::split::Picker;
-use crate::fit;
+use crate::fit::{self, Coordinates};
 use crate::intervals;
 use crate::model::{Effect, FrictionModel};
-use crate::sim::{co_simulate_robust, co_simulate_with, system_parameters, FrictionSim};
+use crate::sim::{
+    co_simulate_robust, co_simulate_with, co_simulate_with_sensitivities, system_parameters,
+    FrictionSim,
+};
 use crate::ssp::SystemFile;
 use crate::system::ParameterValue;
+use crate::tangent::Coupling;
 use crate::{CANDIDATE_OUTPUT_ERROR_ITERATIONS, OUTPUT_ERROR_STARTS_REFINED};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
+use std::fmt::Write as _;
+use std::sync::atomic::Ordering;
+
 use rayon::prelude::*;
 
 /// The models a fit starts from, built from a fold's current model.
@@ -155,7 +162,136 @@ impl Problem<'_> {
                 .collect()
         };
         let budget = iterations * (model.free().len() + 1) + 1;
-        fit::polish(model, &mut residual, budget)
+        let mut exact = |c: &fit::Freed, theta: &[f64]| self.output_jacobian(c, theta, pick);
+        fit::polish(model, &mut residual, Some(&mut exact), budget)
+    }
+
+    /// The coupling of the system whose output sensitivities the
+    /// output-error fits can carry ([`crate::tangent`]), or why not.
+    pub(crate) fn coupling(&self) -> Result<&Coupling, &str> {
+        self.sensitivities
+            .coupling
+            .get_or_init(|| {
+                let system = self
+                    .file
+                    .build(0.0)
+                    .map_err(|e| format!("building the system: {e}"))?;
+                let params = system_parameters(self.file, &self.setup, &self.setup.nominal);
+                Coupling::new(
+                    &system,
+                    self.setup.friction,
+                    &params,
+                    (&self.data.time, &self.data.inputs),
+                )
+            })
+            .as_ref()
+            .map_err(String::as_str)
+    }
+
+    /// Where the output-error fits took their Jacobian from, for the
+    /// report ([`crate::Diagnosis::output_jacobian`]).
+    pub(crate) fn output_jacobian_words(&self) -> String {
+        let s = &self.sensitivities;
+        let (carried, differenced) = (
+            s.carried.load(Ordering::Relaxed),
+            s.differenced.load(Ordering::Relaxed),
+        );
+        match s.coupling.get() {
+            None => "no output-error fit".into(),
+            Some(Err(why)) => format!("forward differences ({why})"),
+            Some(Ok(_)) => {
+                let mut words = format!(
+                    "output sensitivities carried along one co-simulation for {carried} of {} Jacobians",
+                    carried + differenced
+                );
+                if let Some(why) = s.first_failure.get() {
+                    let _ = write!(
+                        words,
+                        "; forward differences for the others (the first: {why})"
+                    );
+                }
+                words
+            }
+        }
+    }
+
+    /// The Jacobian of the output residuals of the fit samples `pick` in
+    /// the coordinates θ of `c`, from one co-simulation that carries the
+    /// output sensitivities ([`crate::tangent`]); `None` (forward
+    /// differences instead) where the system is not covered or the
+    /// co-simulation or the sensitivities fail (counted, with the first
+    /// reason, for the report).
+    fn output_jacobian(
+        &self,
+        c: &fit::Freed,
+        theta: &[f64],
+        pick: &Picker,
+    ) -> Option<DMatrix<f64>> {
+        let coupling = self.coupling().ok()?;
+        if self.budget.stop_here() {
+            return None;
+        }
+        let s = &self.sensitivities;
+        match self.carried_jacobian(coupling, c, theta, pick) {
+            Ok(jacobian) => {
+                s.carried.fetch_add(1, Ordering::Relaxed);
+                Some(jacobian)
+            }
+            Err(why) => {
+                s.differenced.fetch_add(1, Ordering::Relaxed);
+                let _ = s.first_failure.set(why);
+                None
+            }
+        }
+    }
+
+    /// [`Self::output_jacobian`], or why it could not be carried.
+    fn carried_jacobian(
+        &self,
+        coupling: &Coupling,
+        c: &fit::Freed,
+        theta: &[f64],
+        pick: &Picker,
+    ) -> Result<DMatrix<f64>, String> {
+        let map = fit::parameter_map(&c.model, &c.free, theta);
+        let names: Vec<String> = map.iter().map(|(n, _)| n.clone()).collect();
+        let model = c.at(theta);
+        let params = system_parameters(self.file, &self.setup, &model);
+        self.budget.cosimulation();
+        let mut system = self
+            .file
+            .build(0.0)
+            .map_err(|e| format!("building the system: {e}"))?;
+        let (r, by_sample) = co_simulate_with_sensitivities(
+            &mut system,
+            (&params, &model.parameters()),
+            &self.setup,
+            &self.data,
+            pick.records.as_deref(),
+            coupling,
+            &names,
+        )?;
+        let picked = (pick.pick)(&r);
+        let channels = self.scales.len();
+        let norm = ((picked.len() * channels) as f64).sqrt();
+        let mut jacobian = DMatrix::<f64>::zeros(picked.len() * channels, theta.len());
+        for (row, &s) in picked.iter().enumerate() {
+            for (ch, sens) in by_sample.iter().enumerate() {
+                // residual = measured − simulated
+                let scale = -1.0 / (self.scales[ch] * norm);
+                for (i, (_, dp)) in map.iter().enumerate() {
+                    let ds = sens[(s, i)] * scale;
+                    for (j, &d) in dp.iter().enumerate() {
+                        jacobian[(row * channels + ch, j)] += ds * d;
+                    }
+                }
+            }
+        }
+        if jacobian.iter().all(|x| x.is_finite()) {
+            Ok(jacobian)
+        } else {
+            Err("a sensitivity is not finite".into())
+        }
     }
 
     /// Fit by output error alone, for an effect the force the data imply
@@ -164,10 +300,11 @@ impl Problem<'_> {
     /// fit samples `pick`, then the best refined ([`Problem::polish`]).
     ///
     /// Where the data give no force (another plant than Rig1D) the
-    /// [`OUTPUT_ERROR_STARTS_REFINED`] best starts are refined, each for
-    /// the same few iterations, and the best refined kept; on Rig1D the
-    /// best start only (one of them is the force fit's result, near the
-    /// optimum already).
+    /// [`OUTPUT_ERROR_STARTS_REFINED`] best starts are refined for one
+    /// iteration each, and the best of those for the rest of the
+    /// screen's [`CANDIDATE_OUTPUT_ERROR_ITERATIONS`]; on Rig1D the best
+    /// start only, for all of them (one of the starts is the force fit's
+    /// result, near the optimum already).
     pub(crate) fn fit_output_error(&self, starts: &[FrictionModel], pick: &Picker) -> fit::Fitted {
         let costs: Vec<f64> = starts
             .par_iter()
@@ -178,20 +315,37 @@ impl Problem<'_> {
             .collect();
         let mut order: Vec<usize> = (0..starts.len()).collect();
         order.sort_by(|&a, &b| costs[a].total_cmp(&costs[b]));
-        order.truncate(if self.force.output_error_only.is_some() {
-            OUTPUT_ERROR_STARTS_REFINED
-        } else {
-            1
-        });
-        let fits: Vec<fit::Fitted> = order
+        if self.force.output_error_only.is_none() {
+            order.truncate(1);
+            let mut fitted =
+                self.polish(&starts[order[0]], pick, CANDIDATE_OUTPUT_ERROR_ITERATIONS);
+            fitted.evaluations += starts.len();
+            return fitted;
+        }
+        // one iteration from each of the best starts, the rest of the
+        // screen's iterations from the best of those
+        order.truncate(OUTPUT_ERROR_STARTS_REFINED);
+        let first: Vec<fit::Fitted> = order
             .par_iter()
-            .map(|&k| self.polish(&starts[k], pick, CANDIDATE_OUTPUT_ERROR_ITERATIONS))
+            .map(|&k| self.polish(&starts[k], pick, 1))
             .collect();
-        let evaluations: usize = fits.iter().map(|f| f.evaluations).sum();
-        let mut fitted = fits
+        let mut evaluations: usize = first.iter().map(|f| f.evaluations).sum();
+        let best = first
             .into_iter()
             .min_by(|a, b| a.rms.total_cmp(&b.rms))
             .expect("a fit has a start");
+        let further = CANDIDATE_OUTPUT_ERROR_ITERATIONS.saturating_sub(1);
+        let mut fitted = if further > 0 {
+            let more = self.polish(&best.model, pick, further);
+            evaluations += more.evaluations;
+            if more.rms <= best.rms {
+                more
+            } else {
+                best
+            }
+        } else {
+            best
+        };
         fitted.evaluations = evaluations + starts.len();
         fitted
     }

@@ -13,7 +13,10 @@ use crate::budget::Budget;
 use crate::model::Context;
 use crate::problem::{FrictionData, Measured, Setup};
 use crate::ssp::SystemFile;
+use crate::tangent::Coupling;
 use crate::{Options, FINE_STEP_DIVISOR};
+use std::sync::atomic::AtomicUsize;
+use std::sync::OnceLock;
 
 /// What every stage after the split reads.
 pub(crate) struct Problem<'a> {
@@ -39,6 +42,22 @@ pub(crate) struct Problem<'a> {
     pub(crate) every_sample: Picker,
     /// The time limit and the progress counters ([`Budget`]).
     pub(crate) budget: &'a Budget,
+    /// The output sensitivities of the output-error fits
+    /// ([`crate::tangent`]), set at their first use.
+    pub(crate) sensitivities: Sensitivities,
+}
+
+/// Whether the output-error fits take their Jacobian from the output
+/// sensitivities ([`crate::tangent`]) and, if not, why.
+#[derive(Default)]
+pub(crate) struct Sensitivities {
+    /// The system's coupling, or why it is not covered.
+    pub(crate) coupling: OnceLock<Result<Coupling, String>>,
+    /// Jacobians carried, and those differenced after all.
+    pub(crate) carried: AtomicUsize,
+    pub(crate) differenced: AtomicUsize,
+    /// Why the first of those was differenced.
+    pub(crate) first_failure: OnceLock<String>,
 }
 
 impl<'a> Problem<'a> {
@@ -67,6 +86,7 @@ impl<'a> Problem<'a> {
             context,
             every_sample: Picker::all(),
             budget,
+            sensitivities: Sensitivities::default(),
         }
     }
 

@@ -155,6 +155,7 @@ pub(crate) fn summarise(
         cosimulations: p.budget.cosimulations(),
         polish_seconds: polishing.seconds,
         polish_cosimulations: polishing.cosimulations,
+        output_jacobian: p.output_jacobian_words(),
         step: p.setup.step,
         master: p.setup.master.clone(),
         plots,

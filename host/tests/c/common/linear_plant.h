@@ -14,6 +14,10 @@
  *   VR_H_MAX          the largest RK4 sub-step, a parameter (> 0)
  *   INTERPOLATES_INPUTS  1 if the inputs may ramp over a step (optional, 0)
  *   N_STATES          the number of continuous states
+ *   STATE_VR[N_STATES]  the value reference of each state's variable (an
+ *                     output, or a local of its own)
+ *   FIRST_DERIVATIVE  the value reference of der(state 0); the N_STATES
+ *                     derivatives follow it, locals
  *   REAL_NAMES[N_REAL], REAL_START[N_REAL]   names and start values
  *
  * and after it the plant's physics:
@@ -25,8 +29,11 @@
  *   bad_parameter(p)      the value reference of the first parameter out of
  *                         range, or -1 (h_max is checked here)
  *
- * Every other variable is an input or a parameter, settable before
- * initialization ends; after it only the inputs are.
+ * The states and their derivatives are Real variables (the model
+ * description lists them under ModelStructure/Derivatives), readable in
+ * every phase and never settable. Every other variable is an input or a
+ * parameter, settable before initialization ends; after it only the
+ * inputs are.
  *
  * The step sensitivity needs `derivatives` and `output` to be linear in the
  * state and the inputs together (no constant term; the parameters fixed):
@@ -40,6 +47,14 @@
  * input at u + u'·h; the directional derivatives stay the sensitivity to
  * the input's value with its slope held (the system is linear, so the
  * ramp does not change it), as an importer expects of them.
+ *
+ * With a state among the knowns or a state derivative among the
+ * unknowns, fmi2GetDirectionalDerivative gives the continuous-time
+ * partial derivatives at the current point (∂der/∂state = A, ∂der/∂input
+ * = B, ∂output/∂state = C, ∂output/∂input = D: FMI 2.0 §2.1.9, the same
+ * in Co-Simulation as in Model Exchange), from which an importer can carry
+ * the sensitivity of the state through its own steps; outputs by inputs
+ * alone keep the step sensitivity above.
  *
  * Phases: instantiated -> initialization mode -> step complete ->
  * terminated, and error after a step that failed; each function names the
@@ -99,6 +114,17 @@ typedef struct {
 #define INTERPOLATES_INPUTS 0
 #endif
 #define IS_OUTPUT(vr) IN_RANGE(vr, FIRST_OUTPUT, LAST_OUTPUT)
+#define IS_DERIVATIVE(vr) IN_RANGE(vr, FIRST_DERIVATIVE, FIRST_DERIVATIVE + N_STATES - 1)
+
+/* The index of the state whose variable is `vr`, or -1. */
+static int state_index(fmi2ValueReference vr) {
+    for (int i = 0; i < N_STATES; i++)
+        if (STATE_VR[i] == vr) return i;
+    return -1;
+}
+
+/* A state or derivative that is not an output: read, never set. */
+#define IS_LOCAL(vr) (IS_DERIVATIVE(vr) || (state_index(vr) >= 0 && !IS_OUTPUT(vr)))
 
 /* What the plant file gives, after this header. */
 static void rest(const double *p, double y[N_STATES]);
@@ -403,7 +429,10 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
             logf_(b, fmi2Error, "logStatusError", "fmi2GetReal: no Real variable has value reference %u", vr[i]);
             return fmi2Error;
         }
-        value[i] = IS_OUTPUT(vr[i]) ? output(b->s.real, y, dy, vr[i]) : b->s.real[vr[i]];
+        if (IS_DERIVATIVE(vr[i])) value[i] = dy[vr[i] - FIRST_DERIVATIVE];
+        else if (IS_OUTPUT(vr[i])) value[i] = output(b->s.real, y, dy, vr[i]);
+        else if (state_index(vr[i]) >= 0) value[i] = y[state_index(vr[i])];
+        else value[i] = b->s.real[vr[i]];
     }
     return fmi2OK;
 }
@@ -413,9 +442,11 @@ EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], si
     ENTER("fmi2SetReal", BEFORE_STEPPING | STEP_COMPLETE);
     if (!check_arrays(b, "fmi2SetReal", vr, n, value)) return fmi2Error;
     for (size_t i = 0; i < n; i++) { /* check all first: a refused call changes nothing */
-        if (vr[i] >= N_REAL || IS_OUTPUT(vr[i])) {
-            logf_(b, fmi2Error, "logStatusError", "fmi2SetReal: value reference %u is not a settable Real%s%s",
-                  vr[i], vr[i] < N_REAL ? " (output " : "", vr[i] < N_REAL ? REAL_NAMES[vr[i]] : "");
+        if (vr[i] >= N_REAL || IS_OUTPUT(vr[i]) || IS_LOCAL(vr[i])) {
+            logf_(b, fmi2Error, "logStatusError", "fmi2SetReal: value reference %u is not a settable Real%s%s%s",
+                  vr[i],
+                  vr[i] >= N_REAL ? "" : IS_OUTPUT(vr[i]) ? " (output " : " (state or state derivative ",
+                  vr[i] < N_REAL ? REAL_NAMES[vr[i]] : "", vr[i] < N_REAL ? ")" : "");
             return fmi2Error;
         }
         if (!IS_INPUT(vr[i]) && !(b->s.phase & BEFORE_STEPPING)) {
@@ -574,6 +605,23 @@ static void output_sensitivity(const Instance *b, fmi2ValueReference known, doub
     for (fmi2ValueReference o = FIRST_OUTPUT; o <= LAST_OUTPUT; o++) d[o] = output(unit, y, dy, o);
 }
 
+/* The continuous-time partial derivatives of the outputs and the state
+ * derivatives by one known at the current point, indexed by value
+ * reference: the model is linear in the state and the inputs together, so
+ * they are the outputs and derivatives at a unit state or input with
+ * everything else 0. */
+static void continuous_partials(const Instance *b, fmi2ValueReference known, double d[N_REAL]) {
+    memset(d, 0, sizeof(double) * N_REAL);
+    double unit[N_REAL], y[N_STATES] = {0}, dy[N_STATES];
+    memcpy(unit, b->s.real, sizeof unit);
+    for (fmi2ValueReference i = FIRST_INPUT; i <= LAST_INPUT; i++) unit[i] = known == i;
+    int k = state_index(known);
+    if (k >= 0) y[k] = 1.0;
+    derivatives(unit, y, dy);
+    for (fmi2ValueReference o = FIRST_OUTPUT; o <= LAST_OUTPUT; o++) d[o] = output(unit, y, dy, o);
+    for (int i = 0; i < N_STATES; i++) d[FIRST_DERIVATIVE + i] = dy[i];
+}
+
 EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference unknown[],
                                                size_t n_unknown, const fmi2ValueReference known[],
                                                size_t n_known, const fmi2Real d_known[],
@@ -587,17 +635,22 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueR
         return fmi2Error;
     }
     char list[256];
-    for (size_t i = 0; i < n_unknown; i++)
-        if (!IS_OUTPUT(unknown[i])) {
+    /* a state among the knowns or a derivative among the unknowns: the
+     * continuous-time partials; else the step sensitivity */
+    int continuous = 0;
+    for (size_t i = 0; i < n_unknown; i++) {
+        if (!IS_OUTPUT(unknown[i]) && !IS_DERIVATIVE(unknown[i])) {
             logf_(b, fmi2Error, "logStatusError",
-                  "fmi2GetDirectionalDerivative: unknown value reference %u is not an output (%s)",
+                  "fmi2GetDirectionalDerivative: unknown value reference %u is not an output (%s) or a state derivative",
                   unknown[i], names(FIRST_OUTPUT, LAST_OUTPUT, list, sizeof list));
             return fmi2Error;
         }
+        continuous |= IS_DERIVATIVE(unknown[i]);
+    }
     for (size_t j = 0; j < n_known; j++) {
-        if (!IS_INPUT(known[j])) {
+        if (!IS_INPUT(known[j]) && state_index(known[j]) < 0) {
             logf_(b, fmi2Error, "logStatusError",
-                  "fmi2GetDirectionalDerivative: known value reference %u is not an input (%s)", known[j],
+                  "fmi2GetDirectionalDerivative: known value reference %u is not an input (%s) or a state", known[j],
                   names(FIRST_INPUT, LAST_INPUT, list, sizeof list));
             return fmi2Error;
         }
@@ -606,11 +659,13 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueR
                   d_known[j], REAL_NAMES[known[j]]);
             return fmi2Error;
         }
+        continuous |= state_index(known[j]) >= 0;
     }
     for (size_t i = 0; i < n_unknown; i++) d_unknown[i] = 0.0;
     for (size_t j = 0; j < n_known; j++) {
         double d[N_REAL];
-        output_sensitivity(b, known[j], d);
+        if (continuous) continuous_partials(b, known[j], d);
+        else output_sensitivity(b, known[j], d);
         for (size_t i = 0; i < n_unknown; i++) d_unknown[i] += d[unknown[i]] * d_known[j];
     }
     return fmi2OK;

@@ -52,6 +52,8 @@ enum {
     VR_X_M, VR_X_L, VR_V, VR_A,                  /* outputs */
     VR_M_M, VR_M_L, VR_K_B, VR_C_B, VR_C_M,      /* Real parameters */
     VR_X0, VR_H_MAX,
+    VR_V_M,                                      /* local state */
+    VR_DER_X_M, VR_DER_V_M, VR_DER_X_L, VR_DER_V, /* state derivatives */
     N_REAL
 };
 #define FIRST_INPUT VR_U
@@ -59,13 +61,18 @@ enum {
 #define FIRST_OUTPUT VR_X_M
 #define LAST_OUTPUT VR_A
 
-static const char *const REAL_NAMES[N_REAL] = {"u",   "F",   "x_m", "x_l", "v",  "a",    "m_m",
-                                               "m_l", "k_b", "c_b", "c_m", "x0", "h_max"};
-static const double REAL_START[N_REAL] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5,
-                                          2.0, 2e4, 20.0, 1.0, 0.0, 1e-4};
+#define FIRST_DERIVATIVE VR_DER_X_M
 
-/* The continuous state. */
+static const char *const REAL_NAMES[N_REAL] = {
+    "u",   "F",   "x_m", "x_l", "v",  "a",     "m_m",      "m_l",      "k_b",      "c_b",
+    "c_m", "x0",  "h_max", "v_m", "der(x_m)", "der(v_m)", "der(x_l)", "der(v)"};
+static const double REAL_START[N_REAL] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5, 2.0, 2e4,
+                                          20.0, 1.0, 0.0, 1e-4, 0.0, 0.0, 0.0, 0.0, 0.0};
+
+/* The continuous state and the variable of each (the load's velocity is
+ * the output v; the motor's, v_m, a local). */
 enum { XM, VM, XL, VL, N_STATES };
+static const unsigned int STATE_VR[N_STATES] = {VR_X_M, VR_V_M, VR_X_L, VR_V};
 
 #include "../common/linear_plant.h"
 
