@@ -1,7 +1,8 @@
-"""Shared by the tests of the hand-written C plant FMUs
-(host/tests/c/two_mass_drive, host/tests/c/servo_axis, both on
-host/tests/c/common/linear_plant.h): an instance opened with FMPy with its
-messages collected, and the step's outputs and Jacobian read through it."""
+"""Shared by the tests of the plant FMUs (the hand-written C ones,
+host/tests/c/two_mass_drive and host/tests/c/servo_axis, both on
+host/tests/c/common/linear_plant.h, and the shipped Rig1D): an instance
+opened with FMPy with its messages collected, and the step's outputs and
+Jacobian read through it."""
 
 from __future__ import annotations
 
@@ -21,9 +22,17 @@ def open_plant(tmp_path, plant, initialize=True):
     """Build the plant's FMU into tmp_path and yield (slave, value
     references by name, the logged (status, message) list, model
     description), instantiated and (when `initialize`) initialised."""
-    fmu = two_mass_fmu.build(tmp_path, plant)
+    yield from open_fmu(tmp_path, two_mass_fmu.build(tmp_path, plant), initialize=initialize)
+
+
+def open_fmu(tmp_path, fmu, parameters=None, initialize=True):
+    """Yield (slave, value references by name, the logged (status,
+    message) list, model description) of the FMU file `fmu`, instantiated
+    with logging on, its `parameters` (name: value) set, and (when
+    `initialize`) initialised; terminated and freed afterwards."""
     md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
+    variables = {v.name: v for v in md.modelVariables}
+    vr = {n: v.valueReference for n, v in variables.items()}
     messages = []
 
     def logger(env, instance, status, category, message):
@@ -36,9 +45,14 @@ def open_plant(tmp_path, plant, initialize=True):
     add_logger_proxy(callbacks)
     slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=str(tmp_path / "unzipped")),
                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="drive")
-    slave.instantiate(callbacks=callbacks)
+    slave.instantiate(callbacks=callbacks, loggingOn=True)
     if initialize:
         slave.setupExperiment(startTime=0.0)
+        for name, value in (parameters or {}).items():
+            if variables[name].type == "Integer":
+                slave.setInteger([vr[name]], [value])
+            else:
+                slave.setReal([vr[name]], [value])
         slave.enterInitializationMode()
         slave.exitInitializationMode()
     yield slave, vr, messages, md

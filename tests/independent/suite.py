@@ -15,7 +15,7 @@ DATA.csv --out DIR`), and scored from its report.json:
 
 Usage: python3 tests/independent/suite.py [--quick] [--out DIR]
        [--seeds N] [--jobs N] [--fricsim BINARY] [--update BENCHMARKS.md]
-       [--any-plant] [--only KIND,...] [--versus OLD_FRICSIM]
+       [--any-plant] [--only KIND,...] [--versus OLD_FRICSIM [--versus-dist OLD_DIST]]
 --any-plant runs the any-plant cases instead (cases.PLANT_KINDS: every
 effect on each plant that is not Rig1D, at 10 % and 5 %; the null and
 presliding, whose size the magnitude does not set, at 10 %; no coarse
@@ -30,7 +30,8 @@ break-away) against a LuGre nominal, named right as
 --versus OLD_FRICSIM diagnoses each case with an older build as well, in
 turn with this one on the same data (the old first), and writes a
 before/after table: the effects found, the size error, the final/given
-RMS and the time of each case, and both summaries.
+RMS and the time of each case, and both summaries. With --versus-dist
+OLD_DIST the older build runs each system with its own FMUs (its dist/).
 Writes DIR/suite.json and DIR/suite.md; with --update, the table between
 the "independent-suite" markers of BENCHMARKS.md ("any-plant" with
 --any-plant).
@@ -322,12 +323,19 @@ def any_plant_grid(seeds: int, quick: bool, first_seed: int = 1) -> list[tuple[c
     ]
 
 
-def run_case_versus(case: cases.Case, work: Path, extra: tuple, timeout: float | None, old: Path) -> dict:
+def run_case_versus(case: cases.Case, work: Path, extra: tuple, timeout: float | None, old: Path,
+                    old_dist: Path | None = None) -> dict:
     """Make one case and diagnose it with the build `old` and then with
     this one (FRICSIM), in turn on the same data: the row of this build,
-    with the old build's row under "before"."""
+    with the old build's row under "before". With `old_dist`, the old
+    build runs the system with that build's FMUs (its dist/) instead of
+    this one's."""
     data, ssd = cases.make(case, work)
-    before = diagnose_case(case, work, data, ssd, [], False, extra, timeout, old, "-before", time.time())
+    old_ssd = ssd
+    if old_dist is not None:
+        old_ssd = ssd.with_name(ssd.stem + "-before.ssd")
+        old_ssd.write_text(ssd.read_text().replace(str(cases.ROOT / "dist") + "/", str(old_dist) + "/"))
+    before = diagnose_case(case, work, data, old_ssd, [], False, extra, timeout, old, "-before", time.time())
     row = diagnose_case(case, work, data, ssd, [], False, extra, timeout, FRICSIM, "", time.time())
     row["before"] = before
     return row
@@ -480,6 +488,12 @@ def main() -> int:
         "write a before/after table (with --update: between the \"any-plant\" markers when --any-plant)",
     )
     ap.add_argument(
+        "--versus-dist",
+        type=Path,
+        metavar="OLD_DIST",
+        help="with --versus: the older build's FMUs (its dist/ folder), which its runs use instead of this one's",
+    )
+    ap.add_argument(
         "--first-seed",
         type=int,
         default=1,
@@ -509,7 +523,8 @@ def main() -> int:
             rows = list(
                 pool.map(
                     lambda cb: run_case_versus(cb[0], args.out / "cases", tuple(args.diagnose_arg),
-                                               args.case_timeout, old),
+                                               args.case_timeout, old,
+                                               args.versus_dist.resolve() if args.versus_dist else None),
                     [cb for cb in todo if not cb[1]],
                 )
             )

@@ -567,12 +567,13 @@ impl Instance {
     /// The values of the `der(…)` variables ([`Model::derivatives`]) at the
     /// current state and inputs (the model initialized).
     fn compute_derivatives(&mut self) {
-        let Some(me) = self.info.model_exchange else {
+        let states = self.info.continuous_states();
+        if states.is_empty() {
             return;
-        };
-        let mut dx = vec![0.0; me.states.len()];
+        }
+        let mut dx = vec![0.0; states.len()];
         self.model.derivatives(&self.values, &mut dx);
-        for (s, d) in me.states.iter().zip(dx) {
+        for (s, d) in states.iter().zip(dx) {
             self.values.set(s.derivative, d);
         }
     }
@@ -1102,8 +1103,8 @@ impl Instance {
         dv_known: &[f64],
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
-        if self.model_exchange {
-            return self.me_directional_derivative(unknowns, (knowns, dv_known), dv_unknown);
+        if self.model_exchange || self.asks_state_partials(unknowns, knowns) {
+            return self.state_directional_derivative(unknowns, (knowns, dv_known), dv_unknown);
         }
         let is_parameter = |vr: &u32| {
             self.variable(*vr)
@@ -1129,6 +1130,18 @@ impl Instance {
             self.check_directional(unknowns, knowns, dv_known, Causality::Input)?;
         }
         self.directional_checked(unknowns, knowns, dv_known, dv_unknown)
+    }
+
+    /// Whether a call of a Co-Simulation instance asks for the
+    /// continuous-time partial derivatives of the states it lists
+    /// ([`crate::ModelInfo::co_simulation_states`]): a state among the
+    /// knowns or a state derivative among the unknowns. (Outputs by inputs
+    /// alone stay the step sensitivity a strongly coupled master takes.)
+    fn asks_state_partials(&self, unknowns: &[u32], knowns: &[u32]) -> bool {
+        let info = self.info;
+        !info.co_simulation_states.is_empty()
+            && (knowns.iter().any(|&k| info.is_state(k))
+                || unknowns.iter().any(|&u| info.is_derivative(u)))
     }
 
     /// [`Instance::directional_derivative`] with Real parameters as the

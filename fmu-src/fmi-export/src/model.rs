@@ -200,6 +200,24 @@ pub trait Model: Send {
     /// nothing (a model without continuous states).
     fn derivatives(&self, _values: &Values, _dx: &mut [f64]) {}
 
+    /// `∂unknown/∂known` of a Co-Simulation model that lists continuous
+    /// states ([`crate::ModelInfo::co_simulation_states`]), at its current
+    /// state and the inputs in `values`: `unknown` a state derivative or a
+    /// Real output, `known` a listed state or a Real input (value
+    /// references, checked), continuous-time partial derivatives as in
+    /// Model Exchange. `Err` says why the model does not give it (a mode
+    /// without those states, say); the default gives none.
+    fn state_partial_derivative(
+        &self,
+        _values: &Values,
+        unknown: u32,
+        known: u32,
+    ) -> Result<f64, String> {
+        Err(format!(
+            "the model gives no partial derivative of value reference {unknown} with respect to {known}"
+        ))
+    }
+
     /// The Model Exchange part of a model instantiated for it
     /// ([`ModelFactory::create_model_exchange`]); `None` (the default) for
     /// a Co-Simulation model.

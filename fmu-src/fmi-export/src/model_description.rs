@@ -143,11 +143,15 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
         if let Some(s) = start {
             let _ = write!(attrs, r#" start="{s}""#);
         }
+        // a derivative names its state by index (value reference + 1)
+        if let Some(s) = info
+            .continuous_states()
+            .iter()
+            .find(|s| s.derivative == v.vr)
+        {
+            let _ = write!(attrs, r#" derivative="{}""#, s.state + 1);
+        }
         if let Some(me) = &info.model_exchange {
-            // a derivative names its state by index (value reference + 1)
-            if let Some(s) = me.states.iter().find(|s| s.derivative == v.vr) {
-                let _ = write!(attrs, r#" derivative="{}""#, s.state + 1);
-            }
             if me.states_jump_at_events && me.is_state(v.vr) {
                 let _ = write!(attrs, r#" reinit="true""#);
             }
@@ -196,9 +200,10 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
     let mut initial_unknowns: Vec<usize> = outputs.iter().map(|(i, _)| *i).collect();
     // (a model without continuous states, only event indicators, has no
     // `<Derivatives>`: the schema wants at least one `<Unknown>` in it)
-    if let Some(me) = info.model_exchange.filter(|me| !me.states.is_empty()) {
+    let states = info.continuous_states();
+    if !states.is_empty() {
         let _ = writeln!(w, "    <Derivatives>");
-        for s in me.states {
+        for s in states {
             let i = s.derivative as usize;
             unknown(w, i, &info.variables[i]);
             // the derivatives and the states, all `initial="calculated"`

@@ -341,6 +341,15 @@ pub struct ModelInfo {
     /// The Model Exchange interface, for a model that is an ODE with its
     /// states and event indicators; `None`: Co-Simulation only.
     pub model_exchange: Option<ModelExchange>,
+    /// The continuous states a Co-Simulation-only model lists in
+    /// `ModelStructure/Derivatives` (FMI 2.0.4 §2.2.8 allows it for
+    /// Co-Simulation: the states and their derivatives then carry the
+    /// partial derivatives an importer linearizes with,
+    /// `fmi2GetDirectionalDerivative` with a state among the knowns or a
+    /// derivative among the unknowns, [`crate::Model::state_partial_derivative`]).
+    /// Empty for a model with a Model Exchange interface, whose states are
+    /// [`ModelExchange::states`].
+    pub co_simulation_states: &'static [ContinuousState],
 }
 
 /// Log categories every FMU of this layer declares, in this order.
@@ -358,6 +367,26 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
 ];
 
 impl ModelInfo {
+    /// The continuous states the model description lists: those of the
+    /// Model Exchange interface, or those a Co-Simulation-only model lists
+    /// ([`ModelInfo::co_simulation_states`]).
+    pub fn continuous_states(&self) -> &'static [ContinuousState] {
+        match &self.model_exchange {
+            Some(me) => me.states,
+            None => self.co_simulation_states,
+        }
+    }
+
+    /// Whether `vr` is one of the listed state variables.
+    pub fn is_state(&self, vr: u32) -> bool {
+        self.continuous_states().iter().any(|s| s.state == vr)
+    }
+
+    /// Whether `vr` is one of the listed state derivatives.
+    pub fn is_derivative(&self, vr: u32) -> bool {
+        self.continuous_states().iter().any(|s| s.derivative == vr)
+    }
+
     pub fn variable(&self, vr: u32) -> Option<&'static Variable> {
         self.variables.get(vr as usize)
     }
@@ -410,14 +439,14 @@ impl ModelInfo {
                     }
                 }
             }
-            let is_state = |vr: u32| self.model_exchange.is_some_and(|me| me.is_state(vr));
+            let is_state = |vr: u32| self.is_state(vr);
             if let Some(d) = v.depends_on_states.iter().find(|d| !is_state(**d)) {
                 return Err(format!(
                     "{}: {} depends on vr {d} which is not a continuous state",
                     self.model_name, v.name
                 ));
             }
-            let is_derivative = self.model_exchange.is_some_and(|me| me.is_derivative(v.vr));
+            let is_derivative = self.is_derivative(v.vr);
             let local_kind = is_derivative || is_state(v.vr) && v.causality == Causality::Local;
             if (v.causality == Causality::Local) != local_kind {
                 return Err(format!(
@@ -429,21 +458,25 @@ impl ModelInfo {
                 ));
             }
         }
-        if let Some(me) = &self.model_exchange {
-            for s in me.states {
-                let state = self.variable(s.state);
-                let derivative = self.variable(s.derivative);
-                let real_continuous = |v: Option<&Variable>| {
-                    v.is_some_and(|v| {
-                        v.var_type == VarType::Real && v.variability == Variability::Continuous
-                    })
-                };
-                if !real_continuous(state) || !real_continuous(derivative) {
-                    return Err(format!(
-                        "{}: continuous state vr {} or its derivative vr {} is not a continuous Real variable",
-                        self.model_name, s.state, s.derivative
-                    ));
-                }
+        if self.model_exchange.is_some() && !self.co_simulation_states.is_empty() {
+            return Err(format!(
+                "{}: lists Co-Simulation states beside a Model Exchange interface (its states are the interface's)",
+                self.model_name
+            ));
+        }
+        for s in self.continuous_states() {
+            let state = self.variable(s.state);
+            let derivative = self.variable(s.derivative);
+            let real_continuous = |v: Option<&Variable>| {
+                v.is_some_and(|v| {
+                    v.var_type == VarType::Real && v.variability == Variability::Continuous
+                })
+            };
+            if !real_continuous(state) || !real_continuous(derivative) {
+                return Err(format!(
+                    "{}: continuous state vr {} or its derivative vr {} is not a continuous Real variable",
+                    self.model_name, s.state, s.derivative
+                ));
             }
         }
         Ok(())
@@ -476,6 +509,7 @@ mod tests {
                 step_size: 0.1,
             },
             capabilities: Capabilities::FULL,
+            co_simulation_states: &[],
             model_exchange: Some(ModelExchange {
                 states: &[ContinuousState {
                     state: 3,
@@ -485,6 +519,34 @@ mod tests {
                 states_jump_at_events: false,
             }),
         }
+    }
+
+    /// A Co-Simulation-only model may list its states (rendered as Model
+    /// Exchange's are: the `derivative` attribute and `<Derivatives>`,
+    /// with no `<ModelExchange>` element); beside a Model Exchange
+    /// interface, whose states they would be, they are refused.
+    #[test]
+    fn a_co_simulation_model_may_list_its_states() {
+        const STATES: &[ContinuousState] = &[ContinuousState {
+            state: 3,
+            derivative: 2,
+        }];
+        let listed = ModelInfo {
+            co_simulation_states: STATES,
+            model_exchange: None,
+            ..info(Variable::state(3, "s", "", "the state"))
+        };
+        listed.check().unwrap();
+        assert!(listed.is_state(3) && listed.is_derivative(2) && !listed.is_state(2));
+        let xml = crate::model_description::render(&listed, "test").unwrap();
+        assert!(xml.contains(r#"<Real derivative="4"/>"#), "{xml}");
+        assert!(xml.contains("<Derivatives>") && !xml.contains("<ModelExchange"), "{xml}");
+        let both = ModelInfo {
+            co_simulation_states: STATES,
+            ..info(Variable::state(3, "s", "", "the state"))
+        };
+        let e = both.check().unwrap_err();
+        assert!(e.contains("beside a Model Exchange interface"), "{e}");
     }
 
     /// A continuous state may be a local variable (not only an output),

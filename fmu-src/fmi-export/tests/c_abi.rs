@@ -33,6 +33,7 @@ static INFO: ModelInfo = ModelInfo {
         step_size: 0.1,
     },
     capabilities: Capabilities::FULL,
+    co_simulation_states: &[],
     model_exchange: None,
 };
 

@@ -32,6 +32,7 @@ const fn info(name: &'static str, guid: &'static str) -> ModelInfo {
             step_size: 0.1,
         },
         capabilities: Capabilities::FULL,
+        co_simulation_states: &[],
         model_exchange: None,
     }
 }

@@ -136,6 +136,7 @@ pub static INFO: ModelInfo = ModelInfo {
         step_size: 1e-3,
     },
     capabilities: Capabilities::FULL,
+    co_simulation_states: &[],
     model_exchange: Some(ModelExchange {
         states: &[],
         event_indicators: 4,

@@ -122,6 +122,7 @@ pub static INFO: ModelInfo = ModelInfo {
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
+    co_simulation_states: &[],
     model_exchange: Some(ModelExchange {
         states: &[ContinuousState {
             state: vr::F_DAHL,

@@ -300,6 +300,7 @@ pub static INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
     variables: Box::leak(variables().into_boxed_slice()),
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 1.0, step_size: 1e-3 },
     capabilities: Capabilities::FULL,
+    co_simulation_states: &[],
     model_exchange: Some(ModelExchange {
         states: &[ContinuousState { state: vr::Z, derivative: vr::DER_Z }],
         event_indicators: 1,

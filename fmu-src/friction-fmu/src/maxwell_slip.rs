@@ -294,6 +294,7 @@ pub static MAXWELL_SLIP_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
         variables: Box::leak(variables.into_boxed_slice()),
         default_experiment: EXPERIMENT,
         capabilities: Capabilities::FULL,
+        co_simulation_states: &[],
         model_exchange: Some(model_exchange(MAXWELL_SLIP_LAYOUT)),
     }
 });
@@ -350,6 +351,7 @@ pub static GMS_INFO: LazyLock<ModelInfo> = LazyLock::new(|| {
         variables: Box::leak(variables.into_boxed_slice()),
         default_experiment: EXPERIMENT,
         capabilities: Capabilities::FULL,
+        co_simulation_states: &[],
         model_exchange: Some(model_exchange(GMS_LAYOUT)),
     }
 });

@@ -442,6 +442,35 @@ pub struct StepSensitivity {
     pub applied_force: f64,
 }
 
+/// A state or input of the rig's linearization ([`Rig1D::partials`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Known {
+    /// The position state x.
+    Position,
+    /// The velocity state ẋ.
+    Velocity,
+    /// The friction force input F (applied as −F).
+    Friction,
+    /// The external force input F_ext.
+    ExternalForce,
+    /// The actuator point input x_act_in (`Actuator::Input`).
+    ActuatorInput,
+    /// The reference inputs x_ref and v_ref (`Control::Input`).
+    ReferencePosition,
+    ReferenceVelocity,
+}
+
+/// `∂/∂known` of the rig's outputs and of the time derivatives of its
+/// states (x, ẋ) at one instant ([`Rig1D::partials`]): the derivative of
+/// x is ẋ, that of ẋ the acceleration output.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Partials {
+    /// Of dx/dt = ẋ.
+    pub position_rate: f64,
+    /// Of every output; `acceleration` is also that of dẋ/dt.
+    pub outputs: Rig1DOutputs,
+}
+
 /// The state at one instant: position, velocity, velocity-error integral.
 #[derive(Clone, Copy, Debug)]
 struct Point {
@@ -762,6 +791,78 @@ impl Rig1D {
 
     pub fn drive_force_rate(&self) -> f64 {
         self.p.drive.rate(self.t)
+    }
+
+    /// The continuous-time partial derivatives `∂/∂known` of the outputs
+    /// and of (ẋ, ẍ) at the current state and inputs `u`, with the states
+    /// x and ẋ (m > 0): the rig's right-hand side is affine in them and in
+    /// the inputs on each piece of the saturation, so these are its
+    /// coefficients on the piece the command `u` lies in now (saturated:
+    /// the controller adds nothing).
+    ///
+    /// The controller's integral is not a state of its own: ξ = ∫(v_ref −
+    /// ẋ) dt = ∫v_ref dt − (x − x0) from ξ(0) = 0, a function of the
+    /// position, so the command u = Kp·(x_ref − x) + Kd·(β·v_ref − ẋ) +
+    /// Ki·ξ has ∂u/∂x = −(Kp + Ki), ∂u/∂ẋ = −Kd, and from the reference
+    /// inputs ∂u/∂x_ref = Kp, ∂u/∂v_ref = β·Kd. With F_ctrl = G·u,
+    ///
+    /// ```text
+    /// m·ẍ = k·(x_a − x) − c·ẋ + F_ext − F + F_d(t) + F_ctrl,
+    /// F_app = k·(x_a − x) − c·ẋ + F_ext + F_d(t) + F_ctrl − m·a_s(t).
+    /// ```
+    ///
+    /// The quasi-static mode (m = 0) has no velocity state: an error.
+    pub fn partials(&self, u: &Rig1DInputs, known: Known) -> Result<Partials, String> {
+        let p = &self.p;
+        if p.m == 0.0 {
+            return Err(
+                "the quasi-static mode (m = 0) has no velocity state: the partial derivatives of the states x and v_body are not defined"
+                    .into(),
+            );
+        }
+        let one = |k: Known| if k == known { 1.0 } else { 0.0 };
+        let actuator = match p.actuator {
+            Actuator::Input => one(Known::ActuatorInput),
+            Actuator::Prescribed => 0.0,
+        };
+        let g = &p.control;
+        // the command's partial on the piece it lies in now
+        let command = if g.on()
+            && g.piece(self.command_at(&self.here(), 0.0, u, &Rig1DInputs::default())) == 0
+        {
+            let reference = match g.mode {
+                Control::Input => {
+                    g.kp * one(Known::ReferencePosition)
+                        + g.kd * g.ff * one(Known::ReferenceVelocity)
+                }
+                _ => 0.0,
+            };
+            -(g.kp + g.ki) * one(Known::Position) - g.kd * one(Known::Velocity) + reference
+        } else {
+            0.0
+        };
+        let control_force = g.gain * command;
+        let position = one(Known::Position);
+        let velocity = one(Known::Velocity);
+        let spring_force = p.k * (actuator - position);
+        let applied_force =
+            spring_force - p.c * velocity + one(Known::ExternalForce) + control_force;
+        Ok(Partials {
+            position_rate: velocity,
+            outputs: Rig1DOutputs {
+                position,
+                slip_velocity: velocity,
+                acceleration: (applied_force - one(Known::Friction)) / p.m,
+                spring_force,
+                actuator_position: actuator,
+                relative_displacement: position,
+                velocity,
+                drive_force: 0.0,
+                control_command: command,
+                control_force,
+                applied_force,
+            },
+        })
     }
 
     /// Quasi-static ẋ at the current time with inputs u moving at du:

@@ -6,11 +6,18 @@
 //!
 //! Value references 0–14 are those of the first version (ramp actuator
 //! only); the modes' variables follow, then the applied force `F_app`
-//! (43), the input of a friction law with a stuck state (Classical).
+//! (43), the input of a friction law with a stuck state (Classical), then
+//! the derivatives of the two continuous states the model description
+//! lists (44, 45): the position `x` and the body velocity `v_body`, whose
+//! partial derivatives an importer can linearize the rig with
+//! (`fmi2GetDirectionalDerivative` with a state among the knowns or a
+//! derivative among the unknowns; [`Rig1D::partials`]).
 
-use fmi_export::{Capabilities, DefaultExperiment, Model, ModelInfo, Values, Variable};
+use fmi_export::{
+    Capabilities, ContinuousState, DefaultExperiment, Model, ModelInfo, Values, Variable,
+};
 use rig_dynamics::rig1d::{
-    Actuator, Control, Controller, DriveForce, Reference, Rig1D, Rig1DInputs, Rig1DParams,
+    Actuator, Control, Controller, DriveForce, Known, Reference, Rig1D, Rig1DInputs, Rig1DParams,
 };
 use rig_dynamics::signals::Sinusoid;
 
@@ -59,6 +66,8 @@ pub mod vr {
     pub const CTRL_GAIN: u32 = 41;
     pub const CTRL_U_MAX: u32 = 42;
     pub const F_APP: u32 = 43;
+    pub const DER_X: u32 = 44;
+    pub const DER_V_BODY: u32 = 45;
 }
 
 /// Direct feedthrough, over every mode (a dependency that is zero in the
@@ -77,7 +86,12 @@ const REFERENCE_INPUTS: &[u32] = &[vr::X_REF, vr::V_REF];
 /// with it (Classical) and feeding F back forms no algebraic loop.
 const APPLIED_FORCE_DEPS: &[u32] = &[vr::F_EXT, vr::X_ACT_IN, vr::X_REF, vr::V_REF];
 
-static VARIABLES: [Variable; 44] = [
+/// The listed states (position, body velocity) and both.
+const POSITION: &[u32] = &[vr::X];
+const VELOCITY: &[u32] = &[vr::V_BODY];
+const STATES: &[u32] = &[vr::X, vr::V_BODY];
+
+static VARIABLES: [Variable; 46] = [
     Variable::input(
         vr::F,
         "F",
@@ -100,28 +114,32 @@ static VARIABLES: [Variable; 44] = [
         "m",
         "Body position (quasi-static mode m = c = 0: x = x_act + (F_ext - F + F_drive)/k)",
         POSITION_DEPS,
-    ),
+    )
+    .with_state_dependencies(POSITION),
     Variable::output(
         vr::V,
         "v",
         "m/s",
         "Slip velocity: body velocity minus surface velocity, v_body - v_s(t)",
         &[],
-    ),
+    )
+    .with_state_dependencies(VELOCITY),
     Variable::output(
         vr::A,
         "a",
         "m/s2",
         "Body acceleration (0 in the quasi-static mode)",
         ALL_INPUTS,
-    ),
+    )
+    .with_state_dependencies(STATES),
     Variable::output(
         vr::F_SPRING,
         "F_spring",
         "N",
         "Actuator (spring) force on the body k*(x_act - x)",
         POSITION_DEPS,
-    ),
+    )
+    .with_state_dependencies(POSITION),
     Variable::output(
         vr::X_ACT,
         "x_act",
@@ -211,8 +229,16 @@ static VARIABLES: [Variable; 44] = [
         "m",
         "Displacement relative to the surface x - x_s(t), for displacement-driven friction laws",
         POSITION_DEPS,
-    ),
-    Variable::output(vr::V_BODY, "v_body", "m/s", "Body velocity dx/dt", &[]),
+    )
+    .with_state_dependencies(POSITION),
+    Variable::output(
+        vr::V_BODY,
+        "v_body",
+        "m/s",
+        "Body velocity dx/dt",
+        &[],
+    )
+    .with_state_dependencies(VELOCITY),
     Variable::output(
         vr::F_DRIVE,
         "F_drive",
@@ -226,14 +252,16 @@ static VARIABLES: [Variable; 44] = [
         "V",
         "Controller command after saturation, sat(u, +-ctrl_u_max) (EMPS: vir); 0 when control = 0",
         REFERENCE_INPUTS,
-    ),
+    )
+    .with_state_dependencies(STATES),
     Variable::output(
         vr::F_CTRL,
         "F_ctrl",
         "N",
         "Controller force on the body ctrl_gain*u_ctrl",
         REFERENCE_INPUTS,
-    ),
+    )
+    .with_state_dependencies(STATES),
     Variable::integer_parameter(
         vr::ACTUATOR,
         "actuator",
@@ -387,6 +415,23 @@ static VARIABLES: [Variable; 44] = [
         "N",
         "Applied force, every force on the body but F, positive with v (Classical's input F_app): k*(x_act - x) - c*v_body + F_ext + F_drive + F_ctrl - m*a_s, a_s the surface acceleration; holding F = F_app keeps v constant. No feedthrough from F. m = 0: k*(x_act - x_h) + F_ext + F_drive - c*v_s, which holds the body on the surface at x_h (c = 0: x at the start of the last step, moved with the surface)",
         APPLIED_FORCE_DEPS,
+    )
+    .with_state_dependencies(STATES),
+    Variable::derivative(
+        vr::DER_X,
+        "der(x)",
+        "m/s",
+        "Time derivative of the position state x: v_body (m > 0). x and v_body are the continuous states listed in the model structure (not in the quasi-static mode m = 0, whose partial derivatives are refused)",
+        &[],
+        VELOCITY,
+    ),
+    Variable::derivative(
+        vr::DER_V_BODY,
+        "der(v_body)",
+        "m/s2",
+        "Time derivative of the velocity state v_body: the acceleration a. The controller's integral xi = integral of (v_ref - v_body) dt is the integral of v_ref minus (x - x0): a function of x, not a state of its own",
+        ALL_INPUTS,
+        STATES,
     ),
 ];
 
@@ -399,6 +444,10 @@ pub static INFO: ModelInfo = ModelInfo {
     variables: &VARIABLES,
     default_experiment: DefaultExperiment { start_time: 0.0, stop_time: 20.0, step_size: 1e-4 },
     capabilities: Capabilities::FULL,
+    co_simulation_states: &[
+        ContinuousState { state: vr::X, derivative: vr::DER_X },
+        ContinuousState { state: vr::V_BODY, derivative: vr::DER_V_BODY },
+    ],
     model_exchange: None,
 };
 
@@ -613,6 +662,60 @@ impl Model for Rig1DFmu {
 
     fn supplies_step_derivatives(&self) -> bool {
         true
+    }
+
+    /// The derivatives of the listed states: ẋ (the quasi-static rate
+    /// when m = 0, with the inputs held) and the acceleration.
+    fn derivatives(&self, v: &Values, dx: &mut [f64]) {
+        let u = inputs(v.as_slice());
+        dx[0] = self.rig.position_rate(&u, &Rig1DInputs::default());
+        dx[1] = self.rig.acceleration(&u);
+    }
+
+    /// The continuous-time partial derivatives of the rig's outputs and
+    /// state derivatives in its states (x, v_body) and inputs
+    /// ([`Rig1D::partials`]).
+    fn state_partial_derivative(
+        &self,
+        v: &Values,
+        unknown: u32,
+        known: u32,
+    ) -> Result<f64, String> {
+        let known = match known {
+            vr::X => Known::Position,
+            vr::V_BODY => Known::Velocity,
+            vr::F => Known::Friction,
+            vr::F_EXT => Known::ExternalForce,
+            vr::X_ACT_IN => Known::ActuatorInput,
+            vr::X_REF => Known::ReferencePosition,
+            vr::V_REF => Known::ReferenceVelocity,
+            _ => {
+                return Err(format!(
+                    "value reference {known} is not a state or input of Rig1D"
+                ))
+            }
+        };
+        let d = self.rig.partials(&inputs(v.as_slice()), known)?;
+        let y = &d.outputs;
+        Ok(match unknown {
+            vr::DER_X => d.position_rate,
+            vr::DER_V_BODY | vr::A => y.acceleration,
+            vr::X => y.position,
+            vr::V => y.slip_velocity,
+            vr::F_SPRING => y.spring_force,
+            vr::X_ACT => y.actuator_position,
+            vr::X_REL => y.relative_displacement,
+            vr::V_BODY => y.velocity,
+            vr::F_DRIVE => y.drive_force,
+            vr::U_CTRL => y.control_command,
+            vr::F_CTRL => y.control_force,
+            vr::F_APP => y.applied_force,
+            _ => {
+                return Err(format!(
+                    "value reference {unknown} is not an output or state derivative of Rig1D"
+                ))
+            }
+        })
     }
 
     /// Every input value is accepted (no `check_input`).

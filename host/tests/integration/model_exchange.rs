@@ -261,6 +261,9 @@ fn exactly_the_ode_laws_offer_model_exchange() {
             "Dahl" | "LuGre" | "ResetIntegrator" | "ElastoPlastic" => 1,
             // every element's force, 100 declared (FMI 2.0 fixes the number)
             "MaxwellSlip" | "GMS" => 100,
+            // listed for Co-Simulation (its linearization), no Model
+            // Exchange interface
+            "Rig1D" => 2,
             _ => 0,
         };
         assert_eq!(f.nx(), expected_states, "{name}");

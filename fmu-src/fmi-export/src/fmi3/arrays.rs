@@ -205,6 +205,7 @@ mod tests {
                 step_size: 0.1,
             },
             capabilities: crate::Capabilities::FULL,
+            co_simulation_states: &[],
             model_exchange: None,
         };
         let layout = Layout::new(&info);

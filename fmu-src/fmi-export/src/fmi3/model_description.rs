@@ -124,11 +124,12 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
             initial_unknowns.push(v.vr);
         }
     }
-    if let Some(me) = &info.model_exchange {
+    let states = info.continuous_states();
+    if !states.is_empty() {
         // one element per derivative variable (an array of derivatives
         // is one: FMI 3.0 counts the states by its elements)
         for v in &layout.variables {
-            if me.is_derivative(v.vr) {
+            if info.is_derivative(v.vr) {
                 let _ = writeln!(
                     w,
                     "    {}",
@@ -136,7 +137,7 @@ pub fn render(info: &ModelInfo, generation_tool: &str) -> Result<String, String>
                 );
             }
         }
-        for s in me.states {
+        for s in states {
             // the derivatives and the states, all `initial="calculated"`
             // (FMI 3.0 section 2.4.8): a state that is an output is listed
             // once
@@ -193,11 +194,15 @@ fn variable(info: &ModelInfo, layout: &Layout, fmi3: &Fmi3Variable) -> String {
     if let Some(starts) = starts {
         let _ = write!(e, r#" start="{}""#, starts.join(" "));
     }
+    // a derivative names its state (array) by value reference
+    if let Some(s) = info
+        .continuous_states()
+        .iter()
+        .find(|s| s.derivative == v.vr)
+    {
+        let _ = write!(e, r#" derivative="{}""#, layout.head_of(s.state));
+    }
     if let Some(me) = &info.model_exchange {
-        // a derivative names its state (array) by value reference
-        if let Some(s) = me.states.iter().find(|s| s.derivative == v.vr) {
-            let _ = write!(e, r#" derivative="{}""#, layout.head_of(s.state));
-        }
         if me.states_jump_at_events && me.is_state(v.vr) {
             let _ = write!(e, r#" reinit="true""#);
         }

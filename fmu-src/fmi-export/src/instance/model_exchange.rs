@@ -6,9 +6,10 @@
 //! ([`crate::state_machine::ME_ALLOWED`]) has already decided that the call
 //! is allowed, which also means the instance is a Model Exchange one.
 //!
-//! Nothing here runs for a Co-Simulation instance: its calls never reach
-//! this module (the one exception, reading a `der(…)` variable, is
-//! [`Instance::get_computed`]).
+//! Nothing here runs for a Co-Simulation instance but the directional
+//! derivatives of the states a Co-Simulation model lists
+//! ([`crate::ModelInfo::co_simulation_states`]): its other calls never
+//! reach this module.
 
 use super::Instance;
 use crate::model::Ode;
@@ -219,27 +220,29 @@ impl Instance {
 
     // ---- directional derivatives -----------------------------------------
 
-    /// `fmi2GetDirectionalDerivative` of a Model Exchange instance:
-    /// `dv_unknown = J·dv_known` (the knowns with their seeds) with `J`
-    /// the partial derivatives of state
-    /// derivatives and Real outputs (`unknowns`) with respect to continuous
-    /// states and Real inputs (`knowns`) at the current point, each given
-    /// by the model in closed form ([`Ode::partial_derivative`]).
-    pub(super) fn me_directional_derivative(
+    /// `fmi2GetDirectionalDerivative` of a Model Exchange instance, or of
+    /// a Co-Simulation one asked with its listed states
+    /// ([`Instance::asks_state_partials`]): `dv_unknown = J·dv_known`
+    /// (the knowns with their seeds) with `J` the partial derivatives of
+    /// state derivatives and Real outputs (`unknowns`) with respect to
+    /// continuous states and Real inputs (`knowns`) at the current point,
+    /// each given by the model in closed form ([`Ode::partial_derivative`];
+    /// in Co-Simulation [`crate::Model::state_partial_derivative`]).
+    pub(super) fn state_directional_derivative(
         &mut self,
         unknowns: &[u32],
         (knowns, dv_known): (&[u32], &[f64]),
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
-        let me = self.me();
+        let info = self.info;
         // unknowns: derivatives or outputs; knowns: states or inputs
         let role = |vr: u32, known: bool| -> Result<(), String> {
             let v = self.variable_of_type(vr, VarType::Real)?;
             let (fits, what, neither) = if known {
-                let fits = me.is_state(vr) || v.causality == Causality::Input;
+                let fits = info.is_state(vr) || v.causality == Causality::Input;
                 (fits, "known", "a continuous state nor an input")
             } else {
-                let fits = me.is_derivative(vr) || v.causality == Causality::Output;
+                let fits = info.is_derivative(vr) || v.causality == Causality::Output;
                 (fits, "unknown", "a state derivative nor an output")
             };
             match fits {
@@ -259,25 +262,30 @@ impl Instance {
             ));
         }
         self.ensure_initialized()?;
-        let ode = self.ode();
         let values = &self.values;
+        let name = |vr: u32| info.variables[vr as usize].name;
+        let partial = |u: u32, k: u32| -> Result<f64, String> {
+            match self.model.ode() {
+                Some(ode) => ode.partial_derivative(values, u, k).ok_or_else(|| {
+                    format!(
+                        "the partial derivative of {} with respect to {} is not available",
+                        name(u),
+                        name(k)
+                    )
+                }),
+                None => self.model.state_partial_derivative(values, u, k),
+            }
+        };
         for (out, &u) in dv_unknown.iter_mut().zip(unknowns) {
             // Σ ∂u/∂k·dv_k over the seeds that move (an infinite partial
             // times a zero seed would be NaN)
-            let sum = knowns
+            *out = knowns
                 .iter()
                 .zip(dv_known)
                 .filter(|(_, dv)| **dv != 0.0)
                 .try_fold(0.0, |acc, (&k, &dv)| {
-                    let d = ode.partial_derivative(values, u, k).ok_or(k)?;
-                    Ok(acc + d * dv)
-                });
-            *out = sum.map_err(|k: u32| {
-                format!(
-                    "the partial derivative of {} with respect to {} is not available",
-                    self.info.variables[u as usize].name, self.info.variables[k as usize].name
-                )
-            })?;
+                    Ok::<_, String>(acc + partial(u, k)? * dv)
+                })?;
         }
         self.check_finite(unknowns, dv_unknown, "the directional derivative of ")
     }

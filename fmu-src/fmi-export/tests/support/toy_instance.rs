@@ -34,6 +34,7 @@ pub fn toy_info_with(
             step_size: 0.1,
         },
         capabilities: Capabilities::FULL,
+        co_simulation_states: &[],
         model_exchange,
     }))
 }

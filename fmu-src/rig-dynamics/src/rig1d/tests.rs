@@ -1658,3 +1658,121 @@ fn check_applied_force_without_mass(
     }
     n
 }
+
+/// The outputs of `o` in a fixed order, for comparisons.
+fn output_fields(o: &Rig1DOutputs) -> [f64; 11] {
+    [
+        o.position,
+        o.slip_velocity,
+        o.acceleration,
+        o.spring_force,
+        o.actuator_position,
+        o.relative_displacement,
+        o.velocity,
+        o.drive_force,
+        o.control_command,
+        o.control_force,
+        o.applied_force,
+    ]
+}
+
+/// [`Rig1D::partials`] equal central differences of the outputs and of
+/// (ẋ, ẍ) in every state and input, on each piece of the saturation:
+/// a spring pulled through the actuator input with damping and a dither;
+/// the controller on an input reference (PD on the position, PI on the
+/// velocity), unsaturated and saturated. A change δ of the position
+/// moves the controller's integral by −δ (ξ = ∫v_ref dt − (x − x0)).
+/// The rig is affine in each, so the differences are exact to rounding.
+#[test]
+fn partial_derivatives_equal_differences_of_the_outputs() {
+    let spring = Rig1DParams {
+        m: 2.0,
+        c: 3.0,
+        k: 500.0,
+        actuator: Actuator::Input,
+        dither: Sinusoid::new(1e-4, 20.0),
+        ..Rig1DParams::default()
+    };
+    let controller = |u_max: f64| Rig1DParams {
+        m: 1.5,
+        c: 0.5,
+        k: 10.0,
+        control: Controller {
+            mode: Control::Input,
+            kp: 4000.0,
+            kd: 60.0,
+            ki: 2e4,
+            ff: 0.7,
+            gain: 1.3,
+            u_max,
+            reference: Reference::default(),
+        },
+        ..Rig1DParams::default()
+    };
+    let knowns = [
+        Known::Position,
+        Known::Velocity,
+        Known::Friction,
+        Known::ExternalForce,
+        Known::ActuatorInput,
+        Known::ReferencePosition,
+        Known::ReferenceVelocity,
+    ];
+    let u = Rig1DInputs {
+        friction: 0.4,
+        f_ext: -0.2,
+        x_act: 2e-3,
+        x_ref: 1e-3,
+        v_ref: 2e-3,
+    };
+    // (parameters, whether the command is saturated at the state below)
+    for (p, saturated) in [
+        (spring, false),
+        (controller(0.0), false),
+        (controller(0.5), true),
+    ] {
+        let mut rig = Rig1D::new(p).unwrap();
+        rig.step(&u, &no_inputs(), 0.013);
+        (rig.x, rig.xd, rig.xi) = (-4e-4, 3e-3, 1e-4);
+        let raw = rig.command_at(&rig.here(), 0.0, &u, &no_inputs());
+        assert_eq!(rig.p.control.piece(raw) != 0, saturated, "command {raw}");
+        for known in knowns {
+            let d = rig.partials(&u, known).unwrap();
+            let delta = 1e-6;
+            let at = |sign: f64| {
+                let (mut moved, mut inputs) = (rig.clone(), u);
+                let e = sign * delta;
+                match known {
+                    Known::Position => (moved.x, moved.xi) = (rig.x + e, rig.xi - e),
+                    Known::Velocity => moved.xd += e,
+                    Known::Friction => inputs.friction += e,
+                    Known::ExternalForce => inputs.f_ext += e,
+                    Known::ActuatorInput => inputs.x_act += e,
+                    Known::ReferencePosition => inputs.x_ref += e,
+                    Known::ReferenceVelocity => inputs.v_ref += e,
+                }
+                let mut all = output_fields(&moved.outputs(&inputs)).to_vec();
+                all.push(moved.position_rate(&inputs, &no_inputs()));
+                all
+            };
+            let (up, down) = (at(1.0), at(-1.0));
+            let mut given = output_fields(&d.outputs).to_vec();
+            given.push(d.position_rate);
+            for (i, ((a, b), g)) in up.iter().zip(&down).zip(&given).enumerate() {
+                let differenced = (a - b) / (2.0 * delta);
+                assert!(
+                    (differenced - g).abs() <= 1e-6 * g.abs().max(1.0),
+                    "{known:?}, entry {i}: {g} given, {differenced} differenced (saturated: {saturated})"
+                );
+            }
+        }
+    }
+    // the quasi-static mode has no velocity state
+    let quasi_static = Rig1D::new(Rig1DParams {
+        m: 0.0,
+        ..Rig1DParams::default()
+    })
+    .unwrap();
+    let e = quasi_static.partials(&u, Known::Position).unwrap_err();
+    assert!(e.contains("quasi-static mode (m = 0)"), "{e}");
+}
