@@ -540,7 +540,10 @@ mod tests {
         assert!(listed.is_state(3) && listed.is_derivative(2) && !listed.is_state(2));
         let xml = crate::model_description::render(&listed, "test").unwrap();
         assert!(xml.contains(r#"<Real derivative="4"/>"#), "{xml}");
-        assert!(xml.contains("<Derivatives>") && !xml.contains("<ModelExchange"), "{xml}");
+        assert!(
+            xml.contains("<Derivatives>") && !xml.contains("<ModelExchange"),
+            "{xml}"
+        );
         let both = ModelInfo {
             co_simulation_states: STATES,
             ..info(Variable::state(3, "s", "", "the state"))

@@ -551,20 +551,30 @@ pub fn co_simulate_with_sensitivities(
                 vec![Vec::new(); channels.len()],
             )
         });
-        // each compared sample's row of the run (the same time)
-        let mut cursor = 0;
-        for &k in &r.samples {
-            let t = record.time[k];
-            while cursor + 1 < run.time.len() && run.time[cursor] < t - 1e-9 * setup.step {
-                cursor += 1;
-            }
-            if (run.time[cursor] - t).abs() > 1e-9 * setup.step {
-                return Err(format!(
-                    "no communication point at the sample time {t} s: the sensitivities are not interpolated"
-                ));
-            }
-            for (c, m) in by_row.iter().enumerate() {
-                rows[c].extend(m.row(cursor).iter());
+        // at each compared sample, interpolated between the run's rows
+        // as the simulated channels are ([`compare`]): the derivative of
+        // the interpolated output
+        for (c, m) in by_row.iter().enumerate() {
+            let columns: Vec<Vec<f64>> = (0..parameters.len())
+                .map(|j| {
+                    let series: Vec<f64> = m.column(j).iter().copied().collect();
+                    let mut cursor = crate::inputs::Cursor::default();
+                    r.samples
+                        .iter()
+                        .map(|&k| {
+                            crate::inputs::interpolate_from(
+                                &mut cursor,
+                                record.time[k],
+                                &run.time,
+                                &series,
+                                false,
+                            )
+                        })
+                        .collect()
+                })
+                .collect();
+            for s in 0..r.samples.len() {
+                rows[c].extend(columns.iter().map(|column| column[s]));
             }
         }
         residuals

@@ -7,7 +7,8 @@
 //! project's LuGre.fmu) and a plant FMU (FMI 2.0) that lists its
 //! continuous states (`ModelStructure/Derivatives`) and provides
 //! directional derivatives, co-simulated by the strong-coupling master
-//! (`newton`, or `newton-interpolated` as the diagnosis runs it). The
+//! (`newton`, or `newton-interpolated` as the diagnosis runs it) or by
+//! the Jacobi master (EMPS's system file asks for it). The
 //! plant must be linear and time-invariant in its state and the friction
 //! force (the masses, springs, dampers and linear controllers of a
 //! drive): its partial derivatives are compared along a run of it alone
@@ -60,6 +61,18 @@
 //! ```text
 //! δF₁ = (f_p + F_z·(q_v0·δv₀ + q_x0·δx₀) + s_v·a_v + s_x·a_x) / (1 − s_v·g_v − s_x·g_x).
 //! ```
+//!
+//! **The Jacobi master** is explicit: each component steps on the other's
+//! outputs at the step's start, held, and its outputs at the end are read
+//! with those inputs still set. With `δv₀`, `δx_c₀`, `δF₀` the
+//! sensitivities recorded at the step's start,
+//!
+//! ```text
+//! δz⁺ = [carried] + q_v·δv₀ + q_x·δx_c₀,   δF₁ = f_p + s_v·δv₀ + s_x·δx_c₀,
+//! δx⁺ = Φ·δx + Γ·δF₀,   δy₁ = C·δx⁺ + d·δF₀,
+//! ```
+//!
+//! the law's partials taken at the held inputs (`v₀ = v₁`).
 //!
 //! Against central differences of whole co-simulations on the two-mass
 //! drive of the tests: within 2e-5 of each column's size with held
@@ -353,13 +366,15 @@ impl Coupling {
     ) -> Result<Vec<DMatrix<f64>>, String> {
         // the inputs of a component that can interpolate them ramp over
         // each step from their value at its start (newton-interpolated);
-        // else they are held at the step's end values (newton)
-        let interpolated = match master {
-            "newton" => false,
-            "newton-interpolated" => true,
+        // else they are held at the step's end values (newton), or, by
+        // the Jacobi master, at its start values
+        let (interpolated, jacobi) = match master {
+            "newton" => (false, false),
+            "newton-interpolated" => (true, false),
+            "jacobi" => (false, true),
             other => {
                 return Err(format!(
-                    "the master {other} is not covered (newton and newton-interpolated are)"
+                    "the master {other} is not covered (newton, newton-interpolated and jacobi are)"
                 ))
             }
         };
@@ -442,8 +457,13 @@ impl Coupling {
             }
             let dsc = discrete.as_ref().expect("set above");
             // the law's inputs over the step: from the start values to the
-            // end values, or held at the end values
-            let (v1, x1) = (v[k + 1], x[k + 1]);
+            // end values, or held at the end values (at the start values
+            // by the Jacobi master)
+            let (v1, x1) = if jacobi {
+                (v[k], x[k])
+            } else {
+                (v[k + 1], x[k + 1])
+            };
             let (v0, x0) = if law_ramps { (v[k], x[k]) } else { (v1, x1) };
             let inputs = |v0: f64, x0: f64, v1: f64, x1: f64| LuGreInputs {
                 v: Ramp::new(v0, (v1 - v0) / h),
@@ -516,6 +536,24 @@ impl Coupling {
                 let f_p = law
                     .force_sensitivity(p, v1, x1, 1.0)
                     .ok_or("the law carries no parameter sensitivities")?;
+                if jacobi {
+                    // explicit: the law stepped on the plant's outputs at
+                    // the start, the plant on the law's force there
+                    let f_end = f_p + s_v * dv[j] + s_x * dxc[j];
+                    law.add_to_z_sensitivity(p, q_v1 * dv[j] + q_x1 * dxc[j]);
+                    let state = &dsc.phi * dx.column(j) + &dsc.gamma * df[j];
+                    let outputs = &self.c * &state + &self.d * df[j];
+                    for (o, ch) in out.iter_mut().zip(&channel_of) {
+                        o[(k + 1, j)] = match ch {
+                            Channel::Force => f_end,
+                            Channel::Plant(i) => outputs[*i],
+                        };
+                    }
+                    dx.set_column(j, &state);
+                    let x_end = self.x_from.map_or(0.0, |i| outputs[i]);
+                    (dv[j], dxc[j], df[j]) = (outputs[self.v_from], x_end, f_end);
+                    continue;
+                }
                 // the plant's free response: its state, and the force at
                 // the start of a ramp
                 let mut free = &dsc.phi * dx.column(j);
