@@ -292,7 +292,7 @@ def diagnose(
     ``out`` is the output directory (default
     ``out/<system name>-diagnosis``); ``options`` are those of the command
     with underscores: ``candidates`` (list of effect names),
-    ``position_knots``, ``alpha``, ``smooth``, ``blocks``,
+    ``position_knots``, ``max_position_knots``, ``alpha``, ``smooth``, ``blocks``,
     ``cross_validate`` ("auto", "always", "never", "records"), ``polish``,
     ``master``, ``lugre``, ``time_limit`` (seconds of wall time, default
     600, ``math.inf`` for none: past it the diagnosis starts no new work
@@ -305,6 +305,7 @@ def diagnose(
     known = {
         "candidates",
         "position_knots",
+        "max_position_knots",
         "alpha",
         "smooth",
         "blocks",

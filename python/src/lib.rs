@@ -305,7 +305,7 @@ fn sweep(
 /// (default [`fricsim_diagnose::DEFAULT_TIME_LIMIT`], infinity: none);
 /// the progress line on stderr when it is a terminal, unless `quiet`.
 #[pyfunction]
-#[pyo3(signature = (system, data, out, heldout=Vec::new(), candidates=Vec::new(), position_knots=None, alpha=None, smooth=None, blocks=None, cross_validate=None, polish=true, master=None, lugre=None, time_limit=None, quiet=false))]
+#[pyo3(signature = (system, data, out, heldout=Vec::new(), candidates=Vec::new(), position_knots=None, max_position_knots=None, alpha=None, smooth=None, blocks=None, cross_validate=None, polish=true, master=None, lugre=None, time_limit=None, quiet=false))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,
@@ -315,6 +315,7 @@ fn diagnose(
     heldout: Vec<PathBuf>,
     candidates: Vec<String>,
     position_knots: Option<usize>,
+    max_position_knots: Option<usize>,
     alpha: Option<f64>,
     smooth: Option<f64>,
     blocks: Option<usize>,
@@ -330,6 +331,7 @@ fn diagnose(
         let progress = Progress::new();
         let mut options = Options {
             position_knots: position_knots.unwrap_or(defaults.position_knots),
+            max_position_knots: max_position_knots.unwrap_or(defaults.max_position_knots),
             alpha: alpha.unwrap_or(defaults.alpha),
             smooth: smooth.unwrap_or(defaults.smooth),
             blocks: blocks.unwrap_or(defaults.blocks),

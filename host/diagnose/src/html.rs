@@ -197,11 +197,12 @@ pub fn page(d: &Diagnosis, figures: &[Figure], rerun: &[String], min_gain: f64) 
         for e in &d.effects {
             let _ = writeln!(
                 s,
-                "<li><strong>{}</strong>: {}{} {}</li>",
+                "<li><strong>{}</strong>: {}{} {} {}</li>",
                 escape(e.name.name()),
                 escape(&where_line(&e.where_)),
                 escape(&super::report::alternatives_line(e)),
-                escape(&super::report::change_line(e).unwrap_or_default())
+                escape(&super::report::change_line(e).unwrap_or_default()),
+                escape(&super::report::table_line(e).unwrap_or_default())
             );
         }
         s.push_str("</ol>\n");

@@ -94,8 +94,13 @@ use std::time::Instant;
 pub struct Options {
     /// Effects to try (default: the whole library).
     pub candidates: Vec<Effect>,
-    /// Knots of the position table of `position_dependent`.
+    /// Knots of the position table of `position_dependent` when it is
+    /// added.
     pub position_knots: usize,
+    /// The most knots the table may be given once the effect is accepted
+    /// (doubled while the data ask for it, `stages/rounds/table.rs`);
+    /// equal to `position_knots` keeps the table as added.
+    pub max_position_knots: usize,
     /// Savitzky–Golay window for the inverse dynamics (s).
     pub smooth: f64,
     /// Family-wise significance level.
@@ -164,10 +169,21 @@ impl Options {
         if !(self.alpha > 0.0 && self.alpha < 1.0) {
             return Err(format!("alpha {}: must be between 0 and 1", self.alpha));
         }
-        if !(2..=32).contains(&self.position_knots) {
+        if !(2..=model::MAX_TABLE_POINTS).contains(&self.position_knots) {
             return Err(format!(
-                "position_knots {}: must be in 2..=32 (the LuGre table holds 32 points)",
-                self.position_knots
+                "position_knots {}: must be in 2..={} (the LuGre table holds {} points)",
+                self.position_knots,
+                model::MAX_TABLE_POINTS,
+                model::MAX_TABLE_POINTS
+            ));
+        }
+        if !(self.position_knots..=model::MAX_TABLE_POINTS).contains(&self.max_position_knots) {
+            return Err(format!(
+                "max_position_knots {}: must be in {}..={} (at least position_knots, at most the {} points the LuGre table holds)",
+                self.max_position_knots,
+                self.position_knots,
+                model::MAX_TABLE_POINTS,
+                model::MAX_TABLE_POINTS
             ));
         }
         if let Some(s) = self.time_limit {
@@ -188,6 +204,7 @@ impl Default for Options {
         Options {
             candidates: Effect::ALL.to_vec(),
             position_knots: model::DEFAULT_POSITION_KNOTS,
+            max_position_knots: model::MAX_TABLE_POINTS,
             smooth: 0.01,
             alpha: 0.01,
             min_gain: 0.02,
@@ -383,6 +400,25 @@ pub struct FoundEffect {
     /// ([`model::Effect::change`]), in the final model, with its 95 %
     /// interval; `None` for an effect without such a number.
     pub change: Option<EffectChange>,
+    /// For `position_dependent`: each finer table tried after it was
+    /// accepted (the knots doubled while the data ask for it, see
+    /// `stages/rounds/table.rs`); empty for the other effects.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub table: Vec<TableStep>,
+}
+
+/// One finer position table tried: its knots, its held-out RMS against
+/// the coarser table's, the test that would keep it, and whether it was
+/// kept.
+#[derive(Clone, Debug, Serialize)]
+pub struct TableStep {
+    pub knots: usize,
+    pub heldout_rms_before: f64,
+    pub heldout_rms: f64,
+    pub gain: f64,
+    pub p_value: f64,
+    pub fit_evaluations: usize,
+    pub kept: bool,
 }
 
 /// An effect accepted in an earlier round and taken out again once later

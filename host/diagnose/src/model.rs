@@ -62,6 +62,9 @@ pub const STIFF_PRESLIDING_DISTANCE: f64 = 1e-6;
 /// Knots of the position table when `position_dependent` is added.
 pub const DEFAULT_POSITION_KNOTS: usize = 6;
 
+/// Points the LuGre FMU's position table holds (`n_table` at most).
+pub const MAX_TABLE_POINTS: usize = 32;
+
 /// The LuGre parameters that diagnose reads, fits and writes back (SI
 /// units; per newton of normal force in the normal-force form).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -233,6 +236,35 @@ impl FrictionModel {
             m.scale_neg = other.scale_neg.clone();
         }
         m
+    }
+
+    /// The same position table on twice as many intervals (2k − 1
+    /// knots: a knot added halfway between each pair, its scales
+    /// interpolated), so that the model is unchanged and the finer table
+    /// can bend where the coarser could not; `None` without a table or
+    /// when the finer one would have more than `max_knots` (or
+    /// [`MAX_TABLE_POINTS`]).
+    pub fn with_finer_table(&self, max_knots: usize) -> Option<FrictionModel> {
+        let k = self.x_table.len();
+        if !self.position_dependent || k < 2 || 2 * k - 1 > max_knots.min(MAX_TABLE_POINTS) {
+            return None;
+        }
+        let halve = |v: &[f64]| -> Vec<f64> {
+            let mut out = Vec::with_capacity(2 * v.len() - 1);
+            for w in v.windows(2) {
+                out.push(w[0]);
+                out.push(0.5 * (w[0] + w[1]));
+            }
+            out.extend(v.last());
+            out
+        };
+        let mut m = self.clone();
+        m.x_table = halve(&self.x_table);
+        m.scale_pos = halve(&self.scale_pos);
+        if self.scale_neg.len() == k {
+            m.scale_neg = halve(&self.scale_neg);
+        }
+        Some(m)
     }
 
     /// σ0 set to `sigma0`, with σ1 scaled by √(σ0 ratio): the damping ratio

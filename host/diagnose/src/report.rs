@@ -316,6 +316,9 @@ pub fn markdown(d: &Diagnosis) -> String {
         if let Some(line) = change_line(e) {
             let _ = writeln!(s, "{line}\n");
         }
+        if let Some(line) = table_line(e) {
+            let _ = writeln!(s, "{line}\n");
+        }
         if !e.alternatives.is_empty() {
             let _ = writeln!(
                 s,
@@ -498,6 +501,30 @@ pub fn change_line(e: &super::FoundEffect) -> Option<String> {
 /// ` The data do not separate it from offset (held-out RMS 0.0778, p = 4.0e-1): …` and the
 /// like: how the effect stands against the other explanations of its
 /// signature ([`super::Alternative`]), empty when it has none.
+/// The position table made finer after `e` was accepted
+/// ([`super::FoundEffect::table`]), one step after another; `None` when
+/// no finer table was tried.
+pub fn table_line(e: &super::FoundEffect) -> Option<String> {
+    let first = e.table.first()?;
+    let mut line = format!(
+        "Position table made finer while the data ask for it: {} knots",
+        first.knots.div_ceil(2)
+    );
+    for t in &e.table {
+        let _ = write!(
+            line,
+            " → {} knots (held-out RMS {:.3e} → {:.3e}, p = {:.1e}, {})",
+            t.knots,
+            t.heldout_rms_before,
+            t.heldout_rms,
+            t.p_value,
+            if t.kept { "kept" } else { "not kept" }
+        );
+    }
+    line.push('.');
+    Some(line)
+}
+
 pub fn alternatives_line(e: &super::FoundEffect) -> String {
     let mut s = overlap_line(e);
     if e.alternatives.is_empty() {

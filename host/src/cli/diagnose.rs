@@ -48,6 +48,12 @@ pub struct DiagnoseArgs {
     /// Knots of the position table of position_dependent.
     #[arg(long, default_value_t = fricsim::diagnose::model::DEFAULT_POSITION_KNOTS)]
     pub position_knots: usize,
+    /// The most knots the position table may be given once
+    /// position_dependent is accepted: the knots are doubled (2k − 1)
+    /// while the finer table passes the test that admitted the effect;
+    /// set it to --position-knots to keep the table as added.
+    #[arg(long, default_value_t = fricsim::diagnose::model::MAX_TABLE_POINTS)]
+    pub max_position_knots: usize,
     /// Family-wise significance level of the acceptance test.
     #[arg(long, default_value_t = 0.01)]
     pub alpha: f64,
@@ -136,6 +142,7 @@ fn candidates_help() -> String {
 pub fn run(a: &DiagnoseArgs) -> Result<(), String> {
     let mut options = Options {
         position_knots: a.position_knots,
+        max_position_knots: a.max_position_knots,
         alpha: a.alpha,
         smooth: a.smooth,
         blocks: a.blocks,

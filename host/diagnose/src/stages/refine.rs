@@ -82,20 +82,33 @@ fn refine_in_time(
         evaluations,
     } = refine_folds(p, system, models, scored);
     polishing.cosimulations += evaluations;
-    let whole = if p.split.folds.len() == 1 {
-        models[0].clone()
-    } else if !kept {
+    let whole = if !kept && p.split.folds.len() > 1 {
         whole
     } else {
-        let polished = p.polish(&whole, &p.every_sample, POLISH_ITERATIONS);
-        polishing.cosimulations += polished.evaluations;
-        polished.model
+        polish_whole(p, whole, &models, polishing)
     };
     Fitted {
         folds: models,
         scored,
         whole,
     }
+}
+
+/// The model reported, `whole`, refined on the output error of every
+/// sample as its fold models `folds` were on their fit samples; with one
+/// fold, that fold's refined model.
+pub(crate) fn polish_whole(
+    p: &Problem,
+    whole: FrictionModel,
+    folds: &[FrictionModel],
+    polishing: &mut Polishing,
+) -> FrictionModel {
+    if p.split.folds.len() == 1 {
+        return folds[0].clone();
+    }
+    let polished = p.polish(&whole, &p.every_sample, POLISH_ITERATIONS);
+    polishing.cosimulations += polished.evaluations;
+    polished.model
 }
 
 /// Fold models refined on the output error of their fit samples, and

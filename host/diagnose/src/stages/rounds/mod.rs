@@ -17,6 +17,7 @@ mod contenders;
 mod deadline;
 mod explanations;
 mod resolution;
+mod table;
 
 use crate::acceptance::{drop_beyond_step_error, mean, nested_test, Acceptance, Scored};
 use crate::model::{Effect, FrictionModel};
@@ -197,6 +198,7 @@ pub(crate) fn search(
         };
         let earlier = s.effects.len();
         accept(p, system, sim, &mut s, choice, polishing)?;
+        table::resolve_position_table(p, system, &mut s, earlier, group, polishing)?;
         reexamine(p, system, &mut s, earlier, group, polishing)?;
         if !p.budget.skip_if_expired(|| {
             format!(
@@ -672,6 +674,7 @@ fn accept(
             alternatives: std::mem::take(&mut alternatives),
             overlap: overlap.take(),
             change: None,
+            table: Vec::new(),
         });
         s.accepted_as.push(AcceptedAs {
             round: s.rounds.len(),
