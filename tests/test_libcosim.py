@@ -61,6 +61,10 @@ RUNS = {
     "planar_spiral": None,
     "planar_stick_slip": None,
     "planar_dither": 1.0,  # 40 000 steps of 25 µs
+    "reset_integrator_stick_slip": 7.0,  # breaks away at 5.51 s
+    "elasto_plastic_hold": None,
+    "presliding_memory": None,
+    "bliman_sorine_loops": None,
 }
 # (stick_slip_fmi3: libcosim 0.11 has no FMI 3.0 import; its FMI 2.0 twin,
 # stick_slip, is run)
@@ -132,9 +136,10 @@ def run_fricsim(ssp, step, n, tmp_path):
     header = out.read_text().splitlines()[0].split(",")
     data = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
     # fricsim run records the Integer and Boolean outputs too (the laws'
-    # `sliding`, Classical's `stuck`, the bristle model's `n_connected`); the
-    # libcosim runs here record the Real ones, which are compared
-    discrete = (".sliding", ".stuck", ".n_connected")
+    # `sliding`, Classical's `stuck`, the bristle model's `n_connected`,
+    # the elasto-plastic law's `elastic`, the element laws' `n_slipping`);
+    # the libcosim runs here record the Real ones, which are compared
+    discrete = (".sliding", ".stuck", ".n_connected", ".elastic", ".n_slipping")
     return data[:, 0], {c: data[:, k] for k, c in enumerate(header) if k > 0 and not c.endswith(discrete)}
 
 
