@@ -220,9 +220,10 @@ def test_the_position_table_is_made_as_fine_as_the_data_ask(kind, seed, tmp_path
     RMS of 30 times the floor of noise and step error on Rig1D, and a
     Stribeck curve re-sized beside it (vs up by 5 %) was named; on the
     servo axis a viscous term passed and had to be set aside (the test
-    above). Now the table is doubled (11, then 21 knots) while the finer
-    one passes the test that admitted the effect: the table alone is
-    named, and the residual ends within twice the floor."""
+    above). Now, when the rounds end, the table is doubled (11, then 21
+    knots) while the finer one passes the test that admitted the effect:
+    the table alone is named, and the residual ends within twice the
+    floor."""
     case = cases.draw(kind, 0.1, seed)
     row = suite.run_case(case, tmp_path)
     check(row)

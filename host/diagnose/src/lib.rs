@@ -97,7 +97,7 @@ pub struct Options {
     /// Knots of the position table of `position_dependent` when it is
     /// added.
     pub position_knots: usize,
-    /// The most knots the table may be given once the effect is accepted
+    /// The most knots the table may be given when the rounds end with it
     /// (doubled while the data ask for it, `stages/rounds/table.rs`);
     /// equal to `position_knots` keeps the table as added.
     pub max_position_knots: usize,
@@ -400,8 +400,8 @@ pub struct FoundEffect {
     /// ([`model::Effect::change`]), in the final model, with its 95 %
     /// interval; `None` for an effect without such a number.
     pub change: Option<EffectChange>,
-    /// For `position_dependent`: each finer table tried after it was
-    /// accepted (the knots doubled while the data ask for it, see
+    /// For `position_dependent`: each finer table tried when the rounds
+    /// ended (the knots doubled while the data ask for it, see
     /// `stages/rounds/table.rs`); empty for the other effects.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub table: Vec<TableStep>,

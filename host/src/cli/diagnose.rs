@@ -48,10 +48,10 @@ pub struct DiagnoseArgs {
     /// Knots of the position table of position_dependent.
     #[arg(long, default_value_t = fricsim::diagnose::model::DEFAULT_POSITION_KNOTS)]
     pub position_knots: usize,
-    /// The most knots the position table may be given once
-    /// position_dependent is accepted: the knots are doubled (2k − 1)
-    /// while the finer table passes the test that admitted the effect;
-    /// set it to --position-knots to keep the table as added.
+    /// The most knots the position table may be given when the rounds
+    /// end with position_dependent: the knots are doubled (2k − 1) while
+    /// the finer table passes the test that admitted the effect; set it
+    /// to --position-knots to keep the table as added.
     #[arg(long, default_value_t = fricsim::diagnose::model::MAX_TABLE_POINTS)]
     pub max_position_knots: usize,
     /// Family-wise significance level of the acceptance test.

@@ -198,8 +198,16 @@ pub(crate) fn search(
         };
         let earlier = s.effects.len();
         accept(p, system, sim, &mut s, choice, polishing)?;
-        table::resolve_position_table(p, system, &mut s, earlier, group, polishing)?;
-        reexamine(p, system, &mut s, earlier, group, polishing)?;
+        let explained_by = s.effects[earlier..].iter().map(|e| e.name).collect();
+        reexamine(
+            p,
+            system,
+            &mut s,
+            0..earlier,
+            explained_by,
+            group,
+            polishing,
+        )?;
         if !p.budget.skip_if_expired(|| {
             format!(
                 "the co-simulation's step error after round {} (the one before is kept)",
@@ -212,6 +220,21 @@ pub(crate) fn search(
                 .map_or(0.0, |fine| step_error_floor(&s.scored, fine, &p.scales));
             s.fine = Some(fine);
         }
+    }
+    // the position table made as fine as the data ask, and the effects
+    // accepted beside the coarser table examined again against it
+    // (table.rs)
+    if let Some(after_table) = table::resolve_position_table(p, system, &mut s, group, polishing)? {
+        let examine = after_table..s.effects.len();
+        reexamine(
+            p,
+            system,
+            &mut s,
+            examine,
+            vec![Effect::PositionDependent],
+            group,
+            polishing,
+        )?;
     }
     Ok(s)
 }
@@ -689,8 +712,9 @@ fn accept(
     Ok(())
 }
 
-/// Re-examine the effects accepted before this round (the first
-/// `earlier` of `s.effects`): one whose gain the new effects explain
+/// Re-examine the effects `examine` of `s.effects` (those accepted before
+/// this round), in the light of `explained_by` (the effects accepted in
+/// it): one whose gain the new effects explain
 /// (taken out, the rest refitted, the model loses no more than the
 /// acceptance rule that admitted it asks for) is taken out, so that a
 /// greedy early choice (one of two explanations of a signature, taken
@@ -700,12 +724,13 @@ fn reexamine(
     p: &Problem,
     system: &mut System,
     s: &mut Search,
-    mut earlier: usize,
+    examine: std::ops::Range<usize>,
+    explained_by: Vec<Effect>,
     group: &[usize],
     polishing: &mut Polishing,
 ) -> Result<(), String> {
-    let mut i = 0;
-    while i < earlier {
+    let (mut i, mut end) = (examine.start, examine.end);
+    while i < end {
         if p.budget.skip_if_expired(|| {
             format!(
                 "the re-examination of the earlier effects after round {}",
@@ -768,7 +793,7 @@ fn reexamine(
             name: effect,
             accepted_in_round: s.accepted_as[i].round,
             withdrawn_after_round: s.rounds.len(),
-            explained_by: s.effects[earlier..].iter().map(|e| e.name).collect(),
+            explained_by: explained_by.clone(),
             heldout_rms_with: s.scored.rms(),
             heldout_rms_without: reduced_scored.rms(),
             gain,
@@ -800,7 +825,7 @@ fn reexamine(
         }
         s.effects.remove(i);
         s.accepted_as.remove(i);
-        earlier -= 1;
+        end -= 1;
         s.current = without.whole;
         s.folds = without.folds;
         s.fine = None;
